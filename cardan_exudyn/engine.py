@@ -1,0 +1,313 @@
+"""Run a scene with Exudyn and return the common result schema.
+
+Reaction conventions (pinned by ``tests/test_reactions.py``)
+------------------------------------------------------------
+Exudyn 1.13.6 reports for ``ObjectJointGeneric`` in dynamic runs ``ForceLocal`` = minus the force
+that body ``a`` (marker 0) exerts on body ``b``, in the joint frame fixed to body ``a``; and
+``TorqueLocal`` with its in-plane components rotated by 90 degrees and the same sign flip:
+the moment of body ``a`` on body ``b`` is ``M = (-TL_y, TL_x, -TL_z)``.
+The drive torque on the input shaft is minus the ``Force`` of the coordinate connector.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import exudyn as exu
+import numpy as np
+
+from cardan_exudyn.model import ExudynModel, build_model, node_axes_in_canonical
+from cardan_exudyn.rotations import rxyz_angular_velocity, rxyz_matrix
+from cardan_exudyn.stepsize import choose_step
+from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SceneError
+from reference.scene import scene_to_dict
+from reference.schema import (
+    STATUS_OK,
+    Result,
+    instantaneous_efficiency,
+    mean_values,
+    table_columns,
+)
+
+ENGINE_NAME = "exudyn"
+
+
+@dataclass(frozen=True)
+class ExudynOptions:
+    """Solver settings of the Exudyn engine.
+
+    Attributes
+    ----------
+    spectral_radius : float
+        Generalized-alpha spectral radius at infinity, in [0, 1); lower damps more.
+    modified_newton : bool
+        Use modified Newton (Jacobian reused) instead of full Newton.
+    newton_relative_tolerance : float
+        Relative tolerance of the Newton iteration.
+    """
+
+    spectral_radius: float = 0.6
+    modified_newton: bool = False
+    newton_relative_tolerance: float = 1e-10
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.spectral_radius < 1.0:
+            raise SceneError(f"`spectral_radius` must be in [0, 1), got {self.spectral_radius!r}")
+
+
+def engine_version() -> str:
+    return exu.config.Version() if hasattr(exu, "config") else exu.GetVersionString()
+
+
+def end_time(scene: Scene, start: float) -> float:
+    """Time at which the input has turned ``scene.revolutions`` revolutions [s]."""
+    drive = scene.drive
+    target = 2.0 * math.pi * scene.revolutions
+    if drive.kind == "speed":
+        return start + target / abs(drive.speed)
+    if isinstance(drive, AngleDrive):
+        t = np.linspace(drive.time[0], drive.time[-1], 50 * len(drive.time))
+        spline = drive.spline()
+        turned = np.abs(spline(t) - spline(t[0]))
+        k = int(np.searchsorted(np.maximum.accumulate(turned), target))
+        return float(t[min(k, t.size - 1)])
+    return start + 4.0 * target / abs(drive.initial_speed)
+
+
+def simulation_settings(dt: float, t_start: float, t_end: float,
+                        options: ExudynOptions) -> Any:
+    s = exu.SimulationSettings()
+    ti = s.timeIntegration
+    n = max(1, int(round((t_end - t_start) / dt)))
+    ti.startTime = t_start
+    ti.endTime = t_start + n * dt
+    ti.numberOfSteps = n
+    ti.verboseMode = 0
+    ti.adaptiveStep = False
+    ti.automaticStepSize = False
+    ti.generalizedAlpha.spectralRadius = options.spectral_radius
+    ti.newton.useModifiedNewton = options.modified_newton
+    ti.newton.relativeTolerance = options.newton_relative_tolerance
+    s.solution.file.write = False
+    s.solution.sensors.writePeriod = 0.5 * dt
+    s.displayStatistics = False
+    s.displayComputationTime = False
+    return s
+
+
+def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
+    """Simulate ``scene`` with Exudyn and return its time table and summary."""
+    options = options or ExudynOptions()
+    wall_start = time.perf_counter()
+    dt, dt_reason = choose_step(scene)
+    model = build_model(scene)
+    t_end = end_time(scene, model.start_time)
+    settings = simulation_settings(dt, model.start_time, t_end, options)
+    target = 2.0 * math.pi * scene.revolutions
+    if scene.drive.kind == "torque":
+        _stop_after_revolutions(model, target)
+    solver = exu.MainSolverImplicitSecondOrder()
+    status, reason = STATUS_OK, ""
+    try:
+        ok = solver.SolveSystem(model.mbs, settings)
+        if not ok:
+            status, reason = "integration_failure", solver.GetErrorString() or "solver failed"
+    except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
+        status, reason = "integration_failure", str(exc).strip().splitlines()[0][:300]
+    wall = time.perf_counter() - wall_start
+
+    summary: dict[str, Any] = {
+        "status": status,
+        "reason": reason,
+        "engine": ENGINE_NAME,
+        "engine_version": engine_version(),
+        "scene": scene_to_dict(scene),
+        "dt": dt,
+        "dt_choice": dt_reason,
+        "options": {"spectral_radius": options.spectral_radius,
+                    "modified_newton": options.modified_newton,
+                    "newton_relative_tolerance": options.newton_relative_tolerance,
+                    "node_type": "NodeRigidBodyRxyz", "integrator": "generalized-alpha index 3"},
+        "steps": int(solver.it.currentStepIndex),
+        "newton_iterations": int(solver.it.newtonStepsCount),
+        "jacobian_evaluations": int(solver.it.newtonJacobiCount),
+        "wall_time_s": wall,
+    }
+    table = None
+    try:
+        columns = postprocess(model)
+    except Exception as exc:  # no data recorded, e.g. a failure in the first step
+        summary.update(status="integration_failure" if status == STATUS_OK else status,
+                       reason=reason or f"no usable output: {exc}")
+        return Result(None, summary)
+    summary.update(constraint_violation(model, columns))
+    bad = _first_non_finite(columns)
+    if bad and status == STATUS_OK:
+        status, reason = "diverged", f"non-finite values in `{bad}`"
+    if scene.drive.kind == "torque":
+        turned = abs(columns["theta_in"][-1] - columns["theta_in"][0])
+        if turned + 1e-6 < target and status == STATUS_OK:
+            status = "incomplete"
+            reason = (f"torque drive turned {turned / (2 * math.pi):.3g} of "
+                      f"{scene.revolutions:g} revolutions in the time allowed")
+    summary.update(status=status, reason=reason)
+    if status == STATUS_OK:
+        means = mean_values(columns, scene.record.skip_revolutions)
+        if means.get("revolutions", 0) < 1:
+            summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))
+        summary.update({k: v for k, v in means.items() if k != "mean_status"})
+    if scene.record.timeseries:
+        import pandas as pd
+
+        every = scene.record.every
+        table = pd.DataFrame({c: columns[c][::every] for c in table_columns()})
+    return Result(table, summary)
+
+
+def _stop_after_revolutions(model: ExudynModel, target: float) -> None:
+    node = model.nodes["input"]
+    mbs = model.mbs
+    start = {}
+
+    def pre_step(mbs_, t):
+        angle = mbs_.GetNodeOutput(node, exu.OutputVariableType.Coordinates)[3]
+        start.setdefault("angle", angle)
+        return abs(angle - start["angle"]) < target - 1e-12
+
+    model.user_functions.append(pre_step)
+    mbs.SetPreStepUserFunction(pre_step)
+
+
+def _first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
+    for key, values in columns.items():
+        if key != "efficiency" and not np.all(np.isfinite(values)):
+            return key
+    return None
+
+
+def _stored(model: ExudynModel, key: str) -> np.ndarray:
+    return np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
+
+
+def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
+    """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity."""
+    states = {}
+    for name in model.nodes:
+        q = _stored(model, f"{name}_q")
+        q_t = _stored(model, f"{name}_q_t")
+        n = min(len(q), len(q_t))
+        q, q_t = q[:n], q_t[:n]
+        states[name] = {
+            "t": q[:, 0],
+            "r": model.com_reference[name] + q[:, 1:4],
+            "v": q_t[:, 1:4],
+            "A": rxyz_matrix(q[:, 4:7]),
+            "omega": rxyz_angular_velocity(q[:, 4:7], q_t[:, 4:7]),
+            "psi": q[:, 4:7],
+        }
+    return states
+
+
+def _ground_state(n: int) -> dict[str, np.ndarray]:
+    return {"r": np.zeros((n, 3)), "v": np.zeros((n, 3)),
+            "A": np.broadcast_to(np.eye(3), (n, 3, 3)), "omega": np.zeros((n, 3))}
+
+
+def _pair_kinematics(model: ExudynModel, states: dict, n: int) -> dict[str, dict[str, np.ndarray]]:
+    """Pair axes, marker points and their velocities (global) for both bodies of each pair."""
+    out = {}
+    for name in PAIR_NAMES:
+        body_a, body_b = PAIR_BODIES[name]
+        l_a, l_b = model.marker_local[name]
+        frame = model.pair_frames[name]
+        sa = _ground_state(n) if body_a == "ground" else states[body_a]
+        sb = _ground_state(n) if body_b == "ground" else states[body_b]
+        pa = sa["r"][:n] + sa["A"][:n] @ l_a
+        pb = sb["r"][:n] + sb["A"][:n] @ l_b
+        va = sa["v"][:n] + np.cross(sa["omega"][:n], pa - sa["r"][:n])
+        vb = sb["v"][:n] + np.cross(sb["omega"][:n], pb - sb["r"][:n])
+        out[name] = {
+            "frame_a": sa["A"][:n] @ frame,
+            "frame_b": sb["A"][:n] @ frame,
+            "pa": pa, "pb": pb, "va": va, "vb": vb,
+            "omega_a": sa["omega"][:n], "omega_b": sb["omega"][:n],
+        }
+    return out
+
+
+def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
+    """Columns of the result schema from the recorded sensors."""
+    scene = model.scene
+    states = body_states(model)
+    n = min(len(s["t"]) for s in states.values())
+    t = states["input"]["t"][:n]
+    if n < 2:
+        raise ValueError("fewer than two recorded steps")
+    cols: dict[str, np.ndarray] = {"t": t}
+    cols["theta_in"] = states["input"]["psi"][:n, 0]
+    cols["omega_in"] = states["input"]["omega"][:n, 0]
+    a2 = scene.joint.geometry.output_axis()
+    out_axes = node_axes_in_canonical(scene)["output"]
+    a_c = states["output"]["A"][:n] @ out_axes
+    y_c = a_c[:, :, 1]
+    y0 = out_axes[:, 1]
+    cols["theta_out"] = np.unwrap(np.arctan2(y_c @ np.array([0.0, 0.0, 1.0]), y_c @ y0))
+    cols["omega_out"] = states["output"]["omega"][:n] @ a2
+    if scene.drive.kind == "torque":
+        cols["torque_in"] = np.full(n, scene.drive.torque)
+    else:
+        cols["torque_in"] = -_stored(model, "drive_force")[:n, 1]
+    cols["torque_out"] = np.full(n, scene.load.torque)
+    cols["power_in"] = cols["torque_in"] * cols["omega_in"]
+    cols["power_out"] = cols["torque_out"] * cols["omega_out"]
+
+    kin = _pair_kinematics(model, states, n)
+    loss_total = np.zeros(n)
+    for name in PAIR_NAMES:
+        force = _stored(model, f"{name}_force")[:n, 1:4]
+        torque = _stored(model, f"{name}_torque")[:n, 1:4]
+        fx, fy, fz = (-force).T
+        mx, my, mz = -torque[:, 1], torque[:, 0], -torque[:, 2]
+        k = kin[name]
+        axis = k["frame_a"][:, :, 2]
+        omega_rel = np.einsum("ij,ij->i", k["omega_b"] - k["omega_a"], axis)
+        slide_rel = np.einsum("ij,ij->i", k["vb"] - k["va"], axis)
+        if PAIR_KIND[name] == "revolute":
+            slide_rel = np.zeros(n)
+        friction_torque = np.zeros(n)
+        friction_force = np.zeros(n)
+        loss = -(friction_torque * omega_rel + friction_force * slide_rel)
+        loss_total += loss
+        for suffix, values in zip(
+            ("fx", "fy", "fz", "mx", "my", "mz", "friction_torque", "friction_force",
+             "omega_rel", "slide_rel"),
+            (fx, fy, fz, mx, my, mz, friction_torque, friction_force, omega_rel, slide_rel),
+        ):
+            cols[f"{name}_{suffix}"] = values
+        cols[f"power_loss_{name}"] = loss
+    cols["power_loss"] = loss_total
+    cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
+    model.pair_kinematics = kin
+    return cols
+
+
+def constraint_violation(model: ExudynModel, columns: dict[str, np.ndarray]) -> dict[str, float]:
+    """Largest violation of the pair constraints over the run.
+
+    Position [m]: distance of the two marker points (revolute) or of marker b from the axis of
+    marker a (cylindrical). Angle [rad]: misalignment of the two pair axes, and for the revolute
+    the twist is free so only the axis counts.
+    """
+    del columns
+    pos, ang = 0.0, 0.0
+    for name, k in model.pair_kinematics.items():
+        d = k["pb"] - k["pa"]
+        za, zb = k["frame_a"][:, :, 2], k["frame_b"][:, :, 2]
+        if PAIR_KIND[name] == "cylindrical":
+            d = d - np.einsum("ij,ij->i", d, za)[:, None] * za
+        pos = max(pos, float(np.max(np.linalg.norm(d, axis=1))))
+        ang = max(ang, float(np.max(np.linalg.norm(np.cross(za, zb), axis=1))))
+    return {"max_constraint_violation_m": pos, "max_constraint_violation_rad": ang}

@@ -1,0 +1,247 @@
+"""The RCCC Cardan joint as an Exudyn model, built from a scene with only the items it needs.
+
+Modelling choices
+-----------------
+- Three ``NodeRigidBodyRxyz`` nodes, each at its body's centre of mass, with node axes equal to the
+  global axes in the reference configuration (input angle 0). The input rotates about global x,
+  so its first Tait-Bryan angle is the shaft angle (the drive acts on it directly). The spider's
+  orientation is ``Rx(theta) Ry(gamma)`` with ``|gamma| <= beta``, and the output's second angle
+  stays below ``beta`` too: the parametrisation is regular for every shaft angle below 90 deg.
+- Four ``ObjectJointGeneric`` pairs (revolute ``[1,1,1,1,1,0]``, cylindrical ``[1,1,0,1,1,0]``,
+  z the pair axis): 17 constraints on 18 coordinates, mobility one, no redundancy.
+- Constant speed: ``ObjectConnectorCoordinate`` at velocity level on the input angle (no Python
+  user function). Prescribed angle: the same connector at position level with an offset user
+  function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``.
+- Gravity loads and the output load only when they are non-zero.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from cardan_exudyn.rotations import rxyz_from_matrix, rxyz_rates
+from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SpeedDrive
+
+CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
+
+
+def _rot_z(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _rot_x(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def node_axes_in_canonical(scene: Scene) -> dict[str, np.ndarray]:
+    """Rotation from canonical body coordinates to node coordinates (= global at reference)."""
+    beta = scene.joint.geometry.shaft_angle
+    return {"input": np.eye(3), "spider": np.eye(3), "output": _rot_z(beta)}
+
+
+def pair_geometry(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each pair's origin and frame (columns x, y, z; z the pair axis) in the reference configuration."""
+    geo = scene.joint.geometry
+    a2 = geo.output_axis()
+    ex, ey, ez = np.eye(3)
+    y_out = np.cross(ez, a2)
+    return {
+        "frame_input": (-geo.input_bearing * ex, np.column_stack([ey, ez, ex])),
+        "input_spider": (np.zeros(3), np.column_stack([ez, ex, ey])),
+        "spider_output": (np.zeros(3), np.eye(3)),
+        "output_frame": (geo.output_bearing * a2, np.column_stack([y_out, ez, a2])),
+    }
+
+
+def assembled_state(scene: Scene, theta: float, omega: float) -> dict[str, dict[str, np.ndarray]]:
+    """Orientation and angular velocity of each body for input angle ``theta`` and speed ``omega``.
+
+    Closed-form vector geometry of the ideal joint (written here independently of
+    ``reference.kinematics``): the output yoke axis is normal to the output shaft axis and the
+    input yoke axis; the relative rates follow from the velocity loop
+    ``omega e_x + gamma_t u1 = theta2_t a2 + phi_t u2``.
+    """
+    a2 = scene.joint.geometry.output_axis()
+    ex = np.array([1.0, 0.0, 0.0])
+    a_in = _rot_x(theta)
+    u1 = a_in[:, 1]
+    u2 = np.cross(a2, u1)
+    u2 /= np.linalg.norm(u2)
+    a_spider = np.column_stack([np.cross(u1, u2), u1, u2])
+    a_out_canonical = np.column_stack([a2, np.cross(u2, a2), u2])
+    rates = np.linalg.solve(np.column_stack([u1, -a2, -u2]), -omega * ex)
+    w_in = omega * ex
+    axes = node_axes_in_canonical(scene)
+    return {
+        "input": {"A": a_in @ axes["input"].T, "omega": w_in},
+        "spider": {"A": a_spider @ axes["spider"].T, "omega": w_in + rates[0] * u1},
+        "output": {"A": a_out_canonical @ axes["output"].T, "omega": rates[1] * a2},
+    }
+
+
+@dataclass
+class ExudynModel:
+    """An assembled Exudyn system and the indices needed to read it."""
+
+    scene: Scene
+    system_container: Any
+    mbs: Any
+    nodes: dict[str, Any] = field(default_factory=dict)
+    bodies: dict[str, Any] = field(default_factory=dict)
+    joints: dict[str, Any] = field(default_factory=dict)
+    pair_markers: dict[str, tuple[Any, Any]] = field(default_factory=dict)
+    marker_local: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    pair_frames: dict[str, np.ndarray] = field(default_factory=dict)
+    com_reference: dict[str, np.ndarray] = field(default_factory=dict)
+    drive_connector: Any = None
+    sensors: dict[str, Any] = field(default_factory=dict)
+    start_time: float = 0.0
+    user_functions: list = field(default_factory=list)
+    pair_kinematics: dict = field(default_factory=dict)
+
+
+def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
+    """Assemble the Exudyn system for ``scene`` (no solving), with recording sensors."""
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    model = ExudynModel(scene=scene, system_container=sc, mbs=mbs)
+    ground = mbs.AddObject(eii.ObjectGround())
+
+    theta0, omega0, t0 = _initial_drive_state(scene)
+    model.start_time = t0
+    state = assembled_state(scene, theta0, omega0)
+    axes = node_axes_in_canonical(scene)
+    for name, body in scene.joint.bodies():
+        mass, com_c, inertia_c = body.canonical()
+        r = axes[name]
+        com = r @ com_c  # node axes = global axes at reference
+        inertia = r @ inertia_c @ r.T
+        model.com_reference[name] = com
+        a0 = state[name]["A"]
+        psi0 = rxyz_from_matrix(a0)
+        w = state[name]["omega"]
+        pos0 = a0 @ com
+        node = mbs.AddNode(eii.NodeRigidBodyRxyz(
+            referenceCoordinates=[*com, 0.0, 0.0, 0.0],
+            initialCoordinates=[*(pos0 - com), *psi0],
+            initialVelocities=[*np.cross(w, pos0), *rxyz_rates(psi0, w)],
+        ))
+        model.nodes[name] = node
+        model.bodies[name] = mbs.AddObject(eii.ObjectRigidBody(
+            mass=mass,
+            inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2],
+                     inertia[1, 2], inertia[0, 2], inertia[0, 1]],
+            centerOfMass=[0.0, 0.0, 0.0],
+            nodeNumber=node,
+        ))
+
+    def marker(owner: str, position: np.ndarray):
+        if owner == "ground":
+            return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
+                                                     localPosition=list(position))), position
+        local = position - model.com_reference[owner]
+        return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies[owner],
+                                                 localPosition=list(local))), local
+
+    for name, (origin, frame) in pair_geometry(scene).items():
+        body_a, body_b = PAIR_BODIES[name]
+        m_a, l_a = marker(body_a, origin)
+        m_b, l_b = marker(body_b, origin)
+        model.pair_markers[name] = (m_a, m_b)
+        model.marker_local[name] = (l_a, l_b)
+        model.pair_frames[name] = frame
+        model.joints[name] = mbs.AddObject(eii.ObjectJointGeneric(
+            markerNumbers=[m_a, m_b],
+            constrainedAxes=CONSTRAINED_AXES[PAIR_KIND[name]],
+            rotationMarker0=frame.tolist(),
+            rotationMarker1=frame.tolist(),
+        ))
+
+    _add_drive(model, ground)
+    _add_loads(model)
+    if sensors:
+        add_sensors(model)
+    mbs.Assemble()
+    return model
+
+
+def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
+    """Input angle [rad], speed [rad/s] and time [s] at the start of the simulation."""
+    drive = scene.drive
+    if isinstance(drive, SpeedDrive):
+        return 0.0, drive.speed, 0.0
+    if isinstance(drive, AngleDrive):
+        spline = drive.spline()
+        t0 = drive.time[0]
+        return float(spline(t0)), float(spline(t0, 1)), t0
+    return 0.0, drive.initial_speed, 0.0
+
+
+def _add_drive(model: ExudynModel, ground) -> None:
+    mbs, drive = model.mbs, model.scene.drive
+    if drive.kind == "torque":
+        m_in = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["input"]))
+        mbs.AddLoad(eii.LoadTorqueVector(markerNumber=m_in, loadVector=[drive.torque, 0.0, 0.0]))
+        return
+    ground_node = mbs.AddNode(eii.NodePointGround())
+    m_ground = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node, coordinate=0))
+    m_angle = mbs.AddMarker(eii.MarkerNodeRotationCoordinate(nodeNumber=model.nodes["input"],
+                                                             rotationCoordinate=0))
+    if drive.kind == "speed":
+        connector = eii.ObjectConnectorCoordinate(markerNumbers=[m_ground, m_angle],
+                                                  velocityLevel=True, offset=drive.speed)
+    else:
+        spline = drive.spline()
+
+        def angle_offset(mbs_, t, item, offset):
+            return float(spline(t))
+
+        model.user_functions.append(angle_offset)
+        connector = eii.ObjectConnectorCoordinate(markerNumbers=[m_ground, m_angle],
+                                                  offsetUserFunction=angle_offset)
+    model.drive_connector = mbs.AddObject(connector)
+
+
+def _add_loads(model: ExudynModel) -> None:
+    mbs, scene = model.mbs, model.scene
+    if scene.load.torque != 0.0:
+        m_out = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["output"]))
+        vector = -scene.load.torque * scene.joint.geometry.output_axis()
+        mbs.AddLoad(eii.LoadTorqueVector(markerNumber=m_out, loadVector=list(vector)))
+    if scene.has_gravity:
+        for name in model.bodies:
+            m = mbs.AddMarker(eii.MarkerBodyMass(bodyNumber=model.bodies[name]))
+            mbs.AddLoad(eii.LoadMassProportional(markerNumber=m, loadVector=list(scene.gravity)))
+
+
+def add_sensors(model: ExudynModel) -> None:
+    """Internal (in-memory) sensors for node states, pair reactions and the drive force."""
+    mbs = model.mbs
+    out = exu.OutputVariableType
+    for name, node in model.nodes.items():
+        model.sensors[f"{name}_q"] = mbs.AddSensor(eii.SensorNode(
+            nodeNumber=node, outputVariableType=out.Coordinates, storeInternal=True,
+            writeToFile=False))
+        model.sensors[f"{name}_q_t"] = mbs.AddSensor(eii.SensorNode(
+            nodeNumber=node, outputVariableType=out.Coordinates_t, storeInternal=True,
+            writeToFile=False))
+    for name in PAIR_NAMES:
+        joint = model.joints[name]
+        model.sensors[f"{name}_force"] = mbs.AddSensor(eii.SensorObject(
+            objectNumber=joint, outputVariableType=out.ForceLocal, storeInternal=True,
+            writeToFile=False))
+        model.sensors[f"{name}_torque"] = mbs.AddSensor(eii.SensorObject(
+            objectNumber=joint, outputVariableType=out.TorqueLocal, storeInternal=True,
+            writeToFile=False))
+    if model.drive_connector is not None:
+        model.sensors["drive_force"] = mbs.AddSensor(eii.SensorObject(
+            objectNumber=model.drive_connector, outputVariableType=out.Force,
+            storeInternal=True, writeToFile=False))

@@ -1,0 +1,52 @@
+"""Choosing the time step from the scene.
+
+For a second-order integrator the error of the output/input speed ratio of a Cardan joint
+grows as ``K(beta) * h**2`` with ``h = omega * dt`` the input angle step. Measured with this
+model (generalized-alpha, spectral radius 0.6, Rxyz nodes; ``cardan bench --step-model``
+re-measures it), ``K(beta) = 0.19 tan(beta)^2 / cos(beta)^2`` holds within 10 % for beta up to
+50 deg and over-estimates the error above (so the step is conservative there): the speed ratio
+peaks at ``1/cos(beta)`` with a width proportional to ``cos(beta)``, and the step must resolve it.
+"""
+
+from __future__ import annotations
+
+import math
+
+from reference.scene import Scene, SpeedDrive
+
+ERROR_CONSTANT = 0.19
+MIN_STEPS_PER_REVOLUTION = 100
+MAX_STEPS_PER_REVOLUTION = 2_000_000
+
+
+def error_coefficient(shaft_angle: float) -> float:
+    """``K(beta)`` of the error model ``K h^2`` [-]."""
+    t = math.tan(shaft_angle)
+    return ERROR_CONSTANT * t * t / math.cos(shaft_angle) ** 2
+
+
+def steps_per_revolution(shaft_angle: float, accuracy: float) -> int:
+    """Steps per input revolution that meet ``accuracy`` on the speed ratio."""
+    k = error_coefficient(shaft_angle)
+    if k == 0.0:
+        return MIN_STEPS_PER_REVOLUTION
+    n = math.ceil(2.0 * math.pi / math.sqrt(accuracy / k))
+    return int(min(max(n, MIN_STEPS_PER_REVOLUTION), MAX_STEPS_PER_REVOLUTION))
+
+
+def choose_step(scene: Scene) -> tuple[float, str]:
+    """Time step [s] for the scene and a sentence saying how it was chosen.
+
+    With a constant-speed drive the step divides one revolution exactly, so that averages over
+    whole revolutions need no interpolation at the window ends.
+    """
+    if scene.numerics.dt is not None:
+        return scene.numerics.dt, "given"
+    beta = scene.joint.geometry.shaft_angle
+    n = steps_per_revolution(beta, scene.numerics.accuracy)
+    period = 2.0 * math.pi / scene.drive.max_speed()
+    why = (f"auto: {n} steps per input revolution for speed-ratio error "
+           f"<= {scene.numerics.accuracy:g} at {math.degrees(beta):g} deg")
+    if not isinstance(scene.drive, SpeedDrive):
+        why += " (at the highest input speed of the drive)"
+    return period / n, why

@@ -1,0 +1,228 @@
+"""The paper's data (``data/paper.toml``) turned into scenes, with provenance.
+
+Named scenes
+------------
+``paper[-<A>deg][-<R>rpm][-frictionless]``
+    Section 4.1 multibody case (default 10 deg, 2000 rpm, f1 = 0.42, f2 = 0.20, 2 N m).
+``rig``
+    Section 4.2 rig case (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m), ideal geometry.
+
+References
+----------
+Cavacece, Stefanelli, Valentini, Vita: A multibody dynamic model of a Cardan joint with
+experimental validation (shared/paper/cardan-joint-multibody-paper.md).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import re
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+from reference.scene import (
+    DEG,
+    RPM,
+    Body,
+    Geometry,
+    Joint,
+    Load,
+    Pair,
+    Pairs,
+    Record,
+    Scene,
+    SceneError,
+    SpeedDrive,
+)
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+
+
+@functools.lru_cache(maxsize=1)
+def paper_data() -> dict[str, Any]:
+    """The raw data file, every entry with value, unit and source or assumption."""
+    text = resources.files("reference").joinpath("data/paper.toml").read_text(encoding="utf-8")
+    return tomllib.loads(text)
+
+
+def value(path: str) -> Any:
+    """Value of a dotted entry of the data file, e.g. ``value("bearings.frame.length")``."""
+    node: Any = paper_data()
+    for key in path.split("."):
+        node = node[key]
+    return node["value"]
+
+
+def assumption_register() -> list[dict[str, Any]]:
+    """Every value the paper does not state: name, value, unit, assumption, reason."""
+    return [{"name": k, **v} for k, v in paper_data()["assumption"].items()]
+
+
+def stated_values() -> list[dict[str, Any]]:
+    """Every value taken from the paper, with unit and source."""
+    out = []
+
+    def walk(prefix: str, node: dict) -> None:
+        for key, item in node.items():
+            if isinstance(item, dict) and "source" in item:
+                out.append({"name": f"{prefix}{key}", **item})
+            elif isinstance(item, dict):
+                walk(f"{prefix}{key}.", item)
+
+    for section in ("table1", "bearings", "case"):
+        walk(f"{section}.", paper_data()[section])
+    return out
+
+
+# Columns: local x, y, z axes in canonical coordinates (see reference.scene for the frames).
+_E = np.eye(3)
+LOCAL_AXES = {
+    # input: local y is the shaft axis pointing away from the joint (canonical -x); local z kept.
+    "input": np.column_stack([_E[1], -_E[0], _E[2]]),
+    # spider: local z (normal to the arms) -> canonical x; local x, y -> the two arms.
+    "spider": np.column_stack([_E[1], _E[2], _E[0]]),
+    # output: local z is the shaft axis pointing away from the joint (canonical x).
+    "output": np.column_stack([_E[1], _E[2], _E[0]]),
+}
+SHAFT_AXIS_LOCAL = {"input": 1, "spider": 2, "output": 2}
+
+
+def com_from_static_moments(static_moments: np.ndarray, mass: float) -> np.ndarray:
+    """Centre of mass from Table 1 read as S_k = m * (distance of the centre of mass from axis k).
+
+    Solves d_k^2 = r^2 - r_k^2 for the squared coordinates; a coordinate whose square comes out
+    slightly negative from rounding in Table 1 is set to zero. Signs are taken positive (the
+    table gives none).
+    """
+    d2 = (np.asarray(static_moments, dtype=float) / mass) ** 2
+    r2 = 0.5 * d2.sum()
+    return np.sqrt(np.clip(r2 - d2, 0.0, None))
+
+
+def table1_body(name: str, reading: str = "origin", com_at_centre: bool = False) -> Body:
+    """One body of Table 1 as a :class:`Body` under the chosen reading.
+
+    Parameters
+    ----------
+    name : {"input", "spider", "output"}
+    reading : {"origin", "com"}
+        Reference point of Table 1's inertia tensors (see the assumption register).
+    com_at_centre : bool
+        Place the local origin so that the centre of mass sits at the joint centre.
+    """
+    raw = paper_data()["table1"][name]
+    mass = raw["mass"]["value"]
+    com = com_from_static_moments(np.array(raw["static_moments"]["value"]), mass)
+    axes = LOCAL_AXES[name]
+    origin = -axes @ com if com_at_centre else np.zeros(3)
+    return Body(
+        mass=mass,
+        inertia=raw["inertia"]["value"],
+        inertia_about=reading,
+        com=tuple(com),
+        local_origin=tuple(origin),
+        local_axes=tuple(map(tuple, axes)),
+    )
+
+
+def paper_joint(shaft_angle_deg: float = 10.0, reading: str = "origin",
+                friction: bool = True) -> Joint:
+    """The Section 4.1 joint under the assumption register's choices."""
+    bodies = {
+        "input": table1_body("input", reading),
+        "spider": table1_body("spider", reading, com_at_centre=True),
+        "output": table1_body("output", reading),
+    }
+    # Frame bearings at the axial position of each shaft's centre of mass (assumption).
+    com_in = bodies["input"].canonical()[1]
+    com_out = bodies["output"].canonical()[1]
+    geometry = Geometry(
+        shaft_angle=shaft_angle_deg * DEG,
+        input_bearing=abs(com_in[0]),
+        output_bearing=abs(com_out[0]),
+        arm_radius=value("assumption.arm_radius"),
+    )
+    f1 = value("case.multibody.friction_spider") if friction else 0.0
+    f2 = value("case.multibody.friction_frame") if friction else 0.0
+    frame = Pair(f2, value("bearings.frame.diameter"), value("bearings.frame.length"))
+    spider = Pair(f1, value("bearings.spider.diameter"), value("bearings.spider.length"))
+    pairs = Pairs(frame_input=frame, input_spider=spider, spider_output=spider, output_frame=frame)
+    return Joint(geometry=geometry, pairs=pairs, **bodies)
+
+
+def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
+                friction: bool = True, reading: str = "origin") -> Scene:
+    """Section 4.1 scene: constant input speed, 2 N m resisting torque, gravity on."""
+    rpm = value("case.multibody.speed") if speed_rpm is None else speed_rpm
+    tag = f"paper-{shaft_angle_deg:g}deg-{rpm:g}rpm" + ("" if friction else "-frictionless")
+    return Scene(
+        joint=paper_joint(shaft_angle_deg, reading, friction),
+        drive=SpeedDrive(speed=rpm * RPM),
+        load=Load(torque=value("assumption.load")),
+        gravity=tuple(value("assumption.gravity")),
+        revolutions=float(value("assumption.revolutions")),
+        record=Record(),
+        name=tag,
+        description="Section 4.1 multibody case under the assumption register",
+    )
+
+
+def rig_scene(friction: bool = True) -> Scene:
+    """Section 4.2 rig case with ideal geometry: 15 deg, 6 rad/s, f = 0.42, 0.2 N m."""
+    joint = paper_joint(value("case.rig.shaft_angle"), friction=False)
+    f = value("case.rig.friction") if friction else 0.0
+    pairs = Pairs(**{n: Pair(f, p.journal_diameter, p.moment_lever) for n, p in joint.pairs.items()})
+    joint = Joint(joint.input, joint.spider, joint.output, joint.geometry, pairs)
+    return Scene(
+        joint=joint,
+        drive=SpeedDrive(speed=value("case.rig.speed")),
+        load=Load(torque=value("case.rig.input_torque")),
+        gravity=tuple(value("assumption.gravity")),
+        revolutions=2.0,
+        name="rig" + ("" if friction else "-frictionless"),
+        description="Section 4.2 rig case, ideal geometry, constant speed",
+    )
+
+
+_NAME = re.compile(r"^paper(?:-(?P<deg>\d+(?:\.\d+)?)deg)?(?:-(?P<rpm>\d+(?:\.\d+)?)rpm)?"
+                   r"(?P<fl>-frictionless)?$")
+
+
+def named_scene(name: str) -> Scene:
+    """A scene by name (see the module docstring for the names)."""
+    if name in ("rig", "rig-frictionless"):
+        return rig_scene(friction=name == "rig")
+    match = _NAME.match(name) if isinstance(name, str) else None
+    if not match:
+        raise SceneError(
+            f"unknown scene name {name!r}; use 'paper[-<A>deg][-<R>rpm][-frictionless]' "
+            "(e.g. 'paper-10deg-2000rpm') or 'rig'"
+        )
+    deg = float(match["deg"]) if match["deg"] else value("case.speed_study.shaft_angle")
+    rpm = float(match["rpm"]) if match["rpm"] else None
+    return paper_scene(deg, rpm, friction=not match["fl"])
+
+
+def paper_cases() -> list[dict[str, Any]]:
+    """The paper's eleven numbers: Table 2 (8 angles) and the speed study (3 speeds)."""
+    cases = []
+    t2 = paper_data()["case"]["table2"]
+    for deg, eta in zip(t2["shaft_angle"]["value"], t2["mean_efficiency"]["value"]):
+        cases.append({"study": "table2", "shaft_angle_deg": deg,
+                      "speed_rpm": value("case.multibody.speed"), "paper_mean_efficiency": eta})
+    sp = paper_data()["case"]["speed_study"]
+    for rpm, eta in zip(sp["speed"]["value"], sp["mean_efficiency"]["value"]):
+        cases.append({"study": "speed", "shaft_angle_deg": sp["shaft_angle"]["value"],
+                      "speed_rpm": rpm, "paper_mean_efficiency": eta})
+    return cases
+
+
+def hooke_period(speed: float) -> float:
+    """Duration of one input revolution at ``speed`` [rad/s] [s]."""
+    return 2.0 * math.pi / abs(speed)
