@@ -4,8 +4,11 @@ Reaction conventions (pinned by ``tests/test_reactions.py``)
 ------------------------------------------------------------
 Exudyn 1.13.6 reports for ``ObjectJointGeneric`` in dynamic runs ``ForceLocal`` = minus the force
 that body ``a`` (marker 0) exerts on body ``b``, in the joint frame fixed to body ``a``; and
-``TorqueLocal`` with its in-plane components rotated by 90 degrees and the same sign flip:
-the moment of body ``a`` on body ``b`` is ``M = (-TL_y, TL_x, -TL_z)``.
+``TorqueLocal`` with its in-plane components rotated by 90 degrees, the same sign flip, and
+its components in the joint frame attached to body ``b`` (marker 1): the moment of body ``a`` on
+body ``b`` in the pair frame of body ``b`` is ``(-TL_y, TL_x, -TL_z)``; it is rotated into the
+pair frame of body ``a`` with the pair's relative rotation (they differ by the free rotation about
+the pair axis, e.g. the whole shaft angle for ``frame_input``).
 The drive torque on the input shaft is minus the ``Force`` of the coordinate connector.
 """
 
@@ -93,14 +96,18 @@ def simulation_settings(dt: float, t_start: float, t_end: float,
     ti.newton.relativeTolerance = options.newton_relative_tolerance
     s.solution.file.write = False
     s.solution.sensors.writePeriod = 0.5 * dt
-    s.displayStatistics = False
-    s.displayComputationTime = False
+    s.show.statistics = False
+    s.show.computationTime = False
     return s
 
 
 def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     """Simulate ``scene`` with Exudyn and return its time table and summary."""
     options = options or ExudynOptions()
+    if scene.has_friction:
+        raise NotImplementedError(
+            "friction from joint reactions is not implemented in the Exudyn engine yet "
+            "(issue 3); use a '-frictionless' scene or --friction-spider 0 --friction-frame 0")
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene)
     model = build_model(scene)
@@ -269,9 +276,12 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     for name in PAIR_NAMES:
         force = _stored(model, f"{name}_force")[:n, 1:4]
         torque = _stored(model, f"{name}_torque")[:n, 1:4]
-        fx, fy, fz = (-force).T
-        mx, my, mz = -torque[:, 1], torque[:, 0], -torque[:, 2]
         k = kin[name]
+        fx, fy, fz = (-force).T
+        # TorqueLocal: 90-degree in-plane swap, sign flip, and components in the frame of body b
+        m_b = np.stack([-torque[:, 1], torque[:, 0], -torque[:, 2]], axis=1)
+        relative = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])  # frame_a^T frame_b
+        mx, my, mz = np.einsum("nij,nj->ni", relative, m_b).T
         axis = k["frame_a"][:, :, 2]
         omega_rel = np.einsum("ij,ij->i", k["omega_b"] - k["omega_a"], axis)
         slide_rel = np.einsum("ij,ij->i", k["vb"] - k["va"], axis)
@@ -289,9 +299,24 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
             cols[f"{name}_{suffix}"] = values
         cols[f"power_loss_{name}"] = loss
     cols["power_loss"] = loss_total
+    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(model, states, n)
     cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
     model.pair_kinematics = kin
     return cols
+
+
+def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and gravitational potential energy of the three bodies [J]."""
+    kinetic = np.zeros(n)
+    potential = np.zeros(n)
+    g = np.asarray(model.scene.gravity)
+    for name, s in states.items():
+        m, j_body = model.mass[name], model.inertia[name]
+        w_body = np.einsum("nji,nj->ni", s["A"][:n], s["omega"][:n])  # A^T omega
+        kinetic += 0.5 * m * np.einsum("ni,ni->n", s["v"][:n], s["v"][:n])
+        kinetic += 0.5 * np.einsum("ni,ij,nj->n", w_body, j_body, w_body)
+        potential -= m * (s["r"][:n] @ g)
+    return kinetic, potential
 
 
 def constraint_violation(model: ExudynModel, columns: dict[str, np.ndarray]) -> dict[str, float]:

@@ -106,6 +106,8 @@ class ExudynModel:
     start_time: float = 0.0
     user_functions: list = field(default_factory=list)
     pair_kinematics: dict = field(default_factory=dict)
+    mass: dict[str, float] = field(default_factory=dict)
+    inertia: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
@@ -125,6 +127,8 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
         com = r @ com_c  # node axes = global axes at reference
         inertia = r @ inertia_c @ r.T
         model.com_reference[name] = com
+        model.mass[name] = mass
+        model.inertia[name] = inertia
         a0 = state[name]["A"]
         psi0 = rxyz_from_matrix(a0)
         w = state[name]["omega"]
@@ -143,26 +147,23 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
             nodeNumber=node,
         ))
 
-    def marker(owner: str, position: np.ndarray):
-        if owner == "ground":
-            return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
-                                                     localPosition=list(position))), position
-        local = position - model.com_reference[owner]
-        return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies[owner],
-                                                 localPosition=list(local))), local
+    def marker(owner: str, position: np.ndarray, frame: np.ndarray):
+        # node axes equal the global axes at reference, so the pair frame is the marker rotation
+        body = ground if owner == "ground" else model.bodies[owner]
+        local = position - (0.0 if owner == "ground" else model.com_reference[owner])
+        ht = exu.HT(rotation=frame, translation=local)
+        return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localHT=ht)), local
 
     for name, (origin, frame) in pair_geometry(scene).items():
         body_a, body_b = PAIR_BODIES[name]
-        m_a, l_a = marker(body_a, origin)
-        m_b, l_b = marker(body_b, origin)
+        m_a, l_a = marker(body_a, origin, frame)
+        m_b, l_b = marker(body_b, origin, frame)
         model.pair_markers[name] = (m_a, m_b)
         model.marker_local[name] = (l_a, l_b)
         model.pair_frames[name] = frame
         model.joints[name] = mbs.AddObject(eii.ObjectJointGeneric(
             markerNumbers=[m_a, m_b],
             constrainedAxes=CONSTRAINED_AXES[PAIR_KIND[name]],
-            rotationMarker0=frame.tolist(),
-            rotationMarker1=frame.tolist(),
         ))
 
     _add_drive(model, ground)

@@ -8,7 +8,9 @@ its yoke position at input angle 0); ``omega_in``, ``omega_out`` [rad/s];
 ``torque_out`` [N m], torque the output shaft applies to the load about the output axis
 (the resisting torque); ``power_in = torque_in * omega_in``, ``power_out = torque_out * omega_out``
 [W]; ``power_loss_<pair>`` [W] and their sum ``power_loss``; ``efficiency`` [-], the
-instantaneous efficiency of eq. (18), ``1 - power_loss / power_in`` (NaN where power_in is 0).
+instantaneous efficiency of eq. (18), ``1 - power_loss / power_in`` (NaN where power_in is 0);
+``energy_kinetic``, ``energy_potential`` [J], mechanical energy of the three bodies (potential
+energy zero at the joint centre).
 
 Per pair, ``<pair>_fx, _fy, _fz`` [N] and ``<pair>_mx, _my, _mz`` [N m]: the force and moment that
 body ``a`` of the pair exerts on body ``b`` (see :data:`reference.scene.PAIR_BODIES`), about the
@@ -29,7 +31,8 @@ import numpy as np
 from reference.scene import PAIR_NAMES
 
 KINEMATIC_COLUMNS = ("t", "theta_in", "theta_out", "omega_in", "omega_out")
-POWER_COLUMNS = ("torque_in", "torque_out", "power_in", "power_out", "power_loss", "efficiency")
+POWER_COLUMNS = ("torque_in", "torque_out", "power_in", "power_out", "power_loss", "efficiency",
+                 "energy_kinetic", "energy_potential")
 REACTION_SUFFIXES = ("fx", "fy", "fz", "mx", "my", "mz")
 PAIR_SUFFIXES = REACTION_SUFFIXES + ("friction_torque", "friction_force", "omega_rel", "slide_rel")
 

@@ -1,0 +1,182 @@
+"""The ``cardan`` command line.
+
+Exit status: 0 success; 2 bad input (one line on stderr naming the argument, no traceback);
+3 the simulation failed or is physically meaningless (the reason is in the summary ``status``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Any
+
+from reference.scene import DEG, RPM, Scene, SceneError, load_scene, replace
+
+EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
+DEFAULT_SCENE = "paper-10deg-frictionless"
+
+
+class BadInput(Exception):
+    """Raised for invalid command-line input; printed as one line, exit status 2."""
+
+
+def _number(kind: str, *, positive: bool = False, non_negative: bool = False):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number ({kind}), got {text!r}") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"expected a finite number ({kind}), got {text!r}")
+        if positive and value <= 0:
+            raise argparse.ArgumentTypeError(f"must be positive ({kind}), got {text!r}")
+        if non_negative and value < 0:
+            raise argparse.ArgumentTypeError(f"must be >= 0 ({kind}), got {text!r}")
+        return value
+
+    return parse
+
+
+def _add_scene_options(p: argparse.ArgumentParser) -> None:
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--scene", metavar="FILE", help="scene TOML file")
+    src.add_argument("--name", metavar="NAME",
+                     help=f"named scene, e.g. paper-10deg-2000rpm, rig (default {DEFAULT_SCENE})")
+    p.add_argument("--angle", metavar="DEG", type=_number("deg"), help="shaft angle [deg]")
+    p.add_argument("--rpm", metavar="RPM", type=_number("rpm"),
+                   help="constant input speed [rpm] (makes the drive a constant-speed drive)")
+    p.add_argument("--load-torque", metavar="NM", type=_number("N m"),
+                   help="resisting torque on the output shaft [N m]")
+    p.add_argument("--friction-spider", metavar="F", type=_number("-", non_negative=True),
+                   help="friction coefficient of the two spider pairs (the paper's f1)")
+    p.add_argument("--friction-frame", metavar="F", type=_number("-", non_negative=True),
+                   help="friction coefficient of the two frame pairs (the paper's f2)")
+    p.add_argument("--no-gravity", action="store_true", help="switch gravity off")
+    p.add_argument("--dt", metavar="S", type=_number("s", positive=True),
+                   help="time step [s] (default: chosen from the scene to meet --accuracy)")
+    p.add_argument("--accuracy", metavar="E", type=_number("-", positive=True),
+                   help="target max error of omega_out/omega_in when --dt is not given")
+    p.add_argument("--revolutions", metavar="N", type=_number("-", positive=True),
+                   help="input revolutions to simulate")
+
+
+def scene_from_args(args: argparse.Namespace) -> Scene:
+    """The scene named or loaded by the options, with the command-line overrides applied."""
+    from reference.paper import named_scene
+
+    scene = load_scene(args.scene) if args.scene else named_scene(args.name or DEFAULT_SCENE)
+    changes: dict[str, Any] = {}
+    if args.angle is not None:
+        changes["joint.geometry.shaft_angle"] = args.angle * DEG
+    if args.rpm is not None:
+        changes["drive"] = {"kind": "speed", "speed": args.rpm * RPM}
+    if args.load_torque is not None:
+        changes["load.torque"] = args.load_torque
+    for option, pairs in (("friction_spider", ("input_spider", "spider_output")),
+                          ("friction_frame", ("frame_input", "output_frame"))):
+        value = getattr(args, option)
+        if value is not None:
+            for pair in pairs:
+                changes[f"joint.pairs.{pair}.friction_coefficient"] = value
+    if args.no_gravity:
+        changes["gravity"] = [0.0, 0.0, 0.0]
+    if args.dt is not None:
+        changes["numerics.dt"] = args.dt
+    if args.accuracy is not None:
+        changes["numerics.accuracy"] = args.accuracy
+    if args.revolutions is not None:
+        changes["revolutions"] = args.revolutions
+    if not changes:
+        return scene
+    try:
+        return replace(scene, **changes)
+    except SceneError as exc:
+        raise SceneError(f"{exc} (after the command-line overrides)") from None
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from cardan_exudyn.engines import run_scene
+    from cardan_exudyn.io import dumps, write_result
+
+    scene = scene_from_args(args)
+    result = run_scene(scene, args.engine)
+    if args.out:
+        write_result(result, args.out)
+    if args.json:
+        print(dumps(result.summary))
+    else:
+        _print_summary(result.summary, args.out)
+    return EXIT_OK if result.ok else EXIT_FAILED
+
+
+def _print_summary(s: dict[str, Any], out: str | None) -> None:
+    err = sys.stderr
+    if s.get("status") != "ok":
+        print(f"status: {s.get('status')}: {s.get('reason')}", file=err)
+        return
+    print(f"scene {s['scene']['name']} with {s['engine']} {s['engine_version']}: "
+          f"mean efficiency {s['mean_efficiency']:.6f} "
+          f"(time average of eq. (18): {s['mean_instantaneous_efficiency']:.6f}) over "
+          f"{s['revolutions']} revolutions; dt {s.get('dt', float('nan')):.3g} s, "
+          f"{s.get('steps')} steps, {s['wall_time_s']:.3g} s wall")
+    if out:
+        print(f"wrote {out}/timeseries.csv and {out}/summary.json")
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from cardan_exudyn.reproduce import reproduce
+
+    return reproduce(args.out, quick=args.quick)
+
+
+def cmd_scene(args: argparse.Namespace) -> int:
+    import tomli_w
+
+    from reference.scene import scene_to_dict
+
+    scene = scene_from_args(args)
+    print(tomli_w.dumps(scene_to_dict(scene)), end="")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="cardan", description="Mechanical efficiency of Cardan joints with Exudyn.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("run", help="simulate one scene")
+    _add_scene_options(p)
+    p.add_argument("--engine", default="exudyn", help="exudyn (default) or reference")
+    p.add_argument("--out", metavar="DIR", help="write timeseries.csv and summary.json here")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.set_defaults(func=cmd_run)
+
+    p = sub.add_parser("reproduce", help="reproduce the paper's studies into a report folder")
+    p.add_argument("--out", metavar="DIR", default="reports/reproduce", help="report folder")
+    p.add_argument("--quick", action="store_true", help="fewer scenes and a coarser accuracy")
+    p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
+    _add_scene_options(p)
+    p.set_defaults(func=cmd_scene)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    from cardan_exudyn.engines import EngineUnavailable
+
+    try:
+        return args.func(args)
+    except (SceneError, EngineUnavailable, BadInput) as exc:
+        print(f"cardan {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print(f"cardan {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,77 @@
+"""Writing results: CSV time table plus JSON summary, atomically.
+
+A command writes into a temporary sibling folder and renames it into place at the end, so an
+interrupted or failed command leaves either the complete previous output or a complete new one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from reference.schema import Result
+
+
+def to_jsonable(value: Any) -> Any:
+    """Plain JSON data: numpy scalars and arrays converted, NaN and infinities as null."""
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_jsonable(value.tolist())
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    if isinstance(value, (np.bool_,)):
+        return bool(value)
+    return value
+
+
+def dumps(data: Any) -> str:
+    return json.dumps(to_jsonable(data), indent=2, allow_nan=False)
+
+
+@contextlib.contextmanager
+def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary folder that replaces ``target`` only when the block succeeds."""
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    old = None
+    if target.exists():
+        old = target.with_name(f".{target.name}.old-{os.getpid()}")
+        os.replace(target, old)
+    os.replace(tmp, target)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def write_result_files(result: Result, folder: Path) -> None:
+    """``timeseries.csv`` (when recorded) and ``summary.json`` into an existing folder."""
+    if result.table is not None:
+        result.table.to_csv(folder / "timeseries.csv", index=False, float_format="%.12g")
+    (folder / "summary.json").write_text(dumps(result.summary) + "\n", encoding="utf-8")
+
+
+def write_result(result: Result, out: str | os.PathLike) -> Path:
+    """Write a result folder atomically and return its path."""
+    with atomic_directory(out) as tmp:
+        write_result_files(result, tmp)
+    return Path(out)

@@ -1,0 +1,74 @@
+"""Plots: functions take data and an optional Axes and return the Figure."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from reference.scene import PAIR_NAMES  # noqa: E402
+
+
+def _axes(ax):
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
+        return fig, ax
+    return ax.figure, ax
+
+
+def speed_ratio(tables: dict[str, object], ax=None):
+    """omega_out/omega_in against input angle, one line per labelled table."""
+    fig, ax = _axes(ax)
+    for label, t in tables.items():
+        ax.plot(np.degrees(t["theta_in"]) % 360, t["omega_out"] / t["omega_in"], ".", ms=1.5,
+                label=label)
+    ax.set_xlabel("input angle [deg]")
+    ax.set_ylabel("omega_out / omega_in [-]")
+    ax.set_xlim(0, 360)
+    ax.legend(fontsize=7, ncol=2, markerscale=6)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def input_torque(tables: dict[str, object], ax=None):
+    """Drive torque against input angle, one line per labelled table."""
+    fig, ax = _axes(ax)
+    for label, t in tables.items():
+        ax.plot(np.degrees(t["theta_in"]) % 360, t["torque_in"], ".", ms=1.5, label=label)
+    ax.set_xlabel("input angle [deg]")
+    ax.set_ylabel("input torque [N m]")
+    ax.set_xlim(0, 360)
+    ax.legend(fontsize=7, ncol=2, markerscale=6)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def reactions(table, title: str = "", axes=None):
+    """Per pair: magnitude of the radial force and of the bending moment against input angle."""
+    if axes is None:
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
+    fig = axes[0].figure
+    angle = np.degrees(table["theta_in"]) % 360
+    for pair in PAIR_NAMES:
+        f = np.hypot(table[f"{pair}_fx"], table[f"{pair}_fy"])
+        m = np.hypot(table[f"{pair}_mx"], table[f"{pair}_my"])
+        axes[0].plot(angle, f, ".", ms=1.5, label=pair)
+        axes[1].plot(angle, m, ".", ms=1.5, label=pair)
+    axes[0].set_ylabel("radial reaction force [N]")
+    axes[1].set_ylabel("bending reaction moment [N m]")
+    for ax in axes:
+        ax.set_xlabel("input angle [deg]")
+        ax.set_xlim(0, 360)
+        ax.set_yscale("log")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, markerscale=6)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def save(fig, path) -> None:
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
