@@ -194,8 +194,9 @@ def _add_drive(model: ExudynModel, ground) -> None:
         return
     ground_node = mbs.AddNode(eii.NodePointGround())
     m_ground = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node, coordinate=0))
-    m_angle = mbs.AddMarker(eii.MarkerNodeRotationCoordinate(nodeNumber=model.nodes["input"],
-                                                             rotationCoordinate=0))
+    # the raw ODE2 coordinate psi0 (index 3) of the Rxyz node: unlike a rotation-coordinate
+    # marker it does not wrap at +-pi, which breaks a position-level angle drive at half a turn
+    m_angle = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=model.nodes["input"], coordinate=3))
     if drive.kind == "speed":
         connector = eii.ObjectConnectorCoordinate(markerNumbers=[m_ground, m_angle],
                                                   velocityLevel=True, offset=drive.speed)
