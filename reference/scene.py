@@ -539,6 +539,9 @@ def scene_to_dict(obj: Any) -> Any:
 
 def _merge(base: dict, over: Mapping) -> dict:
     out = dict(base)
+    for alias_base, (suffix, _) in _UNIT_ALIASES.items():
+        if alias_base + suffix in over:
+            out.pop(alias_base, None)  # the override's unit-suffixed value replaces the base's
     for key, value in over.items():
         if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
             out[key] = _merge(out[key], value)

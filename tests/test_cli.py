@@ -1,0 +1,85 @@
+"""The ``cardan`` command line: outputs, exit status, and bad input (exit 2, one line)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from cardan_exudyn.cli import main
+
+
+def cardan(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "cardan_exudyn.cli", *args],
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_run_json_prints_only_the_summary():
+    """--json prints one JSON document on stdout with the schema's summary keys."""
+    proc = cardan("run", "--angle", "15", "--revolutions", "1", "--json")
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads(proc.stdout)
+    for key in ("status", "engine", "engine_version", "scene", "mean_efficiency",
+                "mean_instantaneous_efficiency", "revolutions", "wall_time_s", "steps",
+                "newton_iterations", "max_constraint_violation_m", "dt", "dt_choice"):
+        assert key in summary
+    assert summary["status"] == "ok"
+    pairs = summary["scene"]["joint"]["pairs"]
+    assert set(pairs["frame_input"]) == {"friction_coefficient", "journal_diameter", "moment_lever"}
+
+
+def test_run_out_writes_files(tmp_path):
+    """--out writes timeseries.csv with every schema column and summary.json."""
+    import pandas as pd
+
+    from reference.schema import table_columns
+
+    assert main(["run", "--angle", "5", "--rpm", "500", "--revolutions", "1",
+                 "--out", str(tmp_path / "r")]) == 0
+    table = pd.read_csv(tmp_path / "r" / "timeseries.csv")
+    assert list(table.columns) == table_columns()
+    assert json.loads((tmp_path / "r" / "summary.json").read_text())["status"] == "ok"
+
+
+BAD_CLI = [
+    (["run", "--angle", "abc"], "expected a number"),
+    (["run", "--angle", "95"], "`shaft_angle` must be in [0, 90) deg"),
+    (["run", "--rpm", "0"], "must be non-zero"),
+    (["run", "--dt", "-1"], "must be positive"),
+    (["run", "--friction-spider", "-0.1"], "must be >= 0"),
+    (["run", "--scene", "/nonexistent.toml"], "cannot read scene file"),
+    (["run", "--name", "nope"], "unknown scene name 'nope'"),
+    (["run", "--engine", "warp"], "`--engine` must be one of"),
+    (["run", "--revolutions", "0.3"], "`revolutions` must be at least"),
+    (["run", "--angle", "nan"], "expected a finite number"),
+    (["run", "--name", "paper-10deg"], "friction from joint reactions is not implemented"),
+]
+
+
+@pytest.mark.parametrize("args, message", BAD_CLI, ids=[" ".join(a) for a, _ in BAD_CLI])
+def test_bad_cli_input(args, message):
+    """Bad input exits 2 with one line naming the problem and no traceback."""
+    proc = cardan(*args)
+    assert proc.returncode == 2
+    assert message in proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert proc.stdout == ""
+
+
+def test_scene_command_prints_toml():
+    """`cardan scene` prints the resolved scene, which loads back."""
+    proc = cardan("scene", "--name", "paper-frictionless", "--angle", "12")
+    assert proc.returncode == 0
+    assert "shaft_angle = 0.2094" in proc.stdout
+
+
+def test_reproduce_quick(tmp_path):
+    """`cardan reproduce --quick` writes the report folder with its table and plots."""
+    out = tmp_path / "rep"
+    assert main(["reproduce", "--quick", "--out", str(out)]) == 0
+    for name in ("report.md", "results.csv", "assumptions.csv", "speed_ratio.png",
+                 "input_torque.png", "reactions_10deg.png", "summaries.json"):
+        assert (out / name).is_file(), name
+    assert "Assumption register" in (out / "report.md").read_text()
