@@ -25,8 +25,15 @@ import numpy as np
 from cardan_exudyn.model import ExudynModel, build_model, node_axes_in_canonical
 from cardan_exudyn.rotations import rxyz_angular_velocity, rxyz_matrix
 from cardan_exudyn.stepsize import choose_step
-from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SceneError
-from reference.scene import scene_to_dict
+from reference.scene import (
+    PAIR_BODIES,
+    PAIR_KIND,
+    PAIR_NAMES,
+    AngleDrive,
+    Scene,
+    SceneError,
+    scene_to_dict,
+)
 from reference.schema import (
     STATUS_OK,
     Result,
@@ -295,6 +302,7 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
             ("fx", "fy", "fz", "mx", "my", "mz", "friction_torque", "friction_force",
              "omega_rel", "slide_rel"),
             (fx, fy, fz, mx, my, mz, friction_torque, friction_force, omega_rel, slide_rel),
+            strict=True,
         ):
             cols[f"{name}_{suffix}"] = values
         cols[f"power_loss_{name}"] = loss

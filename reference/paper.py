@@ -16,7 +16,6 @@ experimental validation (shared/paper/cardan-joint-multibody-paper.md).
 from __future__ import annotations
 
 import functools
-import math
 import re
 from importlib import resources
 from typing import Any
@@ -213,16 +212,11 @@ def paper_cases() -> list[dict[str, Any]]:
     """The paper's eleven numbers: Table 2 (8 angles) and the speed study (3 speeds)."""
     cases = []
     t2 = paper_data()["case"]["table2"]
-    for deg, eta in zip(t2["shaft_angle"]["value"], t2["mean_efficiency"]["value"]):
+    for deg, eta in zip(t2["shaft_angle"]["value"], t2["mean_efficiency"]["value"], strict=True):
         cases.append({"study": "table2", "shaft_angle_deg": deg,
                       "speed_rpm": value("case.multibody.speed"), "paper_mean_efficiency": eta})
     sp = paper_data()["case"]["speed_study"]
-    for rpm, eta in zip(sp["speed"]["value"], sp["mean_efficiency"]["value"]):
+    for rpm, eta in zip(sp["speed"]["value"], sp["mean_efficiency"]["value"], strict=True):
         cases.append({"study": "speed", "shaft_angle_deg": sp["shaft_angle"]["value"],
                       "speed_rpm": rpm, "paper_mean_efficiency": eta})
     return cases
-
-
-def hooke_period(speed: float) -> float:
-    """Duration of one input revolution at ``speed`` [rad/s] [s]."""
-    return 2.0 * math.pi / abs(speed)

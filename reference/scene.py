@@ -349,7 +349,7 @@ class TorqueDrive:
         return abs(self.initial_speed)
 
 
-Drive = Union[SpeedDrive, AngleDrive, TorqueDrive]
+Drive = Union[SpeedDrive, AngleDrive, TorqueDrive]  # noqa: UP007 (runtime alias, py3.10)
 DRIVES = {"speed": SpeedDrive, "angle": AngleDrive, "torque": TorqueDrive}
 
 

@@ -130,8 +130,7 @@ def mean_values(columns: dict[str, np.ndarray], skip_revolutions: float) -> dict
                      / duration) if np.all(finite) else float("nan")
     out = {
         "revolutions": n,
-        "window_start_s": float(np.interp(theta_0, theta if theta[-1] >= theta[0] else -theta,
-                                          t) if theta[-1] >= theta[0] else float("nan")),
+        "window_start_s": window_duration(t, theta, theta[0], theta_0) + float(t[0]),
         "window_duration_s": duration,
         "input_work": w_in,
         "output_work": w_out,
