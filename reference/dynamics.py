@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 
 import numpy as np
 
@@ -245,7 +244,7 @@ def run(scene: Scene, samples_per_revolution: int = DEFAULT_SAMPLES_PER_REVOLUTI
     Parameters
     ----------
     scene : Scene
-        The scene; its friction coefficients are ignored, with a warning (no friction yet).
+        The scene (constant-speed drive, every friction coefficient zero).
     samples_per_revolution : int
         Samples per input revolution [-].
 
@@ -258,18 +257,20 @@ def run(scene: Scene, samples_per_revolution: int = DEFAULT_SAMPLES_PER_REVOLUTI
     Raises
     ------
     NotImplementedError
-        For angle and torque drives.
+        For angle and torque drives, and for scenes with friction (not implemented yet: a
+        friction-free answer to a friction scene would be a silent wrong result).
     """
+    if scene.has_friction:
+        raise NotImplementedError(
+            "friction in the reference engine is not implemented yet (issue 4); use a "
+            "'-frictionless' scene or --friction-spider 0 --friction-frame 0")
     start = time.perf_counter()
     t, theta, theta_t, theta_tt = drive_samples(scene, samples_per_revolution)
     columns = {"t": t, **inverse_dynamics(scene, theta, theta_t, theta_tt)}
     summary = {"status": STATUS_OK, "reason": "", "engine": ENGINE_NAME,
                "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),
                "samples_per_revolution": int(samples_per_revolution), "dt": float(t[1] - t[0]),
-               "steps": int(t.size - 1), "friction_ignored": scene.has_friction}
-    if scene.has_friction:
-        warnings.warn(f"scene {scene.name!r} has friction; the reference engine ignores it so far",
-                      stacklevel=2)
+               "steps": int(t.size - 1)}
     means = mean_values(columns, scene.record.skip_revolutions)
     if means.get("revolutions", 0) < 1:
         summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))

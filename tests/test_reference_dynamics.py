@@ -177,11 +177,10 @@ def test_result_follows_the_schema():
     assert run(replace(scene, **{"record.timeseries": False})).table is None
 
 
-def test_friction_is_ignored_with_a_warning():
-    """A scene with friction runs frictionless and says so."""
-    with pytest.warns(UserWarning, match="ignores it"):
-        result = run(named_scene("paper-10deg"), samples_per_revolution=36)
-    assert result.summary["friction_ignored"] is True
+def test_friction_scene_is_refused():
+    """A scene with friction is refused rather than answered without friction."""
+    with pytest.raises(NotImplementedError, match="friction"):
+        run(named_scene("paper-10deg"), samples_per_revolution=36)
 
 
 DRIVES = {
