@@ -18,31 +18,27 @@ def _axes(ax):
     return ax.figure, ax
 
 
-def speed_ratio(tables: dict[str, object], ax=None):
-    """omega_out/omega_in against input angle, one line per labelled table."""
+def _against_input_angle(tables: dict[str, object], values, ylabel: str, ax=None):
     fig, ax = _axes(ax)
     for label, t in tables.items():
-        ax.plot(np.degrees(t["theta_in"]) % 360, t["omega_out"] / t["omega_in"], ".", ms=1.5,
-                label=label)
+        ax.plot(np.degrees(t["theta_in"]) % 360, values(t), ".", ms=1.5, label=label)
     ax.set_xlabel("input angle [deg]")
-    ax.set_ylabel("omega_out / omega_in [-]")
+    ax.set_ylabel(ylabel)
     ax.set_xlim(0, 360)
     ax.legend(fontsize=7, ncol=2, markerscale=6)
     ax.grid(alpha=0.3)
     return fig
+
+
+def speed_ratio(tables: dict[str, object], ax=None):
+    """omega_out/omega_in against input angle, one line per labelled table."""
+    return _against_input_angle(tables, lambda t: t["omega_out"] / t["omega_in"],
+                                "omega_out / omega_in [-]", ax)
 
 
 def input_torque(tables: dict[str, object], ax=None):
     """Drive torque against input angle, one line per labelled table."""
-    fig, ax = _axes(ax)
-    for label, t in tables.items():
-        ax.plot(np.degrees(t["theta_in"]) % 360, t["torque_in"], ".", ms=1.5, label=label)
-    ax.set_xlabel("input angle [deg]")
-    ax.set_ylabel("input torque [N m]")
-    ax.set_xlim(0, 360)
-    ax.legend(fontsize=7, ncol=2, markerscale=6)
-    ax.grid(alpha=0.3)
-    return fig
+    return _against_input_angle(tables, lambda t: t["torque_in"], "input torque [N m]", ax)
 
 
 def reactions(table, title: str = "", axes=None):

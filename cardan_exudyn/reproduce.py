@@ -8,7 +8,6 @@ next to the paper's efficiency values for orientation.
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from pathlib import Path
@@ -19,14 +18,9 @@ import pandas as pd
 from cardan_exudyn import plots
 from cardan_exudyn.engine import run
 from cardan_exudyn.io import atomic_directory, dumps
+from reference.kinematics import speed_ratio as hooke_speed_ratio
 from reference.paper import assumption_register, paper_cases, paper_scene, stated_values
 from reference.scene import PAIR_NAMES, replace
-
-
-def hooke_speed_ratio(theta_in: np.ndarray, shaft_angle: float) -> np.ndarray:
-    """Hooke's omega_out/omega_in with the project's yoke phase (input yoke in the shaft plane at 0)."""
-    s = math.sin(shaft_angle)
-    return math.cos(shaft_angle) / (1.0 - s * s * np.cos(theta_in) ** 2)
 
 
 def case_row(case: dict, result) -> dict:

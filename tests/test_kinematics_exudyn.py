@@ -9,17 +9,13 @@ import pytest
 from conftest import balanced_scene
 
 from cardan_exudyn.engine import run
-from cardan_exudyn.reproduce import hooke_speed_ratio
+from reference.kinematics import output_angle, speed_ratio
 
 
 def ratio_error(result) -> float:
     t = result.table
     beta = result.summary["scene"]["joint"]["geometry"]["shaft_angle"]
-    return float(np.max(np.abs(t["omega_out"] / t["omega_in"] - hooke_speed_ratio(t["theta_in"], beta))))
-
-
-def hooke_output_angle(theta: np.ndarray, beta: float) -> np.ndarray:
-    return np.unwrap(np.arctan2(np.sin(theta), math.cos(beta) * np.cos(theta)))
+    return float(np.max(np.abs(t["omega_out"] / t["omega_in"] - speed_ratio(t["theta_in"].to_numpy(), beta))))
 
 
 @pytest.mark.parametrize("beta_deg", [3.0, 10.0, 35.0, 47.0, 63.0], ids=lambda b: f"{b:g}deg")
@@ -37,7 +33,7 @@ def test_output_angle_matches_hooke(beta_deg):
     """The output angle follows tan(theta_out) = tan(theta_in) / cos(beta)."""
     result = run(balanced_scene(beta_deg, rpm=2000, gravity=(0, 0, 0), accuracy=1e-6))
     t = result.table
-    expected = hooke_output_angle(t["theta_in"].to_numpy(), math.radians(beta_deg))
+    expected = output_angle(t["theta_in"].to_numpy(), math.radians(beta_deg))
     # angle errors are the integral of the speed error: <= accuracy * 2 pi per revolution
     np.testing.assert_allclose(t["theta_out"], expected, rtol=0, atol=2 * math.pi * 1e-6)
 
