@@ -157,7 +157,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
         summary.update(status="integration_failure" if status == STATUS_OK else status,
                        reason=reason or f"no usable output: {exc}")
         return Result(None, summary)
-    summary.update(constraint_violation(model, columns))
+    summary.update(constraint_violation(model.pair_kinematics))
     bad = _first_non_finite(columns)
     if bad and status == STATUS_OK:
         status, reason = "diverged", f"non-finite values in `{bad}`"
@@ -327,16 +327,15 @@ def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndar
     return kinetic, potential
 
 
-def constraint_violation(model: ExudynModel, columns: dict[str, np.ndarray]) -> dict[str, float]:
+def constraint_violation(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> dict[str, float]:
     """Largest violation of the pair constraints over the run.
 
     Position [m]: distance of the two marker points (revolute) or of marker b from the axis of
     marker a (cylindrical). Angle [rad]: misalignment of the two pair axes, and for the revolute
     the twist is free so only the axis counts.
     """
-    del columns
     pos, ang = 0.0, 0.0
-    for name, k in model.pair_kinematics.items():
+    for name, k in pair_kinematics.items():
         d = k["pb"] - k["pa"]
         za, zb = k["frame_a"][:, :, 2], k["frame_b"][:, :, 2]
         if PAIR_KIND[name] == "cylindrical":

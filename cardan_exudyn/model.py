@@ -226,24 +226,20 @@ def _add_loads(model: ExudynModel) -> None:
 
 def add_sensors(model: ExudynModel) -> None:
     """Internal (in-memory) sensors for node states, pair reactions and the drive force."""
-    mbs = model.mbs
     out = exu.OutputVariableType
+
+    def sensor(key: str, item: Any, variable: Any, node: bool = False) -> None:
+        kind = eii.SensorNode(nodeNumber=item, outputVariableType=variable, storeInternal=True,
+                              writeToFile=False) if node else \
+            eii.SensorObject(objectNumber=item, outputVariableType=variable, storeInternal=True,
+                             writeToFile=False)
+        model.sensors[key] = model.mbs.AddSensor(kind)
+
     for name, node in model.nodes.items():
-        model.sensors[f"{name}_q"] = mbs.AddSensor(eii.SensorNode(
-            nodeNumber=node, outputVariableType=out.Coordinates, storeInternal=True,
-            writeToFile=False))
-        model.sensors[f"{name}_q_t"] = mbs.AddSensor(eii.SensorNode(
-            nodeNumber=node, outputVariableType=out.Coordinates_t, storeInternal=True,
-            writeToFile=False))
+        sensor(f"{name}_q", node, out.Coordinates, node=True)
+        sensor(f"{name}_q_t", node, out.Coordinates_t, node=True)
     for name in PAIR_NAMES:
-        joint = model.joints[name]
-        model.sensors[f"{name}_force"] = mbs.AddSensor(eii.SensorObject(
-            objectNumber=joint, outputVariableType=out.ForceLocal, storeInternal=True,
-            writeToFile=False))
-        model.sensors[f"{name}_torque"] = mbs.AddSensor(eii.SensorObject(
-            objectNumber=joint, outputVariableType=out.TorqueLocal, storeInternal=True,
-            writeToFile=False))
+        sensor(f"{name}_force", model.joints[name], out.ForceLocal)
+        sensor(f"{name}_torque", model.joints[name], out.TorqueLocal)
     if model.drive_connector is not None:
-        model.sensors["drive_force"] = mbs.AddSensor(eii.SensorObject(
-            objectNumber=model.drive_connector, outputVariableType=out.Force,
-            storeInternal=True, writeToFile=False))
+        sensor("drive_force", model.drive_connector, out.Force)
