@@ -52,6 +52,11 @@ def _add_scene_options(p: argparse.ArgumentParser) -> None:
                    help="friction coefficient of the two spider pairs (the paper's f1)")
     p.add_argument("--friction-frame", metavar="F", type=_number("-", non_negative=True),
                    help="friction coefficient of the two frame pairs (the paper's f2)")
+    p.add_argument("--coupling", choices=("converged", "lagged"),
+                   help="friction coupling: converged per step (default) or lagged one step "
+                        "(the paper's)")
+    p.add_argument("--sign-band", metavar="M_S", type=_number("m/s", non_negative=True),
+                   help="surface speed [m/s] below which sign() of eqs. (3), (5) is a linear ramp")
     p.add_argument("--no-gravity", action="store_true", help="switch gravity off")
     p.add_argument("--dt", metavar="S", type=_number("s", positive=True),
                    help="time step [s] (default: chosen from the scene to meet --accuracy)")
@@ -79,6 +84,10 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
         if value is not None:
             for pair in pairs:
                 changes[f"joint.pairs.{pair}.friction_coefficient"] = value
+    if args.coupling is not None:
+        changes["friction.coupling"] = args.coupling
+    if args.sign_band is not None:
+        changes["friction.sign_band"] = args.sign_band
     if args.no_gravity:
         changes["gravity"] = [0.0, 0.0, 0.0]
     if args.dt is not None:

@@ -12,7 +12,8 @@ Modelling choices
 - Constant speed: ``ObjectConnectorCoordinate`` at velocity level on the input angle (no Python
   user function). Prescribed angle: the same connector at position level with an offset user
   function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``.
-- Gravity loads and the output load only when they are non-zero.
+- Gravity loads and the output load only when they are non-zero; friction loads and their user
+  function only for pairs with a non-zero coefficient (``cardan_exudyn.friction``).
 """
 
 from __future__ import annotations
@@ -108,6 +109,7 @@ class ExudynModel:
     pair_kinematics: dict = field(default_factory=dict)
     mass: dict[str, float] = field(default_factory=dict)
     inertia: dict[str, np.ndarray] = field(default_factory=dict)
+    friction: Any = None  # cardan_exudyn.friction.FrictionCoupling when a pair has friction
 
 
 def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
@@ -168,9 +170,15 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
 
     _add_drive(model, ground)
     _add_loads(model)
+    if scene.has_friction:
+        from cardan_exudyn.friction import FrictionCoupling
+
+        model.friction = FrictionCoupling(model)
     if sensors:
         add_sensors(model)
     mbs.Assemble()
+    if model.friction is not None:
+        model.friction.prepare()
     return model
 
 

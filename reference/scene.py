@@ -387,6 +387,50 @@ class Numerics:
         _set(self, "accuracy", acc)
 
 
+COUPLINGS = ("converged", "lagged")
+
+
+@dataclass(frozen=True)
+class FrictionSettings:
+    """How the friction of eqs. (1)-(5) is coupled to the reactions and regularised.
+
+    Attributes
+    ----------
+    coupling : str
+        ``"converged"``: within each time step, friction and reactions are iterated to a fixed
+        point (the friction applied is the friction of the step's own reactions);
+        ``"lagged"``: the paper's scheme (section 3.1), the reactions at the end of a step set the
+        friction applied during the next step.
+    sign_band : float
+        Relative surface speed [m/s] below which ``sign()`` of eqs. (3), (5) is replaced by a
+        linear ramp ``clip(v / sign_band, -1, 1)``. The surface speed of a rotating journal is
+        ``|omega_rel| d / 2``; a sliding pair uses its sliding speed. 0 means the exact sign.
+    tolerance : float
+        Converged coupling: the fixed point is accepted when the largest change of a friction
+        load is below ``tolerance`` times the largest friction load (forces counted as the
+        torque they make at the journal radius, ``F d / 2``).
+    max_iterations : int
+        Converged coupling: friction updates per step before the step is declared not converged.
+    """
+
+    coupling: str = "converged"
+    sign_band: float = 1e-3
+    tolerance: float = 1e-6
+    max_iterations: int = 20
+
+    def __post_init__(self) -> None:
+        if self.coupling not in COUPLINGS:
+            raise SceneError(f"`coupling` must be one of {list(COUPLINGS)}, got {self.coupling!r}")
+        _set(self, "sign_band", _non_negative("sign_band", self.sign_band))
+        tol = _positive("tolerance", self.tolerance)
+        if tol >= 1.0:
+            raise SceneError(f"`tolerance` must be < 1, got {tol!r}")
+        _set(self, "tolerance", tol)
+        if (isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int)
+                or self.max_iterations < 2):
+            raise SceneError(f"`max_iterations` must be an integer >= 2, got {self.max_iterations!r}")
+
+
 @dataclass(frozen=True)
 class Record:
     """What to record.
@@ -432,6 +476,7 @@ class Scene:
     gravity: tuple = (0.0, 0.0, -9.81)
     revolutions: float = 2.0
     numerics: Numerics = field(default_factory=Numerics)
+    friction: FrictionSettings = field(default_factory=FrictionSettings)
     record: Record = field(default_factory=Record)
     name: str = "scene"
     description: str = ""
@@ -468,7 +513,8 @@ class Scene:
 # --------------------------------------------------------------------------- dict / TOML I/O
 
 _SECTIONS: dict[type, dict[str, Any]] = {
-    Scene: {"joint": Joint, "load": Load, "numerics": Numerics, "record": Record},
+    Scene: {"joint": Joint, "load": Load, "numerics": Numerics, "friction": FrictionSettings,
+            "record": Record},
     Joint: {"input": Body, "spider": Body, "output": Body, "geometry": Geometry, "pairs": Pairs},
     Pairs: {name: Pair for name in PAIR_NAMES},
 }

@@ -54,7 +54,8 @@ BAD_CLI = [
     (["run", "--engine", "warp"], "`--engine` must be one of"),
     (["run", "--revolutions", "0.3"], "`revolutions` must be at least"),
     (["run", "--angle", "nan"], "expected a finite number"),
-    (["run", "--name", "paper-10deg"], "friction from joint reactions is not implemented"),
+    (["run", "--coupling", "halfway"], "invalid choice"),
+    (["run", "--sign-band", "-1"], "must be >= 0"),
 ]
 
 

@@ -1,0 +1,418 @@
+"""Friction of eqs. (1)-(5) in the Exudyn model, computed from the pairs' reaction outputs.
+
+What is added to the model
+--------------------------
+For each pair with a non-zero friction coefficient (and only for those): a body-fixed
+``LoadTorqueVector`` about the pair axis on each non-ground body of the pair, and for cylindrical
+pairs a body-fixed ``LoadForceVector`` along the axis, applied at the pair point of each body.
+Body ``b`` receives the friction (torque ``M_z``, force ``F_z``), body ``a`` the opposite. Both
+load vectors are fixed in their body because the pair axis is fixed in both bodies of the pair.
+
+How the friction is updated (``scene.friction.coupling``)
+---------------------------------------------------------
+One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, after each
+converged Newton solve, the pair reactions (the joints' Lagrange multipliers, i.e. the
+``ForceLocal`` / ``TorqueLocal`` components; only their magnitudes normal to the axis enter eqs.
+(3)-(5), so the frame in which they are expressed does not matter) and the relative speeds (from
+the node coordinates), computes the friction and sets the loads with ``SetLoadParameter``.
+
+- ``lagged`` (the paper's scheme): the function returns zero error, so the friction computed at
+  the end of step n acts during step n+1. First order in the step size (the friction is one
+  step late). The first step runs without friction.
+- ``converged``: the function returns the relative change of the friction as the error of
+  Exudyn's *discontinuous iteration*; Exudyn repeats the Newton solve of the same step with the
+  updated friction until the change is below ``tolerance``. The friction applied in a step is
+  then the friction of that step's own reactions (a fixed point per step), and the error of the
+  mean efficiency falls at the integrator's order (second). When a step is accepted, the
+  friction for the next step is predicted by linear extrapolation of the last two steps, which
+  only shortens the iteration (the fixed point does not depend on it).
+
+Self-locking
+------------
+The fixed-point iteration contracts with the loop gain of the friction feedback (friction ->
+reactions -> friction). In the converged scheme the ratio of successive corrections estimates
+it (``loop_gain_estimate`` in the summary); a step whose iteration stalls (residual reduced by
+less than ``STALL_RATIO`` after ``max_iterations``) has no consistent friction state and stops
+the run with status ``self_locking``; a step that still converges but slowly is counted in
+``unconverged_steps`` and the run goes on. In the lagged scheme every step is one iteration of the same map,
+so a gain >= 1 shows as geometric growth of the friction from step to step: growth by more than
+a factor 1e3 over consecutive growing steps stops the run with status ``self_locking``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import exudyn as exu
+import exudyn.itemInterface as eii
+import numpy as np
+
+from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+
+# geometric growth of the friction (lagged scheme) taken as self-locking
+LAGGED_GROWTH_LIMIT = 1e3
+# converged scheme: a step whose fixed-point residual shrank less than this after
+# max_iterations is taken as self-locking (no consistent friction state)
+STALL_RATIO = 0.1
+
+
+def _sign(speed: float, band: float) -> float:
+    """Regularised sign: linear ramp of width ``band``, exact sign for band 0."""
+    if band <= 0.0:
+        return (speed > 0.0) - (speed < 0.0)
+    return max(-1.0, min(1.0, speed / band))
+
+
+def _rxyz(psi: np.ndarray) -> np.ndarray:
+    c0, c1, c2 = math.cos(psi[0]), math.cos(psi[1]), math.cos(psi[2])
+    s0, s1, s2 = math.sin(psi[0]), math.sin(psi[1]), math.sin(psi[2])
+    return np.array([
+        [c1 * c2, -c1 * s2, s1],
+        [s0 * s1 * c2 + c0 * s2, -s0 * s1 * s2 + c0 * c2, -s0 * c1],
+        [-c0 * s1 * c2 + s0 * s2, c0 * s1 * s2 + s0 * c2, c0 * c1],
+    ])
+
+
+def _omega(psi: np.ndarray, psi_t: np.ndarray) -> np.ndarray:
+    c0, c1 = math.cos(psi[0]), math.cos(psi[1])
+    s0, s1 = math.sin(psi[0]), math.sin(psi[1])
+    return np.array([psi_t[0] + s1 * psi_t[2],
+                     c0 * psi_t[1] - s0 * c1 * psi_t[2],
+                     s0 * psi_t[1] + c0 * c1 * psi_t[2]])
+
+
+@dataclass
+class _PairData:
+    name: str
+    kind: str
+    f: float
+    d: float
+    lever: float
+    ae: np.ndarray                      # global indices of the joint's 6 multipliers
+    bodies: tuple[str, str]
+    local: tuple[np.ndarray, np.ndarray]  # pair point in each body's node frame
+    axis_local: np.ndarray              # pair axis in node frames (same for a and b)
+    torque_loads: list = field(default_factory=list)  # (load number, +1 for b / -1 for a)
+    force_loads: list = field(default_factory=list)
+
+
+@dataclass
+class FrictionLog:
+    """Per accepted step: the inputs read, the friction computed, and the friction applied."""
+
+    t: list = field(default_factory=list)
+    inputs: list = field(default_factory=list)    # per pair (|F_n|, |M_n|, omega_rel, slide)
+    computed: list = field(default_factory=list)  # per pair (M_z, F_z) from this step's state
+    applied: list = field(default_factory=list)   # per pair (M_z, F_z) in effect in the solve
+    iterations: list = field(default_factory=list)
+
+
+class FrictionCoupling:
+    """Friction loads of a model and the user functions that update them (see module doc)."""
+
+    def __init__(self, model: Any) -> None:
+        scene = model.scene
+        self.model = model
+        self.mbs = model.mbs
+        self.settings = scene.friction
+        self.band = scene.friction.sign_band
+        self.converged = scene.friction.coupling == "converged"
+        self.pairs: list[_PairData] = []
+        for name, pair in scene.joint.pairs.items():
+            if pair.friction_coefficient <= 0.0:
+                continue
+            frame = model.pair_frames[name]
+            p = _PairData(name=name, kind=PAIR_KIND[name], f=pair.friction_coefficient,
+                          d=pair.journal_diameter, lever=pair.moment_lever,
+                          ae=np.zeros(6, dtype=int), bodies=PAIR_BODIES[name],
+                          local=model.marker_local[name], axis_local=frame[:, 2].copy())
+            for role, body, local in zip((-1, 1), p.bodies, p.local, strict=True):
+                if body == "ground":
+                    continue
+                marker = self.mbs.AddMarker(eii.MarkerBodyRigid(
+                    bodyNumber=model.bodies[body], localPosition=list(local)))
+                p.torque_loads.append((self.mbs.AddLoad(eii.LoadTorqueVector(
+                    markerNumber=marker, loadVector=[0.0, 0.0, 0.0], bodyFixed=True)), role))
+                if p.kind == "cylindrical":
+                    p.force_loads.append((self.mbs.AddLoad(eii.LoadForceVector(
+                        markerNumber=marker, loadVector=[0.0, 0.0, 0.0], bodyFixed=True)), role))
+            self.pairs.append(p)
+        self.n = len(self.pairs)
+        self.applied = np.zeros((self.n, 2))
+        self.log = FrictionLog()
+        self._step_t = None
+        self._step_iter = 0
+        self._xs: list[np.ndarray] = []
+        self._gs: list[np.ndarray] = []
+        self._step_gain = 0.0
+        self._broyden_b = None
+        mask = np.zeros((self.n, 2), dtype=bool)
+        self._weight = np.ones((self.n, 2))
+        for k, p in enumerate(self.pairs):
+            mask[k, 0] = True
+            mask[k, 1] = p.kind == "cylindrical"
+            self._weight[k, 1] = 0.5 * p.d
+        self._mask = mask.ravel()
+        self._accepted: list[np.ndarray] = []
+        self.loop_gain = 0.0
+        self.unconverged_steps = 0
+        self.status, self.reason = "ok", ""
+        self._growth_steps, self._growth_start = 0, 0.0
+        self._ode2 = {}
+
+    # ------------------------------------------------------------------ set-up after Assemble
+    def prepare(self) -> None:
+        """Look up coordinate indices (after ``mbs.Assemble``) and register the user functions."""
+        sd = self.mbs.systemData
+        for p in self.pairs:
+            p.ae = np.asarray(sd.GetObjectLTGAE(self.model.joints[p.name]), dtype=int)[:6]
+        for name, node in self.model.nodes.items():
+            start = self.mbs.GetNodeODE2Index(node)
+            self._ode2[name] = start
+        self._history = [(self.model.start_time, self._pair_coordinates())]
+        self.mbs.SetPostNewtonUserFunction(self.post_newton)
+        self.model.user_functions.append(self.post_newton)
+
+    def configure(self, settings: Any) -> None:
+        """Discontinuous-iteration settings for the chosen coupling."""
+        d = settings.timeIntegration.discontinuous
+        d.iterationTolerance = self.settings.tolerance if self.converged else 1.0
+        d.maxIterations = self.settings.max_iterations + 1 if self.converged else 1
+        d.ignoreMaxIterations = True
+        d.useRecommendedStepSize = False
+
+    # ------------------------------------------------------------------ the law
+    def _body_states(self) -> dict[str, tuple]:
+        sd = self.mbs.systemData
+        q = sd.GetODE2Coordinates(exu.ConfigurationType.Current)
+        q_t = sd.GetODE2Coordinates_t(exu.ConfigurationType.Current)
+        states = {}
+        for name, i in self._ode2.items():
+            psi, psi_t = q[i + 3:i + 6], q_t[i + 3:i + 6]
+            states[name] = (_rxyz(psi), _omega(psi, psi_t), np.asarray(q_t[i:i + 3]),
+                            self.model.com_reference[name] + np.asarray(q[i:i + 3]))
+        return states
+
+    def _pair_coordinates(self) -> np.ndarray:
+        """Per pair: relative rotation angle of b about the axis, and axial slide of b [m].
+
+        Computed from positions, which index-3 integration keeps on the constraint manifold to
+        the Newton tolerance; their time derivatives are the relative speeds used by the law.
+        """
+        states = self._body_states()
+        ground = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
+        coords = np.zeros((self.n, 2))
+        for k, p in enumerate(self.pairs):
+            a_a, _, _, r_a = states.get(p.bodies[0], ground)
+            a_b, _, _, r_b = states.get(p.bodies[1], ground)
+            frame = self.model.pair_frames[p.name]
+            rel = (a_a @ frame).T @ (a_b @ frame)
+            coords[k, 0] = math.atan2(rel[1, 0], rel[0, 0])
+            if p.kind == "cylindrical":
+                d = (r_b + a_b @ p.local[1]) - (r_a + a_a @ p.local[0])
+                coords[k, 1] = float(d @ (a_a @ p.axis_local))
+        return coords
+
+    def _speeds(self, coords: np.ndarray, t: float) -> np.ndarray:
+        """Relative angular and sliding speeds: BDF2 of the pair coordinates (BDF1 at the start)."""
+        hist = self._history
+        c1 = hist[-1][1]
+        delta = coords - c1
+        delta[:, 0] = (delta[:, 0] + math.pi) % (2.0 * math.pi) - math.pi  # unwrap the angle
+        h1 = t - hist[-1][0]
+        if len(hist) < 2:
+            return delta / h1
+        c2 = hist[-2][1]
+        delta2 = c1 - c2
+        delta2[:, 0] = (delta2[:, 0] + math.pi) % (2.0 * math.pi) - math.pi
+        h2 = hist[-1][0] - hist[-2][0]
+        # second-order backward difference on a possibly non-uniform grid
+        w = h1 / h2
+        return ((1.0 + 2.0 * w) / (1.0 + w) * delta - w * w / (1.0 + w) * delta2) / h1
+
+    def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Inputs (|F_n|, |M_n|, omega_rel, slide), friction (M_z, F_z on b), pair coordinates."""
+        lam = self.mbs.systemData.GetAECoordinates(exu.ConfigurationType.Current)
+        coords = self._pair_coordinates()
+        speeds = self._speeds(coords, t)
+        inputs = np.zeros((self.n, 4))
+        friction = np.zeros((self.n, 2))
+        for k, p in enumerate(self.pairs):
+            lx, ly, _, tx, ty = (lam[i] for i in p.ae[:5])
+            force_n, moment_n = math.hypot(lx, ly), math.hypot(tx, ty)
+            omega_rel, slide = speeds[k]
+            torque = p.f * p.d * moment_n / p.lever + 0.5 * p.f * p.d * force_n
+            friction[k, 0] = -_sign(0.5 * p.d * omega_rel, self.band) * torque
+            if p.kind == "cylindrical":
+                friction[k, 1] = -_sign(slide, self.band) * p.f * (force_n + 2.0 * moment_n / p.lever)
+            else:
+                slide = 0.0
+            inputs[k] = (force_n, moment_n, omega_rel, slide)
+        return inputs, friction, coords
+
+    def apply(self, friction: np.ndarray) -> None:
+        set_load = self.mbs.SetLoadParameter
+        for k, p in enumerate(self.pairs):
+            for load, role in p.torque_loads:
+                set_load(load, "loadVector", list(role * friction[k, 0] * p.axis_local))
+            for load, role in p.force_loads:
+                set_load(load, "loadVector", list(role * friction[k, 1] * p.axis_local))
+        self.applied = friction.copy()
+
+    # ------------------------------------------------------------------ user functions
+    def post_newton(self, mbs: Any, t: float) -> list[float]:
+        if t != self._step_t and self._step_t is not None:  # the previous step was accepted
+            self._history = [self._history[-1], (self._step_t, self._coords)]
+        inputs, friction, self._coords = self.evaluate(t)
+        # forces enter as the torque they make at the journal radius, so one relative measure
+        # covers both kinds of load
+        weighted = np.abs(friction) * self._weight
+        scale = float(weighted.max())
+        change = float((np.abs(friction - self.applied) * self._weight).max())
+        error = change / scale if scale > 0.0 else 0.0
+        if t != self._step_t:  # first evaluation of a new step
+            self._step_t, self._step_iter = t, 0
+            self.log.t.append(t)
+            self.log.inputs.append(inputs)
+            self.log.computed.append(friction)
+            self.log.applied.append(self.applied.copy())
+            self.log.iterations.append(1)
+        else:
+            self._step_iter += 1
+            self.log.inputs[-1] = inputs
+            self.log.computed[-1] = friction
+            self.log.applied[-1] = self.applied.copy()
+            self.log.iterations[-1] = self._step_iter + 1
+        if not self.converged:
+            self._watch_growth(friction)
+            self.apply(friction)
+            return [0.0, -1.0]
+        if self._step_iter == 0:
+            self._xs, self._gs = [], []
+        self._xs.append(self.applied.ravel().copy())
+        self._gs.append(friction.ravel().copy())
+        residuals = [g - x for x, g in zip(self._xs, self._gs, strict=True)]
+        if len(residuals) == 2:  # after one plain update: the contraction of the map
+            r0, r1 = np.linalg.norm(residuals[0]), np.linalg.norm(residuals[1])
+            if r0 > 1e-7 * max(float(np.abs(friction).max()), 1e-300):
+                self._step_gain = r1 / r0
+                self.loop_gain = max(self.loop_gain, self._step_gain)
+        if error <= self.settings.tolerance:
+            self._accept(friction)
+            return [0.0, -1.0]
+        if len(residuals) >= self.settings.max_iterations:
+            self.unconverged_steps += 1
+            shrink = np.linalg.norm(residuals[-1]) / max(np.linalg.norm(residuals[0]), 1e-300)
+            if shrink >= STALL_RATIO:
+                self.status = "self_locking"
+                self.reason = (f"no consistent friction state at t = {t:.6g} s: the fixed-point "
+                               f"iteration stalled (residual ratio {shrink:.3g} after "
+                               f"{len(residuals)} iterations, contraction of the plain map "
+                               f"{self._step_gain:.3g}); the loop gain of the friction feedback "
+                               "is >= 1")
+            self._accept(friction)
+            return [0.0, -1.0]
+        self.apply(self._broyden(residuals).reshape(friction.shape))
+        return [error, -1.0]
+
+    def _broyden(self, residuals: list[np.ndarray]) -> np.ndarray:
+        """Next friction guess: Broyden's quasi-Newton method on ``r(x) = Phi(x) - x``.
+
+        The map friction -> reactions -> friction is nearly linear within a step (signs fixed)
+        and changes slowly from step to step, so the secant approximation ``B`` of ``dr/dx`` is
+        kept across steps (it starts as ``-I``, i.e. a plain fixed-point update, and is updated
+        with every pair of iterates of the same step). After the first steps an accepted step
+        typically needs two or three evaluations where the plain iteration contracts only with
+        the loop gain (0.6-0.9 at 10-35 deg).
+        """
+        mask = self._mask
+        x = self._xs[-1][mask]
+        r = residuals[-1][mask]
+        if self._broyden_b is None:
+            self._broyden_b = -np.eye(mask.sum())
+        if len(residuals) >= 2:
+            dx = x - self._xs[-2][mask]
+            dr = r - residuals[-2][mask]
+            norm = float(dx @ dx)
+            if norm > 0.0:
+                self._broyden_b += np.outer(dr - self._broyden_b @ dx, dx) / norm
+        try:
+            step = np.linalg.solve(self._broyden_b, -r)
+        except np.linalg.LinAlgError:
+            self._broyden_b = -np.eye(mask.sum())
+            step = r
+        out = self._gs[-1].copy()
+        out[mask] = x + step
+        return out
+
+    def _accept(self, friction: np.ndarray) -> None:
+        """Step accepted: predict the next step's friction by extrapolating the last three steps.
+
+        Quadratic extrapolation on the step grid (error O(h^3)) puts the first evaluation of the next step within
+        about 1e-4 of its fixed point at the default step sizes, so one Broyden correction
+        usually meets the tolerance. It only sets the starting guess.
+        """
+        hist = self._accepted
+        hist.append(friction.copy())
+        if len(hist) > 3:
+            hist.pop(0)
+        if len(hist) == 3:
+            prediction = 3.0 * hist[2] - 3.0 * hist[1] + hist[0]
+        elif len(hist) == 2:
+            prediction = 2.0 * hist[1] - hist[0]
+        else:
+            prediction = friction
+        self.apply(prediction)
+
+    def _watch_growth(self, friction: np.ndarray) -> None:
+        size = float(np.max(np.abs(friction)))
+        before = float(np.max(np.abs(self.applied)))
+        if before > 0.0 and size > before:
+            if self._growth_steps == 0:
+                self._growth_start = before
+            self._growth_steps += 1
+            if size > LAGGED_GROWTH_LIMIT * self._growth_start:
+                self.status = "self_locking"
+                self.reason = (f"lagged friction grew geometrically by more than "
+                               f"{LAGGED_GROWTH_LIMIT:g}x over {self._growth_steps} steps up to "
+                               f"t = {self._step_t:.6g} s: the friction feedback loop gain is >= 1")
+        else:
+            self._growth_steps = 0
+
+    # ------------------------------------------------------------------ results
+    def summary(self) -> dict[str, Any]:
+        iterations = np.asarray(self.log.iterations, dtype=float)
+        return {
+            "coupling": self.settings.coupling,
+            "sign_band_m_s": self.band,
+            "pairs_with_friction": [p.name for p in self.pairs],
+            "tolerance": self.settings.tolerance if self.converged else None,
+            "mean_iterations_per_step": float(iterations.mean()) if iterations.size else 0.0,
+            "max_iterations_in_a_step": int(iterations.max()) if iterations.size else 0,
+            "unconverged_steps": self.unconverged_steps,
+            "loop_gain_estimate": self.loop_gain if self.converged else None,
+        }
+
+    def columns(self, times: np.ndarray) -> dict[str, np.ndarray]:
+        """Friction applied in the step ending at each recorded time, per pair (zeros elsewhere)."""
+        n = len(times)
+        out = {f"{name}_{kind}": np.zeros(n) for name in PAIR_NAMES
+               for kind in ("friction_torque", "friction_force")}
+        if not self.log.t:
+            return out
+        # the initial row (no step yet) gets the friction of the first step
+        t_log = np.asarray(self.log.t)
+        applied = np.asarray(self.log.applied)
+        index = np.searchsorted(t_log, times - 1e-12 * max(1.0, abs(times[-1])))
+        index[0] = 0 if times[0] < t_log[0] else index[0]
+        valid = (index < len(t_log))
+        valid[valid] &= np.isclose(t_log[index[valid]], times[valid], rtol=0, atol=1e-9)
+        valid[0] = True
+        for k, p in enumerate(self.pairs):
+            for j, kind in enumerate(("friction_torque", "friction_force")):
+                col = np.zeros(n)
+                col[valid] = applied[index[valid], k, j]
+                out[f"{p.name}_{kind}"] = col
+        return out
