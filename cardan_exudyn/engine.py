@@ -124,7 +124,13 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     solver = exu.MainSolverImplicitSecondOrder()
     status, reason = STATUS_OK, ""
     try:
-        ok = solver.SolveSystem(model.mbs, settings)
+        if friction is None:
+            ok = solver.SolveSystem(model.mbs, settings)
+        else:
+            solver.InitializeSolver(model.mbs, settings)
+            friction.initialise(solver, settings)
+            ok = friction.status != STATUS_OK or solver.SolveSteps(model.mbs, settings)
+            solver.FinalizeSolver(model.mbs, settings)
         if not ok:
             status, reason = "integration_failure", solver.GetErrorString() or "solver failed"
     except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence

@@ -11,9 +11,10 @@ load vectors are fixed in their body because the pair axis is fixed in both bodi
 How the friction is updated (``scene.friction.coupling``)
 ---------------------------------------------------------
 One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, after each
-converged Newton solve, the pair reactions (the joints' Lagrange multipliers, i.e. the
-``ForceLocal`` / ``TorqueLocal`` components; only their magnitudes normal to the axis enter eqs.
-(3)-(5), so the frame in which they are expressed does not matter) and the relative speeds (from
+converged Newton solve, the pair reactions (the joints' ``ForceLocal`` / ``TorqueLocal`` outputs;
+only their magnitudes normal to the pair axis enter eqs. (3)-(5), and these do not depend on
+which of the two pair frames, rotated about the axis, they are expressed in; the raw Lagrange
+multipliers are not used: for the joint to ground their force part is in global components) and the relative speeds (from
 the node coordinates), computes the friction and sets the loads with ``SetLoadParameter``.
 
 - ``lagged`` (the paper's scheme): the function returns zero error, so the friction computed at
@@ -90,7 +91,7 @@ class _PairData:
     f: float
     d: float
     lever: float
-    ae: np.ndarray                      # global indices of the joint's 6 multipliers
+    joint: int                          # the pair's ObjectJointGeneric
     bodies: tuple[str, str]
     local: tuple[np.ndarray, np.ndarray]  # pair point in each body's node frame
     axis_local: np.ndarray              # pair axis in node frames (same for a and b)
@@ -126,7 +127,7 @@ class FrictionCoupling:
             frame = model.pair_frames[name]
             p = _PairData(name=name, kind=PAIR_KIND[name], f=pair.friction_coefficient,
                           d=pair.journal_diameter, lever=pair.moment_lever,
-                          ae=np.zeros(6, dtype=int), bodies=PAIR_BODIES[name],
+                          joint=model.joints[name], bodies=PAIR_BODIES[name],
                           local=model.marker_local[name], axis_local=frame[:, 2].copy())
             for role, body, local in zip((-1, 1), p.bodies, p.local, strict=True):
                 if body == "ground":
@@ -142,6 +143,8 @@ class FrictionCoupling:
         self.n = len(self.pairs)
         self.applied = np.zeros((self.n, 2))
         self.log = FrictionLog()
+        self.initial: np.ndarray | None = None  # friction consistent with the initial state
+        self._accepted: list[np.ndarray] = []
         self._step_t = None
         self._step_iter = 0
         self._xs: list[np.ndarray] = []
@@ -155,7 +158,6 @@ class FrictionCoupling:
             mask[k, 1] = p.kind == "cylindrical"
             self._weight[k, 1] = 0.5 * p.d
         self._mask = mask.ravel()
-        self._accepted: list[np.ndarray] = []
         self.loop_gain = 0.0
         self.unconverged_steps = 0
         self.status, self.reason = "ok", ""
@@ -165,9 +167,6 @@ class FrictionCoupling:
     # ------------------------------------------------------------------ set-up after Assemble
     def prepare(self) -> None:
         """Look up coordinate indices (after ``mbs.Assemble``) and register the user functions."""
-        sd = self.mbs.systemData
-        for p in self.pairs:
-            p.ae = np.asarray(sd.GetObjectLTGAE(self.model.joints[p.name]), dtype=int)[:6]
         for name, node in self.model.nodes.items():
             start = self.mbs.GetNodeODE2Index(node)
             self._ode2[name] = start
@@ -232,15 +231,71 @@ class FrictionCoupling:
         w = h1 / h2
         return ((1.0 + 2.0 * w) / (1.0 + w) * delta - w * w / (1.0 + w) * delta2) / h1
 
-    def evaluate(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _velocity_level_speeds(self) -> np.ndarray:
+        """Relative speeds from the body velocities (used at the initial, consistent state)."""
+        states = self._body_states()
+        ground = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
+        speeds = np.zeros((self.n, 2))
+        for k, p in enumerate(self.pairs):
+            a_a, w_a, v_a, _ = states.get(p.bodies[0], ground)
+            a_b, w_b, v_b, _ = states.get(p.bodies[1], ground)
+            axis = a_a @ p.axis_local
+            speeds[k, 0] = float((w_b - w_a) @ axis)
+            if p.kind == "cylindrical":
+                r_a, r_b = a_a @ p.local[0], a_b @ p.local[1]
+                speeds[k, 1] = float((v_b + np.cross(w_b, r_b) - v_a - np.cross(w_a, r_a)) @ axis)
+        return speeds
+
+    def initialise(self, solver: Any, settings: Any, max_iterations: int = 60) -> None:
+        """Friction consistent with the initial reactions, before the first step.
+
+        Exudyn computes the initial accelerations and reactions from the initial state and the
+        loads in place; the friction loads are iterated with them (Broyden) until consistent,
+        so that the first recorded row, the first step and, in the lagged scheme, the friction
+        of the first step all include friction. Call after ``solver.InitializeSolver``.
+        """
+        b = None
+        x_prev = r_prev = None
+        x = np.zeros(int(self._mask.sum()))
+        for _ in range(max_iterations):
+            _, friction, _ = self.evaluate(None)
+            g = friction.ravel()[self._mask]
+            r = g - x
+            scale = float((np.abs(friction) * self._weight).max())
+            weighted = np.abs(r) * self._weight.ravel()[self._mask]
+            if scale == 0.0 or weighted.max() <= self.settings.tolerance * scale:
+                self.apply(friction)
+                solver.InitializeSolverInitialConditions(self.mbs, settings)
+                self._accepted = [friction.copy()]
+                self.initial = friction.copy()
+                return
+            if b is None:
+                b = -np.eye(x.size)
+            elif x_prev is not None:
+                dx, dr = x - x_prev, r - r_prev
+                if dx @ dx > 0.0:
+                    b += np.outer(dr - b @ dx, dx) / (dx @ dx)
+            x_prev, r_prev = x, r
+            x = x + np.linalg.solve(b, -r)
+            full = np.zeros(self._mask.size)
+            full[self._mask] = x
+            self.apply(full.reshape(self.n, 2))
+            solver.InitializeSolverInitialConditions(self.mbs, settings)
+        self.status = "self_locking"
+        self.reason = (f"no consistent friction state at the start: the fixed-point iteration "
+                       f"did not converge in {max_iterations} iterations (loop gain >= 1)")
+
+    def evaluate(self, t: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Inputs (|F_n|, |M_n|, omega_rel, slide), friction (M_z, F_z on b), pair coordinates."""
-        lam = self.mbs.systemData.GetAECoordinates(exu.ConfigurationType.Current)
+        get = self.mbs.GetObjectOutput
+        force_local, torque_local = exu.OutputVariableType.ForceLocal, exu.OutputVariableType.TorqueLocal
         coords = self._pair_coordinates()
-        speeds = self._speeds(coords, t)
+        speeds = self._velocity_level_speeds() if t is None else self._speeds(coords, t)
         inputs = np.zeros((self.n, 4))
         friction = np.zeros((self.n, 2))
         for k, p in enumerate(self.pairs):
-            lx, ly, _, tx, ty = (lam[i] for i in p.ae[:5])
+            lx, ly, _ = get(p.joint, force_local)
+            tx, ty, _ = get(p.joint, torque_local)
             force_n, moment_n = math.hypot(lx, ly), math.hypot(tx, ty)
             omega_rel, slide = speeds[k]
             torque = p.f * p.d * moment_n / p.lever + 0.5 * p.f * p.d * force_n
@@ -402,7 +457,7 @@ class FrictionCoupling:
                for kind in ("friction_torque", "friction_force")}
         if not self.log.t:
             return out
-        # the initial row (no step yet) gets the friction of the first step
+        # the initial row (no step yet): the initial friction, else that of the first step
         t_log = np.asarray(self.log.t)
         applied = np.asarray(self.log.applied)
         index = np.searchsorted(t_log, times - 1e-12 * max(1.0, abs(times[-1])))
@@ -414,5 +469,7 @@ class FrictionCoupling:
             for j, kind in enumerate(("friction_torque", "friction_force")):
                 col = np.zeros(n)
                 col[valid] = applied[index[valid], k, j]
+                if self.initial is not None and times[0] < t_log[0]:
+                    col[0] = self.initial[k, j]
                 out[f"{p.name}_{kind}"] = col
         return out
