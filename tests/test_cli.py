@@ -84,3 +84,11 @@ def test_reproduce_quick(tmp_path):
                  "input_torque.png", "reactions_10deg.png", "summaries.json"):
         assert (out / name).is_file(), name
     assert "Assumption register" in (out / "report.md").read_text()
+
+
+def test_self_locking_exits_3():
+    """A self-locking run prints its status and reason, not a number, and exits 3."""
+    proc = cardan("run", "--name", "paper-50deg", "--revolutions", "1")
+    assert proc.returncode == 3
+    assert "self_locking" in proc.stderr and "loop gain" in proc.stderr
+    assert "mean efficiency" not in proc.stdout
