@@ -14,12 +14,15 @@ One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, 
 converged Newton solve, the pair reactions (the joints' ``ForceLocal`` / ``TorqueLocal`` outputs;
 only their magnitudes normal to the pair axis enter eqs. (3)-(5), and these do not depend on
 which of the two pair frames, rotated about the axis, they are expressed in; the raw Lagrange
-multipliers are not used: for the joint to ground their force part is in global components) and the relative speeds (from
-the node coordinates), computes the friction and sets the loads with ``SetLoadParameter``.
+multipliers are not used: for the joint to ground their force part is in global components)
+and the relative speeds (BDF2 derivatives of the pairs' relative coordinates, see
+``engine.relative_speeds``), computes the friction and sets the loads with ``SetLoadParameter``.
+Before the first step the friction is iterated to consistency with the initial state
+(``FrictionCoupling.initialise``), so no scheme starts frictionless.
 
 - ``lagged`` (the paper's scheme): the function returns zero error, so the friction computed at
   the end of step n acts during step n+1. First order in the step size (the friction is one
-  step late). The first step runs without friction.
+  step late).
 - ``converged``: the function returns the relative change of the friction as the error of
   Exudyn's *discontinuous iteration*; Exudyn repeats the Newton solve of the same step with the
   updated friction until the change is below ``tolerance``. The friction applied in a step is
@@ -405,7 +408,8 @@ class FrictionCoupling:
     def _accept(self, friction: np.ndarray) -> None:
         """Step accepted: predict the next step's friction by extrapolating the last three steps.
 
-        Quadratic extrapolation on the step grid (error O(h^3)) puts the first evaluation of the next step within
+        Quadratic extrapolation on the step grid (error O(h^3)) puts the first evaluation of the
+        next step within
         about 1e-4 of its fixed point at the default step sizes, so one Broyden correction
         usually meets the tolerance. It only sets the starting guess.
         """

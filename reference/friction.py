@@ -79,7 +79,8 @@ def pair_friction(pair: Pair, kind: str, fx: Any, fy: Any, mx: Any, my: Any, ome
     return torque, force
 
 
-def friction_from_columns(scene: Scene, columns: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def friction_from_columns(scene: Scene,
+                          columns: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Friction torque and force of every pair from result-schema columns (reactions, speeds)."""
     out = {}
     band = scene.friction.sign_band
