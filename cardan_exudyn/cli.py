@@ -139,6 +139,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     return reproduce(args.out, quick=args.quick)
 
 
+def cmd_study(args: argparse.Namespace) -> int:
+    from cardan_exudyn.studies import main_study
+
+    return main_study(args.kind, args.out, args.quick, args.json)
+
+
 def cmd_scene(args: argparse.Namespace) -> int:
     import tomli_w
 
@@ -165,6 +171,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", default="reports/reproduce", help="report folder")
     p.add_argument("--quick", action="store_true", help="fewer scenes and a coarser accuracy")
     p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("study", help="numerical studies of the friction model")
+    p.add_argument("kind", choices=("coupling", "sign-band"),
+                   help="coupling: error of mean efficiency against step size for the lagged and "
+                        "converged schemes; sign-band: mean efficiency against the sign band")
+    p.add_argument("--out", metavar="DIR", help="write CSV, JSON, markdown and a plot here")
+    p.add_argument("--quick", action="store_true", help="one scene, a short ladder")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
+    p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
     _add_scene_options(p)

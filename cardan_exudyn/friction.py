@@ -65,7 +65,7 @@ STALL_RATIO = 0.1
 def _sign(speed: float, band: float) -> float:
     """Regularised sign: linear ramp of width ``band``, exact sign for band 0."""
     if band <= 0.0:
-        return (speed > 0.0) - (speed < 0.0)
+        return float(speed > 0.0) - float(speed < 0.0)
     return max(-1.0, min(1.0, speed / band))
 
 
@@ -369,7 +369,7 @@ class FrictionCoupling:
                                f"iteration stalled (residual ratio {shrink:.3g} after "
                                f"{len(residuals)} iterations, contraction of the plain map "
                                f"{self._step_gain:.3g}); the loop gain of the friction feedback "
-                               "is >= 1")
+                               "is >= 1" + self._band_hint())
             self._accept(friction)
             return [0.0, -1.0]
         self.apply(self._broyden(residuals).reshape(friction.shape))
@@ -425,6 +425,12 @@ class FrictionCoupling:
             prediction = friction
         self.apply(prediction)
 
+    def _band_hint(self) -> str:
+        if self.band > 0.0:
+            return ""
+        return (" (with sign_band = 0 the exact sign of rounding-level relative speeds decides the "
+                "direction of friction in pairs that do not move; use a positive band)")
+
     def _watch_growth(self, friction: np.ndarray) -> None:
         size = float(np.max(np.abs(friction)))
         before = float(np.max(np.abs(self.applied)))
@@ -436,7 +442,8 @@ class FrictionCoupling:
                 self.status = "self_locking"
                 self.reason = (f"lagged friction grew geometrically by more than "
                                f"{LAGGED_GROWTH_LIMIT:g}x over {self._growth_steps} steps up to "
-                               f"t = {self._step_t:.6g} s: the friction feedback loop gain is >= 1")
+                               f"t = {self._step_t:.6g} s: the friction feedback loop gain is >= 1"
+                               + self._band_hint())
         else:
             self._growth_steps = 0
 

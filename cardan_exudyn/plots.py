@@ -65,6 +65,60 @@ def reactions(table, title: str = "", axes=None):
     return fig
 
 
+def efficiency_history(tables: dict[str, object], title: str = "", ax=None, ylim=(0.0, 1.05)):
+    """Instantaneous efficiency of eq. (18) against time (Figures 4, 6, 7 of the paper).
+
+    Where the input power changes sign eq. (18) is unbounded; the axis is clipped to ``ylim``.
+    """
+    fig, ax = _axes(ax)
+    for label, t in tables.items():
+        ax.plot(t["t"], t["efficiency"], lw=0.9, label=label)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("instantaneous efficiency, eq. (18) [-]")
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    if title:
+        ax.set_title(title, fontsize=9)
+    return fig
+
+
+def pair_losses(table, title: str = ""):
+    """Power loss of the spider pairs (left) and of the shaft-frame pairs (right), Figure 5."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
+    for ax, pairs in zip(axes, (("input_spider", "spider_output"), ("frame_input", "output_frame")),
+                         strict=True):
+        for pair in pairs:
+            ax.plot(table["t"], table[f"power_loss_{pair}"], lw=0.9, label=pair)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("power loss [W]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def efficiency_against_paper(rows, x: str, xlabel: str, ax=None):
+    """Mean efficiency (both definitions, each parameter set) against the paper's values."""
+    fig, ax = _axes(ax)
+    first = True
+    for label, df in rows.items():
+        ax.plot(df[x], df["mean_efficiency"], "o-", label=f"{label}: 1 - W_loss / W_in")
+        ax.plot(df[x], df["mean_instantaneous_efficiency"].clip(-0.1, 1.1), "x:",
+                label=f"{label}: time average of eq. (18)")
+        if first:
+            ax.plot(df[x], df["paper_mean_efficiency"], "ks", mfc="none", label="paper")
+            first = False
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("mean efficiency [-]")
+    ax.set_ylim(-0.1, 1.1)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return fig
+
+
 def save(fig, path) -> None:
     fig.savefig(path, dpi=130)
     plt.close(fig)

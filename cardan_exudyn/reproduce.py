@@ -1,9 +1,17 @@
-"""``cardan reproduce``: the paper's eleven scenes, run and reported.
+"""``cardan reproduce``: the paper's results with friction, under two parameter sets, as a report.
 
-This stage runs the scenes of Table 2 and of the speed study *without friction* (friction from
-the joint reactions is the next stage): the report shows the kinematics against Hooke's closed
-form, the input torque, the pair reactions that friction will act on, and the energy balance,
-next to the paper's efficiency values for orientation.
+For each parameter set (``plain``: the paper read literally, with the assumption register for
+what it does not state; ``calibrated``: the few free parameters identified by ``cardan
+calibrate`` from a subset of the paper's numbers) the report has
+
+- Table 2 (0 to 35 deg at 2000 rpm) and the speed study (500, 1000, 2000 rpm at 10 deg) next to
+  the paper, with both mean-efficiency definitions (one minus lost over input energy over whole
+  revolutions, and the time average of eq. (18)); for the calibrated set the cases used in the
+  fit are marked and the error on the held-out cases is summarised;
+- the per-pair loss breakdown (share of the input work lost in each pair);
+- the time histories of Figures 4 (efficiency at 10 deg), 5 (power loss per pair at 10 deg),
+  6 (efficiency at several angles) and 7 (efficiency at several speeds);
+- the energy balance residual of every run, and the assumption register.
 """
 
 from __future__ import annotations
@@ -11,6 +19,7 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -18,130 +27,241 @@ import pandas as pd
 from cardan_exudyn import plots
 from cardan_exudyn.engine import run
 from cardan_exudyn.io import atomic_directory, dumps
-from reference.kinematics import speed_ratio as hooke_speed_ratio
-from reference.paper import assumption_register, paper_cases, paper_scene, stated_values
+from reference.paper import (
+    PARAMETER_SETS,
+    assumption_register,
+    calibrated_parameters,
+    paper_cases,
+    paper_data,
+    paper_scene,
+    stated_values,
+)
 from reference.scene import PAIR_NAMES, replace
 
 
-def case_row(case: dict, result) -> dict:
-    s, t = result.summary, result.table
-    beta = s["scene"]["joint"]["geometry"]["shaft_angle"]
-    ratio_error = np.max(np.abs(t["omega_out"] / t["omega_in"] - hooke_speed_ratio(t["theta_in"], beta)))
-    energy = t["energy_kinetic"] + t["energy_potential"]
-    balance = s["input_work"] - s["output_work"] - s["loss_work"]
-    row = {
+def fit_case_keys() -> list[str]:
+    """The cases the calibrated set was fitted to, as ``study:angle:rpm`` keys."""
+    return list(paper_data().get("calibrated", {}).get("fit_cases", []))
+
+
+def case_key(case: dict) -> str:
+    return f"{case['study']}:{case['shaft_angle_deg']:g}:{case['speed_rpm']:g}"
+
+
+def case_row(case: dict, parameters: str, result) -> dict[str, Any]:
+    s = result.summary
+    row: dict[str, Any] = {
+        "parameters": parameters,
         "study": case["study"],
         "shaft_angle_deg": case["shaft_angle_deg"],
         "speed_rpm": case["speed_rpm"],
-        "status": s["status"],
-        "mean_efficiency": s.get("mean_efficiency"),
-        "mean_instantaneous_efficiency": s.get("mean_instantaneous_efficiency"),
         "paper_mean_efficiency": case["paper_mean_efficiency"],
-        "work_ratio": s.get("work_ratio"),
-        "mean_torque_in": s.get("mean_torque_in"),
-        "torque_in_min": float(t["torque_in"].min()),
-        "torque_in_max": float(t["torque_in"].max()),
-        "speed_ratio_max_error": float(ratio_error),
-        "energy_balance_residual_J": float(balance - (energy.iloc[-1] - energy.iloc[0])),
-        "max_constraint_violation_m": s["max_constraint_violation_m"],
-        "dt": s["dt"],
-        "steps": s["steps"],
-        "newton_iterations": s["newton_iterations"],
-        "wall_time_s": s["wall_time_s"],
+        "status": s["status"],
+        "reason": s.get("reason", ""),
+        "used_in_fit": parameters == "calibrated" and case_key(case) in fit_case_keys(),
     }
+    if not result.ok:
+        return row
+    t = result.table
+    energy = t["energy_kinetic"] + t["energy_potential"]
+    work = {c: float(np.trapezoid(t[c], t["t"])) for c in ("power_in", "power_out", "power_loss")}
+    row.update({
+        "mean_efficiency": s["mean_efficiency"],
+        "mean_instantaneous_efficiency": s["mean_instantaneous_efficiency"],
+        "difference_to_paper": s["mean_efficiency"] - case["paper_mean_efficiency"],
+        "mean_torque_in": s["mean_torque_in"],
+        "input_work_J": s["input_work"],
+        "loss_work_J": s["loss_work"],
+        "energy_balance_residual_J": work["power_in"] - work["power_out"] - work["power_loss"]
+        - float(energy.iloc[-1] - energy.iloc[0]),
+        "loop_gain_estimate": s["friction"]["loop_gain_estimate"],
+        "friction_evaluations_per_step": s["friction"]["mean_iterations_per_step"],
+        "steps": s["steps"],
+        "wall_time_s": s["wall_time_s"],
+    })
     for pair in PAIR_NAMES:
-        row[f"{pair}_max_radial_force_N"] = float(np.hypot(t[f"{pair}_fx"], t[f"{pair}_fy"]).max())
-        row[f"{pair}_max_bending_moment_Nm"] = float(np.hypot(t[f"{pair}_mx"], t[f"{pair}_my"]).max())
+        row[f"loss_share_{pair}"] = s[f"loss_work_{pair}"] / s["input_work"]
     return row
 
 
-def _markdown_table(df: pd.DataFrame, columns: list[str], floatfmt: str = ".6g") -> str:
+def _md(df: pd.DataFrame, columns: list[str], floatfmt: str = ".4f") -> str:
     head = "| " + " | ".join(columns) + " |\n|" + "---|" * len(columns) + "\n"
     lines = []
     for _, r in df[columns].iterrows():
-        cells = [format(v, floatfmt) if isinstance(v, float) else str(v) for v in r]
+        cells = []
+        for c, v in zip(columns, r, strict=True):
+            if isinstance(v, (float, np.floating)):
+                fmt = "g" if c.endswith(("_deg", "_rpm")) else floatfmt
+                cells.append("" if np.isnan(v) else format(v, fmt))
+            else:
+                cells.append(str(v))
         lines.append("| " + " | ".join(cells) + " |")
     return head + "\n".join(lines) + "\n"
 
 
-def write_report(folder: Path, rows: pd.DataFrame, tables: dict, quick: bool) -> None:
+def _held_out_summary(rows: pd.DataFrame) -> str:
+    cal = rows[(rows.parameters == "calibrated") & (rows.status == "ok")]
+    if cal.empty:
+        return ""
+    out = []
+    for label, sel in (("fitted", cal[cal.used_in_fit]), ("held out", cal[~cal.used_in_fit])):
+        if sel.empty:
+            continue
+        err = sel["difference_to_paper"].abs()
+        out.append(f"- {label} ({len(sel)} cases): max |difference| {err.max():.4f}, "
+                   f"RMS {np.sqrt((err ** 2).mean()):.4f}")
+    plain = rows[(rows.parameters == "plain") & (rows.status == "ok")]
+    if not plain.empty:
+        err = plain["difference_to_paper"].abs()
+        out.append(f"- plain reading ({len(plain)} cases): max |difference| {err.max():.4f}, "
+                   f"RMS {np.sqrt((err ** 2).mean()):.4f}")
+    return "\n".join(out) + "\n"
+
+
+def write_report(folder: Path, rows: pd.DataFrame, histories: dict, quick: bool,
+                 wall: float) -> None:
     rows.to_csv(folder / "results.csv", index=False)
-    t2 = {f"{r.shaft_angle_deg:g} deg": tables[k] for k, r in rows.iterrows()
-          if r.study == "table2" and k in tables}
-    plots.save(plots.speed_ratio(t2), folder / "speed_ratio.png")
-    plots.save(plots.input_torque(t2), folder / "input_torque.png")
-    ten = [k for k, r in rows.iterrows() if r.study == "table2" and r.shaft_angle_deg == 10.0]
-    if ten:
-        plots.save(plots.reactions(tables[ten[0]], "pair reactions, 10 deg, 2000 rpm, no friction"),
-                   folder / "reactions_10deg.png")
     register = pd.DataFrame(assumption_register())
     register.to_csv(folder / "assumptions.csv", index=False)
+    calibrated = pd.DataFrame(calibrated_parameters())
     stated = pd.DataFrame(stated_values())
     stated["value"] = stated["value"].astype(str)
+    figures = []
+    for parameters in PARAMETER_SETS:
+        sel = rows[(rows.parameters == parameters) & (rows.status == "ok")]
+        if sel.empty:
+            continue
+        t2 = sel[sel.study == "table2"].sort_values("shaft_angle_deg")
+        sp = sel[sel.study == "speed"].sort_values("speed_rpm")
+        hist = histories.get(parameters, {})
+        if not t2.empty:
+            plots.save(plots.efficiency_against_paper({parameters: t2}, "shaft_angle_deg",
+                                                      "shaft angle [deg]"),
+                       folder / f"table2_{parameters}.png")
+            figures.append(f"table2_{parameters}.png")
+        if not sp.empty:
+            plots.save(plots.efficiency_against_paper({parameters: sp}, "speed_rpm",
+                                                      "input speed [rpm]"),
+                       folder / f"speed_{parameters}.png")
+            figures.append(f"speed_{parameters}.png")
+        if "10deg" in hist:
+            plots.save(plots.efficiency_history({"10 deg, 2000 rpm": hist["10deg"]},
+                                                f"Figure 4 ({parameters})"),
+                       folder / f"fig4_efficiency_10deg_{parameters}.png")
+            plots.save(plots.pair_losses(hist["10deg"], f"Figure 5 ({parameters}): power loss, "
+                                                        "10 deg, 2000 rpm"),
+                       folder / f"fig5_pair_losses_{parameters}.png")
+            figures += [f"fig4_efficiency_10deg_{parameters}.png",
+                        f"fig5_pair_losses_{parameters}.png"]
+        angles = {k: v for k, v in hist.items() if k.startswith("angle ")}
+        if angles:
+            plots.save(plots.efficiency_history(angles, f"Figure 6 ({parameters})", ylim=(-0.5, 1.05)),
+                       folder / f"fig6_angles_{parameters}.png")
+            figures.append(f"fig6_angles_{parameters}.png")
+        speeds = {k: v for k, v in hist.items() if k.startswith("speed ")}
+        if speeds:
+            plots.save(plots.efficiency_history(speeds, f"Figure 7 ({parameters})"),
+                       folder / f"fig7_speeds_{parameters}.png")
+            figures.append(f"fig7_speeds_{parameters}.png")
+
+    main_cols = ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
+                 "paper_mean_efficiency", "mean_efficiency", "difference_to_paper",
+                 "mean_instantaneous_efficiency", "used_in_fit", "loop_gain_estimate"]
+    loss_cols = ["parameters", "shaft_angle_deg", "speed_rpm"] + [f"loss_share_{p}" for p in PAIR_NAMES]
+    check_cols = ["parameters", "shaft_angle_deg", "speed_rpm", "input_work_J", "loss_work_J",
+                  "energy_balance_residual_J", "friction_evaluations_per_step", "steps",
+                  "wall_time_s"]
+    ok = rows[rows.status == "ok"]
+    failed = rows[rows.status != "ok"]
     md = [
-        "# Paper reproduction report (frictionless stage)\n",
-        "Generated by `cardan reproduce`" + (" --quick" if quick else "") + ". Every number below "
-        "was computed by the code in this repository from `reference/data/paper.toml`.\n",
-        "**Stage.** Friction from the joint reactions (eqs. (1)-(5)) is not in the Exudyn model "
-        "yet, so every efficiency here is exactly 1 by construction (eq. (18) with no loss); the "
-        "paper's values are shown only for orientation. What this stage checks is the joint "
-        "itself: kinematics against Hooke's closed form, the energy balance, and the reactions "
-        "that friction will act on.\n",
-        "## The paper's scenes without friction\n",
-        _markdown_table(rows, ["study", "shaft_angle_deg", "speed_rpm", "status",
-                               "mean_efficiency", "paper_mean_efficiency", "work_ratio",
-                               "mean_torque_in", "torque_in_min", "torque_in_max",
-                               "speed_ratio_max_error", "energy_balance_residual_J",
-                               "steps", "wall_time_s"]),
-        "\n`work_ratio` is output work over input work over the same whole revolutions; "
-        "`energy_balance_residual_J` is input work - output work - change of mechanical energy "
-        "(zero up to the integration error).\n",
-        "## Peak pair reactions\n",
-        _markdown_table(rows, ["shaft_angle_deg", "speed_rpm"]
-                        + [f"{p}_max_radial_force_N" for p in PAIR_NAMES]
-                        + [f"{p}_max_bending_moment_Nm" for p in PAIR_NAMES], ".4g"),
-        "\nThe input frame bearing carries the rotating load of the input shaft's 8.6 mm centre "
-        "of mass eccentricity (Table 1 under the register's reading): about "
-        "0.936 kg x 8.6 mm x omega^2, 352 N at 2000 rpm.\n",
-        "## Plots\n",
-        "![speed ratio](speed_ratio.png)\n\n![input torque](input_torque.png)\n\n"
-        "![reactions](reactions_10deg.png)\n",
-        "## Assumption register\n",
-        "Every value the paper does not state, the value used, and why "
-        "(also in `assumptions.csv`).\n",
-        _markdown_table(register.assign(value=register["value"].astype(str)),
-                        ["name", "value", "unit", "assumption", "reason"]),
+        "# The paper's results with friction: plain reading and calibrated set\n",
+        f"Generated by `cardan reproduce{' --quick' if quick else ''}` in {wall:.1f} s. Every "
+        "number and plot here was computed by the code in this repository from "
+        "`reference/data/paper.toml`; nothing is copied from the paper except the column "
+        "`paper_mean_efficiency`.\n",
+        "**Parameter sets.** `plain`: every value the paper states, read literally (moment "
+        "lever of eq. (1) = bearing length L), and the assumption register below for what it "
+        "does not state. `calibrated`: the plain reading with the parameters listed under "
+        "*Calibrated parameters* identified by `cardan calibrate` from the cases marked "
+        "`used_in_fit`; the other cases are held out.\n",
+        "**Definitions.** `mean_efficiency` = 1 - (loss work)/(input work) over whole input "
+        "revolutions; `mean_instantaneous_efficiency` = time average of eq. (18), which is "
+        "unbounded where the input power changes sign (it does at large angles).\n",
+        "## Mean efficiency against the paper\n",
+        _md(ok, main_cols),
+        "\n### Summary of differences to the paper\n",
+        _held_out_summary(rows),
+    ]
+    if not failed.empty:
+        md += ["\n### Cases without a result\n",
+               _md(failed, ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
+                            "reason"])]
+    if not calibrated.empty:
+        cal = calibrated.assign(paths=calibrated["paths"].astype(str))
+        md += ["\n## Calibrated parameters\n",
+               _md(cal, [c for c in ("name", "value", "unit", "plain_value", "paths", "meaning")
+                         if c in cal.columns], ".5g")]
+    md += [
+        "\n## Where the power goes: share of the input work lost in each pair\n",
+        _md(ok, loss_cols),
+        "\n## Checks: energy balance and cost\n",
+        "`energy_balance_residual_J` = input work - output work - friction loss work - change "
+        "of mechanical energy over the run (trapezoidal, zero up to the integration error).\n\n",
+        _md(ok, check_cols, ".4g"),
+        "\n## Plots\n",
+        "\n".join(f"![{f}]({f})\n" for f in figures),
+        "\n## Assumption register\n",
+        "Every value the paper does not state, the value used, and why (also "
+        "`assumptions.csv`).\n\n",
+        _md(register.assign(value=register["value"].astype(str)),
+            ["name", "value", "unit", "assumption", "reason"]),
         "\n## Values taken from the paper\n",
-        _markdown_table(stated, ["name", "value", "unit", "source"]),
+        _md(stated, ["name", "value", "unit", "source"]),
     ]
     (folder / "report.md").write_text("\n".join(md), encoding="utf-8")
 
 
+HISTORY_ANGLES = (0.0, 10.0, 20.0, 35.0)
+
+
 def reproduce(out: str, quick: bool = False) -> int:
-    """Run the paper's scenes and write the report folder; exit status 0, or 3 if a case failed."""
+    """Run the paper's cases under both parameter sets; write the report; 0, or 3 on a failure."""
     cases = paper_cases()
     if quick:
-        cases = [c for c in cases if c["shaft_angle_deg"] in (0.0, 10.0, 35.0)
-                 and (c["study"] == "table2" or c["speed_rpm"] == 500.0)]
-    rows, tables, summaries = [], {}, []
+        cases = [c for c in cases if (c["study"] == "table2" and c["shaft_angle_deg"] in (0.0, 10.0))
+                 or (c["study"] == "speed" and c["speed_rpm"] == 500.0)]
+    sets = [p for p in PARAMETER_SETS if p == "plain" or calibrated_parameters()]
+    rows, histories, summaries = [], {p: {} for p in sets}, []
     start = time.perf_counter()
-    for i, case in enumerate(cases):
-        scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], friction=False)
-        if quick:
-            scene = replace(scene, **{"numerics.accuracy": 1e-4})
-        result = run(scene)
-        summaries.append(result.summary)
-        print(f"[{i + 1}/{len(cases)}] {scene.name}: {result.summary['status']}, "
-              f"{result.summary['wall_time_s']:.2f} s", file=sys.stderr, flush=True)
-        if result.ok:
-            tables[len(rows)] = result.table
-            rows.append(case_row(case, result))
-        else:
-            rows.append({**case, "status": result.summary["status"]})
+    total = len(cases) * len(sets)
+    k = 0
+    for parameters in sets:
+        for case in cases:
+            k += 1
+            scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"],
+                                parameters=parameters)
+            if quick:
+                scene = replace(scene, **{"numerics.accuracy": 1e-4, "revolutions": 1.0})
+            result = run(scene)
+            summaries.append(result.summary)
+            s = result.summary
+            eta = s.get("mean_efficiency")
+            print(f"[{k}/{total}] {scene.name}: {s['status']}"
+                  + (f", mean efficiency {eta:.4f}" if eta is not None else "")
+                  + f", {s['wall_time_s']:.2f} s", file=sys.stderr, flush=True)
+            rows.append(case_row(case, parameters, result))
+            if result.ok:
+                hist = histories[parameters]
+                if case["study"] == "table2" and case["shaft_angle_deg"] in HISTORY_ANGLES:
+                    hist[f"angle {case['shaft_angle_deg']:g} deg"] = result.table
+                if case["study"] == "table2" and case["shaft_angle_deg"] == 10.0:
+                    hist["10deg"] = result.table
+                if case["study"] == "speed":
+                    hist[f"speed {case['speed_rpm']:g} rpm"] = result.table
     frame = pd.DataFrame(rows)
+    wall = time.perf_counter() - start
     with atomic_directory(out) as folder:
-        write_report(folder, frame, tables, quick)
+        write_report(folder, frame, histories, quick, wall)
         (folder / "summaries.json").write_text(dumps(summaries) + "\n", encoding="utf-8")
-    print(f"wrote {out}/report.md ({len(cases)} scenes, {time.perf_counter() - start:.1f} s)",
-          file=sys.stderr)
+    print(f"wrote {out}/report.md ({total} runs, {wall:.1f} s)", file=sys.stderr)
     return 0 if all(s["status"] == "ok" for s in summaries) else 3

@@ -2,8 +2,10 @@
 
 Named scenes
 ------------
-``paper[-<A>deg][-<R>rpm][-frictionless]``
-    Section 4.1 multibody case (default 10 deg, 2000 rpm, f1 = 0.42, f2 = 0.20, 2 N m).
+``paper[-calibrated][-<A>deg][-<R>rpm][-frictionless]``
+    Section 4.1 multibody case (default 10 deg, 2000 rpm, f1 = 0.42, f2 = 0.20, 2 N m), under
+    the plain reading of the paper (the assumption register), or with the calibrated parameter
+    set (``[calibrated]`` in ``data/paper.toml``, identified by ``cardan calibrate``).
 ``rig``
     Section 4.2 rig case (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m), ideal geometry.
 
@@ -155,12 +157,39 @@ def paper_joint(shaft_angle_deg: float = 10.0, reading: str = "origin",
     return Joint(geometry=geometry, pairs=pairs, **bodies)
 
 
+PARAMETER_SETS = ("plain", "calibrated")
+
+
+def calibrated_parameters() -> list[dict[str, Any]]:
+    """The calibrated parameter set: name, value, unit, the scene paths it sets, and why."""
+    section = paper_data().get("calibrated", {}).get("parameters", {})
+    return [{"name": k, **v} for k, v in section.items()]
+
+
+def parameter_overrides(parameters: str) -> dict[str, Any]:
+    """Dotted scene paths and values of a parameter set (empty for the plain reading)."""
+    if parameters not in PARAMETER_SETS:
+        raise SceneError(f"parameter set must be one of {list(PARAMETER_SETS)}, got {parameters!r}")
+    if parameters == "plain":
+        return {}
+    changes = {}
+    for p in calibrated_parameters():
+        for path in p["paths"]:
+            changes[path] = p["value"]
+    return changes
+
+
 def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
-                friction: bool = True, reading: str = "origin") -> Scene:
-    """Section 4.1 scene: constant input speed, 2 N m resisting torque, gravity on."""
+                friction: bool = True, reading: str = "origin", parameters: str = "plain") -> Scene:
+    """Section 4.1 scene: constant input speed, 2 N m resisting torque, gravity on.
+
+    ``parameters`` selects the plain reading or the calibrated set (see :data:`PARAMETER_SETS`).
+    """
     rpm = value("case.multibody.speed") if speed_rpm is None else speed_rpm
-    tag = f"paper-{shaft_angle_deg:g}deg-{rpm:g}rpm" + ("" if friction else "-frictionless")
-    return Scene(
+    tag = (f"paper{'-calibrated' if parameters == 'calibrated' else ''}-{shaft_angle_deg:g}deg-"
+           f"{rpm:g}rpm" + ("" if friction else "-frictionless"))
+    changes = parameter_overrides(parameters)
+    scene = Scene(
         joint=paper_joint(shaft_angle_deg, reading, friction),
         drive=SpeedDrive(speed=rpm * RPM),
         load=Load(torque=value("assumption.load")),
@@ -168,8 +197,14 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
         revolutions=float(value("assumption.revolutions")),
         record=Record(),
         name=tag,
-        description="Section 4.1 multibody case under the assumption register",
+        description=f"Section 4.1 multibody case, {parameters} parameter set",
     )
+    if changes:
+        from reference.scene import replace
+
+        friction_paths = {k: v for k, v in changes.items() if not friction and "friction_coefficient" in k}
+        scene = replace(scene, **{k: v for k, v in changes.items() if k not in friction_paths})
+    return scene
 
 
 def rig_scene(friction: bool = True) -> Scene:
@@ -189,7 +224,7 @@ def rig_scene(friction: bool = True) -> Scene:
     )
 
 
-_NAME = re.compile(r"^paper(?:-(?P<deg>\d+(?:\.\d+)?)deg)?(?:-(?P<rpm>\d+(?:\.\d+)?)rpm)?"
+_NAME = re.compile(r"^paper(?P<cal>-calibrated)?(?:-(?P<deg>\d+(?:\.\d+)?)deg)?(?:-(?P<rpm>\d+(?:\.\d+)?)rpm)?"
                    r"(?P<fl>-frictionless)?$")
 
 
@@ -200,12 +235,14 @@ def named_scene(name: str) -> Scene:
     match = _NAME.match(name) if isinstance(name, str) else None
     if not match:
         raise SceneError(
-            f"unknown scene name {name!r}; use 'paper[-<A>deg][-<R>rpm][-frictionless]' "
+            f"unknown scene name {name!r}; use "
+            "'paper[-calibrated][-<A>deg][-<R>rpm][-frictionless]' "
             "(e.g. 'paper-10deg-2000rpm') or 'rig'"
         )
     deg = float(match["deg"]) if match["deg"] else value("case.speed_study.shaft_angle")
     rpm = float(match["rpm"]) if match["rpm"] else None
-    return paper_scene(deg, rpm, friction=not match["fl"])
+    return paper_scene(deg, rpm, friction=not match["fl"],
+                       parameters="calibrated" if match["cal"] else "plain")
 
 
 def paper_cases() -> list[dict[str, Any]]:
