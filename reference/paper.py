@@ -202,7 +202,8 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
     if changes:
         from reference.scene import replace
 
-        friction_paths = {k: v for k, v in changes.items() if not friction and "friction_coefficient" in k}
+        friction_paths = {k: v for k, v in changes.items()
+                          if not friction and "friction_coefficient" in k}
         scene = replace(scene, **{k: v for k, v in changes.items() if k not in friction_paths})
     return scene
 
@@ -224,8 +225,8 @@ def rig_scene(friction: bool = True) -> Scene:
     )
 
 
-_NAME = re.compile(r"^paper(?P<cal>-calibrated)?(?:-(?P<deg>\d+(?:\.\d+)?)deg)?(?:-(?P<rpm>\d+(?:\.\d+)?)rpm)?"
-                   r"(?P<fl>-frictionless)?$")
+_NAME = re.compile(r"^paper(?P<cal>-calibrated)?(?:-(?P<deg>\d+(?:\.\d+)?)deg)?"
+                   r"(?:-(?P<rpm>\d+(?:\.\d+)?)rpm)?(?P<fl>-frictionless)?$")
 
 
 def named_scene(name: str) -> Scene:
