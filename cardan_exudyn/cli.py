@@ -145,6 +145,17 @@ def cmd_study(args: argparse.Namespace) -> int:
     return main_study(args.kind, args.out, args.quick, args.json)
 
 
+def cmd_calibrate(args: argparse.Namespace) -> int:
+    from cardan_exudyn.calibrate import main_calibrate
+    from reference.paper import CALIBRATION_PARAMETERS
+
+    names = [n.strip() for n in args.parameters.split(",") if n.strip()] if args.parameters else None
+    unknown = [n for n in names or [] if n not in CALIBRATION_PARAMETERS]
+    if unknown:
+        raise BadInput(f"--parameters: unknown {unknown}; choose from {list(CALIBRATION_PARAMETERS)}")
+    return main_calibrate(names, args.json)
+
+
 def cmd_scene(args: argparse.Namespace) -> int:
     import tomli_w
 
@@ -180,6 +191,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="one scene, a short ladder")
     p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
     p.set_defaults(func=cmd_study)
+
+    p = sub.add_parser("calibrate", help="fit the paper's open parameters to a subset of its results")
+    p.add_argument("--parameters", metavar="A,B",
+                   help="parameters to fit (default spider_lever,frame_lever,input_eccentricity)")
+    p.add_argument("--json", action="store_true", help="print the fit as JSON on stdout")
+    p.set_defaults(func=cmd_calibrate)
 
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
     _add_scene_options(p)

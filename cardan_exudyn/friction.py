@@ -153,6 +153,7 @@ class FrictionCoupling:
         self._xs: list[np.ndarray] = []
         self._gs: list[np.ndarray] = []
         self._step_gain = 0.0
+        self._gains: list[float] = []
         self._broyden_b = None
         mask = np.zeros((self.n, 2), dtype=bool)
         self._weight = np.ones((self.n, 2))
@@ -161,7 +162,6 @@ class FrictionCoupling:
             mask[k, 1] = p.kind == "cylindrical"
             self._weight[k, 1] = 0.5 * p.d
         self._mask = mask.ravel()
-        self.loop_gain = 0.0
         self.unconverged_steps = 0
         self.status, self.reason = "ok", ""
         self._growth_steps, self._growth_start = 0, 0.0
@@ -356,7 +356,6 @@ class FrictionCoupling:
             r0, r1 = np.linalg.norm(residuals[0]), np.linalg.norm(residuals[1])
             if r0 > 1e-7 * max(float(np.abs(friction).max()), 1e-300):
                 self._step_gain = r1 / r0
-                self.loop_gain = max(self.loop_gain, self._step_gain)
         if error <= self.settings.tolerance:
             self._accept(friction)
             return [0.0, -1.0]
@@ -406,13 +405,21 @@ class FrictionCoupling:
         return out
 
     def _accept(self, friction: np.ndarray) -> None:
-        """Step accepted: predict the next step's friction by extrapolating the last three steps.
+        """Step accepted: record the loop gain; predict the next step's friction by extrapolating
+        the last three steps.
+
+        Loop gain: the spectral radius of the Broyden approximation of d(friction out)/d(friction
+        in), ``B + I``, i.e. the contraction of the plain fixed-point map friction -> reactions ->
+        friction at this step (exact for the directions the iterations have explored).
 
         Quadratic extrapolation on the step grid (error O(h^3)) puts the first evaluation of the
         next step within
         about 1e-4 of its fixed point at the default step sizes, so one Broyden correction
         usually meets the tolerance. It only sets the starting guess.
         """
+        if self._broyden_b is not None:
+            g = self._broyden_b + np.eye(self._broyden_b.shape[0])
+            self._gains.append(float(np.max(np.abs(np.linalg.eigvals(g)))))
         hist = self._accepted
         hist.append(friction.copy())
         if len(hist) > 3:
@@ -458,7 +465,10 @@ class FrictionCoupling:
             "mean_iterations_per_step": float(iterations.mean()) if iterations.size else 0.0,
             "max_iterations_in_a_step": int(iterations.max()) if iterations.size else 0,
             "unconverged_steps": self.unconverged_steps,
-            "loop_gain_estimate": self.loop_gain if self.converged else None,
+            # spectral radius of the secant estimate of the friction feedback map per accepted
+            # step (see _accept); the median is robust to the start-up steps
+            "loop_gain_estimate": float(np.median(self._gains)) if self._gains else None,
+            "loop_gain_estimate_max": float(np.max(self._gains)) if self._gains else None,
         }
 
     def columns(self, times: np.ndarray) -> dict[str, np.ndarray]:

@@ -25,11 +25,13 @@ import numpy as np
 import pandas as pd
 
 from cardan_exudyn import plots
+from cardan_exudyn.calibrate import in_fit
 from cardan_exudyn.engine import run
 from cardan_exudyn.io import atomic_directory, dumps
 from reference.paper import (
     PARAMETER_SETS,
     assumption_register,
+    calibrated_choices,
     calibrated_parameters,
     paper_cases,
     paper_data,
@@ -58,7 +60,7 @@ def case_row(case: dict, parameters: str, result) -> dict[str, Any]:
         "paper_mean_efficiency": case["paper_mean_efficiency"],
         "status": s["status"],
         "reason": s.get("reason", ""),
-        "used_in_fit": parameters == "calibrated" and case_key(case) in fit_case_keys(),
+        "used_in_fit": parameters == "calibrated" and in_fit(case, fit_case_keys()),
     }
     if not result.ok:
         return row
@@ -197,10 +199,21 @@ def write_report(folder: Path, rows: pd.DataFrame, histories: dict, quick: bool,
                _md(failed, ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
                             "reason"])]
     if not calibrated.empty:
-        cal = calibrated.assign(paths=calibrated["paths"].astype(str))
+        cal = calibrated.assign(plain_value=calibrated["plain_value"].astype(str))
+        choices = pd.DataFrame([{"name": k, **v} for k, v in calibrated_choices().items()])
         md += ["\n## Calibrated parameters\n",
-               _md(cal, [c for c in ("name", "value", "unit", "plain_value", "paths", "meaning")
-                         if c in cal.columns], ".5g")]
+               f"Fitted by `cardan calibrate` to {', '.join(fit_case_keys())} "
+               "(study:angle:rpm):\n\n",
+               _md(cal, ["name", "value", "unit", "plain_value", "meaning"], ".5g"),
+               "\nDiscrete choices of the calibrated set (not fitted):\n\n",
+               _md(choices.assign(value=choices["value"].astype(str)), ["name", "value", "reason"]),
+               "\n**Reading.** The fitted levers are not plausible dimensions for a joint this "
+               "size (a 60 mm spider lever is a 30 mm arm radius on a 45.6 g spider; a 0.61 m "
+               "frame lever is a bearing spacing far beyond shafts whose centres of mass sit "
+               "0.13 m and 0.09 m from the joint). They act as correction factors: the paper's "
+               "numbers need the moment term of eqs. (1)-(2) about 10 times weaker in the "
+               "spider pairs and about 60 times weaker in the frame pairs than the stated "
+               "bearing lengths give.\n"]
     md += [
         "\n## Where the power goes: share of the input work lost in each pair\n",
         _md(ok, loss_cols),

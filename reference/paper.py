@@ -159,36 +159,98 @@ def paper_joint(shaft_angle_deg: float = 10.0, reading: str = "origin",
 
 PARAMETER_SETS = ("plain", "calibrated")
 
+# Parameters that ``cardan calibrate`` may identify: unit, plain-reading value, fit start and
+# bounds (physical ranges), and what each means. Applied by :func:`apply_parameters`.
+CALIBRATION_PARAMETERS: dict[str, dict[str, Any]] = {
+    "spider_lever": {
+        "unit": "m", "plain": 0.006, "start": 0.024, "bounds": (0.002, 1.0),
+        "meaning": "moment lever of eq. (1) in both spider pairs; literal: trunnion bearing "
+                   "length L; physical reading of a lumped pair of two trunnion bearings: their "
+                   "spacing, 2 x arm radius",
+    },
+    "frame_lever": {
+        "unit": "m", "plain": 0.01, "start": 0.05, "bounds": (0.002, 2.0),
+        "meaning": "moment lever of eq. (1) in both shaft-frame pairs; literal: bearing length "
+                   "L; physical reading: the spacing of a shaft's two support bearings",
+    },
+    "input_eccentricity": {
+        "unit": "m", "plain": None, "start": 2e-4, "bounds": (1e-6, 0.01),
+        "meaning": "distance of the input shaft's centre of mass from its axis (Table 1 under "
+                   "the register's reading: 8.6 mm); centroidal inertia kept, products dropped",
+    },
+}
+
 
 def calibrated_parameters() -> list[dict[str, Any]]:
-    """The calibrated parameter set: name, value, unit, the scene paths it sets, and why."""
+    """The calibrated parameter set as stored: name, value, unit, plain value, meaning."""
     section = paper_data().get("calibrated", {}).get("parameters", {})
-    return [{"name": k, **v} for k, v in section.items()]
+    out = []
+    for name, entry in section.items():
+        spec = CALIBRATION_PARAMETERS[name]
+        out.append({"name": name, "value": entry["value"], "unit": spec["unit"],
+                    "plain_value": spec["plain"], "meaning": spec["meaning"]})
+    return out
 
 
-def parameter_overrides(parameters: str) -> dict[str, Any]:
-    """Dotted scene paths and values of a parameter set (empty for the plain reading)."""
-    if parameters not in PARAMETER_SETS:
-        raise SceneError(f"parameter set must be one of {list(PARAMETER_SETS)}, got {parameters!r}")
-    if parameters == "plain":
-        return {}
-    changes = {}
-    for p in calibrated_parameters():
-        for path in p["paths"]:
-            changes[path] = p["value"]
-    return changes
+def calibrated_choices() -> dict[str, Any]:
+    """Discrete choices of the calibrated set (not fitted), with reasons."""
+    return dict(paper_data().get("calibrated", {}).get("choices", {}))
+
+
+def apply_parameters(scene: Scene, values: dict[str, float], choices: dict | None = None) -> Scene:
+    """``scene`` with calibration parameters (see :data:`CALIBRATION_PARAMETERS`) applied."""
+    from reference.scene import replace
+
+    changes: dict[str, Any] = {}
+    for name, v in values.items():
+        if name not in CALIBRATION_PARAMETERS:
+            raise SceneError(f"unknown calibration parameter {name!r}; "
+                             f"choose from {list(CALIBRATION_PARAMETERS)}")
+        if name == "spider_lever":
+            changes["joint.pairs.input_spider.moment_lever"] = v
+            changes["joint.pairs.spider_output.moment_lever"] = v
+        elif name == "frame_lever":
+            changes["joint.pairs.frame_input.moment_lever"] = v
+            changes["joint.pairs.output_frame.moment_lever"] = v
+        elif name == "input_eccentricity":
+            body = scene.joint.input
+            centroidal = np.diag(np.diag(body.centroidal_inertia_local()))
+            com = list(body.com)
+            # local z: the eccentric direction of Table 1's input shaft; the 0.03 mm that
+            # Table 1's rounding leaves in local x is dropped
+            com[0], com[2] = 0.0, float(v)
+            changes["joint.input.com"] = com
+            changes["joint.input.inertia_about"] = "com"
+            changes["joint.input.inertia"] = centroidal.tolist()
+    for name, choice in (choices or {}).items():
+        if name == "gravity":
+            changes["gravity"] = list(choice["value"])
+        elif name == "spider_com_offset":
+            # the spider's centre of mass on its normal (canonical x), `value` from the centre
+            body = scene.joint.spider
+            normal_local = int(np.argmax(np.abs(np.asarray(body.local_axes)[0])))
+            changes["joint.spider.local_origin"] = [float(choice["value"]) - body.com[normal_local],
+                                                    0.0, 0.0]
+        else:
+            raise SceneError(f"unknown calibrated choice {name!r}")
+    return replace(scene, **changes) if changes else scene
 
 
 def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
-                friction: bool = True, reading: str = "origin", parameters: str = "plain") -> Scene:
+                friction: bool = True, reading: str = "origin",
+                parameters: str | dict[str, float] = "plain") -> Scene:
     """Section 4.1 scene: constant input speed, 2 N m resisting torque, gravity on.
 
-    ``parameters`` selects the plain reading or the calibrated set (see :data:`PARAMETER_SETS`).
+    ``parameters``: ``"plain"`` (the register), ``"calibrated"`` (the stored calibrated set,
+    with its discrete choices), or a dictionary of calibration parameter values (applied with
+    the calibrated set's discrete choices; used by ``cardan calibrate``).
     """
+    if isinstance(parameters, str) and parameters not in PARAMETER_SETS:
+        raise SceneError(f"parameter set must be one of {list(PARAMETER_SETS)}, got {parameters!r}")
     rpm = value("case.multibody.speed") if speed_rpm is None else speed_rpm
-    tag = (f"paper{'-calibrated' if parameters == 'calibrated' else ''}-{shaft_angle_deg:g}deg-"
+    calibrated = parameters != "plain"
+    tag = (f"paper{'-calibrated' if calibrated else ''}-{shaft_angle_deg:g}deg-"
            f"{rpm:g}rpm" + ("" if friction else "-frictionless"))
-    changes = parameter_overrides(parameters)
     scene = Scene(
         joint=paper_joint(shaft_angle_deg, reading, friction),
         drive=SpeedDrive(speed=rpm * RPM),
@@ -197,15 +259,14 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
         revolutions=float(value("assumption.revolutions")),
         record=Record(),
         name=tag,
-        description=f"Section 4.1 multibody case, {parameters} parameter set",
+        description=f"Section 4.1 multibody case, {'calibrated' if calibrated else 'plain'} "
+                    "parameter set",
     )
-    if changes:
-        from reference.scene import replace
-
-        friction_paths = {k: v for k, v in changes.items()
-                          if not friction and "friction_coefficient" in k}
-        scene = replace(scene, **{k: v for k, v in changes.items() if k not in friction_paths})
-    return scene
+    if not calibrated:
+        return scene
+    values = ({p["name"]: p["value"] for p in calibrated_parameters()}
+              if parameters == "calibrated" else dict(parameters))
+    return apply_parameters(scene, values, calibrated_choices())
 
 
 def rig_scene(friction: bool = True) -> Scene:
