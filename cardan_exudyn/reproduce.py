@@ -208,7 +208,7 @@ def write_report(folder: Path, rows: pd.DataFrame, histories: dict, quick: bool,
                "\nDiscrete choices of the calibrated set (not fitted):\n\n",
                _md(choices.assign(value=choices["value"].astype(str)), ["name", "value", "reason"]),
                "\n**Reading.** The fitted levers are not plausible dimensions for a joint this "
-               "size (a 60 mm spider lever is a 30 mm arm radius on a 45.6 g spider; a 0.61 m "
+               "size (a 60 mm spider lever is a 30 mm arm radius on a 45.6 g spider; a 0.59 m "
                "frame lever is a bearing spacing far beyond shafts whose centres of mass sit "
                "0.13 m and 0.09 m from the joint). They act as correction factors: the paper's "
                "numbers need the moment term of eqs. (1)-(2) about 10 times weaker in the "
