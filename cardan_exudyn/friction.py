@@ -62,6 +62,10 @@ LAGGED_GROWTH_LIMIT = 1e3
 STALL_RATIO = 0.1
 
 
+# state of the ground in the per-body tuples (rotation, angular velocity, velocity, position)
+_GROUND = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
+
+
 def _sign(speed: float, band: float) -> float:
     """Regularised sign: linear ramp of width ``band``, exact sign for band 0."""
     if band <= 0.0:
@@ -104,11 +108,9 @@ class _PairData:
 
 @dataclass
 class FrictionLog:
-    """Per accepted step: the inputs read, the friction computed, and the friction applied."""
+    """Per accepted step: its time, the friction in effect in its final solve, evaluations."""
 
     t: list = field(default_factory=list)
-    inputs: list = field(default_factory=list)    # per pair (|F_n|, |M_n|, omega_rel, slide)
-    computed: list = field(default_factory=list)  # per pair (M_z, F_z) from this step's state
     applied: list = field(default_factory=list)   # per pair (M_z, F_z) in effect in the solve
     iterations: list = field(default_factory=list)
 
@@ -173,7 +175,7 @@ class FrictionCoupling:
         for name, node in self.model.nodes.items():
             start = self.mbs.GetNodeODE2Index(node)
             self._ode2[name] = start
-        self._history = [(self.model.start_time, self._pair_coordinates())]
+        self._history = [(self.model.start_time, self._pair_coordinates(self._body_states()))]
         self.mbs.SetPostNewtonUserFunction(self.post_newton)
         self.model.user_functions.append(self.post_newton)
 
@@ -197,18 +199,16 @@ class FrictionCoupling:
                             self.model.com_reference[name] + np.asarray(q[i:i + 3]))
         return states
 
-    def _pair_coordinates(self) -> np.ndarray:
+    def _pair_coordinates(self, states: dict[str, tuple]) -> np.ndarray:
         """Per pair: relative rotation angle of b about the axis, and axial slide of b [m].
 
         Computed from positions, which index-3 integration keeps on the constraint manifold to
         the Newton tolerance; their time derivatives are the relative speeds used by the law.
         """
-        states = self._body_states()
-        ground = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
         coords = np.zeros((self.n, 2))
         for k, p in enumerate(self.pairs):
-            a_a, _, _, r_a = states.get(p.bodies[0], ground)
-            a_b, _, _, r_b = states.get(p.bodies[1], ground)
+            a_a, _, _, r_a = states.get(p.bodies[0], _GROUND)
+            a_b, _, _, r_b = states.get(p.bodies[1], _GROUND)
             frame = self.model.pair_frames[p.name]
             rel = (a_a @ frame).T @ (a_b @ frame)
             coords[k, 0] = math.atan2(rel[1, 0], rel[0, 0])
@@ -234,14 +234,12 @@ class FrictionCoupling:
         w = h1 / h2
         return ((1.0 + 2.0 * w) / (1.0 + w) * delta - w * w / (1.0 + w) * delta2) / h1
 
-    def _velocity_level_speeds(self) -> np.ndarray:
+    def _velocity_level_speeds(self, states: dict[str, tuple]) -> np.ndarray:
         """Relative speeds from the body velocities (used at the initial, consistent state)."""
-        states = self._body_states()
-        ground = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
         speeds = np.zeros((self.n, 2))
         for k, p in enumerate(self.pairs):
-            a_a, w_a, v_a, _ = states.get(p.bodies[0], ground)
-            a_b, w_b, v_b, _ = states.get(p.bodies[1], ground)
+            a_a, w_a, v_a, _ = states.get(p.bodies[0], _GROUND)
+            a_b, w_b, v_b, _ = states.get(p.bodies[1], _GROUND)
             axis = a_a @ p.axis_local
             speeds[k, 0] = float((w_b - w_a) @ axis)
             if p.kind == "cylindrical":
@@ -261,7 +259,7 @@ class FrictionCoupling:
         x_prev = r_prev = None
         x = np.zeros(int(self._mask.sum()))
         for _ in range(max_iterations):
-            _, friction, _ = self.evaluate(None)
+            friction, _ = self.evaluate(None)
             g = friction.ravel()[self._mask]
             r = g - x
             scale = float((np.abs(friction) * self._weight).max())
@@ -288,13 +286,14 @@ class FrictionCoupling:
         self.reason = (f"no consistent friction state at the start: the fixed-point iteration "
                        f"did not converge in {max_iterations} iterations (loop gain >= 1)")
 
-    def evaluate(self, t: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Inputs (|F_n|, |M_n|, omega_rel, slide), friction (M_z, F_z on b), pair coordinates."""
+    def evaluate(self, t: float | None) -> tuple[np.ndarray, np.ndarray]:
+        """Friction (M_z, F_z on body b) of each pair, and the pair coordinates, at the current
+        state (``t`` None: the initial state, with velocity-level speeds)."""
         get = self.mbs.GetObjectOutput
         force_local, torque_local = exu.OutputVariableType.ForceLocal, exu.OutputVariableType.TorqueLocal
-        coords = self._pair_coordinates()
-        speeds = self._velocity_level_speeds() if t is None else self._speeds(coords, t)
-        inputs = np.zeros((self.n, 4))
+        states = self._body_states()
+        coords = self._pair_coordinates(states)
+        speeds = self._velocity_level_speeds(states) if t is None else self._speeds(coords, t)
         friction = np.zeros((self.n, 2))
         for k, p in enumerate(self.pairs):
             lx, ly, _ = get(p.joint, force_local)
@@ -305,10 +304,7 @@ class FrictionCoupling:
             friction[k, 0] = -_sign(0.5 * p.d * omega_rel, self.band) * torque
             if p.kind == "cylindrical":
                 friction[k, 1] = -_sign(slide, self.band) * p.f * (force_n + 2.0 * moment_n / p.lever)
-            else:
-                slide = 0.0
-            inputs[k] = (force_n, moment_n, omega_rel, slide)
-        return inputs, friction, coords
+        return friction, coords
 
     def apply(self, friction: np.ndarray) -> None:
         set_load = self.mbs.SetLoadParameter
@@ -323,7 +319,7 @@ class FrictionCoupling:
     def post_newton(self, mbs: Any, t: float) -> list[float]:
         if t != self._step_t and self._step_t is not None:  # the previous step was accepted
             self._history = [self._history[-1], (self._step_t, self._coords)]
-        inputs, friction, self._coords = self.evaluate(t)
+        friction, self._coords = self.evaluate(t)
         # forces enter as the torque they make at the journal radius, so one relative measure
         # covers both kinds of load
         weighted = np.abs(friction) * self._weight
@@ -333,14 +329,10 @@ class FrictionCoupling:
         if t != self._step_t:  # first evaluation of a new step
             self._step_t, self._step_iter = t, 0
             self.log.t.append(t)
-            self.log.inputs.append(inputs)
-            self.log.computed.append(friction)
             self.log.applied.append(self.applied.copy())
             self.log.iterations.append(1)
         else:
             self._step_iter += 1
-            self.log.inputs[-1] = inputs
-            self.log.computed[-1] = friction
             self.log.applied[-1] = self.applied.copy()
             self.log.iterations[-1] = self._step_iter + 1
         if not self.converged:

@@ -46,10 +46,6 @@ def fit_case_keys() -> list[str]:
     return list(paper_data().get("calibrated", {}).get("fit_cases", []))
 
 
-def case_key(case: dict) -> str:
-    return f"{case['study']}:{case['shaft_angle_deg']:g}:{case['speed_rpm']:g}"
-
-
 def case_row(case: dict, parameters: str, result) -> dict[str, Any]:
     s = result.summary
     row: dict[str, Any] = {

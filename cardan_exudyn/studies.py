@@ -28,7 +28,7 @@ from reference.scene import Scene, replace
 
 def _efficiency(scene: Scene) -> dict[str, Any]:
     start = time.perf_counter()
-    result = run(scene)
+    result = run(replace(scene, **{"record.timeseries": False}))
     wall = time.perf_counter() - start
     s = result.summary
     out = {"status": s["status"], "reason": s.get("reason", ""), "wall_time_s": wall,
