@@ -1,36 +1,47 @@
-"""Inverse dynamics of the ideal, frictionless Cardan joint: Newton-Euler, one linear solve per sample.
+"""Dynamics of the ideal Cardan joint with the paper's friction: Newton-Euler, batched over samples.
 
-For a prescribed input motion the closed-form kinematics (:mod:`reference.kinematics`) give every
+For a given input motion the closed-form kinematics (:mod:`reference.kinematics`) give every
 body's motion. Newton-Euler for the three moving bodies (force balance and moment balance about
 the joint centre O, a fixed point) is then linear in the 18 unknowns
 
 - ``frame_input`` (revolute): fx, fy, fz, mx, my;
 - ``input_spider``, ``spider_output``, ``output_frame`` (cylindrical): fx, fy, mx, my;
-- the drive torque on the input about +x,
+- the drive torque on the input about +x (inverse dynamics) or the input acceleration
+  (forward dynamics, the drive torque given),
 
 each reaction being the force and moment (about the pair origin) that body ``a`` exerts on body
 ``b``, in the pair frame attached to body ``a`` (:func:`reference.kinematics.pair_frames`). Body
-``b`` receives the wrench, body ``a`` its opposite. The 18 x 18 systems of all samples are solved
-as one batch.
+``b`` receives the wrench, body ``a`` its opposite.
+
+Friction (eqs. (3) and (5), :mod:`reference.friction`) is an applied load that depends on the
+reactions, and the reactions depend on it. With ``phi`` the friction values (a torque per pair
+with friction, an axial force per cylindrical pair with friction), the equations are
+``K x = r - W phi`` and ``phi = G(x)``: linear in ``x``, so ``x = x0 - S phi`` with
+``x0 = K^-1 r`` and ``S = K^-1 W``, and the fixed point reduces to at most seven unknowns,
+``phi = G(x0 - S phi)``. It is solved by Newton's method with the analytic Jacobian of ``G``,
+every sample at once. A sample whose fixed point does not converge, or converges to a point where
+the loop gain (spectral radius of ``dG/dphi``) is 1 or more, is *self-locking*: friction grows
+faster than the reactions that cause it, the Coulomb problem has no unique finite solution.
 
 The pair origins are fixed in space in the ideal joint: ``frame_input`` at ``-input_bearing e_x``,
 the two spider pairs at O and ``output_frame`` at ``output_bearing a2``, all on the rotation
-axes of their bodies.
+axes of their bodies. The ideal joint does not slide, so the axial friction of eq. (5) does no
+work here; it still loads the pairs.
 
 References
 ----------
 Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation": Section 3 (RCCC model, reactions in the joint frames, eqs. (8)-(9))
-and eq. (18) (instantaneous efficiency).
+experimental validation": Section 3 (RCCC model, reactions in the joint frames, eqs. (8)-(9)),
+eqs. (3), (5) (friction from the reactions) and eq. (18) (instantaneous efficiency).
 """
 
 from __future__ import annotations
 
-import math
-import time
+from dataclasses import dataclass
 
 import numpy as np
 
+from reference.friction import friction_magnitudes, pair_power_loss, regularised_sign
 from reference.kinematics import (
     BodyMotion,
     body_motions,
@@ -46,22 +57,22 @@ from reference.scene import (
     Body,
     Geometry,
     Scene,
-    SpeedDrive,
-    scene_to_dict,
 )
 from reference.schema import (
     PAIR_SUFFIXES,
-    STATUS_OK,
-    Result,
     instantaneous_efficiency,
-    mean_values,
-    table_columns,
 )
 
-ENGINE_NAME = "reference"
-ENGINE_VERSION = "reference-0.1"
-DEFAULT_SAMPLES_PER_REVOLUTION = 360
+DRIVE_ROW = 3  # the input's moment about x (rows: per body force x, y, z, moment x, y, z)
 _COMPONENTS = {"revolute": ("fx", "fy", "fz", "mx", "my"), "cylindrical": ("fx", "fy", "mx", "my")}
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product over the last axis (``numpy.cross`` without its per-call overhead)."""
+    a, b = np.broadcast_arrays(a, b)
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], -1)
 
 
 def unknowns() -> list[tuple[str, str]]:
@@ -101,8 +112,8 @@ def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
     mass, com, inertia = body.canonical()
     rot = motion.rotation
     r = rot @ com
-    v = np.cross(motion.omega, r)
-    a = np.cross(motion.alpha, r) + np.cross(motion.omega, v)
+    v = cross(motion.omega, r)
+    a = cross(motion.alpha, r) + cross(motion.omega, v)
     return {"mass": mass, "r": r, "v": v, "a": a,
             "inertia": rot @ inertia @ np.swapaxes(rot, -1, -2)}
 
@@ -118,7 +129,7 @@ def required_wrench(body: Body, motion: BodyMotion,
     force = k["mass"] * (k["a"] - gravity)
     j_omega = np.einsum("...ij,...j->...i", k["inertia"], motion.omega)
     j_alpha = np.einsum("...ij,...j->...i", k["inertia"], motion.alpha)
-    return force, np.cross(k["r"], force) + j_alpha + np.cross(motion.omega, j_omega)
+    return force, cross(k["r"], force) + j_alpha + cross(motion.omega, j_omega)
 
 
 def mechanical_energy(scene: Scene,
@@ -135,12 +146,32 @@ def mechanical_energy(scene: Scene,
     return kinetic, potential
 
 
-def _unit_wrench(frame: np.ndarray, origin: np.ndarray, component: str) -> np.ndarray:
-    """Wrench (force, moment about O), shape (..., 6), of one unit reaction component on body b."""
-    d = frame[..., :, "xyz".index(component[1])]
-    if component[0] == "f":
-        return np.concatenate([d, np.cross(origin, d)], -1)
-    return np.concatenate([np.zeros_like(d), d], -1)
+def wrench_columns(scene: Scene, motions: dict[str, BodyMotion],
+                   components: list[tuple[str, str]]) -> np.ndarray:
+    """Body wrenches of unit pair loads, rows as :func:`reaction_system`, shape (..., 18, m).
+
+    Each component ``(pair, "fx" | "fy" | "fz" | "mx" | "my" | "mz")`` is a unit force along
+    (at the pair origin) or moment about that axis of the pair frame, acting on body b; body a
+    receives the opposite. All components are built in one vectorised pass.
+    """
+    shape = motions["input"].omega.shape[:-1]
+    if not components:
+        return np.zeros(shape + (6 * len(BODY_NAMES), 0))
+    frames = pair_frames(motions)
+    origins = pair_origins(scene.joint.geometry)
+    d = np.stack([frames[p][..., :, "xyz".index(c[1])] for p, c in components], -2)
+    is_force = np.array([c[0] == "f" for _, c in components])[:, None]
+    lever = np.stack([origins[p] for p, _ in components])
+    unit = np.concatenate([np.where(is_force, d, 0.0),
+                           np.where(is_force, cross(lever, d), d)], -1)  # (..., m, 6)
+    incidence = np.zeros((len(BODY_NAMES), len(components)))
+    for j, (pair, _) in enumerate(components):
+        a, b = PAIR_BODIES[pair]
+        for body, sign in ((b, 1.0), (a, -1.0)):
+            if body in BODY_NAMES:
+                incidence[BODY_NAMES.index(body), j] = sign
+    out = np.einsum("bm,...mk->...bkm", incidence, unit)
+    return out.reshape(shape + (6 * len(BODY_NAMES), len(components)))
 
 
 def reaction_system(scene: Scene,
@@ -158,16 +189,8 @@ def reaction_system(scene: Scene,
     shape = motions["input"].omega.shape[:-1]
     rows = {name: 6 * i for i, name in enumerate(BODY_NAMES)}
     matrix = np.zeros(shape + (18, 18))
-    frames = pair_frames(motions)
-    origins = pair_origins(scene.joint.geometry)
-    for j, (pair, component) in enumerate(unknowns()[:-1]):
-        unit = _unit_wrench(frames[pair], origins[pair], component)
-        a, b = PAIR_BODIES[pair]
-        if b in rows:
-            matrix[..., rows[b]:rows[b] + 6, j] += unit
-        if a in rows:
-            matrix[..., rows[a]:rows[a] + 6, j] -= unit
-    matrix[..., rows["input"] + 3, -1] = 1.0  # drive torque about +x (the fixed input axis)
+    matrix[..., :-1] = wrench_columns(scene, motions, unknowns()[:-1])
+    matrix[..., rows["input"] + DRIVE_ROW, -1] = 1.0  # drive torque about +x (the fixed input axis)
     rhs = np.concatenate([np.concatenate(required_wrench(body, motions[name],
                                                          np.asarray(scene.gravity)), -1)
                           for name, body in scene.joint.bodies()], -1)
@@ -177,109 +200,301 @@ def reaction_system(scene: Scene,
     return matrix, rhs
 
 
-def inverse_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
-                     theta_tt: np.ndarray) -> dict[str, np.ndarray]:
-    """Result-schema columns (without ``t``) for a prescribed input motion, no friction.
+def friction_slots(scene: Scene) -> list[tuple[str, str]]:
+    """The friction values the scene produces: ``(pair, "torque" | "force")`` in solution order.
+
+    A pair with friction gets a torque about its axis; a cylindrical one also an axial force.
+    Frictionless pairs get none, so a frictionless scene has no friction unknowns at all.
+    """
+    slots = []
+    for pair, data in scene.joint.pairs.items():
+        if data.friction_coefficient > 0.0:
+            slots.append((pair, "torque"))
+            if PAIR_KIND[pair] == "cylindrical":
+                slots.append((pair, "force"))
+    return slots
+
+
+def friction_matrix(scene: Scene, motions: dict[str, BodyMotion],
+                    slots: list[tuple[str, str]]) -> np.ndarray:
+    """Body wrenches of unit friction values, rows as :func:`reaction_system`, shape (..., 18, K).
+
+    A friction torque acts on body b about the pair axis, an axial force along it at the pair
+    origin; body a receives the opposite.
+    """
+    return wrench_columns(scene, motions,
+                          [(pair, "mz" if kind == "torque" else "fz") for pair, kind in slots])
+
+
+class FrictionLaw:
+    """Eqs. (3) and (5) as a function of the reaction vector, with its Jacobian.
+
+    The law is linear in the normal force and moment magnitudes ``|F|``, ``|M|``; its
+    coefficients per slot are taken from :func:`reference.friction.friction_magnitudes`.
 
     Parameters
     ----------
     scene : Scene
-        Joint, load and gravity (the drive is replaced by the given motion).
-    theta, theta_t, theta_tt : ndarray, shape (n,)
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
+    slots : list of (pair, "torque" | "force")
+        From :func:`friction_slots`.
+    """
+
+    def __init__(self, scene: Scene, slots: list[tuple[str, str]]) -> None:
+        position = {key: j for j, key in enumerate(unknowns()[:-1])}
+        self.index = np.array([[position[(pair, c)] for c in ("fx", "fy", "mx", "my")]
+                               for pair, _ in slots], dtype=int).reshape(len(slots), 4)
+        coefficients = []
+        for pair, kind in slots:
+            which = 0 if kind == "torque" else 1  # eq. (3) torque or eq. (5) axial force
+            data = getattr(scene.joint.pairs, pair)
+            coefficients.append((float(friction_magnitudes(data, 1.0, 0.0)[which]),
+                                 float(friction_magnitudes(data, 0.0, 1.0)[which])))
+        self.k_force, self.k_moment = np.array(coefficients, float).reshape(len(slots), 2).T
+
+    def __call__(self, x: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Friction values ``G(x)`` and Jacobian ``dG/dx``.
+
+        Parameters
+        ----------
+        x : ndarray, shape (n, 18)
+            Reactions (and the drive unknown, unused), ordered as :func:`unknowns`.
+        signs : ndarray, shape (n, K)
+            Regularised sign of the relative motion for each slot (fixed by the kinematics).
+
+        Returns
+        -------
+        values : ndarray, shape (n, K)
+            Friction torque [N m] / axial force [N] on body b.
+        jacobian : ndarray, shape (n, K, 18)
+            Derivatives with respect to ``x``; where a norm is exactly zero, the zero
+            subgradient.
+        """
+        c = x[:, self.index]  # (n, K, 4): fx, fy, mx, my
+        force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
+        norms = np.stack([force, force, moment, moment], -1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = np.where(norms > 0, c / norms, 0.0)
+        s = -signs
+        values = s * (self.k_force * force + self.k_moment * moment)
+        gains = np.stack([self.k_force, self.k_force, self.k_moment, self.k_moment], -1)
+        jacobian = np.zeros(x.shape[:1] + self.index.shape[:1] + x.shape[1:])
+        rows = np.arange(self.index.shape[0])[:, None]
+        jacobian[:, rows, self.index] = s[..., None] * gains * unit
+        return values, jacobian
+
+
+def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
+                slide_rel: dict[str, np.ndarray]) -> np.ndarray:
+    """Relative surface speed (rotation: ``omega_rel d / 2``) or sliding speed of each slot [m/s].
+
+    These are the speeds whose sign the friction law takes, shape (..., K).
+    """
+    out = []
+    for pair, kind in slots:
+        if kind == "torque":
+            out.append(0.5 * getattr(scene.joint.pairs, pair).journal_diameter * omega_rel[pair])
+        else:
+            out.append(slide_rel[pair])
+    return np.stack(out, -1)
+
+
+@dataclass
+class FixedPoint:
+    """Outcome of the friction fixed point, per sample.
+
+    Attributes
+    ----------
+    x : ndarray, shape (n, 18)
+        Reactions and the drive unknown, :func:`unknowns` order.
+    friction : ndarray, shape (n, K)
+        Friction values of :func:`friction_slots`.
+    converged : ndarray of bool, shape (n,)
+        Newton converged to the relative tolerance.
+    loop_gain : ndarray, shape (n,)
+        Spectral radius of ``dG/dphi`` at the solution (0 without friction); where the
+        infinity norm of ``dG/dphi`` is below 0.5 that norm is reported instead (an upper bound,
+        enough to tell that the sample does not lock).
+    iterations : int
+        Newton iterations of the slowest sample.
+    """
+
+    x: np.ndarray
+    friction: np.ndarray
+    converged: np.ndarray
+    loop_gain: np.ndarray
+    iterations: int
+
+    @property
+    def self_locking(self) -> np.ndarray:
+        return ~self.converged | ~(self.loop_gain < 1.0)
+
+
+def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
+                   signs: np.ndarray, tolerance: float = 1e-13,
+                   max_iterations: int = 50) -> FixedPoint:
+    """Solve ``phi = G(x0 - S phi)`` for every sample by Newton's method.
+
+    Parameters
+    ----------
+    law : FrictionLaw
+        ``G`` and its Jacobian.
+    x0 : ndarray, shape (n, 18)
+        Solution without friction.
+    s : ndarray, shape (n, 18, K)
+        Response of the solution to unit friction values.
+    signs : ndarray, shape (n, K)
+        Regularised signs of the relative motions.
+    tolerance : float
+        Converged when the Newton update is at most ``tolerance`` times the largest friction
+        value of the sample (or of the frictionless estimate, whichever is larger).
+    max_iterations : int
+        Newton iterations before a sample is declared not converged.
+    """
+    n, k = x0.shape[0], s.shape[-1]
+    if k == 0:
+        return FixedPoint(x0, np.zeros((n, 0)), np.ones(n, bool), np.zeros(n), 0)
+    phi, _ = law(x0, signs)
+    scale = np.max(np.abs(phi), -1)
+    converged = np.zeros(n, bool)
+    active = np.arange(n)
+    iterations = 0
+    for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported below)
+        x = x0[active] - np.einsum("nik,nk->ni", s[active], phi[active])
+        g, g_x = law(x, signs[active])
+        jac = np.eye(k) + g_x @ s[active]
+        with np.errstate(all="ignore"):
+            step = np.linalg.solve(jac, (phi[active] - g)[..., None])[..., 0]
+        phi[active] -= step
+        size = np.max(np.abs(step), -1)
+        scale[active] = np.maximum(scale[active], np.max(np.abs(phi[active]), -1))
+        done = size <= tolerance * np.maximum(scale[active], np.finfo(float).tiny)
+        bad = ~np.all(np.isfinite(phi[active]), -1)
+        converged[active[done & ~bad]] = True
+        active = active[~done & ~bad]
+        if active.size == 0:
+            break
+    x = x0 - np.einsum("nik,nk->ni", s, phi)
+    _, g_x = law(x, signs)
+    with np.errstate(all="ignore"):
+        gain_matrix = np.nan_to_num(g_x @ s, nan=np.inf, posinf=np.inf, neginf=-np.inf)
+    finite = np.all(np.isfinite(gain_matrix), (-2, -1))
+    # the spectral radius is at most any induced norm: eigenvalues only where the norm is >= 0.5
+    gain = np.where(finite, np.max(np.sum(np.abs(gain_matrix), -1), -1), np.inf)
+    exact = finite & (gain >= 0.5)
+    gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
+    return FixedPoint(x, phi, converged, gain, iterations)
+
+
+def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
+                   theta_tt: np.ndarray | None = None,
+                   torque_in: float | np.ndarray | None = None) -> tuple[dict, FixedPoint]:
+    """Reactions, friction and the drive unknown for every sample.
+
+    Exactly one of ``theta_tt`` (inverse dynamics: the drive torque is the unknown) and
+    ``torque_in`` (forward dynamics: the input acceleration is the unknown) is given.
 
     Returns
     -------
-    dict of str to ndarray, shape (n,)
-        Every column of :func:`reference.schema.table_columns` but ``t``; friction and loss
-        columns are zero.
+    motions : dict of str to BodyMotion
+        Body motions (with the solved acceleration in forward dynamics).
+    fixed_point : FixedPoint
+        ``x[..., -1]`` is the drive torque [N m] or the input acceleration [rad/s^2].
+    """
+    if (theta_tt is None) == (torque_in is None):
+        raise ValueError("give exactly one of `theta_tt` (inverse) and `torque_in` (forward)")
+    beta = scene.joint.geometry.shaft_angle
+    theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
+    at_zero = body_motions(theta, theta_t, np.zeros_like(theta), beta)
+    if theta_tt is not None:
+        motions = body_motions(theta, theta_t, np.broadcast_to(theta_tt, theta.shape), beta)
+        matrix, rhs = reaction_system(scene, motions)
+    else:  # one batch at accelerations 0 and 1: the right-hand side is affine in theta_tt
+        n = theta.size
+        pair = body_motions(np.tile(theta, 2), np.tile(theta_t, 2),
+                            np.repeat([0.0, 1.0], n), beta)
+        matrix, rhs = reaction_system(scene, pair)
+        matrix, rhs_one, rhs = matrix[:n], rhs[n:], rhs[:n]
+        matrix[..., :, -1] = -(rhs_one - rhs)  # the acceleration's share moves to the left
+        rhs[..., DRIVE_ROW] -= torque_in
+    slots = friction_slots(scene)
+    omega_rel = relative_speeds(at_zero)  # velocity level: independent of the acceleration
+    wrenches = friction_matrix(scene, at_zero, slots)
+    both = np.linalg.solve(matrix, np.concatenate([rhs[..., None], wrenches], -1))
+    slide = {p: np.zeros_like(theta) for p in PAIR_NAMES}  # the ideal joint does not slide
+    signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide), scene.friction.sign_band)
+             if slots else np.zeros(theta.shape + (0,)))
+    fixed = solve_friction(FrictionLaw(scene, slots), both[..., 0], both[..., 1:], signs)
+    if torque_in is not None:
+        motions = body_motions(theta, theta_t, fixed.x[..., -1], beta)
+    return motions, fixed
+
+
+def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
+                     theta_tt: np.ndarray | None = None,
+                     torque_in: float | None = None) -> tuple[dict[str, np.ndarray], FixedPoint]:
+    """Result-schema columns (without ``t``) for the given motion, with friction.
+
+    Inverse dynamics when ``theta_tt`` is given, forward dynamics when ``torque_in`` is (see
+    :func:`solve_dynamics`). Samples that self-lock carry NaN reactions, friction and powers.
+
+    Returns
+    -------
+    columns : dict of str to ndarray, shape (n,)
+        Every column of :func:`reference.schema.table_columns` but ``t``, plus
+        ``input_acceleration`` [rad/s^2], ``friction_loop_gain`` [-] and ``self_locking``.
+    fixed_point : FixedPoint
     """
     beta = scene.joint.geometry.shaft_angle
-    motions = body_motions(theta, theta_t, theta_tt, beta)
-    matrix, rhs = reaction_system(scene, motions)
-    solution = np.linalg.solve(matrix, rhs[..., None])[..., 0]
-    theta_out, omega_out, _ = output_motion(theta, theta_t, theta_tt, beta)
+    motions, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in)
+    theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
+    locked = fixed.self_locking
+    x = np.where(locked[:, None], np.nan, fixed.x)
+    phi = np.where(locked[:, None], np.nan, fixed.friction)
+    if torque_in is None:
+        accel = np.broadcast_to(np.asarray(theta_tt, float), theta.shape) + 0.0
+        drive = x[:, -1]
+    else:
+        accel, drive = x[:, -1], np.where(locked, np.nan, np.broadcast_to(torque_in, theta.shape))
+    theta_out, omega_out, _ = output_motion(theta, theta_t, np.nan_to_num(accel), beta)
     zero = np.zeros_like(theta_out)
     cols = {"theta_in": theta + zero, "theta_out": theta_out, "omega_in": theta_t + zero,
-            "omega_out": omega_out, "torque_in": solution[..., -1],
+            "omega_out": omega_out, "torque_in": drive + zero,
             "torque_out": zero + scene.load.torque}
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * omega_out
-    cols["power_loss"] = zero
-    cols["efficiency"] = instantaneous_efficiency(cols["power_in"], zero)
     cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(scene, motions)
     omega_rel = relative_speeds(motions)
+    applied = {(pair, kind): phi[:, j] for j, (pair, kind) in enumerate(friction_slots(scene))}
+    loss_total = zero.copy()
     for pair in PAIR_NAMES:
-        cols[f"power_loss_{pair}"] = zero
+        torque = applied.get((pair, "torque"), zero)
+        force = applied.get((pair, "force"), zero)
+        loss = pair_power_loss(torque, force, omega_rel[pair], zero)
+        loss_total = loss_total + loss
+        cols[f"power_loss_{pair}"] = loss
         cols.update({f"{pair}_{suffix}": zero for suffix in PAIR_SUFFIXES})
+        cols[f"{pair}_friction_torque"] = torque + zero
+        cols[f"{pair}_friction_force"] = force + zero
         cols[f"{pair}_omega_rel"] = omega_rel[pair]
     for j, (pair, component) in enumerate(unknowns()[:-1]):
-        cols[f"{pair}_{component}"] = solution[..., j]
-    return cols
+        cols[f"{pair}_{component}"] = x[:, j]
+    cols["power_loss"] = loss_total
+    cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
+    cols["input_acceleration"] = accel
+    cols["friction_loop_gain"] = fixed.loop_gain
+    cols["self_locking"] = locked
+    return cols, fixed
 
 
-def drive_samples(scene: Scene, samples_per_revolution: int) -> tuple[np.ndarray, ...]:
-    """Sample times [s] and input angle [rad], speed [rad/s], acceleration [rad/s^2].
-
-    The span of ``scene.revolutions`` input revolutions from t = 0 is cut into
-    ``round(revolutions * samples_per_revolution)`` equal steps, both ends included.
-    """
-    drive = scene.drive
-    if not isinstance(drive, SpeedDrive):
-        raise NotImplementedError(
-            f"the reference engine handles only constant-speed drives so far, got a "
-            f"{drive.kind!r} drive"
-        )
-    spr = samples_per_revolution
-    if isinstance(spr, bool) or not isinstance(spr, (int, np.integer)) or spr < 1:
-        raise ValueError(f"`samples_per_revolution` must be a positive integer, got {spr!r}")
-    steps = max(1, round(scene.revolutions * spr))
-    t = np.linspace(0.0, 2.0 * math.pi * scene.revolutions / abs(drive.speed), steps + 1)
-    return t, drive.speed * t, np.full_like(t, drive.speed), np.zeros_like(t)
-
-
-def run(scene: Scene, samples_per_revolution: int = DEFAULT_SAMPLES_PER_REVOLUTION) -> Result:
-    """Inverse dynamics of ``scene`` (constant-speed drive, no friction) in the result schema.
+def inverse_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
+                     theta_tt: np.ndarray) -> dict[str, np.ndarray]:
+    """Result-schema columns (without ``t``) for a prescribed input motion, with friction.
 
     Parameters
     ----------
     scene : Scene
-        The scene (constant-speed drive, every friction coefficient zero).
-    samples_per_revolution : int
-        Samples per input revolution [-].
-
-    Returns
-    -------
-    Result
-        Time table (every ``scene.record.every``-th sample, or None) and summary with the mean
-        values of :func:`reference.schema.mean_values` over all samples.
-
-    Raises
-    ------
-    NotImplementedError
-        For angle and torque drives, and for scenes with friction (not implemented yet: a
-        friction-free answer to a friction scene would be a silent wrong result).
+        Joint, load, gravity and friction (the drive is replaced by the given motion).
+    theta, theta_t, theta_tt : ndarray, shape (n,)
+        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
     """
-    if scene.has_friction:
-        raise NotImplementedError(
-            "friction in the reference engine is not implemented yet (issue 4); use a "
-            "'-frictionless' scene or --friction-spider 0 --friction-frame 0")
-    start = time.perf_counter()
-    t, theta, theta_t, theta_tt = drive_samples(scene, samples_per_revolution)
-    columns = {"t": t, **inverse_dynamics(scene, theta, theta_t, theta_tt)}
-    summary = {"status": STATUS_OK, "reason": "", "engine": ENGINE_NAME,
-               "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),
-               "samples_per_revolution": int(samples_per_revolution), "dt": float(t[1] - t[0]),
-               "steps": int(t.size - 1)}
-    means = mean_values(columns, scene.record.skip_revolutions)
-    if means.get("revolutions", 0) < 1:
-        summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))
-    summary.update({k: v for k, v in means.items() if k != "mean_status"})
-    table = None
-    if scene.record.timeseries:
-        import pandas as pd
-
-        every = scene.record.every
-        table = pd.DataFrame({c: columns[c][::every] for c in table_columns()})
-    summary["wall_time_s"] = time.perf_counter() - start
-    return Result(table, summary)
+    return dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt)[0]

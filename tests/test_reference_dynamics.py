@@ -8,18 +8,17 @@ import numpy as np
 import pytest
 from test_reference_kinematics import derivative
 
-from reference.dynamics import inverse_dynamics, reaction_system, run
+from reference import engine
+from reference.dynamics import inverse_dynamics, reaction_system
 from reference.kinematics import body_motions, speed_ratio
 from reference.paper import named_scene
 from reference.scene import (
-    AngleDrive,
     Body,
     Geometry,
     Joint,
     Load,
     Scene,
     SpeedDrive,
-    TorqueDrive,
     replace,
 )
 from reference.schema import table_columns
@@ -63,6 +62,10 @@ def hand_statics(gy: float, gz: float) -> dict[str, list[float]]:
                          (L_OUT - X_OUT) * M_OUT * gz, (X_OUT * M_OUT - L_OUT * (M_SPIDER + M_OUT)) * gy,
                          0.0],
     }
+
+
+def run(scene: Scene, samples_per_revolution: int | None = None):
+    return engine.run(scene, engine.ReferenceOptions(samples_per_revolution=samples_per_revolution))
 
 
 GRAVITIES = {"gravity-z": (0.0, 0.0, -9.81), "gravity-y": (0.0, -9.81, 0.0),
@@ -162,7 +165,7 @@ def test_result_follows_the_schema():
     scene = replace(named_scene("paper-10deg-frictionless"), **{"record.every": 2})
     result = run(scene, samples_per_revolution=36)
     table, s = result.table, result.summary
-    assert list(table.columns) == table_columns()
+    assert list(table.columns) == table_columns() + list(engine.EXTRA_COLUMNS)
     assert len(table) == (2 * 36) // 2 + 1  # 2 revolutions, endpoint included, every 2nd row
     assert table["t"].iloc[0] == 0.0
     assert table["theta_in"].iloc[-1] == pytest.approx(4 * np.pi, rel=1e-15)
@@ -170,32 +173,11 @@ def test_result_follows_the_schema():
     assert {"engine_version", "wall_time_s", "input_work", "mean_efficiency"} <= s.keys()
     # no friction, no sliding, and no axial force / torque in the cylindrical pairs
     zero_suffixes = ("_mz", "friction_torque", "friction_force", "slide_rel")
-    zero_cols = [c for c in table.columns if c.startswith("power_loss") or c.endswith(zero_suffixes)
+    zero_cols = [c for c in table_columns() if c.startswith("power_loss") or c.endswith(zero_suffixes)
                  or (c.endswith("_fz") and c != "frame_input_fz")]
     assert not table[zero_cols].to_numpy().any()
     assert np.all(table["efficiency"] == 1.0) and s["mean_efficiency"] == 1.0
     assert run(replace(scene, **{"record.timeseries": False})).table is None
-
-
-def test_friction_scene_is_refused():
-    """A scene with friction is refused rather than answered without friction."""
-    with pytest.raises(NotImplementedError, match="friction"):
-        run(named_scene("paper-10deg"), samples_per_revolution=36)
-
-
-DRIVES = {
-    "angle": AngleDrive(time=(0.0, 1.0, 2.0, 3.0), angle=(0.0, 5.0, 10.0, 15.0)),
-    "torque": TorqueDrive(torque=1.0, initial_speed=10.0),
-}
-
-
-@pytest.mark.parametrize("drive", DRIVES.values(), ids=DRIVES.keys())
-def test_other_drives_are_not_implemented(drive):
-    """Angle and torque drives raise NotImplementedError naming the drive."""
-    scene = balanced_scene()
-    scene = Scene(scene.joint, drive, scene.load, revolutions=1.0)
-    with pytest.raises(NotImplementedError, match=f"constant-speed drives.*{drive.kind!r}"):
-        run(scene)
 
 
 @pytest.mark.parametrize("bad", [0, 2.5, True], ids=["zero", "float", "bool"])
