@@ -12,6 +12,8 @@ the output yoke's along global z. With these conventions the canonical body fram
 Every function takes arrays of any (common) shape; rotation matrices get two trailing axes of
 length 3 and vectors one. Angles are in radians, times in seconds.
 
+See also :mod:`reference.rccc`: the same joint as an RCCC loop in dual numbers, with mounting errors.
+
 References
 ----------
 Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with

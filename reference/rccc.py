@@ -1,0 +1,535 @@
+"""The Cardan joint as an RCCC loop, solved in dual numbers from Denavit-Hartenberg parameters.
+
+The four joints, in chain order, are the pairs of :data:`reference.scene.PAIR_NAMES`: joint 1
+``frame_input`` (revolute), 2 ``input_spider``, 3 ``spider_output``, 4 ``output_frame``
+(cylindrical). Link k carries joints k and k + 1 (joint 5 is joint 1): link 1 is the input,
+2 the spider, 3 the output and 4 the frame (ground), so joint k joins link k - 1 (body ``a`` of
+the pair) to link k (body ``b``).
+
+Denavit-Hartenberg convention
+-----------------------------
+Frame ``F_k`` has its z axis on joint k, its x axis on the common normal of link k - 1 (from
+joint k - 1 towards joint k) and its origin at that normal's foot on joint k. With the dual angles
+``theta_hat_k = theta_k + eps s_k`` (joint rotation [rad] and slide [m]) and
+``alpha_hat_k = alpha_k + eps a_k`` (link twist [rad] and offset [m], about and along link k's
+common normal),
+
+    F_{k+1} = F_k Z(theta_hat_k) X(alpha_hat_k),   prod_{k=1..4} Z(theta_hat_k) X(alpha_hat_k) = I.
+
+``theta_k`` is the rotation of link k relative to link k - 1 about joint k, i.e. of body ``b``
+relative to body ``a`` about the pair axis, and ``s_k`` the distance along joint k from the foot of
+link k - 1's normal to the foot of link k's. ``F_k Z(theta_hat_k)`` is link k's own frame.
+
+Placement in the scene (:mod:`reference.kinematics`)
+----------------------------------------------------
+``F_1`` is fixed to the ground: its z axis (joint 1) is global x, its x axis (the frame link's
+common normal) global z, its origin the global origin. The ideal joint with shaft angle ``b``
+(:meth:`DHParameters.ideal`) has all ``a_k = 0``, ``s_1 = 0`` and twists
+``(90, 90, 90, -b)`` deg. At ``theta_1 = 0`` the joint axes are then global x, y, z and
+``a2 = (cos b, sin b, 0)``, exactly the pair axes of :mod:`reference.kinematics` at input angle
+0, and ``theta_1`` is that module's input angle.
+
+Assembly branches and continuity
+--------------------------------
+The real part of the loop is a spherical four-bar whose input-output equation
+``A cos theta_4 + B sin theta_4 = C`` (quadratic in ``tan(theta_4 / 2)``) has the two roots
+``atan2(B, A) -+ atan2(sqrt(A^2 + B^2 - C^2), C)``. Branch ``"hooke"`` takes the minus sign: for
+the ideal joint it is the project's configuration (``theta_4 = 90 deg`` at ``theta_1 = 0``), and
+under mounting errors it continues it as long as the discriminant stays positive. ``"flipped"``
+is the other assembly (for the ideal joint: the spider turned by half a turn about the input yoke
+and the output about its axis, with the same motion relative to ``theta_1 = 0``).
+
+Joint angles are reported continuous in ``theta_1``, independently of the sampling: each is its
+value at ``theta_1 = 0`` on the same branch, plus ``w_k theta_1`` with windings
+``w = (1, 0, 0, -1)`` (input and output turn once per input turn, the spider stays near both),
+plus the deviation from that wrapped into (-pi, pi]. Assumption: the deviation stays within
++-pi, true for any Cardan joint (it is at most about the shaft angle) and for mounting errors that
+keep the loop a double crank. The loop must close at ``theta_1 = 0``.
+
+References
+----------
+Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
+experimental validation", section 3.2, eqs. (10)-(14), Figure 3 (RCCC model and its parameters).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference import dual
+from reference.dual import Dual
+from reference.scene import PAIR_NAMES
+
+LINK_NAMES = ("input", "spider", "output", "ground")
+BRANCHES = ("hooke", "flipped")
+MIN_BRANCH_SEPARATION = 1e-6
+"""Smallest ``sin`` of the half-angle between the two branches' ``theta_4`` that is solved [-].
+
+Below it the branches (nearly) meet: the slides and rates grow like its inverse, and the real
+solution has lost about half of its digits to the discriminant's cancellation."""
+
+_BRANCH_SIGN = {"hooke": -1.0, "flipped": 1.0}
+_WINDING = np.array([1.0, 0.0, 0.0, -1.0])
+_E_Z = Dual(np.array([0.0, 0.0, 1.0]))
+# Global components of F_1's axes (columns): x_F1 = e_z, y_F1 = -e_y, z_F1 = e_x.
+_GLOBAL_FROM_F1 = np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
+# Canonical body axes (reference.scene) in the link's own D-H frame F_k Z(theta_hat_k), chosen so
+# that both coincide for the ideal joint: input (z_F, -y_F, x_F), spider (x_F, z_F, -y_F),
+# output (-y_F, x_F, z_F).
+_CANONICAL_IN_LINK = {
+    "input": _GLOBAL_FROM_F1.T,
+    "spider": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]),
+    "output": np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+}
+
+
+class LoopClosureError(ValueError):
+    """The loop cannot close, or its two branches meet, at some input angles.
+
+    Attributes
+    ----------
+    angles : ndarray
+        The offending input angles ``theta_1`` [rad].
+    """
+
+    def __init__(self, message: str, angles: np.ndarray) -> None:
+        super().__init__(message)
+        self.angles = angles
+
+
+def _finite(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"`{name}` must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise ValueError(f"`{name}` must be finite, got {value!r}")
+    return float(value)
+
+
+def _four(name: str, values) -> tuple[float, float, float, float]:
+    if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)) \
+            or len(values) != 4:
+        raise ValueError(f"`{name}` must be a sequence of 4 numbers (one per link), got {values!r}")
+    return tuple(_finite(f"{name}[{k}]", v) for k, v in enumerate(values))
+
+
+@dataclass(frozen=True)
+class DHParameters:
+    """Denavit-Hartenberg parameters of the single RCCC loop.
+
+    Attributes
+    ----------
+    alpha : tuple of 4 float
+        Twists of the input, spider, output and frame links [rad]: the angle from joint k's axis
+        to joint k + 1's about link k's common normal. The first three in (0, 180) deg, the frame
+        link's (minus the shaft angle) in (-90, 90) deg.
+    a : tuple of 4 float
+        Offsets of the same links [m]: the signed length of each common normal.
+    s1 : float
+        Axial offset of the revolute joint 1 [m]: from the frame link's normal to the input's.
+    """
+
+    alpha: tuple[float, float, float, float]
+    a: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    s1: float = 0.0
+
+    def __post_init__(self) -> None:
+        alpha = _four("alpha", self.alpha)
+        for k in range(3):
+            if not 0.0 < alpha[k] < math.pi:
+                raise ValueError(f"`alpha[{k}]` (twist of the {LINK_NAMES[k]}) must be in (0, 180) "
+                                 f"deg, got {math.degrees(alpha[k])!r} deg")
+        if not abs(alpha[3]) < 0.5 * math.pi:
+            raise ValueError(f"`alpha[3]` (twist of the ground, minus the shaft angle) must be in "
+                             f"(-90, 90) deg, got {math.degrees(alpha[3])!r} deg")
+        object.__setattr__(self, "alpha", alpha)
+        object.__setattr__(self, "a", _four("a", self.a))
+        object.__setattr__(self, "s1", _finite("s1", self.s1))
+
+    @classmethod
+    def ideal(cls, shaft_angle: float) -> DHParameters:
+        """The ideal Cardan joint: twists (90, 90, 90, -shaft_angle) deg, no offsets.
+
+        Parameters
+        ----------
+        shaft_angle : float
+            Angle between the input and output shafts [rad], in [0, pi/2).
+        """
+        beta = _finite("shaft_angle", shaft_angle)
+        if not 0.0 <= beta < 0.5 * math.pi:
+            raise ValueError(f"`shaft_angle` must be in [0, 90) deg, got {math.degrees(beta)!r} deg")
+        return cls(alpha=(0.5 * math.pi, 0.5 * math.pi, 0.5 * math.pi, -beta))
+
+    def with_errors(self, a: Sequence[float] = (0.0,) * 4, alpha: Sequence[float] = (0.0,) * 4,
+                    s1: float = 0.0) -> DHParameters:
+        """These parameters with errors added: offsets ``a`` [m], twists ``alpha`` [rad], ``s1`` [m]."""
+        d_a, d_alpha, d_s1 = _four("a", a), _four("alpha", alpha), _finite("s1", s1)
+        return DHParameters(alpha=tuple(x + y for x, y in zip(self.alpha, d_alpha, strict=True)),
+                            a=tuple(x + y for x, y in zip(self.a, d_a, strict=True)), s1=self.s1 + d_s1)
+
+    def twists(self) -> Dual:
+        """Dual link twists ``alpha_k + eps a_k``, shape (4,)."""
+        return Dual(np.array(self.alpha), np.array(self.a))
+
+
+@dataclass(frozen=True)
+class LoopPositions:
+    """Solved configuration of the loop for an array of input angles.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (..., 4)
+        Joint angles ``theta_1..theta_4`` [rad], continuous in ``theta_1``.
+    s : ndarray, shape (..., 4)
+        Joint slides ``s_1..s_4`` [m]; ``s_1`` is the constant parameter.
+    reference : ndarray, shape (4,)
+        Joint angles at ``theta_1 = 0`` on the same branch [rad].
+    branch : str
+        One of :data:`BRANCHES`.
+    """
+
+    theta: np.ndarray
+    s: np.ndarray
+    reference: np.ndarray
+    branch: str
+
+    def dual_angles(self) -> Dual:
+        """``theta_k + eps s_k``, shape (..., 4)."""
+        return Dual(self.theta, self.s)
+
+
+@dataclass(frozen=True)
+class LoopRates:
+    """First and second time derivatives of the joint variables, shape (..., 4) each.
+
+    Attributes
+    ----------
+    theta_t, theta_tt : ndarray
+        Joint angular speeds [rad/s] and accelerations [rad/s^2].
+    s_t, s_tt : ndarray
+        Joint sliding speeds [m/s] and accelerations [m/s^2] (zero for joint 1).
+    """
+
+    theta_t: np.ndarray
+    s_t: np.ndarray
+    theta_tt: np.ndarray
+    s_tt: np.ndarray
+
+
+@dataclass(frozen=True)
+class BodyPose:
+    """Canonical body frame (:mod:`reference.scene`) of one link, global components.
+
+    Attributes
+    ----------
+    rotation : ndarray, shape (..., 3, 3)
+        Columns: the body's canonical axes [-].
+    origin : ndarray, shape (..., 3)
+        The link's D-H frame origin: the foot of its common normal on its first joint [m]
+        (the joint centre for the ideal joint; the global origin for the ground).
+    """
+
+    rotation: np.ndarray
+    origin: np.ndarray
+
+
+@dataclass(frozen=True)
+class BodyMotion:
+    """Pose and motion of one link, global components.
+
+    Attributes
+    ----------
+    rotation, origin : ndarray
+        As :class:`BodyPose` [-], [m].
+    omega, alpha : ndarray, shape (..., 3)
+        Angular velocity [rad/s] and acceleration [rad/s^2].
+    velocity, acceleration : ndarray, shape (..., 3)
+        Velocity [m/s] and acceleration [m/s^2] of the body point at ``origin``.
+    """
+
+    rotation: np.ndarray
+    origin: np.ndarray
+    omega: np.ndarray
+    velocity: np.ndarray
+    alpha: np.ndarray
+    acceleration: np.ndarray
+
+
+@dataclass(frozen=True)
+class PairMotion:
+    """Motion of body ``b`` relative to body ``a`` along and about one pair's axis.
+
+    Attributes
+    ----------
+    angle, speed, acceleration : ndarray
+        Rotation since ``theta_1 = 0`` [rad], its speed [rad/s] and acceleration [rad/s^2].
+    slide, slide_speed, slide_acceleration : ndarray
+        Joint slide ``s_k`` [m] and its rates [m/s], [m/s^2] (constant for the revolute pair).
+    """
+
+    angle: np.ndarray
+    speed: np.ndarray
+    acceleration: np.ndarray
+    slide: np.ndarray
+    slide_speed: np.ndarray
+    slide_acceleration: np.ndarray
+
+
+def _samples(name: str, value, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a numeric array, got {value!r}") from None
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"`{name}` must be finite, got {value!r}")
+    if shape is None:
+        return arr
+    try:
+        return np.broadcast_to(arr, shape)
+    except ValueError:
+        raise ValueError(f"`{name}` must broadcast to the shape {shape} of the solved input angles, "
+                         f"got shape {arr.shape}") from None
+
+
+def _listing(angles: np.ndarray) -> str:
+    shown = ", ".join(f"{v:.6g}" for v in angles[:8])
+    return f"[{shown}{', ...' if angles.size > 8 else ''}] rad ({angles.size} sample(s))"
+
+
+def _check_closure(disc: np.ndarray, radius2: np.ndarray, theta1: np.ndarray, where: str) -> None:
+    open_ = disc < -MIN_BRANCH_SEPARATION**2 * radius2
+    meet = ~open_ & (disc <= MIN_BRANCH_SEPARATION**2 * radius2)
+    if open_.any():
+        bad = theta1[open_]
+        raise LoopClosureError(f"the RCCC loop cannot close (discriminant < 0) at {where} "
+                               f"theta_1 = {_listing(bad)}", bad)
+    if meet.any():
+        bad = theta1[meet]
+        raise LoopClosureError(f"the two assembly branches meet (singular configuration, sin of "
+                               f"their half-separation < {MIN_BRANCH_SEPARATION:g}) at {where} "
+                               f"theta_1 = {_listing(bad)}", bad)
+
+
+def _angle_about_z(v: Dual) -> Dual:
+    """Dual angle ``t`` of the line ``Z(t) X(alpha) e_z = (sin t sin alpha, -cos t sin alpha, .)``."""
+    return dual.atan2(v[..., 0], -v[..., 1])
+
+
+def _solve_wrapped(params: DHParameters, theta1: np.ndarray, sign: float, where: str) -> Dual:
+    """Dual joint angles (..., 4) with real parts in (-pi, pi] (``theta_1`` as given)."""
+    tw = params.twists()
+    t1 = Dual(theta1, np.full_like(theta1, params.s1))
+    # joint 2 in F_4 Z(theta_4) coordinates, against joint 3 = X(-alpha_4) Z(-theta_4) (0, w_y, w_z)
+    z2 = dual.matvec(dual.rot_x(tw[3]) @ dual.screw_transform(t1, tw[0]), _E_Z)
+    w_y, w_z = dual.sin(tw[2]), dual.cos(tw[2])
+    a, b, c = z2[..., 1] * w_y, z2[..., 0] * w_y, dual.cos(tw[1]) - z2[..., 2] * w_z
+    radius2 = a.re**2 + b.re**2
+    disc = radius2 - c.re**2
+    _check_closure(disc, radius2, theta1, where)
+    x = np.arctan2(b.re, a.re) + sign * np.arctan2(np.sqrt(np.maximum(disc, 0.0)), c.re)
+    cx, sx = np.cos(x), np.sin(x)
+    # eps part of A cos t4 + B sin t4 = C, linear in s_4; the coefficient is -+sqrt(disc) != 0
+    s4 = (c.du - a.du * cx - b.du * sx) / (b.re * cx - a.re * sx)
+    t4 = Dual(np.arctan2(sx, cx), s4)
+    z3_in_f1 = dual.matvec(dual.rot_x(-tw[3]) @ dual.rot_z(-t4) @ dual.rot_x(-tw[2]), _E_Z)
+    t2 = _angle_about_z(dual.matvec(dual.rot_x(-tw[0]) @ dual.rot_z(-t1), z3_in_f1))
+    z4_in_f2 = dual.matvec(dual.rot_x(-tw[0]) @ dual.rot_z(-t1) @ dual.rot_x(-tw[3]), _E_Z)
+    t3 = _angle_about_z(dual.matvec(dual.rot_x(-tw[1]) @ dual.rot_z(-t2), z4_in_f2))
+    return dual.stack([t1, t2, t3, t4], -1)
+
+
+def solve_positions(params: DHParameters, theta1, branch: str = "hooke") -> LoopPositions:
+    """Joint angles and slides closing the loop for given input angles.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    theta1 : array_like
+        Input angles ``theta_1`` [rad], any shape.
+    branch : {"hooke", "flipped"}
+        Assembly branch (module docstring).
+
+    Returns
+    -------
+    LoopPositions
+
+    Raises
+    ------
+    LoopClosureError
+        If the loop cannot close, or its branches meet, at some input angle or at 0.
+    """
+    if branch not in BRANCHES:
+        raise ValueError(f"`branch` must be one of {list(BRANCHES)}, got {branch!r}")
+    theta1 = _samples("theta1", theta1)
+    sign = _BRANCH_SIGN[branch]
+    reference = _solve_wrapped(params, np.zeros(1), sign, "the reference input angle").re[0]
+    raw = _solve_wrapped(params, theta1, sign, "input angles")
+    nominal = reference + _WINDING * theta1[..., None]
+    theta = nominal + np.remainder(raw.re - nominal + np.pi, 2.0 * np.pi) - np.pi
+    theta[..., 0] = theta1
+    return LoopPositions(theta=theta, s=raw.du, reference=reference, branch=branch)
+
+
+def _joint_frames(params: DHParameters, positions: LoopPositions) -> Dual:
+    """``F_1..F_4`` as dual matrices in global components, shape (..., 4, 3, 3)."""
+    steps = dual.screw_transform(positions.dual_angles(), params.twists())
+    frame = Dual(np.broadcast_to(_GLOBAL_FROM_F1, steps.shape[:-3] + (3, 3)))
+    frames = [frame]
+    for k in range(3):
+        frame = frame @ steps[..., k, :, :]
+        frames.append(frame)
+    return dual.stack(frames, -3)
+
+
+def joint_screws(params: DHParameters, positions: LoopPositions) -> Dual:
+    """Joint axes as unit lines ``u + eps (p x u)`` in global components, shape (..., 4, 3).
+
+    The direction is each pair's z axis of :func:`reference.kinematics.pair_frames` [-]; the
+    moment is about the global origin [m].
+    """
+    return dual.matvec(_joint_frames(params, positions), _E_Z)
+
+
+def pair_axes(params: DHParameters, positions: LoopPositions) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each pair's axis: unit direction [-] and its point closest to the origin [m], (..., 3) each."""
+    screws = joint_screws(params, positions)
+    return {p: (screws.re[..., k, :], dual.line_point(screws[..., k, :]))
+            for k, p in enumerate(PAIR_NAMES)}
+
+
+def body_poses(params: DHParameters, positions: LoopPositions) -> dict[str, BodyPose]:
+    """Canonical frames of ``ground``, ``input``, ``spider`` and ``output`` (global components).
+
+    For the ideal joint these are the rotations of :func:`reference.kinematics.body_motions`
+    and all origins are the joint centre.
+    """
+    links = _joint_frames(params, positions) @ dual.rot_z(positions.dual_angles())
+    rotation, origin = dual.displacement(links)
+    shape = positions.theta.shape[:-1]
+    poses = {"ground": BodyPose(np.broadcast_to(np.eye(3), shape + (3, 3)), np.zeros(shape + (3,)))}
+    for k, name in enumerate(LINK_NAMES[:3]):
+        poses[name] = BodyPose(rotation[..., k, :, :] @ _CANONICAL_IN_LINK[name], origin[..., k, :])
+    return poses
+
+
+def _with_input(first: np.ndarray, rest: Dual) -> Dual:
+    """Prepend the (slide-free) joint 1 value to dual values of joints 2..4, shape (..., 4)."""
+    return Dual(np.concatenate([first[..., None], rest.re], -1),
+                np.concatenate([np.zeros_like(first)[..., None], rest.du], -1))
+
+
+def _screw_rates(screws: Dual, joint_rates: Dual) -> Dual:
+    """``dS_k/dt = V_k x S_k``, ``V_k`` the velocity screw of link k (``V_k x S_k = V_{k-1} x S_k``)."""
+    return dual.cross((joint_rates[..., None] * screws).cumsum(-2), screws)
+
+
+def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t, theta1_tt) -> LoopRates:
+    """Joint speeds and accelerations for a given input motion (analytic, no differencing).
+
+    The relative velocity screws close the loop, ``sum_k (theta_k_t + eps s_k_t) S_k = 0``, six
+    linear equations for the rates of joints 2..4; differentiated once more with
+    ``dS_k/dt = V_k x S_k`` they give the accelerations with the same matrix.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        From :func:`solve_positions` for the same ``params``.
+    theta1_t, theta1_tt : array_like
+        Input speed [rad/s] and acceleration [rad/s^2], broadcastable to the input angles' shape.
+
+    Returns
+    -------
+    LoopRates
+    """
+    shape = positions.theta.shape[:-1]
+    theta1_t = _samples("theta1_t", theta1_t, shape)
+    theta1_tt = _samples("theta1_tt", theta1_tt, shape)
+    screws = joint_screws(params, positions)
+    matrix = screws[..., 1:, :].T
+    rates = _with_input(theta1_t, dual.solve(matrix, -(theta1_t[..., None] * screws[..., 0, :])))
+    drift = (rates[..., None] * _screw_rates(screws, rates)).sum(-2)
+    accels = _with_input(theta1_tt,
+                         dual.solve(matrix, -(theta1_tt[..., None] * screws[..., 0, :] + drift)))
+    return LoopRates(theta_t=rates.re, s_t=rates.du, theta_tt=accels.re, s_tt=accels.du)
+
+
+def solve_motion(params: DHParameters, theta1, theta1_t, theta1_tt,
+                 branch: str = "hooke") -> tuple[LoopPositions, LoopRates]:
+    """:func:`solve_positions` and :func:`solve_rates` in one call (same arguments)."""
+    positions = solve_positions(params, theta1, branch)
+    return positions, solve_rates(params, positions, theta1_t, theta1_tt)
+
+
+def body_motions(params: DHParameters, positions: LoopPositions,
+                 rates: LoopRates) -> dict[str, BodyMotion]:
+    """Pose, velocity and acceleration of ``ground``, ``input``, ``spider`` and ``output``.
+
+    Link k's velocity screw is ``V_k = sum_{j<=k} (theta_j_t + eps s_j_t) S_j``; its real part is
+    the angular velocity, its dual part the velocity of the body point at the global origin.
+    """
+    screws = joint_screws(params, positions)
+    joint_rates, joint_accels = Dual(rates.theta_t, rates.s_t), Dual(rates.theta_tt, rates.s_tt)
+    twist = (joint_rates[..., None] * screws).cumsum(-2)
+    twist_t = (joint_accels[..., None] * screws
+               + joint_rates[..., None] * _screw_rates(screws, joint_rates)).cumsum(-2)
+    poses = body_poses(params, positions)
+    zero = np.zeros(positions.theta.shape[:-1] + (3,))
+    out = {"ground": BodyMotion(poses["ground"].rotation, zero, zero, zero, zero, zero)}
+    for k, name in enumerate(LINK_NAMES[:3]):
+        p = poses[name].origin
+        omega, alpha = twist.re[..., k, :], twist_t.re[..., k, :]
+        velocity = twist.du[..., k, :] + np.cross(omega, p)
+        acceleration = twist_t.du[..., k, :] + np.cross(alpha, p) + np.cross(omega, velocity)
+        out[name] = BodyMotion(poses[name].rotation, p, omega, velocity, alpha, acceleration)
+    return out
+
+
+def pair_motions(positions: LoopPositions, rates: LoopRates) -> dict[str, PairMotion]:
+    """Relative rotation (b relative to a, about the pair axis, from ``theta_1 = 0``) and slide."""
+    angle = positions.theta - positions.reference
+    return {p: PairMotion(angle[..., k], rates.theta_t[..., k], rates.theta_tt[..., k],
+                          positions.s[..., k], rates.s_t[..., k], rates.s_tt[..., k])
+            for k, p in enumerate(PAIR_NAMES)}
+
+
+def output_motion(positions: LoopPositions,
+                  rates: LoopRates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Output shaft angle [rad], speed [rad/s], acceleration [rad/s^2] about its own axis.
+
+    Measured like :func:`reference.kinematics.output_angle`: from the output's position at
+    ``theta_1 = 0``; it is minus the ``output_frame`` pair's rotation (ground relative to output).
+    """
+    pair = pair_motions(positions, rates)["output_frame"]
+    return -pair.angle, -pair.speed, -pair.acceleration
+
+
+def spider_motion(positions: LoopPositions,
+                  rates: LoopRates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Spider angle ``gamma`` relative to the input about the input yoke [rad] and its rates.
+
+    The ``input_spider`` pair's rotation, as :func:`reference.kinematics.spider_motion`.
+    """
+    pair = pair_motions(positions, rates)["input_spider"]
+    return pair.angle, pair.speed, pair.acceleration
+
+
+def loop_closure_residual(params: DHParameters, positions: LoopPositions) -> tuple[float, float]:
+    """Largest deviation of ``prod_k Z(theta_hat_k) X(alpha_hat_k)`` from the identity.
+
+    Returns
+    -------
+    real : float
+        Max abs entry of the real part minus the identity, over all samples [-].
+    dual : float
+        Max abs entry of the dual part [m].
+    """
+    steps = dual.screw_transform(positions.dual_angles(), params.twists())
+    loop = steps[..., 0, :, :] @ steps[..., 1, :, :] @ steps[..., 2, :, :] @ steps[..., 3, :, :]
+    return float(np.max(np.abs(loop.re - np.eye(3)), initial=0.0)), \
+        float(np.max(np.abs(loop.du), initial=0.0))
