@@ -156,6 +156,19 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return main_calibrate(names, args.json)
 
 
+def cmd_compare(args: argparse.Namespace) -> int:
+    from cardan_exudyn.compare import main_compare
+
+    engines = [e.strip() for e in args.engines.split(",") if e.strip()]
+    try:
+        return main_compare(scene_from_args(args), engines, args.skip_revolutions, args.out,
+                            args.json)
+    except ValueError as exc:
+        if isinstance(exc, SceneError):
+            raise
+        raise BadInput(str(exc)) from None
+
+
 def cmd_scene(args: argparse.Namespace) -> int:
     import tomli_w
 
@@ -173,7 +186,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("run", help="simulate one scene")
     _add_scene_options(p)
-    p.add_argument("--engine", default="exudyn", help="exudyn (default) or reference")
+    p.add_argument("--engine", default="exudyn",
+                   help="exudyn (default), reference, or mujoco (frictionless; optional extra)")
     p.add_argument("--out", metavar="DIR", help="write timeseries.csv and summary.json here")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     p.set_defaults(func=cmd_run)
@@ -197,6 +211,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="parameters to fit (default spider_lever,frame_lever,input_eccentricity)")
     p.add_argument("--json", action="store_true", help="print the fit as JSON on stdout")
     p.set_defaults(func=cmd_calibrate)
+
+    p = sub.add_parser("compare", help="run several engines on one scene and compare them")
+    _add_scene_options(p)
+    p.add_argument("--engines", default="exudyn,reference", metavar="A,B",
+                   help="engines, the first is the base (default exudyn,reference; mujoco needs "
+                        "the optional extra and a frictionless scene)")
+    p.add_argument("--skip-revolutions", type=_number("--skip-revolutions", non_negative=True),
+                   default=0.0, metavar="N",
+                   help="leave the first N revolutions out of the 'steady' statistics")
+    p.add_argument("--out", metavar="DIR",
+                   help="report folder: comparison.json, report.md, tables, overlay plots")
+    p.add_argument("--json", action="store_true", help="print the comparison as JSON on stdout")
+    p.set_defaults(func=cmd_compare)
 
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
     _add_scene_options(p)

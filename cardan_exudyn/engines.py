@@ -12,7 +12,7 @@ from reference.schema import Result
 # name -> "module:function"; imported on first use so that a missing optional engine costs nothing
 ENGINES = {
     "exudyn": "cardan_exudyn.engine:run",
-    "reference": "reference.dynamics:run",
+    "reference": "reference.engine:run",
 }
 
 
