@@ -13,6 +13,7 @@ from reference.schema import Result
 ENGINES = {
     "exudyn": "cardan_exudyn.engine:run",
     "reference": "reference.engine:run",
+    "mujoco": "cardan_exudyn.mujoco_engine:run",  # optional extra; frictionless scenes only
 }
 
 

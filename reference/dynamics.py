@@ -313,7 +313,7 @@ class FixedPoint:
     loop_gain : ndarray, shape (n,)
         Spectral radius of ``dG/dphi`` at the solution (0 without friction); where the
         infinity norm of ``dG/dphi`` is below 0.5 that norm is reported instead (an upper bound,
-        enough to tell that the sample does not lock).
+        enough to tell that the sample does not lock); infinite where Newton found no solution.
     iterations : int
         Newton iterations of the slowest sample.
     """
@@ -382,6 +382,7 @@ def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
     gain = np.where(finite, np.max(np.sum(np.abs(gain_matrix), -1), -1), np.inf)
     exact = finite & (gain >= 0.5)
     gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
+    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
     return FixedPoint(x, phi, converged, gain, iterations)
 
 

@@ -165,7 +165,6 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
     target = 2.0 * math.pi * scene.revolutions
     w0 = drive.initial_speed
-    direction = math.copysign(1.0, w0)
     t_max = 4.0 * target / abs(w0)  # the span the Exudyn engine allows, for the same scene
     count = {"n": 0}
 
@@ -176,8 +175,8 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
             raise SelfLocking(t, float(y[0]))
         return np.array([y[1], fixed.x[0, -1]])
 
-    def reached(t: float, y: np.ndarray) -> float:
-        return direction * y[0] - target
+    def reached(t: float, y: np.ndarray) -> float:  # turned `target` either way, as Exudyn's stop
+        return abs(y[0]) - target
 
     reached.terminal = True
     try:

@@ -208,7 +208,7 @@ def external_wrench(scene: Scene, table) -> np.ndarray:
 
     Ground pairs from the table (frame_input acts on the input; output_frame is what the output
     exerts on the ground, so it enters with a minus sign; its frame turns with the output by
-    theta_out about a2), the drive and load torques, and gravity.
+    theta_out about a2), their friction torques, the drive and load torques, and gravity.
     """
     def reaction(pair):
         return (table[[f"{pair}_f{c}" for c in "xyz"]].to_numpy(),
@@ -228,6 +228,10 @@ def external_wrench(scene: Scene, table) -> np.ndarray:
     force = force - f_out
     moment = moment - np.einsum("nij,nj->ni", frame_out, m) - np.cross(geo.output_bearing * a2, f_out)
     moment = moment + np.outer(table["torque_in"], e_x) - np.outer(table["torque_out"], a2)
+    # friction torques of the ground pairs: on the input (body b of frame_input) and, opposite,
+    # on the output (body a of output_frame); the ideal joint does not slide (no axial force)
+    moment = (moment + np.outer(table["frame_input_friction_torque"], e_x)
+              - np.outer(table["output_frame_friction_torque"], a2))
     t = table["t"].to_numpy()
     motions = body_motions(speed * t, np.full_like(t, speed), np.zeros_like(t), beta)
     g = np.asarray(scene.gravity)

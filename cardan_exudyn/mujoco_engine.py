@@ -1,0 +1,796 @@
+"""Optional MuJoCo engine for the frictionless Cardan joint (``pip install mujoco``).
+
+MuJoCo cannot express the paper's friction law (friction forces proportional to the pair
+reactions, eqs. (1)-(5)): its friction loss is a constant-magnitude joint friction. This engine
+therefore runs frictionless scenes only and refuses the others. ``docs/mujoco.md`` holds the
+settings study behind :class:`MujocoSettings`' defaults. Importing this module needs MuJoCo; the
+engine registry imports it on first use, so a missing MuJoCo makes only this engine unavailable.
+
+Model
+-----
+- Body frames are the canonical frames of :mod:`reference.scene` (origin at the joint centre O),
+  so :meth:`reference.scene.Body.canonical` gives each body's inertial element directly.
+- Kinematic tree, all three hinges through O: ``input`` (hinge about global x) -> ``spider``
+  (hinge about the input yoke, the spider's y axis) -> ``output`` (hinge about the output yoke,
+  the output's z axis; the output body frame is turned by the shaft angle about z).
+- Loop closure: one ``connect`` equality between a site on the output axis at the output
+  bearing (``output_bearing * a2``) and the same point fixed to the ground. In the tree the
+  output's origin is already held at O, so only its orientation is free; holding one more point
+  of its axis removes the two tilts and leaves the spin. Of the connect's three rows, the one
+  along ``a2`` is redundant: the point can only move on a sphere about O, so that row's Jacobian
+  vanishes on the constraint manifold. MuJoCo's primal solver regularises every row, so the
+  redundant row costs nothing and carries (almost) no force. A ``weld`` would also fix the spin
+  and lock the mechanism; two connects (two points of the axis) would add three more redundant
+  rows and nothing else.
+- Constant speed and prescribed angle: a heavy ``drive_reference`` hinge about x in its own tree
+  (its centre of mass on its axis, so only the drive acts on it) is reset to the prescribed angle
+  and speed before every step and pushed with ``inertia * acceleration`` during the step; a joint
+  equality ``q_input = q_reference`` couples the input to it. The constraint's velocity error is
+  then the input's speed error, and its force is the drive torque. The alternatives are worse:
+  a velocity servo is integrated explicitly by RK4 (stable only for ``kv < ~2.8 J / dt``, far
+  too soft), and a joint equality whose target is moved by hand every step damps the speed
+  towards zero (``a_ref = -b qdot - k r``), a lag of ``2 timeconst * omega``.
+- Torque drive: a generalized force on the input hinge. Load: the constant world torque
+  ``-T a2`` on the output (``xfrc_applied``), as in :mod:`reference.dynamics`.
+
+Reactions
+---------
+The tree joints are revolute (with an axial force) and the closure is a point, where the schema's
+RCCC has cylindrical spider pairs (no axial force) and a cylindrical output bearing (with bending
+moments): MuJoCo solves a different, also statically determinate, support structure, so its pair
+forces and both frame-pair reactions are not the schema's and are left NaN. The spider-pair
+moments are the same in both structures and are filled: the moment balance of the spider about O
+(both spider-pair forces pass through O) fixes the components of the two moments along the other
+arm, and the input's moment balance about its axis, ``torque_in`` being the same for any support
+(virtual work), fixes the rest. They come from ``mjData.cfrc_int`` (the wrench the parent body
+exerts on a body, about the tree's centre of mass, world axes), moved to O and rotated into the
+pair frame of body ``a``.
+
+References
+----------
+Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
+experimental validation": Section 3 (RCCC model, pair frames) and eq. (18).
+MuJoCo documentation, "Computation" (soft constraints: impedance ``d``, reference acceleration
+``a_ref = -b J v - k r``) and "Modeling / Solver parameters" (``solref``, ``solimp``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass, replace
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from reference.kinematics import (
+    body_motions,
+    pair_frames_in_body_a,
+    rot_z,
+    speed_ratio,
+)
+from reference.scene import (
+    PAIR_BODIES,
+    PAIR_NAMES,
+    AngleDrive,
+    Scene,
+    SpeedDrive,
+    TorqueDrive,
+    scene_to_dict,
+)
+from reference.schema import (
+    STATUS_OK,
+    Result,
+    instantaneous_efficiency,
+    mean_values,
+    table_columns,
+)
+
+ENGINE_NAME = "mujoco"
+INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast", "discrete")
+# MuJoCo's own defaults (option timestep and integrator, solref, solimp), for the study
+MUJOCO_DEFAULT_TIMESTEP = 0.002
+MUJOCO_DEFAULT_SOLREF = (0.02, 1.0)
+MUJOCO_DEFAULT_SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
+# Impedance at MuJoCo's cap mjMAXIMP = 0.9999 (larger values are clamped to it).
+STIFF_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+BODY_IDS = {"input": 1, "spider": 2, "output": 3}
+# A loop that opens by more than this is no Cardan joint any more: the run is flagged [rad].
+VIOLATION_LIMIT_RAD = 1e-2
+# Pairs whose moments (mx, my, mz) are filled; see the module docstring.
+_FILLED_REACTIONS = ("input_spider", "spider_output")
+
+
+def _floats(name: str, value: Any) -> tuple[float, ...]:
+    try:
+        return tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a sequence of numbers, got {value!r}") from None
+
+
+def _solref(name: str, value: Any) -> tuple[float, ...]:
+    ref = _floats(name, value)
+    if len(ref) != 2 or not (min(ref) > 0.0 or (ref[0] < 0.0 and ref[1] <= 0.0)):
+        raise ValueError(f"`{name}` must be (timeconst > 0, dampratio > 0) or "
+                         f"(-stiffness < 0, -damping <= 0), got {value!r}")
+    return ref
+
+
+def _solimp(name: str, value: Any) -> tuple[float, ...]:
+    imp = _floats(name, value)
+    if len(imp) != 5 or not (0.0 < imp[0] < 1.0 and 0.0 < imp[1] < 1.0):
+        raise ValueError(f"`{name}` must be 5 numbers with 0 < d0, dwidth < 1, got {value!r}")
+    return imp
+
+
+@dataclass(frozen=True)
+class MujocoSettings:
+    """Solver settings of the MuJoCo engine; the defaults are the recommended ones.
+
+    Attributes
+    ----------
+    integrator : str
+        One of :data:`INTEGRATORS` (MuJoCo's ``option/integrator``).
+    timestep : float or None
+        Time step [s]; None takes ``scene.numerics.dt`` or, if that is None too, the step that
+        meets ``scene.numerics.accuracy`` (:func:`choose_timestep`).
+    timeconst_steps : float
+        Constraint time constant in time steps: ``solref = (timeconst_steps * dt, dampratio)``
+        when ``solref`` is None [-].
+    dampratio : float
+        Damping ratio of the constraint stabilisation when ``solref`` is None [-].
+    solref : tuple of 2 float or None
+        Explicit ``solref`` of every equality: ``(timeconst [s], dampratio [-])`` or the direct
+        form ``(-stiffness [1/s^2], -damping [1/s])``.
+    solimp : tuple of 5 float
+        ``solimp`` of every equality: ``(d0, dwidth, width [m or rad], midpoint, power)``.
+    refsafe : bool
+        MuJoCo's ``refsafe`` flag: the time constant is raised to at least ``2 dt``.
+    iterations : int
+        Maximum constraint-solver iterations [-].
+    tolerance : float
+        Constraint-solver tolerance [-].
+    noslip_iterations : int
+        Noslip post-processing iterations [-] (acts on friction rows only; there are none).
+    o_solref, o_solimp : tuple or None
+        When either is given, MuJoCo's contact override is enabled with these ``o_solref`` /
+        ``o_solimp`` (MuJoCo's defaults for the one not given). The override acts on contacts
+        only, and there are none: the study shows that it leaves the equalities alone.
+    reference_inertia : float
+        Inertia of the drive-reference body about its axis [kg m^2]: the drive torque changes its
+        speed by ``torque * dt / reference_inertia`` within a step before it is reset.
+    """
+
+    integrator: str = "RK4"
+    timestep: float | None = None
+    timeconst_steps: float = 20.0
+    dampratio: float = 1.0
+    solref: tuple | None = None
+    solimp: tuple = STIFF_SOLIMP
+    refsafe: bool = True
+    iterations: int = 100
+    tolerance: float = 1e-8
+    noslip_iterations: int = 0
+    o_solref: tuple | None = None
+    o_solimp: tuple | None = None
+    reference_inertia: float = 1e6
+
+    def __post_init__(self) -> None:
+        if self.integrator not in INTEGRATORS:
+            raise ValueError(f"`integrator` must be one of {list(INTEGRATORS)}, got {self.integrator!r}")
+        for name in ("timeconst_steps", "dampratio", "reference_inertia"):
+            if not getattr(self, name) > 0.0:
+                raise ValueError(f"`{name}` must be positive, got {getattr(self, name)!r}")
+        if self.timestep is not None and not self.timestep > 0.0:
+            raise ValueError(f"`timestep` must be positive or None, got {self.timestep!r}")
+        for name, check in (("solref", _solref), ("o_solref", _solref), ("o_solimp", _solimp)):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, check(name, getattr(self, name)))
+        object.__setattr__(self, "solimp", _solimp("solimp", self.solimp))
+        for name in ("iterations", "noslip_iterations"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < (name == "iterations"):
+                raise ValueError(f"`{name}` must be a non-negative integer (iterations >= 1), "
+                                 f"got {value!r}")
+        if not self.tolerance >= 0.0:
+            raise ValueError(f"`tolerance` must be >= 0, got {self.tolerance!r}")
+
+    def solref_for(self, dt: float) -> tuple[float, float]:
+        """The ``solref`` used at time step ``dt`` [s]."""
+        return self.solref if self.solref is not None else (self.timeconst_steps * dt, self.dampratio)
+
+
+MUJOCO_DEFAULTS = MujocoSettings(integrator="Euler", timestep=MUJOCO_DEFAULT_TIMESTEP,
+                                 solref=MUJOCO_DEFAULT_SOLREF, solimp=MUJOCO_DEFAULT_SOLIMP)
+
+# Error model of the recommended settings (RK4, solref None): the largest error of
+# omega_out / omega_in is about
+#     C_H tan(b)^2 / cos(b)^2 h^1.5  +  C_G |g| timeconst / omega
+# with h = omega dt the input angle per step [rad]. The first term is the integration error at
+# speed (the paper scenes at 10-75 deg, 2000 rpm: C_H bounds the measured values by 1.2-8x), the
+# second the drift that the impedance cap lets gravity cause within one constraint time constant
+# (the rig scene, 6 rad/s: the measured values are half of it). Measured by `settings_study`,
+# see docs/mujoco.md.
+ERROR_CONSTANT_SPEED = 1.5e-4  # [-]
+ERROR_CONSTANT_GRAVITY = 1e-4  # [1/m]
+MIN_STEPS_PER_REVOLUTION = 100
+MAX_STEPS_PER_REVOLUTION = 2_000_000
+
+
+def engine_version() -> str:
+    return mujoco.__version__
+
+
+def speed_ratio_error_model(scene: Scene, settings: MujocoSettings, steps: int) -> float:
+    """Predicted largest speed-ratio error [-] of a run with ``steps`` steps per revolution.
+
+    Valid for the recommended integrator and constraint settings (RK4, ``solref`` from
+    ``timeconst_steps``); see the constants above.
+    """
+    beta = scene.joint.geometry.shaft_angle
+    omega = scene.drive.max_speed()
+    h = 2.0 * math.pi / steps
+    timeconst = settings.timeconst_steps * h / omega
+    gravity = float(np.linalg.norm(scene.gravity))
+    return (ERROR_CONSTANT_SPEED * (math.tan(beta) / math.cos(beta)) ** 2 * h**1.5
+            + ERROR_CONSTANT_GRAVITY * gravity * timeconst / omega)
+
+
+def choose_timestep(scene: Scene, settings: MujocoSettings) -> tuple[float, str]:
+    """Time step [s] and a sentence saying how it was chosen.
+
+    Without a given step, the fewest whole steps per revolution (at the drive's highest speed),
+    at least :data:`MIN_STEPS_PER_REVOLUTION`, whose :func:`speed_ratio_error_model` meets
+    ``scene.numerics.accuracy``.
+
+    Raises
+    ------
+    ValueError
+        When no step is given and the settings are not the ones the error model was measured
+        with (another integrator or an explicit ``solref``).
+    """
+    if settings.timestep is not None:
+        return settings.timestep, "given (engine settings)"
+    if scene.numerics.dt is not None:
+        return scene.numerics.dt, "given (scene)"
+    if settings.integrator != "RK4" or settings.solref is not None:
+        raise ValueError("the automatic time step is measured for RK4 with `solref` from "
+                         f"`timeconst_steps` only; give `timestep` for integrator "
+                         f"{settings.integrator!r} and solref {settings.solref!r}")
+    accuracy = scene.numerics.accuracy
+    low, high = MIN_STEPS_PER_REVOLUTION, MIN_STEPS_PER_REVOLUTION
+    while speed_ratio_error_model(scene, settings, high) > accuracy and high < MAX_STEPS_PER_REVOLUTION:
+        low, high = high, 2 * high
+    while high - low > 1:  # the smallest count in (low, high] that meets the accuracy
+        middle = (low + high) // 2
+        if speed_ratio_error_model(scene, settings, middle) <= accuracy:
+            high = middle
+        else:
+            low = middle
+    n = min(high, MAX_STEPS_PER_REVOLUTION)
+    why = (f"auto: {n} steps per input revolution for a speed-ratio error <= {accuracy:g} at "
+           f"{math.degrees(scene.joint.geometry.shaft_angle):g} deg (error model of docs/mujoco.md)")
+    return 2.0 * math.pi / scene.drive.max_speed() / n, why
+
+
+def _numbers(values: Iterable[float]) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(np.asarray(values, dtype=float)))
+
+
+def _inertial(scene: Scene, name: str) -> str:
+    mass, com, j = getattr(scene.joint, name).canonical()
+    full = [j[0, 0], j[1, 1], j[2, 2], j[0, 1], j[0, 2], j[1, 2]]
+    return f'<inertial pos="{_numbers(com)}" mass="{mass!r}" fullinertia="{_numbers(full)}"/>'
+
+
+def mjcf(scene: Scene, settings: MujocoSettings, dt: float) -> str:
+    """The MJCF model of ``scene`` (see the module docstring) with time step ``dt`` [s]."""
+    geo = scene.joint.geometry
+    half = 0.5 * geo.shaft_angle
+    solref = f'solref="{_numbers(settings.solref_for(dt))}" solimp="{_numbers(settings.solimp)}"'
+    prescribed = not isinstance(scene.drive, TorqueDrive)
+    i_ref = settings.reference_inertia
+    reference_body = (
+        f'<body name="drive_reference"><joint name="drive_reference" axis="1 0 0"/>'
+        f'<inertial pos="0 0 0" mass="1" diaginertia="{i_ref!r} {i_ref!r} {i_ref!r}"/></body>'
+        if prescribed else "")
+    drive = (f'<joint name="drive" joint1="input" joint2="drive_reference" polycoef="0 1 0 0 0" '
+             f'{solref}/>' if prescribed else "")
+    override = settings.o_solref is not None or settings.o_solimp is not None
+    o_solref = settings.o_solref if settings.o_solref is not None else MUJOCO_DEFAULT_SOLREF
+    o_solimp = settings.o_solimp if settings.o_solimp is not None else MUJOCO_DEFAULT_SOLIMP
+    return f"""<mujoco model="cardan">
+  <option timestep="{dt!r}" integrator="{settings.integrator}" gravity="{_numbers(scene.gravity)}"
+          solver="Newton" jacobian="dense" iterations="{settings.iterations}"
+          tolerance="{settings.tolerance!r}" noslip_iterations="{settings.noslip_iterations}"
+          o_solref="{_numbers(o_solref)}" o_solimp="{_numbers(o_solimp)}">
+    <flag refsafe="{'enable' if settings.refsafe else 'disable'}" autoreset="disable"
+          override="{'enable' if override else 'disable'}"/>
+  </option>
+  <worldbody>
+    <site name="bearing_ground" pos="{_numbers(geo.output_bearing * geo.output_axis())}"/>
+    <body name="input">
+      <joint name="input" axis="1 0 0"/>
+      {_inertial(scene, "input")}
+      <body name="spider">
+        <joint name="spider" axis="0 1 0"/>
+        {_inertial(scene, "spider")}
+        <body name="output" quat="{math.cos(half)!r} 0 0 {math.sin(half)!r}">
+          <joint name="output" axis="0 0 1"/>
+          {_inertial(scene, "output")}
+          <site name="bearing_output" pos="{geo.output_bearing!r} 0 0"/>
+        </body>
+      </body>
+    </body>
+    {reference_body}
+  </worldbody>
+  <equality>
+    <connect name="closure" site1="bearing_output" site2="bearing_ground" {solref}/>
+    {drive}
+  </equality>
+</mujoco>
+"""
+
+
+def joint_state(scene: Scene, theta: float, theta_t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Assembled angles [rad] and rates [rad/s] of the input, spider and output hinges.
+
+    From the closed-form kinematics: the spider angle about the input yoke, and the output
+    hinge angle ``phi`` defined by ``R_output = R_spider Rz(beta) Rz(phi)``; the rates are the
+    relative angular velocities projected on the hinge axes.
+    """
+    beta = scene.joint.geometry.shaft_angle
+    m = body_motions(np.array(theta), np.array(theta_t), np.array(0.0), beta)
+    r_input, r_spider, r_output = (m[b].rotation for b in ("input", "spider", "output"))
+    spider_relative = r_input.T @ r_spider
+    output_relative = rot_z(np.array(-beta)) @ r_spider.T @ r_output
+    gamma = math.atan2(spider_relative[0, 2], spider_relative[0, 0])
+    phi = math.atan2(output_relative[1, 0], output_relative[0, 0])
+    gamma_t = float((m["spider"].omega - m["input"].omega) @ r_input[:, 1])
+    phi_t = float((m["output"].omega - m["spider"].omega) @ r_spider[:, 2])
+    return np.array([theta, gamma, phi]), np.array([theta_t, gamma_t, phi_t])
+
+
+@dataclass(frozen=True)
+class DrivePlan:
+    """How the input is driven: start, longest span, prescribed motion and stop angle.
+
+    Attributes
+    ----------
+    start : float
+        Start time [s].
+    span : float
+        Longest simulated time [s].
+    motion : callable or None
+        ``t -> (angle [rad], speed [rad/s], acceleration [rad/s^2])`` of a prescribed input;
+        None for the torque drive.
+    theta0, omega0 : float
+        Input angle [rad] and speed [rad/s] at ``start``.
+    turn : float
+        Input rotation [rad] after which the run stops (the scene's revolutions).
+    """
+
+    start: float
+    span: float
+    motion: Callable[[float], tuple[float, float, float]] | None
+    theta0: float
+    omega0: float
+    turn: float
+
+
+def drive_plan(scene: Scene) -> DrivePlan:
+    """The :class:`DrivePlan` of the scene's drive (speed, angle history or torque)."""
+    drive = scene.drive
+    turn = 2.0 * math.pi * scene.revolutions
+    if isinstance(drive, SpeedDrive):
+        w = drive.speed
+        return DrivePlan(0.0, turn / abs(w), lambda t: (w * t, w, 0.0), 0.0, w, turn)
+    if isinstance(drive, AngleDrive):
+        spline = drive.spline()
+        rates = (spline, spline.derivative(), spline.derivative(2))
+        t = np.linspace(drive.time[0], drive.time[-1], 50 * len(drive.time))
+        turned = np.maximum.accumulate(np.abs(spline(t) - spline(t[0])))
+        end = float(t[min(int(np.searchsorted(turned, turn - 1e-9)), t.size - 1)])
+        start = drive.time[0]
+        return DrivePlan(start, end - start, lambda s: tuple(float(f(s)) for f in rates),
+                         float(spline(start)), float(rates[1](start)), turn)
+    if isinstance(drive, TorqueDrive):
+        # as the Exudyn engine: four times the time at the initial speed, stopped at `turn`
+        return DrivePlan(0.0, 4.0 * turn / abs(drive.initial_speed), None, 0.0,
+                         drive.initial_speed, turn)
+    raise NotImplementedError(f"the MuJoCo engine cannot run a {type(drive).__name__}")
+
+
+class _Record:
+    """Per-step copies of the mjData fields the result table is computed from."""
+
+    def __init__(self, n: int) -> None:
+        self.t = np.zeros(n)
+        self.q = np.zeros((n, 3))
+        self.qd = np.zeros((n, 3))
+        self.reference = np.zeros(n)
+        self.xmat = np.zeros((n, 3, 3, 3))
+        self.cvel = np.zeros((n, 3, 6))
+        self.centre = np.zeros((n, 3))
+        self.sites = np.zeros((n, 2, 3))
+        self.cfrc_int = np.zeros((n, 3, 6))
+        self.torque_in = np.zeros(n)
+        self.size = 0
+
+    def take(self, d: Any, drive_row: int | None, torque: float) -> None:
+        k, bodies = self.size, slice(1, 4)
+        self.t[k] = d.time
+        self.q[k], self.qd[k] = d.qpos[:3], d.qvel[:3]
+        self.reference[k] = d.qpos[3] if drive_row is not None else np.nan
+        self.xmat[k] = d.xmat[bodies].reshape(3, 3, 3)
+        self.cvel[k] = d.cvel[bodies]
+        self.centre[k] = d.subtree_com[BODY_IDS["input"]]
+        self.sites[k] = d.site_xpos[:2]
+        self.cfrc_int[k] = d.cfrc_int[bodies]
+        self.torque_in[k] = d.efc_force[drive_row] if drive_row is not None else torque
+        self.size += 1
+
+    def trimmed(self) -> _Record:
+        for name, value in vars(self).items():
+            if isinstance(value, np.ndarray):
+                setattr(self, name, value[:self.size])
+        return self
+
+
+def _integrate(m: Any, d: Any) -> None:
+    """Advance one step from an mjData on which ``mj_forward`` has just run."""
+    integrator = m.opt.integrator
+    if integrator == mujoco.mjtIntegrator.mjINT_RK4:
+        mujoco.mj_RungeKutta(m, d, 4)
+    elif integrator == mujoco.mjtIntegrator.mjINT_EULER:
+        mujoco.mj_Euler(m, d)
+    elif integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST):
+        mujoco.mj_implicit(m, d)
+    else:  # "discrete" has no separate integration call: mj_step repeats the forward pass
+        mujoco.mj_step(m, d)
+
+
+def simulate(scene: Scene, settings: MujocoSettings, dt: float) -> tuple[_Record, str, str]:
+    """Run the MuJoCo model of ``scene``; per-step records, status and reason.
+
+    Every step runs ``mj_forward`` and ``mj_rnePostConstraint`` at the current state, records,
+    and integrates, so that every record (state, drive torque, reactions) belongs to one instant.
+    """
+    plan = drive_plan(scene)
+    m = mujoco.MjModel.from_xml_string(mjcf(scene, settings, dt))
+    d = mujoco.MjData(m)
+    q0, qd0 = joint_state(scene, plan.theta0, plan.omega0)
+    d.qpos[:3], d.qvel[:3] = q0, qd0
+    a2 = scene.joint.geometry.output_axis()
+    d.xfrc_applied[BODY_IDS["output"], 3:] = -scene.load.torque * a2
+    torque = scene.drive.torque if isinstance(scene.drive, TorqueDrive) else 0.0
+    d.qfrc_applied[0] = torque
+    # The run ends once the input itself has turned `revolutions`. A prescribed input lags its
+    # reference (by a fraction of a step with the recommended settings, by 0.06 rad with
+    # MuJoCo's default solref/solimp), so it may take up to 1 % more steps than the span.
+    steps = max(1, math.ceil(plan.span / dt - 1e-9))
+    if plan.motion is not None:
+        steps += math.ceil(0.01 * steps)
+    record = _Record(steps + 1)
+    drive_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "drive")
+    drive_row = None
+    status, reason = STATUS_OK, ""
+    for k in range(steps + 1):
+        d.time = plan.start + k * dt
+        if plan.motion is not None:
+            angle, speed, acceleration = plan.motion(d.time)
+            d.qpos[3], d.qvel[3] = angle, speed
+            d.qfrc_applied[3] = settings.reference_inertia * acceleration
+        mujoco.mj_forward(m, d)
+        mujoco.mj_rnePostConstraint(m, d)
+        if plan.motion is not None and drive_row is None:  # equality rows keep their place
+            drive_row = int(np.flatnonzero((d.efc_type == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+                                           & (d.efc_id == drive_id))[0])
+        record.take(d, drive_row, torque)
+        if not math.isfinite(d.qvel @ d.qvel + d.qacc @ d.qacc):
+            status, reason = "diverged", f"non-finite state at t = {d.time:.6g} s (step {k})"
+            break
+        if abs(d.qpos[0] - plan.theta0) >= plan.turn - 1e-12 or k == steps:
+            break
+        _integrate(m, d)
+    turned = abs(d.qpos[0] - plan.theta0)
+    if status == STATUS_OK and turned < plan.turn - 1e-9:
+        status = "incomplete"
+        reason = (f"the input turned {turned / (2 * math.pi):.6g} of {scene.revolutions:g} "
+                  "revolutions in the time allowed")
+    return record.trimmed(), status, reason
+
+
+def _point_velocity(cvel: np.ndarray, centre: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """Velocity [m/s] of a body point from MuJoCo's com-based velocity ``[omega, v(centre)]``."""
+    return cvel[:, 3:] + np.cross(cvel[:, :3], point - centre)
+
+
+def _body_motion(record: _Record) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Rotation matrices (columns: canonical axes) and angular velocities [rad/s], ground included."""
+    n = record.t.size
+    rot = {"ground": np.broadcast_to(np.eye(3), (n, 3, 3))}
+    omega = {"ground": np.zeros((n, 3))}
+    for name, i in BODY_IDS.items():
+        rot[name], omega[name] = record.xmat[:, i - 1], record.cvel[:, i - 1, :3]
+    return rot, omega
+
+
+def mechanical_energy(scene: Scene, record: _Record) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy of the three bodies [J] (potential zero at O)."""
+    rot, omega = _body_motion(record)
+    kinetic, potential = np.zeros(record.t.size), np.zeros(record.t.size)
+    for name, i in BODY_IDS.items():
+        mass, com, inertia = getattr(scene.joint, name).canonical()
+        r = rot[name] @ com
+        v = _point_velocity(record.cvel[:, i - 1], record.centre, r)
+        j_omega = np.einsum("nij,jk,nlk,nl->ni", rot[name], inertia, rot[name], omega[name])
+        kinetic += 0.5 * mass * np.sum(v * v, 1) + 0.5 * np.sum(omega[name] * j_omega, 1)
+        potential -= mass * (r @ np.asarray(scene.gravity))
+    return kinetic, potential
+
+
+def pair_columns(scene: Scene, record: _Record) -> dict[str, np.ndarray]:
+    """Relative motion, zero friction and the reactions of each pair (NaN where not filled)."""
+    n = record.t.size
+    geo = scene.joint.geometry
+    rot, omega = _body_motion(record)
+    points = {"frame_input": np.broadcast_to([-geo.input_bearing, 0.0, 0.0], (n, 3)),
+              "input_spider": np.zeros((n, 3)), "spider_output": np.zeros((n, 3)),
+              "output_frame": record.sites[:, 1]}
+    local = pair_frames_in_body_a()
+    cols = {}
+    for pair in PAIR_NAMES:
+        a, b = PAIR_BODIES[pair]
+        frame = rot[a] @ local[pair]
+        velocity = {body: np.zeros((n, 3)) if body == "ground" else
+                    _point_velocity(record.cvel[:, BODY_IDS[body] - 1], record.centre, points[pair])
+                    for body in (a, b)}
+        cols[f"{pair}_omega_rel"] = np.sum((omega[b] - omega[a]) * frame[:, :, 2], 1)
+        cols[f"{pair}_slide_rel"] = np.sum((velocity[b] - velocity[a]) * frame[:, :, 2], 1)
+        for key in (f"power_loss_{pair}", f"{pair}_friction_torque", f"{pair}_friction_force"):
+            cols[key] = np.zeros(n)
+        for component in ("fx", "fy", "fz", "mx", "my", "mz"):
+            cols[f"{pair}_{component}"] = np.full(n, np.nan)
+        if pair in _FILLED_REACTIONS:  # the wrench a exerts on b, moved to the pair origin
+            wrench = record.cfrc_int[:, BODY_IDS[b] - 1]
+            moment = wrench[:, :3] + np.cross(record.centre - points[pair], wrench[:, 3:])
+            local_moment = np.einsum("nji,nj->ni", frame, moment)
+            for i, component in enumerate(("mx", "my", "mz")):
+                cols[f"{pair}_{component}"] = local_moment[:, i]
+    return cols
+
+
+def columns(scene: Scene, record: _Record) -> dict[str, np.ndarray]:
+    """Result-schema columns from the records (see the module docstring for the reactions)."""
+    n = record.t.size
+    geo = scene.joint.geometry
+    y_out = record.xmat[:, BODY_IDS["output"] - 1, :, 1]
+    y_ref = np.array([-math.sin(geo.shaft_angle), math.cos(geo.shaft_angle), 0.0])
+    cols = {"t": record.t, "theta_in": record.q[:, 0], "omega_in": record.qd[:, 0],
+            "theta_out": np.unwrap(np.arctan2(y_out[:, 2], y_out @ y_ref)),
+            "omega_out": record.cvel[:, BODY_IDS["output"] - 1, :3] @ geo.output_axis(),
+            "torque_in": record.torque_in, "torque_out": np.full(n, scene.load.torque)}
+    cols["power_in"] = cols["torque_in"] * cols["omega_in"]
+    cols["power_out"] = cols["torque_out"] * cols["omega_out"]
+    cols["power_loss"] = np.zeros(n)
+    cols["efficiency"] = instantaneous_efficiency(cols["power_in"], cols["power_loss"])
+    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(scene, record)
+    cols.update(pair_columns(scene, record))
+    return cols
+
+
+def constraint_violation(scene: Scene, record: _Record) -> dict[str, float]:
+    """Largest loop-closure and drive violations over the run.
+
+    ``max_constraint_violation_m``: distance of the output's bearing point from its place on the
+    ground [m]; ``max_constraint_violation_rad``: misalignment of the output axis from ``a2``
+    [rad]; ``max_drive_error_rad``: input angle minus prescribed angle [rad] (NaN for a torque
+    drive).
+    """
+    drift = np.linalg.norm(record.sites[:, 1] - record.sites[:, 0], axis=1)
+    axis = record.xmat[:, BODY_IDS["output"] - 1, :, 0]
+    tilt = np.linalg.norm(np.cross(axis, scene.joint.geometry.output_axis()), axis=1)
+    lag = np.abs(record.q[:, 0] - record.reference)
+    return {"max_constraint_violation_m": float(np.max(drift)),
+            "max_constraint_violation_rad": float(np.max(tilt)),
+            "max_drive_error_rad": float(np.max(lag)) if np.all(np.isfinite(lag)) else float("nan")}
+
+
+def run(scene: Scene, settings: MujocoSettings | None = None) -> Result:
+    """Simulate the frictionless ``scene`` with MuJoCo and return its time table and summary.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene with every friction coefficient zero.
+    settings : MujocoSettings, optional
+        Solver settings; the defaults are the recommended ones (``docs/mujoco.md``).
+
+    Returns
+    -------
+    Result
+        The columns of :func:`reference.schema.table_columns` (pair forces and frame-pair
+        reactions NaN, see the module docstring) and the summary with the mean values.
+
+    Raises
+    ------
+    NotImplementedError
+        For scenes with friction: MuJoCo has no friction proportional to the reactions.
+    """
+    if scene.has_friction:
+        raise NotImplementedError(
+            "MuJoCo cannot model the paper's friction (eqs. (1)-(5): friction forces "
+            "proportional to the pair reactions); its frictionloss is a constant joint friction. "
+            "Use the exudyn engine or a '-frictionless' scene")
+    settings = settings or MujocoSettings()
+    start = time.perf_counter()
+    dt, why = choose_timestep(scene, settings)
+    record, status, reason = simulate(scene, settings, dt)
+    cols = columns(scene, record)
+    summary: dict[str, Any] = {
+        "status": status, "reason": reason, "engine": ENGINE_NAME,
+        "engine_version": engine_version(), "scene": scene_to_dict(scene), "dt": dt,
+        "dt_choice": why, "steps": int(record.t.size - 1),
+        "options": {**asdict(settings), "solref": list(settings.solref_for(dt))},
+        **constraint_violation(scene, record),
+    }
+    if status == STATUS_OK:
+        means = mean_values(cols, scene.record.skip_revolutions)
+        if means.get("revolutions", 0) < 1:
+            summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))
+        elif summary["max_constraint_violation_rad"] > VIOLATION_LIMIT_RAD:
+            summary.update(status="constraint_violated", reason=(
+                f"the output axis left its bearing by up to "
+                f"{summary['max_constraint_violation_rad']:.3g} rad (limit {VIOLATION_LIMIT_RAD:g}):"
+                " the loop closure is too soft for this time step and these settings"))
+        summary.update({k: v for k, v in means.items() if k != "mean_status"})
+    table = None
+    if scene.record.timeseries:
+        import pandas as pd
+
+        every = scene.record.every
+        table = pd.DataFrame({c: cols[c][::every] for c in table_columns()})
+    summary["wall_time_s"] = time.perf_counter() - start
+    return Result(table, summary)
+
+
+
+STUDY_SCENES = ("paper-10deg-frictionless", "paper-30deg-frictionless")
+STUDY_TIMESTEPS = (1e-4, 5e-5, 2e-5, 1e-5)
+
+
+def accuracy(scene: Scene, result: Result) -> dict[str, float]:
+    """The study's error measures of one constant-speed run (defined here once).
+
+    Returns
+    -------
+    dict
+        ``speed_ratio_error``: largest ``|omega_out / omega_in - Hooke's ratio at theta_in|`` [-];
+        ``torque_in_error``: largest ``|torque_in - reference|`` over the largest ``|reference|``
+        [-], the reference being :func:`reference.dynamics.inverse_dynamics` at the prescribed
+        motion and the run's times; ``mean_torque_in_error``: ``|mean_torque_in - T|`` [N m]
+        (over whole revolutions of a frictionless joint the mean input torque is exactly the load
+        torque ``T``); ``axis_misalignment_rad``, ``bearing_drift_m``, ``drive_error_rad``: the
+        summary's constraint violations. NaN when the run has no mean values (it diverged or
+        did not finish).
+    """
+    from reference.dynamics import inverse_dynamics  # the study's yardstick, not the engine's
+
+    keys = ("speed_ratio_error", "torque_in_error", "mean_torque_in_error",
+            "axis_misalignment_rad", "bearing_drift_m", "drive_error_rad")
+    if "mean_torque_in" not in result.summary:
+        return dict.fromkeys(keys, float("nan"))
+    table, summary = result.table, result.summary
+    beta = scene.joint.geometry.shaft_angle
+    ratio = table["omega_out"].to_numpy() / table["omega_in"].to_numpy()
+    t = table["t"].to_numpy()
+    w = scene.drive.speed
+    ref = inverse_dynamics(scene, w * t, np.full_like(t, w), np.zeros_like(t))["torque_in"]
+    values = (
+        np.max(np.abs(ratio - speed_ratio(table["theta_in"].to_numpy(), beta))),
+        np.max(np.abs(table["torque_in"].to_numpy() - ref)) / np.max(np.abs(ref)),
+        abs(summary["mean_torque_in"] - scene.load.torque),
+        summary["max_constraint_violation_rad"], summary["max_constraint_violation_m"],
+        summary["max_drive_error_rad"],
+    )
+    return {k: float(v) for k, v in zip(keys, values, strict=True)}
+
+
+def study_cases(timesteps: Iterable[float] = STUDY_TIMESTEPS) -> list[tuple[str, MujocoSettings]]:
+    """The settings compared in ``docs/mujoco.md``: ``(label, settings)`` pairs.
+
+    MuJoCo's defaults as they come (Euler, 2 ms); then for every time step the default
+    ``solref``/``solimp``, each integrator with the stiffest constraint ``refsafe`` allows
+    (time constant 2 dt, impedance 0.9999), and RK4 with longer time constants; then, at the
+    first time step, the knobs that should not matter or that trade one error for another.
+    """
+    stiff = {"solimp": STIFF_SOLIMP}
+    soft = {"solref": MUJOCO_DEFAULT_SOLREF, "solimp": MUJOCO_DEFAULT_SOLIMP}
+    cases = [("MuJoCo defaults", MUJOCO_DEFAULTS)]
+    timesteps = list(timesteps)
+    for dt in timesteps:
+        cases += [(f"default solref/solimp, {i}", MujocoSettings(integrator=i, timestep=dt, **soft))
+                  for i in ("Euler", "RK4")]
+        cases += [(f"{i}, tc 2 dt", MujocoSettings(integrator=i, timestep=dt, timeconst_steps=2, **stiff))
+                  for i in INTEGRATORS]
+        cases += [(f"RK4, tc {n:g} dt", MujocoSettings(timestep=dt, timeconst_steps=n))
+                  for n in (5, 20, 50)]
+    dt = timesteps[0]
+    tc = 20 * dt
+    recommended = MujocoSettings(timestep=dt)
+    cases += [
+        ("RK4, tc 20 dt, direct solref", replace(recommended, solref=(-1.0 / tc**2, -2.0 / tc))),
+        ("RK4, tc 20 dt, dampratio 0.5", replace(recommended, dampratio=0.5)),
+        ("RK4, tc 20 dt, dampratio 2", replace(recommended, dampratio=2.0)),
+        ("RK4, tc 20 dt, d 0.99", replace(recommended, solimp=(0.99, 0.99, 0.001, 0.5, 2.0))),
+        ("RK4, tc 20 dt, d 0.9", replace(recommended, solimp=(0.9, 0.9, 0.001, 0.5, 2.0))),
+        ("RK4, tc 0.5 dt, refsafe on", replace(recommended, timeconst_steps=0.5)),
+        ("RK4, tc 0.5 dt, refsafe off", replace(recommended, timeconst_steps=0.5, refsafe=False)),
+        ("Euler, tc 0.5 dt, refsafe off",
+         replace(recommended, integrator="Euler", timeconst_steps=0.5, refsafe=False)),
+        ("discrete, tc 0.1 dt, refsafe off",
+         replace(recommended, integrator="discrete", timeconst_steps=0.1, refsafe=False)),
+        ("RK4, tc 20 dt, noslip 10", replace(recommended, noslip_iterations=10)),
+        ("RK4, tc 20 dt, contact override (soft o_solref/o_solimp)",
+         replace(recommended, o_solref=MUJOCO_DEFAULT_SOLREF, o_solimp=MUJOCO_DEFAULT_SOLIMP)),
+        ("RK4, tc 20 dt, 1 solver iteration", replace(recommended, iterations=1)),
+        ("RK4, tc 20 dt, reference inertia 1e3", replace(recommended, reference_inertia=1e3)),
+    ]
+    return cases
+
+
+def low_speed_cases(timesteps: Iterable[float] = (1e-3, 3e-4, 1e-4)) -> list[tuple[str, MujocoSettings]]:
+    """RK4 with constraint time constants of 5 and 20 steps, for the slow rig scene.
+
+    At low speed gravity, not inertia, loads the loop closure, and the drift the impedance cap
+    lets it cause grows with the time constant (the error model's second term).
+    """
+    return [(f"RK4, tc {n} dt", MujocoSettings(timestep=dt, timeconst_steps=n))
+            for dt in timesteps for n in (5, 20)]
+
+
+def settings_study(scenes: Iterable[str] = STUDY_SCENES,
+                   cases: Iterable[tuple[str, MujocoSettings]] | None = None,
+                   repeats: int = 3) -> Any:
+    """Error and cost of MuJoCo settings on frictionless constant-speed scenes.
+
+    Parameters
+    ----------
+    scenes : iterable of str
+        Named scenes (:func:`reference.paper.named_scene`), frictionless, constant speed.
+    cases : iterable of (str, MujocoSettings), optional
+        Labelled settings; default :func:`study_cases`.
+    repeats : int
+        Runs per case; the wall time is their median [-].
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per scene and case: ``scene``, ``case``, ``integrator``, ``dt`` [s],
+        ``steps_per_revolution`` [-], ``solref``, ``solimp``, ``status``, the measures of
+        :func:`accuracy` and ``wall_time_s`` [s] (median, model compilation included).
+    """
+    import pandas as pd
+
+    from reference.paper import named_scene
+    from reference.scene import replace as replace_scene
+
+    cases = study_cases() if cases is None else list(cases)
+    rows = []
+    for name in scenes:
+        scene = replace_scene(named_scene(name), **{"record.timeseries": True, "record.every": 1})
+        run(scene, cases[0][1])  # import and warm up outside the timings
+        for label, settings in cases:
+            results = [run(scene, settings) for _ in range(repeats)]
+            dt = results[0].summary["dt"]
+            rows.append({
+                "scene": name, "case": label, "integrator": settings.integrator, "dt": dt,
+                "steps_per_revolution": 2.0 * math.pi / abs(scene.drive.speed) / dt,
+                "solref": settings.solref_for(dt), "solimp": settings.solimp,
+                "status": results[0].summary["status"], **accuracy(scene, results[0]),
+                "wall_time_s": float(np.median([r.summary["wall_time_s"] for r in results])),
+            })
+    return pd.DataFrame(rows)

@@ -1,0 +1,191 @@
+"""The optional MuJoCo engine against Hooke's closed form, the reference engine and the schema.
+
+Tolerances come from docs/mujoco.md. With the recommended settings (RK4, constraint time
+constant 20 steps, impedance 0.9999) at dt = 1e-4 s (300 steps per revolution at 2000 rpm):
+
+- the speed-ratio error is bounded by the documented error model
+  (:func:`cardan_exudyn.mujoco_engine.speed_ratio_error_model`), which over-estimates the
+  measured values (3.9e-9 at 10 deg, 2.4e-8 at 30 deg) by 2-40x;
+- every constraint force, the drive torque included, misses a fraction of about ``1 - d = 1e-4``
+  (MuJoCo caps the impedance d at 0.9999): the measured torque and spider-moment errors are
+  5e-5 to 9e-5 of their peak at every step size, so the tolerance is ``2 * (1 - d)`` of the peak.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from cardan_exudyn.mujoco_engine import (  # noqa: E402 (after the optional-import skip)
+    MUJOCO_DEFAULTS,
+    MujocoSettings,
+    accuracy,
+    run,
+    settings_study,
+    speed_ratio_error_model,
+    study_cases,
+)
+from reference.dynamics import inverse_dynamics  # noqa: E402
+from reference.paper import named_scene  # noqa: E402
+from reference.scene import Numerics, Scene, TorqueDrive, replace  # noqa: E402
+from reference.schema import table_columns  # noqa: E402
+
+DT = 1e-4
+STEPS_PER_REVOLUTION = 300  # 2000 rpm at DT
+IMPEDANCE_LEAK = 1.0 - 0.9999
+ANGLES = (10, 30)
+
+
+def paper_scene(deg: int, **changes) -> Scene:
+    return replace(named_scene(f"paper-{deg}deg-frictionless"), **{"numerics.dt": DT, **changes})
+
+
+@pytest.fixture(scope="module")
+def runs() -> dict:
+    """The frictionless paper scenes at 10 and 30 deg, 2000 rpm, recommended settings."""
+    out = {}
+    for deg in ANGLES:
+        scene = paper_scene(deg)
+        out[deg] = (scene, run(scene))
+    return out
+
+
+def reference_columns(scene: Scene, t: np.ndarray) -> dict[str, np.ndarray]:
+    w = scene.drive.speed
+    return inverse_dynamics(scene, w * t, np.full_like(t, w), np.zeros_like(t))
+
+
+@pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
+def test_speed_ratio_matches_hooke(runs, deg):
+    """omega_out / omega_in follows Hooke's formula within the documented error model."""
+    scene, result = runs[deg]
+    assert result.ok, result.summary["reason"]
+    bound = speed_ratio_error_model(scene, MujocoSettings(), STEPS_PER_REVOLUTION)
+    assert accuracy(scene, result)["speed_ratio_error"] <= bound
+
+
+@pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
+def test_loop_closure_holds(runs, deg):
+    """The output axis stays in its bearing: 1e-7 rad and 1e-8 m (measured 2.9e-8, 2.7e-9)."""
+    summary = runs[deg][1].summary
+    assert summary["max_constraint_violation_rad"] < 1e-7
+    assert summary["max_constraint_violation_m"] < 1e-8
+
+
+@pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
+def test_torque_in_matches_reference(runs, deg):
+    """The drive torque equals the reference engine's within twice the impedance leak."""
+    scene, result = runs[deg]
+    t = result.table["t"].to_numpy()
+    desired = reference_columns(scene, t)["torque_in"]
+    np.testing.assert_allclose(result.table["torque_in"], desired, rtol=0.0,
+                               atol=2.0 * IMPEDANCE_LEAK * np.max(np.abs(desired)))
+
+
+@pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
+def test_mean_torque_is_the_load(runs, deg):
+    """Over whole revolutions the mean drive torque of a frictionless joint is the load torque.
+
+    Measured 6e-8 (10 deg) and 4e-7 N m (30 deg) at this step; 5x that is the tolerance.
+    """
+    scene, result = runs[deg]
+    np.testing.assert_allclose(result.summary["mean_torque_in"], scene.load.torque,
+                               rtol=0.0, atol=2e-6)
+    np.testing.assert_allclose(result.summary["work_ratio"], 1.0, rtol=0.0, atol=1e-6)
+
+
+@pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
+def test_spider_moments_match_reference(runs, deg):
+    """The spider-pair moments, sign and frame included, equal the reference's (leak tolerance)."""
+    scene, result = runs[deg]
+    desired = reference_columns(scene, result.table["t"].to_numpy())
+    for pair in ("input_spider", "spider_output"):
+        peak = max(np.max(np.abs(desired[f"{pair}_{c}"])) for c in ("mx", "my"))
+        for component in ("mx", "my", "mz"):
+            np.testing.assert_allclose(result.table[f"{pair}_{component}"],
+                                       desired[f"{pair}_{component}"], rtol=0.0,
+                                       atol=2.0 * IMPEDANCE_LEAK * peak, err_msg=pair + component)
+
+
+def test_columns_and_summary_follow_the_schema(runs):
+    """Same columns as the schema; unfillable reactions are NaN; summary keys of every engine."""
+    scene, result = runs[30]
+    assert list(result.table.columns) == table_columns()
+    unfilled = [f"{p}_{c}" for p in ("frame_input", "output_frame") for c in ("fx", "fy", "fz",
+                                                                                "mx", "my", "mz")]
+    unfilled += [f"{p}_{c}" for p in ("input_spider", "spider_output") for c in ("fx", "fy", "fz")]
+    assert result.table[unfilled].isna().all().all()
+    filled = [c for c in table_columns() if c not in unfilled]
+    assert result.table[filled].notna().all().all()
+    for key in ("status", "reason", "engine_version", "scene", "dt", "steps", "wall_time_s",
+                "mean_efficiency", "mean_torque_in", "work_ratio"):
+        assert key in result.summary
+    assert result.summary["engine"] == "mujoco"
+    assert result.summary["dt"] == DT
+
+
+def test_friction_scene_is_refused():
+    """MuJoCo cannot model friction proportional to reactions: friction scenes raise."""
+    with pytest.raises(NotImplementedError, match="friction"):
+        run(named_scene("paper-10deg"))
+
+
+def test_mujoco_defaults_are_flagged():
+    """MuJoCo's own defaults (Euler, 2 ms, solref 0.02) open the loop: the run is flagged."""
+    result = run(named_scene("paper-30deg-frictionless"), MUJOCO_DEFAULTS)
+    assert result.summary["status"] == "constraint_violated"
+    assert result.summary["max_constraint_violation_rad"] > 0.1
+
+
+def test_automatic_step_meets_the_accuracy():
+    """Without a step, the engine picks one that meets ``numerics.accuracy`` on the speed ratio."""
+    scene = replace(named_scene("paper-30deg-frictionless"), **{"numerics.accuracy": 1e-7})
+    result = run(scene)
+    assert result.summary["dt_choice"].startswith("auto")
+    assert accuracy(scene, result)["speed_ratio_error"] <= 1e-7
+
+
+def test_torque_drive_balances_energy():
+    """Torque drive: input work = output work + change of mechanical energy (measured 1e-6)."""
+    base = named_scene("paper-30deg-frictionless")
+    scene = Scene(joint=base.joint, drive=TorqueDrive(torque=3.0, initial_speed=100.0),
+                  load=base.load, gravity=base.gravity, revolutions=2.0, numerics=Numerics(dt=DT))
+    result = run(scene)
+    assert result.ok, result.summary["reason"]
+    table = result.table
+    assert table["theta_in"].iloc[-1] >= 2.0 * 2.0 * math.pi
+    t = table["t"].to_numpy()
+
+    def work(power: np.ndarray) -> np.ndarray:
+        return np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+
+    net = work((table["power_in"] - table["power_out"]).to_numpy())
+    energy = (table["energy_kinetic"] + table["energy_potential"]).to_numpy()
+    input_work = work(table["power_in"].to_numpy())[-1]
+    np.testing.assert_allclose(net, energy - energy[0], rtol=0.0, atol=1e-5 * input_work)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"integrator": "Verlet"}, "integrator"),
+    ({"solimp": (0.9, 1.0, 0.001, 0.5, 2)}, "solimp"),
+    ({"solref": (-1.0, 2.0)}, "solref"),
+    ({"o_solref": "soft"}, "o_solref"),
+    ({"timeconst_steps": 0}, "timeconst_steps"),
+    ({"iterations": 0}, "iterations"),
+], ids=["integrator", "solimp", "solref", "o_solref", "timeconst", "iterations"])
+def test_invalid_settings_are_rejected(kwargs, match):
+    """Bad settings raise ValueError naming the argument."""
+    with pytest.raises(ValueError, match=match):
+        MujocoSettings(**kwargs)
+
+
+def test_settings_study_table():
+    """The study returns one row per scene and case with every error measure."""
+    cases = study_cases((DT,))[:3]
+    table = settings_study(scenes=("paper-10deg-frictionless",), cases=cases, repeats=1)
+    assert list(table["case"]) == [label for label, _ in cases]
+    assert {"speed_ratio_error", "torque_in_error", "bearing_drift_m", "wall_time_s"} <= set(table)
