@@ -25,8 +25,8 @@ faster than the reactions that cause it, the Coulomb problem has no unique finit
 
 The pair origins are fixed in space in the ideal joint: ``frame_input`` at ``-input_bearing e_x``,
 the two spider pairs at O and ``output_frame`` at ``output_bearing a2``, all on the rotation
-axes of their bodies. The ideal joint does not slide, so the axial friction of eq. (5) does no
-work here; it still loads the pairs.
+axes of their bodies. The ideal joint does not slide: the regularised sign of a zero sliding
+speed is 0, so the axial friction of eq. (5) is zero here (it matters with mounting errors).
 
 References
 ----------
