@@ -79,12 +79,8 @@ def end_time(scene: Scene, start: float) -> float:
     if drive.kind == "speed":
         return start + target / abs(drive.speed)
     if isinstance(drive, AngleDrive):
-        t = np.linspace(drive.time[0], drive.time[-1], 50 * len(drive.time))
-        spline = drive.spline()
-        turned = np.abs(spline(t) - spline(t[0]))
-        k = int(np.searchsorted(np.maximum.accumulate(turned), target))
-        return float(t[min(k, t.size - 1)])
-    return start + 4.0 * target / abs(drive.initial_speed)
+        return drive.time_to_turn(target)
+    return start + drive.time_allowed(target)
 
 
 def simulation_settings(dt: float, t_start: float, t_end: float,

@@ -390,15 +390,13 @@ def drive_plan(scene: Scene) -> DrivePlan:
     if isinstance(drive, AngleDrive):
         spline = drive.spline()
         rates = (spline, spline.derivative(), spline.derivative(2))
-        t = np.linspace(drive.time[0], drive.time[-1], 50 * len(drive.time))
-        turned = np.maximum.accumulate(np.abs(spline(t) - spline(t[0])))
-        end = float(t[min(int(np.searchsorted(turned, turn - 1e-9)), t.size - 1)])
+        end = drive.time_to_turn(turn)
         start = drive.time[0]
         return DrivePlan(start, end - start, lambda s: tuple(float(f(s)) for f in rates),
                          float(spline(start)), float(rates[1](start)), turn)
     if isinstance(drive, TorqueDrive):
         # as the Exudyn engine: four times the time at the initial speed, stopped at `turn`
-        return DrivePlan(0.0, 4.0 * turn / abs(drive.initial_speed), None, 0.0,
+        return DrivePlan(0.0, drive.time_allowed(turn), None, 0.0,
                          drive.initial_speed, turn)
     raise NotImplementedError(f"the MuJoCo engine cannot run a {type(drive).__name__}")
 

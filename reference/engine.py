@@ -133,6 +133,10 @@ class InputMotion:
     ode_evaluations: int = 0
     periodic: bool = False
 
+    def angle(self, t: float) -> float:
+        """Input angle [rad] at one instant."""
+        return float(np.asarray(self.state(np.array([t]))[0]).ravel()[0])
+
 
 def _speed_motion(scene: Scene, drive: SpeedDrive) -> InputMotion:
     w = drive.speed
@@ -143,19 +147,11 @@ def _speed_motion(scene: Scene, drive: SpeedDrive) -> InputMotion:
 
 
 def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
-    from scipy.optimize import brentq
 
     spline = drive.spline()
-    t0, t_last = drive.time[0], drive.time[-1]
-    target = 2.0 * math.pi * scene.revolutions
-    grid = np.linspace(t0, t_last, 50 * len(drive.time))
-    turned = np.maximum.accumulate(np.abs(spline(grid) - spline(t0)))
-    k = int(np.searchsorted(turned, target))
-    if k >= grid.size:
-        t_end = t_last  # the history ends first; the means say how many revolutions it holds
-    else:
-        t_end = brentq(lambda t: abs(spline(t) - spline(t0)) - target, grid[max(k - 1, 0)],
-                       grid[k], xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    t0 = drive.time[0]
+    # a history shorter than the span ends first; the means say how many revolutions it holds
+    t_end = drive.time_to_turn(2.0 * math.pi * scene.revolutions)
     return InputMotion(t0, float(t_end), lambda t: (spline(t), spline(t, 1), spline(t, 2)),
                        knots=np.asarray(drive.time))
 
@@ -165,7 +161,7 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
     target = 2.0 * math.pi * scene.revolutions
     w0 = drive.initial_speed
-    t_max = 4.0 * target / abs(w0)  # the span the Exudyn engine allows, for the same scene
+    t_max = drive.time_allowed(target)  # the span every engine allows
     count = {"n": 0}
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
@@ -252,7 +248,7 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
         omega_rel = relative_speeds(body_motions(theta, theta_t, np.zeros(np.shape(t)), beta))
         return slot_speeds(scene, slots, omega_rel, {p: np.zeros(np.shape(t)) for p in omega_rel})
 
-    theta_a, theta_b = (float(np.asarray(motion.state(np.array([x]))[0])[0]) for x in (t_a, t_b))
+    theta_a, theta_b = motion.angle(t_a), motion.angle(t_b)
     n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
     grid = np.linspace(t_a, t_b, n + 1)
     values = speeds(grid)
@@ -344,7 +340,7 @@ def _time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> f
     from scipy.optimize import brentq
 
     def f(t: float) -> float:
-        return float(np.asarray(motion.state(np.array([t]))[0])[0]) - theta
+        return motion.angle(t) - theta
 
     f_lo, f_hi = f(lo), f(hi)
     if f_lo == 0.0:
@@ -426,8 +422,7 @@ def _table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -
         steps = max(1, round(span / scene.numerics.dt))
     else:
         spr = options.samples_per_revolution or 360
-        theta_a, theta_b = (float(np.asarray(motion.state(np.array([x]))[0])[0])
-                            for x in (motion.t0, motion.t_end))
+        theta_a, theta_b = motion.angle(motion.t0), motion.angle(motion.t_end)
         steps = max(1, round(abs(theta_b - theta_a) / (2.0 * math.pi) * spr))
     return np.linspace(motion.t0, motion.t_end, steps + 1)
 

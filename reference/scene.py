@@ -321,6 +321,23 @@ class AngleDrive:
         t = np.linspace(self.time[0], self.time[-1], 20 * len(self.time))
         return float(np.max(np.abs(s(t))))
 
+    def time_to_turn(self, angle: float) -> float:
+        """First time [s] at which the input has turned ``angle`` [rad] either way from its
+        start, to rounding; the history's last time if it never turns that far."""
+        from scipy.optimize import brentq
+
+        spline = self.spline()
+        t0 = self.time[0]
+        grid = np.linspace(t0, self.time[-1], 50 * len(self.time))
+        turned = np.maximum.accumulate(np.abs(spline(grid) - spline(t0)))
+        k = int(np.searchsorted(turned, angle))
+        if k >= grid.size:
+            return float(grid[-1])
+        if k == 0:
+            return float(t0)
+        return float(brentq(lambda t: abs(spline(t) - spline(t0)) - angle, grid[k - 1], grid[k],
+                            xtol=1e-15, rtol=4 * np.finfo(float).eps))
+
 
 def _is_seq(x: Any) -> bool:
     return isinstance(x, (list, tuple, np.ndarray))
@@ -347,6 +364,11 @@ class TorqueDrive:
 
     def max_speed(self) -> float:
         return abs(self.initial_speed)
+
+    def time_allowed(self, angle: float) -> float:
+        """Time [s] every engine allows the drive to turn ``angle`` [rad]: four times the time
+        at the initial speed (the joint may decelerate); engines stop earlier once it has."""
+        return 4.0 * angle / abs(self.initial_speed)
 
 
 Drive = Union[SpeedDrive, AngleDrive, TorqueDrive]  # noqa: UP007 (runtime alias, py3.10)
