@@ -22,7 +22,7 @@ from typing import Any
 import exudyn as exu
 import numpy as np
 
-from cardan_exudyn.model import ExudynModel, build_model, node_axes_in_canonical
+from cardan_exudyn.model import ExudynModel, build_model
 from cardan_exudyn.rotations import rxyz_angular_velocity, rxyz_matrix
 from cardan_exudyn.stepsize import choose_step
 from reference.scene import (
@@ -274,13 +274,12 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     cols: dict[str, np.ndarray] = {"t": t}
     cols["theta_in"] = states["input"]["psi"][:n, 0]
     cols["omega_in"] = states["input"]["omega"][:n, 0]
-    a2 = scene.joint.geometry.output_axis()
-    out_axes = node_axes_in_canonical(scene)["output"]
-    a_c = states["output"]["A"][:n] @ out_axes
-    y_c = a_c[:, :, 1]
-    y0 = out_axes[:, 1]
-    cols["theta_out"] = np.unwrap(np.arctan2(y_c @ np.array([0.0, 0.0, 1.0]), y_c @ y0))
-    cols["omega_out"] = states["output"]["omega"][:n] @ a2
+    kin = _pair_kinematics(model, states, n)
+    # the output turns about the output_frame axis (fixed in the ground); its angle is minus the
+    # pair's relative rotation (ground relative to output), zero in the reference configuration
+    out = kin["output_frame"]
+    cols["theta_out"] = -_relative_angle(out)
+    cols["omega_out"] = states["output"]["omega"][:n] @ model.pair_frames["output_frame"][:, 2]
     if scene.drive.kind == "torque":
         cols["torque_in"] = np.full(n, scene.drive.torque)
     else:
@@ -289,7 +288,6 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * cols["omega_out"]
 
-    kin = _pair_kinematics(model, states, n)
     if model.friction is not None:
         applied = model.friction.columns(t)
     else:
@@ -325,6 +323,12 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     return cols
 
 
+def _relative_angle(k: dict[str, np.ndarray]) -> np.ndarray:
+    """Rotation of body b's pair frame relative to body a's about the pair axis [rad], unwrapped."""
+    rel = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])
+    return np.unwrap(np.arctan2(rel[:, 1, 0], rel[:, 0, 0]))
+
+
 def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
                     cylindrical: bool) -> tuple[np.ndarray, np.ndarray]:
     """Relative angular and sliding speed of body b w.r.t. body a of a pair.
@@ -337,8 +341,7 @@ def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
     (consistent) initial velocities. The friction law uses the same definition in the step loop.
     """
     axis = k["frame_a"][:, :, 2]
-    rel = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])
-    angle = np.unwrap(np.arctan2(rel[:, 1, 0], rel[:, 0, 0]))
+    angle = _relative_angle(k)
     velocity_level = [np.einsum("ij,ij->i", k["omega_b"] - k["omega_a"], axis)]
     coords = [angle]
     if cylindrical:

@@ -14,6 +14,13 @@ Modelling choices
   function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``.
 - Gravity loads and the output load only when they are non-zero; friction loads and their user
   function only for pairs with a non-zero coefficient (``cardan_exudyn.friction``).
+- Mounting errors (``scene.joint.errors``): each pair's marker frames are displaced and rotated
+  to the joint's Denavit-Hartenberg geometry (the pair axes no longer meet at one point, so the
+  cylindrical pairs slide). The marker frames and the initial assembled state are taken from
+  :mod:`reference.rccc` at the start; from there on the motion is Exudyn's own (its constraints
+  keep the loop closed; the tests compare it with the reference engine). The ideal joint keeps
+  the closed form below, written independently of ``reference``. In both cases the reference
+  configuration (node axes = global axes) is the assembled joint at input angle 0.
 """
 
 from __future__ import annotations
@@ -27,6 +34,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cardan_exudyn.rotations import rxyz_from_matrix, rxyz_rates
+from reference import rccc
 from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SpeedDrive
 
 CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
@@ -42,14 +50,31 @@ def _rot_x(angle: float) -> np.ndarray:
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
+def _loop_motion(scene: Scene, theta: float, omega: float) -> dict[str, rccc.BodyMotion]:
+    """Body motions of the joint with mounting errors at one input state (reference.rccc)."""
+    params = rccc.DHParameters.of_joint(scene.joint)
+    positions, rates = rccc.solve_motion(params, np.array([theta]), omega, 0.0)
+    return {name: rccc.BodyMotion(*(np.asarray(v)[0] for v in (m.rotation, m.origin, m.omega,
+                                                                m.velocity, m.alpha, m.acceleration)))
+            for name, m in rccc.body_motions(params, positions, rates).items()}
+
+
 def node_axes_in_canonical(scene: Scene) -> dict[str, np.ndarray]:
     """Rotation from canonical body coordinates to node coordinates (= global at reference)."""
+    if scene.joint.errors.any:
+        return {name: m.rotation for name, m in _loop_motion(scene, 0.0, 0.0).items()
+                if name != "ground"}
     beta = scene.joint.geometry.shaft_angle
     return {"input": np.eye(3), "spider": np.eye(3), "output": _rot_z(beta)}
 
 
 def pair_geometry(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each pair's origin and frame (columns x, y, z; z the pair axis) in the reference configuration."""
+    if scene.joint.errors.any:
+        params = rccc.DHParameters.of_joint(scene.joint)
+        frames = rccc.pair_frames(params, rccc.solve_positions(params, np.array([0.0])),
+                                  rccc.axial_positions(scene.joint.geometry))
+        return {name: (origin[0], frame[0]) for name, (frame, origin) in frames.items()}
     geo = scene.joint.geometry
     a2 = geo.output_axis()
     ex, ey, ez = np.eye(3)
@@ -63,13 +88,23 @@ def pair_geometry(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 
 def assembled_state(scene: Scene, theta: float, omega: float) -> dict[str, dict[str, np.ndarray]]:
-    """Orientation and angular velocity of each body for input angle ``theta`` and speed ``omega``.
+    """Orientation, angular velocity, frame origin and its velocity of each body at an input state.
 
-    Closed-form vector geometry of the ideal joint (written here independently of
+    ``A`` rotates node coordinates to global ones; ``origin`` is the body's canonical-frame origin
+    [m] and ``velocity`` its velocity [m/s] (both zero for the ideal joint, whose bodies turn
+    about the joint centre).
+
+    Ideal joint: closed-form vector geometry (written here independently of
     ``reference.kinematics``): the output yoke axis is normal to the output shaft axis and the
     input yoke axis; the relative rates follow from the velocity loop
-    ``omega e_x + gamma_t u1 = theta2_t a2 + phi_t u2``.
+    ``omega e_x + gamma_t u1 = theta2_t a2 + phi_t u2``. With mounting errors:
+    :mod:`reference.rccc`.
     """
+    axes = node_axes_in_canonical(scene)
+    if scene.joint.errors.any:
+        return {name: {"A": m.rotation @ axes[name].T, "omega": m.omega, "origin": m.origin,
+                       "velocity": m.velocity}
+                for name, m in _loop_motion(scene, theta, omega).items() if name != "ground"}
     a2 = scene.joint.geometry.output_axis()
     ex = np.array([1.0, 0.0, 0.0])
     a_in = _rot_x(theta)
@@ -80,11 +115,13 @@ def assembled_state(scene: Scene, theta: float, omega: float) -> dict[str, dict[
     a_out_canonical = np.column_stack([a2, np.cross(u2, a2), u2])
     rates = np.linalg.solve(np.column_stack([u1, -a2, -u2]), -omega * ex)
     w_in = omega * ex
-    axes = node_axes_in_canonical(scene)
+    zero = np.zeros(3)
     return {
-        "input": {"A": a_in @ axes["input"].T, "omega": w_in},
-        "spider": {"A": a_spider @ axes["spider"].T, "omega": w_in + rates[0] * u1},
-        "output": {"A": a_out_canonical @ axes["output"].T, "omega": rates[1] * a2},
+        "input": {"A": a_in @ axes["input"].T, "omega": w_in, "origin": zero, "velocity": zero},
+        "spider": {"A": a_spider @ axes["spider"].T, "omega": w_in + rates[0] * u1,
+                   "origin": zero, "velocity": zero},
+        "output": {"A": a_out_canonical @ axes["output"].T, "omega": rates[1] * a2,
+                   "origin": zero, "velocity": zero},
     }
 
 
@@ -122,23 +159,25 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
     theta0, omega0, t0 = _initial_drive_state(scene)
     model.start_time = t0
     state = assembled_state(scene, theta0, omega0)
+    reference_state = assembled_state(scene, 0.0, 0.0)
     axes = node_axes_in_canonical(scene)
     for name, body in scene.joint.bodies():
         mass, com_c, inertia_c = body.canonical()
         r = axes[name]
-        com = r @ com_c  # node axes = global axes at reference
+        com = r @ com_c  # from the body's frame origin, node axes = global axes at reference
         inertia = r @ inertia_c @ r.T
-        model.com_reference[name] = com
+        model.com_reference[name] = reference_state[name]["origin"] + com
         model.mass[name] = mass
         model.inertia[name] = inertia
         a0 = state[name]["A"]
         psi0 = rxyz_from_matrix(a0)
         w = state[name]["omega"]
-        pos0 = a0 @ com
+        arm = a0 @ com
+        pos0 = state[name]["origin"] + arm
         node = mbs.AddNode(eii.NodeRigidBodyRxyz(
-            referenceCoordinates=[*com, 0.0, 0.0, 0.0],
-            initialCoordinates=[*(pos0 - com), *psi0],
-            initialVelocities=[*np.cross(w, pos0), *rxyz_rates(psi0, w)],
+            referenceCoordinates=[*model.com_reference[name], 0.0, 0.0, 0.0],
+            initialCoordinates=[*(pos0 - model.com_reference[name]), *psi0],
+            initialVelocities=[*(state[name]["velocity"] + np.cross(w, arm)), *rxyz_rates(psi0, w)],
         ))
         model.nodes[name] = node
         model.bodies[name] = mbs.AddObject(eii.ObjectRigidBody(
@@ -224,7 +263,7 @@ def _add_loads(model: ExudynModel) -> None:
     mbs, scene = model.mbs, model.scene
     if scene.load.torque != 0.0:
         m_out = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["output"]))
-        vector = -scene.load.torque * scene.joint.geometry.output_axis()
+        vector = -scene.load.torque * model.pair_frames["output_frame"][:, 2]  # the output axis
         mbs.AddLoad(eii.LoadTorqueVector(markerNumber=m_out, loadVector=list(vector)))
     if scene.has_gravity:
         for name in model.bodies:

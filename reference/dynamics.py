@@ -1,8 +1,9 @@
 """Dynamics of the ideal Cardan joint with the paper's friction: Newton-Euler, batched over samples.
 
-For a given input motion the closed-form kinematics (:mod:`reference.kinematics`) give every
-body's motion. Newton-Euler for the three moving bodies (force balance and moment balance about
-the joint centre O, a fixed point) is then linear in the 18 unknowns
+For a given input motion the kinematics (:func:`reference.joint_motion.joint_motion`: closed
+form for the ideal joint, the dual-number loop with mounting errors) give every body's motion.
+Newton-Euler for the three moving bodies (force balance and moment balance about the global
+origin O) is then linear in the 18 unknowns
 
 - ``frame_input`` (revolute): fx, fy, fz, mx, my;
 - ``input_spider``, ``spider_output``, ``output_frame`` (cylindrical): fx, fy, mx, my;
@@ -23,10 +24,11 @@ every sample at once. A sample whose fixed point does not converge, or converges
 the loop gain (spectral radius of ``dG/dphi``) is 1 or more, is *self-locking*: friction grows
 faster than the reactions that cause it, the Coulomb problem has no unique finite solution.
 
-The pair origins are fixed in space in the ideal joint: ``frame_input`` at ``-input_bearing e_x``,
-the two spider pairs at O and ``output_frame`` at ``output_bearing a2``, all on the rotation
-axes of their bodies. The ideal joint does not slide: the regularised sign of a zero sliding
-speed is 0, so the axial friction of eq. (5) is zero here (it matters with mounting errors).
+Pair origins and frames come with the joint motion: in the ideal joint the origins are fixed in
+space (``frame_input`` at ``-input_bearing e_x``, the spider pairs at O, ``output_frame`` at
+``output_bearing a2``) and no pair slides, so the regularised sign of the zero sliding speed is 0
+and the axial friction of eq. (5) vanishes. With mounting errors the cylindrical pairs slide and
+their axial friction does work (``power_loss_<pair>_sliding``).
 
 References
 ----------
@@ -42,20 +44,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.friction import friction_magnitudes, pair_power_loss, regularised_sign
-from reference.kinematics import (
-    BodyMotion,
-    body_motions,
-    output_motion,
-    pair_frames,
-    relative_speeds,
-)
+from reference.joint_motion import JointMotion, joint_motion
+from reference.rccc import BodyMotion
 from reference.scene import (
     BODY_NAMES,
     PAIR_BODIES,
     PAIR_KIND,
     PAIR_NAMES,
     Body,
-    Geometry,
     Scene,
 )
 from reference.schema import (
@@ -81,16 +77,6 @@ def unknowns() -> list[tuple[str, str]]:
     return out + [("drive", "torque_in")]
 
 
-def pair_origins(geometry: Geometry) -> dict[str, np.ndarray]:
-    """Pair origins in global coordinates [m] (fixed in the ideal joint)."""
-    return {
-        "frame_input": np.array([-geometry.input_bearing, 0.0, 0.0]),
-        "input_spider": np.zeros(3),
-        "spider_output": np.zeros(3),
-        "output_frame": geometry.output_bearing * geometry.output_axis(),
-    }
-
-
 def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
     """Centre-of-mass position, velocity, acceleration and inertia of a body, global components.
 
@@ -98,9 +84,9 @@ def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
     ----------
     body : Body
         Mass properties; :meth:`Body.canonical` places them in the canonical body frame, whose
-        origin is the joint centre O.
-    motion : BodyMotion
-        Orientation and angular motion of the body.
+        origin is the body's frame origin (the joint centre O for the ideal joint).
+    motion : reference.rccc.BodyMotion
+        Pose and motion of the body.
 
     Returns
     -------
@@ -111,10 +97,10 @@ def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
     """
     mass, com, inertia = body.canonical()
     rot = motion.rotation
-    r = rot @ com
-    v = cross(motion.omega, r)
-    a = cross(motion.alpha, r) + cross(motion.omega, v)
-    return {"mass": mass, "r": r, "v": v, "a": a,
+    c = rot @ com
+    w_c = cross(motion.omega, c)
+    return {"mass": mass, "r": motion.origin + c, "v": motion.velocity + w_c,
+            "a": motion.acceleration + cross(motion.alpha, c) + cross(motion.omega, w_c),
             "inertia": rot @ inertia @ np.swapaxes(rot, -1, -2)}
 
 
@@ -146,22 +132,19 @@ def mechanical_energy(scene: Scene,
     return kinetic, potential
 
 
-def wrench_columns(scene: Scene, motions: dict[str, BodyMotion],
-                   components: list[tuple[str, str]]) -> np.ndarray:
+def wrench_columns(motion: JointMotion, components: list[tuple[str, str]]) -> np.ndarray:
     """Body wrenches of unit pair loads, rows as :func:`reaction_system`, shape (..., 18, m).
 
     Each component ``(pair, "fx" | "fy" | "fz" | "mx" | "my" | "mz")`` is a unit force along
     (at the pair origin) or moment about that axis of the pair frame, acting on body b; body a
     receives the opposite. All components are built in one vectorised pass.
     """
-    shape = motions["input"].omega.shape[:-1]
+    shape = motion.bodies["input"].omega.shape[:-1]
     if not components:
         return np.zeros(shape + (6 * len(BODY_NAMES), 0))
-    frames = pair_frames(motions)
-    origins = pair_origins(scene.joint.geometry)
-    d = np.stack([frames[p][..., :, "xyz".index(c[1])] for p, c in components], -2)
+    d = np.stack([motion.frames[p][..., :, "xyz".index(c[1])] for p, c in components], -2)
     is_force = np.array([c[0] == "f" for _, c in components])[:, None]
-    lever = np.stack([origins[p] for p, _ in components])
+    lever = np.stack([motion.origins[p] for p, _ in components], -2)
     unit = np.concatenate([np.where(is_force, d, 0.0),
                            np.where(is_force, cross(lever, d), d)], -1)  # (..., m, 6)
     incidence = np.zeros((len(BODY_NAMES), len(components)))
@@ -174,8 +157,7 @@ def wrench_columns(scene: Scene, motions: dict[str, BodyMotion],
     return out.reshape(shape + (6 * len(BODY_NAMES), len(components)))
 
 
-def reaction_system(scene: Scene,
-                    motions: dict[str, BodyMotion]) -> tuple[np.ndarray, np.ndarray]:
+def reaction_system(scene: Scene, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
     """Newton-Euler equations of the three bodies as ``matrix @ unknowns = rhs``.
 
     Returns
@@ -186,17 +168,17 @@ def reaction_system(scene: Scene,
     rhs : ndarray, shape (..., 18)
         Required wrench minus the known applied wrench (the load torque on the output).
     """
-    shape = motions["input"].omega.shape[:-1]
+    shape = motion.bodies["input"].omega.shape[:-1]
     rows = {name: 6 * i for i, name in enumerate(BODY_NAMES)}
     matrix = np.zeros(shape + (18, 18))
-    matrix[..., :-1] = wrench_columns(scene, motions, unknowns()[:-1])
+    matrix[..., :-1] = wrench_columns(motion, unknowns()[:-1])
     matrix[..., rows["input"] + DRIVE_ROW, -1] = 1.0  # drive torque about +x (the fixed input axis)
-    rhs = np.concatenate([np.concatenate(required_wrench(body, motions[name],
+    rhs = np.concatenate([np.concatenate(required_wrench(body, motion.bodies[name],
                                                          np.asarray(scene.gravity)), -1)
                           for name, body in scene.joint.bodies()], -1)
-    # the load's moment -T a2 on the output, moved to the right-hand side
+    # the load's moment -T u on the output (u its axis, the output_frame pair's z), to the right
     rhs[..., rows["output"] + 3:rows["output"] + 6] += (scene.load.torque
-                                                       * scene.joint.geometry.output_axis())
+                                                       * motion.frames["output_frame"][..., :, 2])
     return matrix, rhs
 
 
@@ -215,15 +197,13 @@ def friction_slots(scene: Scene) -> list[tuple[str, str]]:
     return slots
 
 
-def friction_matrix(scene: Scene, motions: dict[str, BodyMotion],
-                    slots: list[tuple[str, str]]) -> np.ndarray:
+def friction_matrix(motion: JointMotion, slots: list[tuple[str, str]]) -> np.ndarray:
     """Body wrenches of unit friction values, rows as :func:`reaction_system`, shape (..., 18, K).
 
     A friction torque acts on body b about the pair axis, an axial force along it at the pair
     origin; body a receives the opposite.
     """
-    return wrench_columns(scene, motions,
-                          [(pair, "mz" if kind == "torque" else "fz") for pair, kind in slots])
+    return wrench_columns(motion, [(pair, "mz" if kind == "torque" else "fz") for pair, kind in slots])
 
 
 class FrictionLaw:
@@ -388,51 +368,56 @@ def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
 
 def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                    theta_tt: np.ndarray | None = None,
-                   torque_in: float | np.ndarray | None = None) -> tuple[dict, FixedPoint]:
+                   torque_in: float | np.ndarray | None = None,
+                   method: str = "auto") -> tuple[JointMotion, FixedPoint]:
     """Reactions, friction and the drive unknown for every sample.
 
     Exactly one of ``theta_tt`` (inverse dynamics: the drive torque is the unknown) and
     ``torque_in`` (forward dynamics: the input acceleration is the unknown) is given.
+    ``method`` chooses the kinematics (:func:`reference.joint_motion.joint_motion`).
 
     Returns
     -------
-    motions : dict of str to BodyMotion
-        Body motions (with the solved acceleration in forward dynamics).
+    motion : JointMotion
+        The joint's motion (with the solved acceleration in forward dynamics).
     fixed_point : FixedPoint
         ``x[..., -1]`` is the drive torque [N m] or the input acceleration [rad/s^2].
     """
     if (theta_tt is None) == (torque_in is None):
         raise ValueError("give exactly one of `theta_tt` (inverse) and `torque_in` (forward)")
-    beta = scene.joint.geometry.shaft_angle
+    joint = scene.joint
     theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
-    at_zero = body_motions(theta, theta_t, np.zeros_like(theta), beta)
+    n = theta.size
     if theta_tt is not None:
-        motions = body_motions(theta, theta_t, np.broadcast_to(theta_tt, theta.shape), beta)
-        matrix, rhs = reaction_system(scene, motions)
+        motion = joint_motion(joint, theta, theta_t, np.broadcast_to(theta_tt, theta.shape), method)
+        matrix, rhs = reaction_system(scene, motion)
+        omega_rel, slide_rel = motion.omega_rel, motion.slide_rel
+        wrenches = friction_matrix(motion, friction_slots(scene))
     else:  # one batch at accelerations 0 and 1: the right-hand side is affine in theta_tt
-        n = theta.size
-        pair = body_motions(np.tile(theta, 2), np.tile(theta_t, 2),
-                            np.repeat([0.0, 1.0], n), beta)
+        pair = joint_motion(joint, np.tile(theta, 2), np.tile(theta_t, 2), np.repeat([0.0, 1.0], n),
+                            method)
         matrix, rhs = reaction_system(scene, pair)
         matrix, rhs_one, rhs = matrix[:n], rhs[n:], rhs[:n]
         matrix[..., :, -1] = -(rhs_one - rhs)  # the acceleration's share moves to the left
         rhs[..., DRIVE_ROW] -= torque_in
+        # velocity-level quantities and the pair geometry do not depend on the acceleration
+        omega_rel = {p: v[:n] for p, v in pair.omega_rel.items()}
+        slide_rel = {p: v[:n] for p, v in pair.slide_rel.items()}
+        wrenches = friction_matrix(pair, friction_slots(scene))[:n]
     slots = friction_slots(scene)
-    omega_rel = relative_speeds(at_zero)  # velocity level: independent of the acceleration
-    wrenches = friction_matrix(scene, at_zero, slots)
     both = np.linalg.solve(matrix, np.concatenate([rhs[..., None], wrenches], -1))
-    slide = {p: np.zeros_like(theta) for p in PAIR_NAMES}  # the ideal joint does not slide
-    signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide), scene.friction.sign_band)
+    signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide_rel), scene.friction.sign_band)
              if slots else np.zeros(theta.shape + (0,)))
     fixed = solve_friction(FrictionLaw(scene, slots), both[..., 0], both[..., 1:], signs)
     if torque_in is not None:
-        motions = body_motions(theta, theta_t, fixed.x[..., -1], beta)
-    return motions, fixed
+        motion = joint_motion(joint, theta, theta_t, fixed.x[..., -1], method)
+    return motion, fixed
 
 
 def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                      theta_tt: np.ndarray | None = None,
-                     torque_in: float | None = None) -> tuple[dict[str, np.ndarray], FixedPoint]:
+                     torque_in: float | None = None,
+                     method: str = "auto") -> tuple[dict[str, np.ndarray], FixedPoint]:
     """Result-schema columns (without ``t``) for the given motion, with friction.
 
     Inverse dynamics when ``theta_tt`` is given, forward dynamics when ``torque_in`` is (see
@@ -442,11 +427,12 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     -------
     columns : dict of str to ndarray, shape (n,)
         Every column of :func:`reference.schema.table_columns` but ``t``, plus
-        ``input_acceleration`` [rad/s^2], ``friction_loop_gain`` [-] and ``self_locking``.
+        ``input_acceleration`` [rad/s^2], ``friction_loop_gain`` [-], ``self_locking`` and, per
+        pair, ``<pair>_slide`` [m] (the D-H slide; zero in the ideal joint) and the two parts of
+        its loss, ``power_loss_<pair>_rotation`` and ``power_loss_<pair>_sliding`` [W].
     fixed_point : FixedPoint
     """
-    beta = scene.joint.geometry.shaft_angle
-    motions, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in)
+    motion, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in, method)
     theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
     locked = fixed.self_locking
     x = np.where(locked[:, None], np.nan, fixed.x)
@@ -456,27 +442,32 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
         drive = x[:, -1]
     else:
         accel, drive = x[:, -1], np.where(locked, np.nan, np.broadcast_to(torque_in, theta.shape))
-    theta_out, omega_out, _ = output_motion(theta, theta_t, np.nan_to_num(accel), beta)
+    theta_out, omega_out, _ = motion.output
     zero = np.zeros_like(theta_out)
     cols = {"theta_in": theta + zero, "theta_out": theta_out, "omega_in": theta_t + zero,
             "omega_out": omega_out, "torque_in": drive + zero,
             "torque_out": zero + scene.load.torque}
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * omega_out
-    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(scene, motions)
-    omega_rel = relative_speeds(motions)
+    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(scene, motion.bodies)
     applied = {(pair, kind): phi[:, j] for j, (pair, kind) in enumerate(friction_slots(scene))}
     loss_total = zero.copy()
     for pair in PAIR_NAMES:
         torque = applied.get((pair, "torque"), zero)
         force = applied.get((pair, "force"), zero)
-        loss = pair_power_loss(torque, force, omega_rel[pair], zero)
-        loss_total = loss_total + loss
-        cols[f"power_loss_{pair}"] = loss
+        omega_rel, slide_rel = motion.omega_rel[pair] + zero, motion.slide_rel[pair] + zero
+        rotation = pair_power_loss(torque, zero, omega_rel, zero)
+        sliding = pair_power_loss(zero, force, zero, slide_rel)
+        loss_total = loss_total + rotation + sliding
+        cols[f"power_loss_{pair}"] = rotation + sliding
+        cols[f"power_loss_{pair}_rotation"] = rotation
+        cols[f"power_loss_{pair}_sliding"] = sliding
         cols.update({f"{pair}_{suffix}": zero for suffix in PAIR_SUFFIXES})
         cols[f"{pair}_friction_torque"] = torque + zero
         cols[f"{pair}_friction_force"] = force + zero
-        cols[f"{pair}_omega_rel"] = omega_rel[pair]
+        cols[f"{pair}_omega_rel"] = omega_rel
+        cols[f"{pair}_slide_rel"] = slide_rel
+        cols[f"{pair}_slide"] = motion.slide[pair] + zero
     for j, (pair, component) in enumerate(unknowns()[:-1]):
         cols[f"{pair}_{component}"] = x[:, j]
     cols["power_loss"] = loss_total

@@ -32,7 +32,8 @@ from reference.dynamics import (
     slot_speeds,
     solve_dynamics,
 )
-from reference.kinematics import body_motions, relative_speeds
+from reference.joint_motion import joint_motion
+from reference.rccc import LoopClosureError
 from reference.scene import PAIR_NAMES, AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.schema import (
     STATUS_OK,
@@ -45,7 +46,10 @@ from reference.schema import (
 ENGINE_NAME = "reference"
 ENGINE_VERSION = "reference-0.2"
 STATUS_SELF_LOCKING = "self_locking"
-EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking")
+EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
+                 *(f"{p}_slide" for p in PAIR_NAMES),
+                 *(f"power_loss_{p}_{part}" for p in PAIR_NAMES for part in ("rotation", "sliding")))
+STATUS_NO_CLOSURE = "loop_does_not_close"
 
 
 @dataclass(frozen=True)
@@ -239,14 +243,11 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     slots = friction_slots(scene)
     if not slots or t_b <= t_a:
         return np.zeros(0)
-    beta = scene.joint.geometry.shaft_angle
 
     def speeds(t: np.ndarray) -> np.ndarray:
         theta, theta_t, _ = motion.state(t)
-        theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
-        theta_t = np.broadcast_to(np.asarray(theta_t, float), np.shape(t))
-        omega_rel = relative_speeds(body_motions(theta, theta_t, np.zeros(np.shape(t)), beta))
-        return slot_speeds(scene, slots, omega_rel, {p: np.zeros(np.shape(t)) for p in omega_rel})
+        kin = joint_motion(scene.joint, theta, theta_t, 0.0)  # speeds do not need accelerations
+        return slot_speeds(scene, slots, kin.omega_rel, kin.slide_rel)
 
     theta_a, theta_b = motion.angle(t_a), motion.angle(t_b)
     n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
@@ -354,7 +355,8 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
                     options: ReferenceOptions) -> dict:
     """Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature.
 
-    Returns the summary keys ``input_work``, ``output_work``, ``loss_work``, ``loss_work_<pair>``,
+    Returns the summary keys ``input_work``, ``output_work``, ``loss_work``, ``loss_work_<pair>``
+    and its axial-friction part ``loss_work_<pair>_sliding`` (zero in the ideal joint),
     ``mean_efficiency``, ``work_ratio``, ``mean_torque_in``, ``energy_balance_residual``
     (W_in - W_out - W_loss - change of mechanical energy [J], zero up to rounding for an exact
     solution) and ``quadrature`` (how it was done); empty when there is no whole revolution.
@@ -380,7 +382,7 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
     lo, hi = initial_panels(edges, period / options.panels_per_revolution)
     keys = ["power_in", "power_out", "power_loss", "self_locking",
-            *(f"power_loss_{p}" for p in PAIR_NAMES)]
+            *(f"power_loss_{p}" for p in PAIR_NAMES), *(f"power_loss_{p}_sliding" for p in PAIR_NAMES)]
 
     def integrand(times: np.ndarray) -> np.ndarray:
         cols = columns_at(scene, motion, times)
@@ -395,6 +397,7 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
            "loss_work": work["power_loss"]}
     for pair in PAIR_NAMES:
         out[f"loss_work_{pair}"] = work[f"power_loss_{pair}"]
+        out[f"loss_work_{pair}_sliding"] = work[f"power_loss_{pair}_sliding"]
     w_in = out["input_work"]
     out["mean_efficiency"] = 1.0 - out["loss_work"] / w_in if w_in != 0 else float("nan")
     out["work_ratio"] = out["output_work"] / w_in if w_in != 0 else float("nan")
@@ -437,10 +440,20 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
         ``scene.record.every``-th row; None when ``record.timeseries`` is off) and summary: the
         keys of :func:`reference.schema.mean_values`, with the work-based means replaced by
         :func:`work_quadrature`'s, ``self_locking_samples`` and, when friction locks, status
-        ``self_locking`` with the first input angle where it does.
+        ``self_locking`` with the first input angle where it does; status
+        ``loop_does_not_close`` (no table) when mounting errors keep the loop from closing.
     """
     options = options or ReferenceOptions()
     start = time.perf_counter()
+    try:
+        return _run(scene, options, start)
+    except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
+        return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
+                             "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),
+                             "wall_time_s": time.perf_counter() - start})
+
+
+def _run(scene: Scene, options: ReferenceOptions, start: float) -> Result:
     motion = input_motion(scene, options)
     summary = {"status": motion.status, "reason": motion.reason, "engine": ENGINE_NAME,
                "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),

@@ -62,7 +62,7 @@ import numpy as np
 
 from reference import dual
 from reference.dual import Dual
-from reference.scene import PAIR_NAMES
+from reference.scene import PAIR_NAMES, Geometry, Joint
 
 LINK_NAMES = ("input", "spider", "output", "ground")
 BRANCHES = ("hooke", "flipped")
@@ -169,6 +169,13 @@ class DHParameters:
         d_a, d_alpha, d_s1 = _four("a", a), _four("alpha", alpha), _finite("s1", s1)
         return DHParameters(alpha=tuple(x + y for x, y in zip(self.alpha, d_alpha, strict=True)),
                             a=tuple(x + y for x, y in zip(self.a, d_a, strict=True)), s1=self.s1 + d_s1)
+
+    @classmethod
+    def of_joint(cls, joint: Joint) -> DHParameters:
+        """The scene joint's loop: the ideal joint of its shaft angle plus its mounting errors."""
+        e = joint.errors
+        return cls.ideal(joint.geometry.shaft_angle).with_errors(
+            a=(e.a1, e.a2, e.a3, e.a4), alpha=(e.alpha1, e.alpha2, e.alpha3, e.alpha4), s1=e.s1)
 
     def twists(self) -> Dual:
         """Dual link twists ``alpha_k + eps a_k``, shape (4,)."""
@@ -383,6 +390,49 @@ def _joint_frames(params: DHParameters, positions: LoopPositions) -> Dual:
         frame = frame @ steps[..., k, :, :]
         frames.append(frame)
     return dual.stack(frames, -3)
+
+
+def joint_frames(params: DHParameters, positions: LoopPositions) -> tuple[np.ndarray, np.ndarray]:
+    """The D-H frames ``F_1..F_4``: rotations (..., 4, 3, 3) [-] and origins (..., 4, 3) [m].
+
+    ``F_k`` is fixed in link k - 1, body ``a`` of joint k; its z axis is the joint axis.
+    """
+    return dual.displacement(_joint_frames(params, positions))
+
+
+# Each pair's frame of reference.kinematics.pair_frames in its D-H frame F_k (checked by the tests):
+# F_1 turned by -90 deg about its z axis (the pair's x is global y at input angle 0), the rest F_k.
+_PAIR_IN_F = np.stack([np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+                       np.eye(3), np.eye(3), np.eye(3)])
+
+
+def axial_positions(geometry: Geometry) -> tuple[float, float, float, float]:
+    """Where each pair's bearing sits along its axis from the D-H frame origin [m].
+
+    The frame bearings at ``-input_bearing`` (input axis, towards the input) and
+    ``+output_bearing`` (output axis); the spider pairs at the foot of the common normal.
+    """
+    return (-geometry.input_bearing, 0.0, 0.0, geometry.output_bearing)
+
+
+def pair_frames(params: DHParameters, positions: LoopPositions,
+                axial: Sequence[float] = (0.0,) * 4) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each pair's frame, attached to body ``a`` (global components), and its origin.
+
+    The frame is the D-H frame of the pair's joint with the axes of
+    :func:`reference.kinematics.pair_frames` (z the pair axis); the origin is ``F_k``'s origin
+    moved ``axial[k]`` along the axis (:func:`axial_positions`): the point where the bearing sits,
+    about which the reaction moments are taken.
+
+    Returns
+    -------
+    dict of str to (rotation (..., 3, 3) [-], origin (..., 3) [m])
+    """
+    rotation, origin = joint_frames(params, positions)
+    axial = np.asarray(_four("axial", axial))
+    frames = rotation @ _PAIR_IN_F
+    origins = origin + axial[:, None] * rotation[..., :, 2]
+    return {p: (frames[..., k, :, :], origins[..., k, :]) for k, p in enumerate(PAIR_NAMES)}
 
 
 def joint_screws(params: DHParameters, positions: LoopPositions) -> Dual:

@@ -59,6 +59,9 @@ _UNIT_ALIASES = {
     "shaft_angle": ("_deg", DEG),
     "speed": ("_rpm", RPM),
     "initial_speed": ("_rpm", RPM),
+    **{f"a{k}": ("_mm", 1e-3) for k in range(1, 5)},
+    **{f"alpha{k}": ("_deg", DEG) for k in range(1, 5)},
+    "s1": ("_mm", 1e-3),
 }
 
 
@@ -246,15 +249,74 @@ class Geometry:
         return np.array([math.cos(self.shaft_angle), math.sin(self.shaft_angle), 0.0])
 
 
+ERROR_NAMES = ("a1", "a2", "a3", "a4", "alpha1", "alpha2", "alpha3", "alpha4", "s1")
+"""Fields of :class:`MountingErrors`, in the order the tolerance studies report them."""
+
+
+@dataclass(frozen=True)
+class MountingErrors:
+    """Manufacturing and mounting errors as Denavit-Hartenberg parameter deviations (Figure 3).
+
+    Links are numbered as the pairs they carry (:mod:`reference.rccc`): link 1 the input (from
+    the ``frame_input`` axis to the ``input_spider`` axis), 2 the spider (to ``spider_output``),
+    3 the output (to ``output_frame``), 4 the frame (from ``output_frame`` back to
+    ``frame_input``). All zero is the ideal joint. At the boundary ``a<k>_mm``,
+    ``alpha<k>_deg`` and ``s1_mm`` are accepted.
+
+    Attributes
+    ----------
+    a1, a2, a3, a4 : float
+        Offsets [m]: length of each link's common normal between its two pair axes (ideal 0:
+        the axes intersect at the joint centre). The paper's tolerance case has
+        ``a1 = a2 = a3 = 0.5 mm``.
+    alpha1, alpha2, alpha3, alpha4 : float
+        Twist errors [rad], added to the ideal twists (90, 90, 90, -shaft angle) deg: the
+        paper's case has ``alpha1 = alpha2 = alpha3 = 6e-3 deg``.
+    s1 : float
+        Axial offset of the input along its axis [m] (moves the input and its yoke along x).
+    """
+
+    a1: float = 0.0
+    a2: float = 0.0
+    a3: float = 0.0
+    a4: float = 0.0
+    alpha1: float = 0.0
+    alpha2: float = 0.0
+    alpha3: float = 0.0
+    alpha4: float = 0.0
+    s1: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ERROR_NAMES:
+            _set(self, name, _finite(name, getattr(self, name)))
+        for k in (1, 2, 3):
+            twist = getattr(self, f"alpha{k}")
+            if not abs(twist) < 0.5 * math.pi:
+                raise SceneError(f"`alpha{k}` must be in (-90, 90) deg (the link's twist stays in "
+                                 f"(0, 180) deg), got {twist / DEG!r} deg")
+
+    @property
+    def any(self) -> bool:
+        """True when some error is non-zero (the joint is not ideal)."""
+        return any(getattr(self, name) != 0.0 for name in ERROR_NAMES)
+
+
 @dataclass(frozen=True)
 class Joint:
-    """The RCCC Cardan joint: three bodies, geometry and four pairs."""
+    """The RCCC Cardan joint: three bodies, geometry, four pairs and the mounting errors."""
 
     input: Body
     spider: Body
     output: Body
     geometry: Geometry = field(default_factory=Geometry)
     pairs: Pairs = field(default_factory=Pairs)
+    errors: MountingErrors = field(default_factory=MountingErrors)
+
+    def __post_init__(self) -> None:
+        twist = self.errors.alpha4 - self.geometry.shaft_angle
+        if not abs(twist) < 0.5 * math.pi:
+            raise SceneError(f"`errors.alpha4` minus the shaft angle (the frame's twist) must be in "
+                             f"(-90, 90) deg, got {twist / DEG!r} deg")
 
     def bodies(self) -> list[tuple[str, Body]]:
         return [(name, getattr(self, name)) for name in BODY_NAMES]
@@ -537,7 +599,8 @@ class Scene:
 _SECTIONS: dict[type, dict[str, Any]] = {
     Scene: {"joint": Joint, "load": Load, "numerics": Numerics, "friction": FrictionSettings,
             "record": Record},
-    Joint: {"input": Body, "spider": Body, "output": Body, "geometry": Geometry, "pairs": Pairs},
+    Joint: {"input": Body, "spider": Body, "output": Body, "geometry": Geometry, "pairs": Pairs,
+            "errors": MountingErrors},
     Pairs: {name: Pair for name in PAIR_NAMES},
 }
 

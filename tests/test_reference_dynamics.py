@@ -10,6 +10,7 @@ from test_reference_kinematics import derivative
 
 from reference import engine
 from reference.dynamics import inverse_dynamics, reaction_system
+from reference.joint_motion import joint_motion
 from reference.kinematics import body_motions, speed_ratio
 from reference.paper import named_scene
 from reference.scene import (
@@ -148,8 +149,7 @@ def test_power_balance_at_every_sample(beta_deg):
     theta, omega = table["theta_in"].to_numpy(), table["omega_in"].to_numpy()
     rate, scale, kinetic, potential = energy_rate(scene, theta, omega)
     scale = scale + np.abs(table["power_in"]) + np.abs(table["power_out"])
-    matrix, _ = reaction_system(scene, body_motions(theta, omega, 0 * omega,
-                                                    scene.joint.geometry.shaft_angle))
+    matrix, _ = reaction_system(scene, joint_motion(scene.joint, theta, omega, 0 * omega))
     # rounding: the drive torque comes from a solve of condition number cond (4 at 0 deg, 60 at
     # 85 deg); allow 10 cond ulp of the largest term of the balance
     tol = 10 * np.max(np.linalg.cond(matrix)) * EPS * scale

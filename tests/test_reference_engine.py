@@ -14,7 +14,7 @@ from test_reference_kinematics import derivative
 from reference.dynamics import reaction_system
 from reference.engine import EXTRA_COLUMNS, ReferenceOptions, run
 from reference.friction import friction_from_columns
-from reference.kinematics import body_motions
+from reference.joint_motion import joint_motion
 from reference.paper import named_scene, paper_scene
 from reference.scene import AngleDrive, Scene, TorqueDrive, replace
 from reference.schema import table_columns
@@ -51,8 +51,7 @@ def test_power_balance_with_friction_at_every_sample(name):
     theta, omega = table["theta_in"].to_numpy(), table["omega_in"].to_numpy()
     rate, scale, _, _ = energy_rate(scene, theta, omega)
     scale = scale + np.abs(table["power_in"]) + np.abs(table["power_out"]) + table["power_loss"]
-    matrix, _ = reaction_system(scene, body_motions(theta, omega, 0 * omega,
-                                                    scene.joint.geometry.shaft_angle))
+    matrix, _ = reaction_system(scene, joint_motion(scene.joint, theta, omega, 0 * omega))
     # rounding of the solves (condition number cond), amplified by the friction loop (gain
     # <= 1 / (1 - max gain)): 10 cond ulp of the largest term, times that amplification
     gain = table["friction_loop_gain"].max()
