@@ -25,6 +25,7 @@ import numpy as np
 from cardan_exudyn.model import ExudynModel, build_model
 from cardan_exudyn.rotations import rxyz_angular_velocity, rxyz_matrix
 from cardan_exudyn.stepsize import choose_step
+from reference.friction import friction_from_columns
 from reference.scene import (
     PAIR_BODIES,
     PAIR_KIND,
@@ -288,12 +289,6 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * cols["omega_out"]
 
-    if model.friction is not None:
-        applied = model.friction.columns(t)
-    else:
-        applied = {f"{p}_{k}": np.zeros(n) for p in PAIR_NAMES
-                   for k in ("friction_torque", "friction_force")}
-    loss_total = np.zeros(n)
     for name in PAIR_NAMES:
         force = _stored(model, f"{name}_force")[:n, 1:4]
         torque = _stored(model, f"{name}_torque")[:n, 1:4]
@@ -304,17 +299,26 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
         relative = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])  # frame_a^T frame_b
         mx, my, mz = np.einsum("nij,nj->ni", relative, m_b).T
         omega_rel, slide_rel = relative_speeds(t, k, cylindrical=PAIR_KIND[name] == "cylindrical")
+        for suffix, values in zip(("fx", "fy", "fz", "mx", "my", "mz", "omega_rel", "slide_rel"),
+                                  (fx, fy, fz, mx, my, mz, omega_rel, slide_rel), strict=True):
+            cols[f"{name}_{suffix}"] = values
+    if model.friction is not None:
+        applied = model.friction.columns(t)
+    elif scene.has_friction:  # uncoupled: the law evaluated on the frictionless reactions
+        law = friction_from_columns(scene, cols)
+        applied = {f"{p}_{kind}": law[p][j] for p in PAIR_NAMES
+                   for j, kind in enumerate(("friction_torque", "friction_force"))}
+    else:
+        applied = {f"{p}_{k}": np.zeros(n) for p in PAIR_NAMES
+                   for k in ("friction_torque", "friction_force")}
+    loss_total = np.zeros(n)
+    for name in PAIR_NAMES:
         friction_torque = applied[f"{name}_friction_torque"]
         friction_force = applied[f"{name}_friction_force"]
-        loss = -(friction_torque * omega_rel + friction_force * slide_rel)
+        loss = -(friction_torque * cols[f"{name}_omega_rel"] + friction_force * cols[f"{name}_slide_rel"])
         loss_total += loss
-        for suffix, values in zip(
-            ("fx", "fy", "fz", "mx", "my", "mz", "friction_torque", "friction_force",
-             "omega_rel", "slide_rel"),
-            (fx, fy, fz, mx, my, mz, friction_torque, friction_force, omega_rel, slide_rel),
-            strict=True,
-        ):
-            cols[f"{name}_{suffix}"] = values
+        cols[f"{name}_friction_torque"] = friction_torque
+        cols[f"{name}_friction_force"] = friction_force
         cols[f"power_loss_{name}"] = loss
     cols["power_loss"] = loss_total
     cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(model, states, n)

@@ -146,7 +146,7 @@ class ExudynModel:
     pair_kinematics: dict = field(default_factory=dict)
     mass: dict[str, float] = field(default_factory=dict)
     inertia: dict[str, np.ndarray] = field(default_factory=dict)
-    friction: Any = None  # cardan_exudyn.friction.FrictionCoupling when a pair has friction
+    friction: Any = None  # cardan_exudyn.friction.FrictionCoupling when friction is applied
 
 
 def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
@@ -209,7 +209,7 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
 
     _add_drive(model, ground)
     _add_loads(model)
-    if scene.has_friction:
+    if scene.has_friction and scene.friction.coupling != "uncoupled":
         from cardan_exudyn.friction import FrictionCoupling
 
         model.friction = FrictionCoupling(model)

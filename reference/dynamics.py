@@ -1,4 +1,4 @@
-"""Dynamics of the ideal Cardan joint with the paper's friction: Newton-Euler, batched over samples.
+"""Dynamics of the Cardan joint with the paper's friction: Newton-Euler, batched over samples.
 
 For a given input motion the kinematics (:func:`reference.joint_motion.joint_motion`: closed
 form for the ideal joint, the dual-number loop with mounting errors) give every body's motion.
@@ -408,7 +408,11 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     both = np.linalg.solve(matrix, np.concatenate([rhs[..., None], wrenches], -1))
     signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide_rel), scene.friction.sign_band)
              if slots else np.zeros(theta.shape + (0,)))
-    fixed = solve_friction(FrictionLaw(scene, slots), both[..., 0], both[..., 1:], signs)
+    law = FrictionLaw(scene, slots)
+    if scene.friction.coupling == "uncoupled":  # evaluated on the frictionless reactions only
+        fixed = FixedPoint(both[..., 0], law(both[..., 0], signs)[0], np.ones(n, bool), np.zeros(n), 0)
+    else:
+        fixed = solve_friction(law, both[..., 0], both[..., 1:], signs)
     if torque_in is not None:
         motion = joint_motion(joint, theta, theta_t, fixed.x[..., -1], method)
     return motion, fixed

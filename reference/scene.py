@@ -471,7 +471,7 @@ class Numerics:
         _set(self, "accuracy", acc)
 
 
-COUPLINGS = ("converged", "lagged")
+COUPLINGS = ("converged", "lagged", "uncoupled")
 
 
 @dataclass(frozen=True)
@@ -484,7 +484,11 @@ class FrictionSettings:
         ``"converged"``: within each time step, friction and reactions are iterated to a fixed
         point (the friction applied is the friction of the step's own reactions);
         ``"lagged"``: the paper's scheme (section 3.1), the reactions at the end of a step set the
-        friction applied during the next step.
+        friction applied during the next step; ``"uncoupled"``: friction is *not* applied to the
+        dynamics, eqs. (3), (5) are evaluated on the frictionless reactions and their power is
+        the loss (a first-order estimate, used to explain the paper's tolerance figure; the
+        energy balance then misses the loss). The reference engine has no time step: it solves
+        the converged fixed point for ``"converged"`` and ``"lagged"`` alike.
     sign_band : float
         Relative surface speed [m/s] below which ``sign()`` of eqs. (3), (5) is replaced by a
         linear ramp ``clip(v / sign_band, -1, 1)``. The surface speed of a rotating journal is
