@@ -6,8 +6,10 @@ Named scenes
     Section 4.1 multibody case (default 10 deg, 2000 rpm, f1 = 0.42, f2 = 0.20, 2 N m), under
     the plain reading of the paper (the assumption register), or with the calibrated parameter
     set (``[calibrated]`` in ``data/paper.toml``, identified by ``cardan calibrate``).
-``rig``
-    Section 4.2 rig case (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m), ideal geometry.
+``rig[-calibrated][-errors][-frictionless]``
+    Section 4.2 rig case (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m), ideal geometry
+    or, with ``-errors``, the section's manufacturing tolerances (:func:`paper_errors`); plain
+    or calibrated parameter set as above.
 
 References
 ----------
@@ -269,37 +271,71 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
     return apply_parameters(scene, values, calibrated_choices())
 
 
-def rig_scene(friction: bool = True) -> Scene:
-    """Section 4.2 rig case with ideal geometry: 15 deg, 6 rad/s, f = 0.42, 0.2 N m."""
+def paper_errors() -> dict[str, float]:
+    """Section 4.2's tolerances as scene overrides: ``a_i = 0.5 mm``, ``alpha_i`` errors 6e-3 deg.
+
+    The paper gives magnitudes for i = 1, 2, 3 without signs; all are taken positive (the
+    Monte Carlo study of ``cardan tolerance`` draws both signs).
+    """
+    a, alpha = value("case.rig.offset_error"), value("case.rig.twist_error") * DEG
+    return {**{f"joint.errors.a{k}": a for k in (1, 2, 3)},
+            **{f"joint.errors.alpha{k}": alpha for k in (1, 2, 3)}}
+
+
+def rig_scene(friction: bool = True, parameters: str = "plain", errors: bool = False) -> Scene:
+    """Section 4.2 rig case: 15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m.
+
+    Parameters
+    ----------
+    friction : bool
+    parameters : {"plain", "calibrated"}
+        The plain reading, or the calibrated lever, eccentricity and choices of the multibody case.
+    errors : bool
+        Apply the section's tolerances (:func:`paper_errors`); otherwise the ideal geometry.
+    """
+    from reference.scene import replace
+
     joint = paper_joint(value("case.rig.shaft_angle"), friction=False)
     f = value("case.rig.friction") if friction else 0.0
     pairs = Pairs(**{n: Pair(f, p.journal_diameter, p.moment_lever) for n, p in joint.pairs.items()})
     joint = Joint(joint.input, joint.spider, joint.output, joint.geometry, pairs)
-    return Scene(
+    name = ("rig" + ("-calibrated" if parameters == "calibrated" else "") + ("-errors" if errors else "")
+            + ("" if friction else "-frictionless"))
+    scene = Scene(
         joint=joint,
         drive=SpeedDrive(speed=value("case.rig.speed")),
         load=Load(torque=value("case.rig.input_torque")),
         gravity=tuple(value("assumption.gravity")),
         revolutions=2.0,
-        name="rig" + ("" if friction else "-frictionless"),
-        description="Section 4.2 rig case, ideal geometry, constant speed",
+        name=name,
+        description=(f"Section 4.2 rig case, {'stated tolerances' if errors else 'ideal geometry'}, "
+                     f"constant speed, {parameters} parameter set"),
     )
+    if parameters == "calibrated":
+        scene = apply_parameters(scene, {p["name"]: p["value"] for p in calibrated_parameters()},
+                                 calibrated_choices())
+    elif parameters != "plain":
+        raise SceneError(f"`parameters` must be 'plain' or 'calibrated', got {parameters!r}")
+    return replace(scene, **paper_errors()) if errors else scene
 
 
+_RIG = re.compile(r"^rig(?P<cal>-calibrated)?(?P<err>-errors)?(?P<fl>-frictionless)?$")
 _NAME = re.compile(r"^paper(?P<cal>-calibrated)?(?:-(?P<deg>\d+(?:\.\d+)?)deg)?"
                    r"(?:-(?P<rpm>\d+(?:\.\d+)?)rpm)?(?P<fl>-frictionless)?$")
 
 
 def named_scene(name: str) -> Scene:
     """A scene by name (see the module docstring for the names)."""
-    if name in ("rig", "rig-frictionless"):
-        return rig_scene(friction=name == "rig")
+    rig = _RIG.match(name) if isinstance(name, str) else None
+    if rig:
+        return rig_scene(friction=not rig["fl"], parameters="calibrated" if rig["cal"] else "plain",
+                         errors=bool(rig["err"]))
     match = _NAME.match(name) if isinstance(name, str) else None
     if not match:
         raise SceneError(
             f"unknown scene name {name!r}; use "
             "'paper[-calibrated][-<A>deg][-<R>rpm][-frictionless]' "
-            "(e.g. 'paper-10deg-2000rpm') or 'rig'"
+            "(e.g. 'paper-10deg-2000rpm') or 'rig[-calibrated][-errors][-frictionless]'"
         )
     deg = float(match["deg"]) if match["deg"] else value("case.speed_study.shaft_angle")
     rpm = float(match["rpm"]) if match["rpm"] else None

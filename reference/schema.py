@@ -145,6 +145,9 @@ def mean_values(columns: dict[str, np.ndarray], skip_revolutions: float) -> dict
         key = f"power_loss_{p}"
         if key in columns:
             out[f"loss_work_{p}"] = window_integral(columns[key], t, theta, theta_0, theta_1)
+        if f"{p}_friction_force" in columns and f"{p}_slide_rel" in columns:  # axial friction's part
+            sliding = -np.asarray(columns[f"{p}_friction_force"]) * np.asarray(columns[f"{p}_slide_rel"])
+            out[f"loss_work_{p}_sliding"] = window_integral(sliding, t, theta, theta_0, theta_1)
     return out
 
 
