@@ -84,11 +84,20 @@ def end_time(scene: Scene, start: float) -> float:
     return start + drive.time_allowed(target)
 
 
+def steps_for_span(span: float, dt: float) -> int:
+    """Fewest whole steps of at most ``dt`` (to rounding) that cover ``span``.
+
+    Rounding to the nearest count instead would stop short of the span by up to half a step, and
+    a span of exactly ``1 + skip`` revolutions would then average less than one revolution.
+    """
+    return max(1, math.ceil(span / dt - 1e-9))
+
+
 def simulation_settings(dt: float, t_start: float, t_end: float,
                         options: ExudynOptions) -> Any:
     s = exu.SimulationSettings()
     ti = s.timeIntegration
-    n = max(1, int(round((t_end - t_start) / dt)))
+    n = steps_for_span(t_end - t_start, dt)
     ti.startTime = t_start
     ti.endTime = t_start + n * dt
     ti.numberOfSteps = n
@@ -112,6 +121,8 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     dt, dt_reason = choose_step(scene)
     model = build_model(scene)
     t_end = end_time(scene, model.start_time)
+    span = t_end - model.start_time
+    dt = span / steps_for_span(span, dt)  # whole steps end exactly at the span's end
     settings = simulation_settings(dt, model.start_time, t_end, options)
     target = 2.0 * math.pi * scene.revolutions
     friction = model.friction

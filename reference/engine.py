@@ -422,7 +422,7 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
 def _table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
     span = motion.t_end - motion.t0
     if options.samples_per_revolution is None and scene.numerics.dt is not None:
-        steps = max(1, round(span / scene.numerics.dt))
+        steps = max(1, math.ceil(span / scene.numerics.dt - 1e-9))  # as the Exudyn engine
     else:
         spr = options.samples_per_revolution or 360
         theta_a, theta_b = motion.angle(motion.t0), motion.angle(motion.t_end)

@@ -417,12 +417,14 @@ def axial_positions(geometry: Geometry) -> tuple[float, float, float, float]:
 
 def pair_frames(params: DHParameters, positions: LoopPositions,
                 axial: Sequence[float] = (0.0,) * 4) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each pair's frame, attached to body ``a`` (global components), and its origin.
+    """Each pair's frame (global components) and origin, the point reactions are taken about.
 
-    The frame is the D-H frame of the pair's joint with the axes of
-    :func:`reference.kinematics.pair_frames` (z the pair axis); the origin is ``F_k``'s origin
-    moved ``axial[k]`` along the axis (:func:`axial_positions`): the point where the bearing sits,
-    about which the reaction moments are taken.
+    The frame is the D-H frame ``F_k`` of the pair's joint, fixed in body ``a``, with the axes of
+    :func:`reference.kinematics.pair_frames` (z the pair axis). The origin is the point of body
+    ``b`` on the axis that sits ``axial[k]`` from ``F_k``'s origin at input angle 0
+    (:func:`axial_positions`); when the pair slides it moves along the axis with body ``b``.
+    Body ``b`` carries the bearing of the ``spider_output`` (output yoke) and ``output_frame``
+    (frame) pairs; it is also the point Exudyn's joint reactions refer to.
 
     Returns
     -------
@@ -430,8 +432,9 @@ def pair_frames(params: DHParameters, positions: LoopPositions,
     """
     rotation, origin = joint_frames(params, positions)
     axial = np.asarray(_four("axial", axial))
+    start = solve_positions(params, np.zeros(1), positions.branch).s[0]
     frames = rotation @ _PAIR_IN_F
-    origins = origin + axial[:, None] * rotation[..., :, 2]
+    origins = origin + (axial + positions.s - start)[..., None] * rotation[..., :, 2]
     return {p: (frames[..., k, :, :], origins[..., k, :]) for k, p in enumerate(PAIR_NAMES)}
 
 

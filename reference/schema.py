@@ -14,7 +14,8 @@ energy zero at the joint centre).
 
 Per pair, ``<pair>_fx, _fy, _fz`` [N] and ``<pair>_mx, _my, _mz`` [N m]: the force and moment that
 body ``a`` of the pair exerts on body ``b`` (see :data:`reference.scene.PAIR_BODIES`), about the
-pair's origin, in the pair frame (z along the pair axis) attached to body ``a``. The constraint
+pair's origin (on the axis, moving with body ``b`` when a pair with mounting errors slides), in
+the pair frame (z along the pair axis) attached to body ``a``. The constraint
 part excludes the applied friction; friction appears in ``<pair>_friction_torque`` [N m] and
 ``<pair>_friction_force`` [N] (on body b, about / along the pair axis), with the relative motion
 ``<pair>_omega_rel`` [rad/s] and ``<pair>_slide_rel`` [m/s] of b with respect to a.
