@@ -1,7 +1,8 @@
 """The ``cardan`` command line.
 
 Exit status: 0 success; 2 bad input (one line on stderr naming the argument, no traceback);
-3 the simulation failed or is physically meaningless (the reason is in the summary ``status``).
+3 the simulation failed or is physically meaningless (the reason is in the summary ``status``);
+4 (``cardan sweep``) the sweep stopped before every case ran (rerun the command to resume).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 from reference.scene import DEG, RPM, Scene, SceneError, load_scene, replace
 
 EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
+EXIT_INCOMPLETE = 4
 DEFAULT_SCENE = "paper-10deg-frictionless"
 
 
@@ -179,6 +181,90 @@ def cmd_scene(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _count(name: str):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer ({name}), got {text!r}") from None
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"must be >= 1 ({name}), got {text!r}")
+        return value
+
+    return parse
+
+
+def _cli_value(text: str) -> Any:
+    """A TOML value (number, boolean, quoted string, array), else the text itself."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        import tomli as tomllib
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def _path_value(option: str, text: str, form: str) -> tuple[str, str]:
+    path, sep, value = text.partition("=")
+    if not sep or not path.strip() or not value.strip():
+        raise BadInput(f"{option} must look like {form}, got {text!r}")
+    return path.strip(), value
+
+
+def sweep_spec_from_args(args: argparse.Namespace) -> Any:
+    """The sweep spec of ``cardan sweep``: the SPEC file, with the command-line options applied."""
+    import os
+
+    from cardan_exudyn.sweep import SweepError, looks_like_path, read_spec_file, spec_from_mapping
+
+    data = read_spec_file(args.spec) if args.spec else {}
+    if args.scene is not None:
+        scene = args.scene
+        data["scene"] = os.path.abspath(scene) if looks_like_path(scene) or os.path.isfile(scene) else scene
+    for key in ("engine", "function"):
+        if getattr(args, key) is not None:
+            data[key] = getattr(args, key)
+    for option, key, items, form in (("--grid", "grid", args.grid, "PATH=V1,V2,..."),
+                                     ("--set", "fixed", args.set, "PATH=VALUE")):
+        for text in items or ():
+            path, value = _path_value(option, text, form)
+            table = data.setdefault(key, {})
+            table[path] = [_cli_value(v) for v in value.split(",")] if key == "grid" else _cli_value(value)
+    data.setdefault("scene", None)
+    if not args.spec:
+        return spec_from_mapping(data)
+    try:
+        return spec_from_mapping(data, base_dir=os.path.dirname(os.path.abspath(args.spec)))
+    except SweepError as exc:
+        raise SweepError(f"{args.spec}: {exc}") from None
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from cardan_exudyn.io import dumps
+    from cardan_exudyn.sweep import SweepError, SweepIncomplete, run_sweep
+
+    try:
+        spec = sweep_spec_from_args(args)
+        summary = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler,
+                            restart=args.restart, retry_failed=args.retry_failed,
+                            progress=False if args.quiet else None)
+    except SweepError as exc:
+        raise BadInput(str(exc)) from None
+    except SweepIncomplete as exc:
+        print(f"cardan sweep: {exc}", file=sys.stderr)
+        return EXIT_INCOMPLETE
+    if args.json:
+        print(dumps(summary))
+    elif not args.quiet:
+        counts = ", ".join(f"{n} {status}" for status, n in summary["status_counts"].items())
+        print(f"sweep {args.out}: {summary['done']} cases ({counts}), {summary['run_now']} run now in "
+              f"{summary['wall_time_s']:.3g} s ({summary['executor']['kind']}); wrote "
+              f"{args.out}/results.csv and {args.out}/sweep.json", file=sys.stderr)
+    return EXIT_OK if summary["failed"] == 0 else EXIT_FAILED
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="cardan", description="Mechanical efficiency of Cardan joints with Exudyn.")
@@ -224,6 +310,31 @@ def build_parser() -> argparse.ArgumentParser:
                    help="report folder: comparison.json, report.md, tables, overlay plots")
     p.add_argument("--json", action="store_true", help="print the comparison as JSON on stdout")
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("sweep", help="run a scene over a grid or random samples of its parameters",
+                       description="Run a sweep (docs/sweep.md). Records go to OUT/cases.jsonl as "
+                                   "cases finish; rerunning the same command resumes.")
+    p.add_argument("spec", nargs="?", metavar="SPEC.toml", help="sweep spec (scene, engine, grid, random)")
+    p.add_argument("--out", required=True, metavar="DIR",
+                   help="output folder: plan.json, cases.jsonl, results.csv, sweep.json")
+    p.add_argument("--scene", metavar="NAME|FILE", help="named scene or scene TOML (overrides the spec)")
+    p.add_argument("--engine", help="engine (overrides the spec; default exudyn)")
+    p.add_argument("--function", metavar="MODULE:NAME",
+                   help="case function fn(scene, engine) -> dict (default: the summary's scalars)")
+    p.add_argument("--grid", action="append", metavar="PATH=V1,V2,...",
+                   help="grid parameter (dotted scene path), repeatable; adds to the spec's grid")
+    p.add_argument("--set", action="append", metavar="PATH=VALUE",
+                   help="override applied to every case, repeatable")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_count("--workers"), metavar="N",
+                       help="local processes (default: all cores; 1 runs in this process)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                       help="run on this Dask distributed scheduler instead")
+    p.add_argument("--restart", action="store_true", help="discard the records in --out and start over")
+    p.add_argument("--retry-failed", action="store_true", help="rerun the cases recorded as failed")
+    p.add_argument("--quiet", action="store_true", help="no progress bar, no closing line")
+    p.add_argument("--json", action="store_true", help="print the sweep summary as JSON on stdout")
+    p.set_defaults(func=cmd_sweep)
 
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
     _add_scene_options(p)

@@ -26,6 +26,7 @@ from cardan_exudyn.model import ExudynModel, build_model
 from cardan_exudyn.rotations import rxyz_angular_velocity, rxyz_matrix
 from cardan_exudyn.stepsize import choose_step
 from reference.friction import friction_from_columns
+from reference.rccc import LoopClosureError
 from reference.scene import (
     PAIR_BODIES,
     PAIR_KIND,
@@ -36,6 +37,7 @@ from reference.scene import (
     scene_to_dict,
 )
 from reference.schema import (
+    STATUS_NO_CLOSURE,
     STATUS_OK,
     Result,
     instantaneous_efficiency,
@@ -119,7 +121,12 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     options = options or ExudynOptions()
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene)
-    model = build_model(scene)
+    try:
+        model = build_model(scene)
+    except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
+        return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
+                             "engine_version": engine_version(), "scene": scene_to_dict(scene),
+                             "wall_time_s": time.perf_counter() - wall_start})
     t_end = end_time(scene, model.start_time)
     span = t_end - model.start_time
     dt = span / steps_for_span(span, dt)  # whole steps end exactly at the span's end

@@ -36,6 +36,7 @@ from reference.joint_motion import joint_motion
 from reference.rccc import LoopClosureError
 from reference.scene import PAIR_NAMES, AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.schema import (
+    STATUS_NO_CLOSURE,
     STATUS_OK,
     Result,
     mean_values,
@@ -49,7 +50,6 @@ STATUS_SELF_LOCKING = "self_locking"
 EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
                  *(f"{p}_slide" for p in PAIR_NAMES),
                  *(f"power_loss_{p}_{part}" for p in PAIR_NAMES for part in ("rotation", "sliding")))
-STATUS_NO_CLOSURE = "loop_does_not_close"
 
 
 @dataclass(frozen=True)
@@ -324,7 +324,10 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
         left, right = both[:a.size], both[a.size:]
         diff = np.abs(left + right - whole)
         allowed = rtol * scale * (b - a) / total_width
-        done = np.all(diff <= allowed[:, None], -1) | (rounds == max_rounds)
+        # a non-finite panel (NaN from a locked or failed sample) cannot converge: close it and
+        # let the NaN reach the result instead of splitting it every round (2^rounds panels)
+        done = (np.all(diff <= allowed[:, None], -1) | (rounds == max_rounds)
+                | ~np.all(np.isfinite(left + right), -1))
         result += (left + right)[done].sum(0)
         error += diff[done].sum(0)
         closed += int(np.count_nonzero(done))

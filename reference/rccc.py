@@ -54,6 +54,7 @@ experimental validation", section 3.2, eqs. (10)-(14), Figure 3 (RCCC model and 
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -348,6 +349,38 @@ def _solve_wrapped(params: DHParameters, theta1: np.ndarray, sign: float, where:
     return dual.stack([t1, t2, t3, t4], -1)
 
 
+WINDING_SAMPLES = 1440
+"""Input angles per turn at which :func:`solve_positions` checks the windings (0.25 deg apart)."""
+
+
+@functools.lru_cache(maxsize=256)
+def _check_windings(params: DHParameters, branch: str) -> None:
+    """Raise unless every joint angle turns as the Cardan joint's do over one input turn.
+
+    The continuity rule of the module docstring assumes that the spider stays near both shafts
+    and the output turns once per input turn (windings ``(1, 0, 0, -1)``). Large twist errors
+    can make the spherical loop a crank-rocker (e.g. an input twist below the shaft angle): the
+    loop still closes, but a joint angle then jumps by a full turn between neighbouring input
+    angles. Checked once per parameter set on a fine grid.
+    """
+    theta1 = np.linspace(0.0, 2.0 * np.pi, WINDING_SAMPLES + 1)
+    sign = _BRANCH_SIGN[branch]
+    try:
+        reference = _solve_wrapped(params, np.zeros(1), sign, "the reference input angle").re[0]
+        raw = _solve_wrapped(params, theta1, sign, "input angles").re
+    except LoopClosureError:  # reported by the caller's own solve, at the caller's angles
+        return
+    nominal = reference + _WINDING * theta1[:, None]
+    deviation = np.remainder(raw - nominal + np.pi, 2.0 * np.pi) - np.pi
+    jumps = np.abs(np.diff(deviation[:, 1:], axis=0)) > 0.5 * np.pi
+    if np.any(jumps):
+        at = theta1[1:][np.any(jumps, -1)]
+        raise LoopClosureError(
+            "with these mounting errors the loop is not a Cardan joint's double crank: a joint "
+            "angle does not follow the input turn for turn (it jumps by a full turn near input "
+            f"angle(s) {_listing(at)})", at)
+
+
 def solve_positions(params: DHParameters, theta1, branch: str = "hooke") -> LoopPositions:
     """Joint angles and slides closing the loop for given input angles.
 
@@ -373,6 +406,7 @@ def solve_positions(params: DHParameters, theta1, branch: str = "hooke") -> Loop
         raise ValueError(f"`branch` must be one of {list(BRANCHES)}, got {branch!r}")
     theta1 = _samples("theta1", theta1)
     sign = _BRANCH_SIGN[branch]
+    _check_windings(params, branch)
     reference = _solve_wrapped(params, np.zeros(1), sign, "the reference input angle").re[0]
     raw = _solve_wrapped(params, theta1, sign, "input angles")
     nominal = reference + _WINDING * theta1[..., None]

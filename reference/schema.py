@@ -52,6 +52,7 @@ def table_columns() -> list[str]:
 
 
 STATUS_OK = "ok"
+STATUS_NO_CLOSURE = "loop_does_not_close"  # mounting errors the loop cannot be assembled with
 
 
 @dataclass
