@@ -265,6 +265,68 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK if summary["failed"] == 0 else EXIT_FAILED
 
 
+def _distribution(text: str) -> tuple[str, dict[str, Any]]:
+    """``PATH=uniform:LOW:HIGH`` or ``PATH=normal:MEAN:STD[:LOW:HIGH]`` for ``--error``."""
+    from cardan_exudyn.sweep import Distribution, SweepError
+
+    path, value = _path_value("--error", text, "PATH=uniform:LOW:HIGH or PATH=normal:MEAN:STD[:LOW:HIGH]")
+    kind, *numbers = value.split(":")
+    names = {"uniform": ("low", "high"), "normal": ("mean", "std", "low", "high")}.get(kind)
+    if names is None or not (2 <= len(numbers) <= len(names)) or (kind == "normal" and len(numbers) == 3):
+        raise BadInput(f"--error {text!r}: give uniform:LOW:HIGH or normal:MEAN:STD[:LOW:HIGH]")
+    try:
+        table = {"dist": kind, **{n: float(v) for n, v in zip(names, numbers, strict=False)}}
+        Distribution(**table)
+    except (ValueError, SweepError) as exc:
+        raise BadInput(f"--error {text!r}: {exc}") from None
+    return path, table
+
+
+def cmd_tolerance(args: argparse.Namespace) -> int:
+    from cardan_exudyn.engines import ENGINES, EngineUnavailable
+    from cardan_exudyn.io import dumps
+    from cardan_exudyn.sweep import SweepError
+
+    if args.study == "paper":
+        engines = [e.strip() for e in args.engines.split(",") if e.strip()]
+        unknown = [e for e in engines if e not in ENGINES]
+        if not engines or unknown:
+            raise BadInput(f"--engines must name engines of {sorted(ENGINES)}, got {args.engines!r}")
+        from cardan_exudyn.tolerance import paper_report
+
+        def show(row: dict) -> None:
+            if not args.json:
+                print(f"  {row['parameters']:10s} {row['coupling']:9s} {row['engine']:9s} "
+                      f"{row['status_errors']:12s} change {row['relative_change']:+.3%}", file=sys.stderr)
+
+        summary = paper_report(args.out, engines, progress=show)
+        if args.json:
+            print(dumps(summary))
+        else:
+            print(f"wrote {args.out}/report.md", file=sys.stderr)
+        return EXIT_OK
+    from cardan_exudyn.tolerance import default_distributions, monte_carlo
+
+    scene = scene_from_args(args)
+    distributions = dict(_distribution(t) for t in args.error) if args.error else default_distributions()
+    try:
+        summary = monte_carlo(scene, args.engine, args.samples, args.seed, distributions, out=args.out,
+                              method=args.method, workers=args.workers, scheduler=args.scheduler,
+                              restart=args.restart, progress=False if args.json else None)
+    except SweepError as exc:
+        raise BadInput(str(exc)) from None
+    except EngineUnavailable:
+        raise
+    if args.json:
+        print(dumps(summary))
+    else:
+        m = summary["mean_efficiency"]
+        print(f"{summary['status_counts']}; ideal {summary['ideal_mean_efficiency']:.6f}; "
+              f"p5/p50/p95 {m.get('p5', float('nan')):.6f} / {m.get('p50', float('nan')):.6f} / "
+              f"{m.get('p95', float('nan')):.6f}; wrote {args.out}/study/report.md", file=sys.stderr)
+    return EXIT_OK if summary["status_counts"].get("ok", 0) == summary["samples"] else EXIT_FAILED
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="cardan", description="Mechanical efficiency of Cardan joints with Exudyn.")
@@ -335,6 +397,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar, no closing line")
     p.add_argument("--json", action="store_true", help="print the sweep summary as JSON on stdout")
     p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("tolerance", help="mounting-error studies: the paper's case, Monte Carlo",
+                       description="`paper`: the rig case with and without the paper's tolerances "
+                                   "(both parameter sets and couplings, per-pair breakdown). "
+                                   "`montecarlo`: errors drawn from distributions (default: the "
+                                   "paper's tolerances, uniform with both signs), resumable.")
+    p.add_argument("study", choices=("paper", "montecarlo"))
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--engines", default="reference,exudyn", help="paper: engines to compare")
+    p.add_argument("--engine", default="reference", help="montecarlo: engine (default reference)")
+    p.add_argument("--samples", type=_count("--samples"), default=1000, help="montecarlo: N (1000)")
+    p.add_argument("--seed", type=int, default=1, help="montecarlo: seed of the draws (1)")
+    p.add_argument("--method", choices=("lhs", "random"), default="lhs",
+                   help="montecarlo: Latin hypercube (default) or independent draws")
+    p.add_argument("--error", action="append", metavar="PATH=DIST:...",
+                   help="montecarlo: e.g. joint.errors.a1_mm=uniform:-0.5:0.5, "
+                        "joint.errors.alpha2_deg=normal:0:0.002:-0.006:0.006; repeatable")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=_count("--workers"), metavar="N",
+                       help="local processes (default: all cores; 1 runs in this process)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="Dask scheduler to run on")
+    p.add_argument("--restart", action="store_true", help="montecarlo: discard earlier samples in --out")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    _add_scene_options(p)
+    p.set_defaults(func=cmd_tolerance, name="rig-calibrated")
 
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
     _add_scene_options(p)

@@ -1,0 +1,99 @@
+"""Tolerance studies: sensitivity measures, the Monte Carlo study, the paper's case and the CLI."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cardan_exudyn.cli import main
+from cardan_exudyn.tolerance import correlation_ratio, monte_carlo, paper_case, sensitivities
+from reference.paper import named_scene
+from reference.scene import replace
+
+
+def test_correlation_ratio_sees_even_dependence_that_rank_correlation_misses():
+    rng = np.random.default_rng(3)
+    x, noise = rng.uniform(-1, 1, 4000), rng.uniform(-1, 1, 4000)
+    y = x**2 + 0.05 * noise
+    table = pd.DataFrame({"x": x, "noise": noise, "mean_efficiency": y})
+    sens = sensitivities(table, ["x", "noise"]).set_index("parameter")
+    assert abs(sens.loc["x", "spearman"]) < 0.05          # blind to an even effect
+    assert sens.loc["x", "spearman_magnitude"] > 0.95      # the magnitude carries it
+    assert sens.loc["x", "correlation_ratio"] > 0.9  # 10 bins: ~0.94, the rest is in-bin spread
+    assert sens.loc["noise", "correlation_ratio"] < 0.02   # ~bins / n sampling noise
+    assert correlation_ratio(x, 2 * x + 1) > 0.97  # a function of x: 1 - 1/bins^2 = 0.99
+
+
+@pytest.fixture(scope="module")
+def small_study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("mc")
+    scene = replace(named_scene("rig-calibrated"), revolutions=1.0, **{"record.skip_revolutions": 0.0})
+    dists = {"joint.errors.a2_mm": {"dist": "uniform", "low": -0.5, "high": 0.5},
+             "joint.errors.alpha3_deg": {"dist": "normal", "mean": 0.0, "std": 0.003,
+                                         "low": -0.006, "high": 0.006}}
+    summary = monte_carlo(scene, "reference", 24, 7, dists, out=out, workers=1, progress=False)
+    return out, scene, dists, summary
+
+
+def test_monte_carlo_draws_reproducibly_and_reports(small_study, tmp_path):
+    out, scene, dists, summary = small_study
+    samples = pd.read_csv(out / "study" / "samples.csv")
+    assert len(samples) == 24 and summary["status_counts"] == {"ok": 24}
+    assert samples["joint.errors.a2_mm"].between(-0.5, 0.5).all()
+    assert samples["joint.errors.alpha3_deg"].between(-0.006, 0.006).all()
+    # the same seed gives the same draws and the same efficiencies (a fresh folder)
+    again = monte_carlo(scene, "reference", 24, 7, dists, out=tmp_path, workers=1, progress=False)
+    second = pd.read_csv(tmp_path / "study" / "samples.csv")
+    np.testing.assert_array_equal(second["joint.errors.a2_mm"], samples["joint.errors.a2_mm"])
+    np.testing.assert_allclose(second["mean_efficiency"], samples["mean_efficiency"], rtol=1e-12)
+    assert again["mean_efficiency"]["p50"] == summary["mean_efficiency"]["p50"]
+    m = summary["mean_efficiency"]
+    assert m["p5"] <= m["p50"] <= m["p95"] and m["max"] <= summary["ideal_mean_efficiency"] + 1e-12
+    # the spider offset a2 dominates (sliding friction, even in its sign): see the single-error test
+    sens = {r["parameter"]: r for r in summary["sensitivity"]}
+    assert sens["joint.errors.a2_mm"]["spearman_magnitude"] < -0.9
+    for name in ("report.md", "tolerance.json", "sensitivity.csv", "efficiency_histogram.png",
+                 "efficiency_vs_errors.png"):
+        assert (out / "study" / name).stat().st_size > 0
+
+
+def test_monte_carlo_resumes_without_rerunning(small_study):
+    out, scene, dists, _ = small_study
+    summary = monte_carlo(scene, "reference", 24, 7, dists, out=out, workers=1, progress=False)
+    assert summary["run_now"] == 0 and summary["status_counts"] == {"ok": 24}
+
+
+def test_paper_case_rows_agree_between_engines():
+    rows = paper_case(["reference", "exudyn"], parameter_sets=["calibrated"], couplings=["uncoupled"])
+    ref, exu = rows.set_index("engine").loc["reference"], rows.set_index("engine").loc["exudyn"]
+    assert ref.status_errors == exu.status_errors == "ok"
+    assert ref.change < 0 and exu.change == pytest.approx(ref.change, rel=2e-2)
+    # the per-pair changes account for the efficiency change (the input work hardly changes)
+    total = sum(ref[f"d_loss_{p}"] for p in ("frame_input", "input_spider", "spider_output", "output_frame"))
+    assert total == pytest.approx(-ref.change, rel=2e-2)
+    assert ref.sliding_share > 0
+
+
+def test_tolerance_cli_bad_inputs(tmp_path, capsys):
+    out = tmp_path / "x"
+    for argv, message in (
+        (["--error", "joint.errors.a1_mm=triangle:0:1"], "give uniform:LOW:HIGH"),
+        (["--error", "joint.errors.a1_mm=uniform:1:0"], "`low` must be below `high`"),
+        (["--error", "joint.errors.a9_mm=uniform:0:1"], "a9"),
+        (["--engine", "nope"], "nope"),
+    ):
+        code = main(["tolerance", "montecarlo", "--samples", "2", "--workers", "1", "--out", str(out), *argv])
+        err = capsys.readouterr().err
+        assert code == 2 and message in err and "Traceback" not in err, (argv, err)
+        assert not (out / "study").exists()
+    assert main(["tolerance", "paper", "--engines", "reference,bogus", "--out", str(out)]) == 2
+
+
+def test_tolerance_cli_json(tmp_path, capsys):
+    code = main(["tolerance", "montecarlo", "--samples", "3", "--workers", "1", "--revolutions", "1",
+                 "--out", str(tmp_path), "--json",
+                 "--error", "joint.errors.a1_mm=uniform:-0.2:0.2"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["samples"] == 3 and summary["status_counts"] == {"ok": 3}
+    assert list(summary["distributions"]) == ["joint.errors.a1_mm"]
