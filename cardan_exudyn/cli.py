@@ -283,7 +283,7 @@ def _distribution(text: str) -> tuple[str, dict[str, Any]]:
 
 
 def cmd_tolerance(args: argparse.Namespace) -> int:
-    from cardan_exudyn.engines import ENGINES, EngineUnavailable
+    from cardan_exudyn.engines import ENGINES
     from cardan_exudyn.io import dumps
     from cardan_exudyn.sweep import SweepError
 
@@ -315,8 +315,6 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
                               restart=args.restart, progress=False if args.json else None)
     except SweepError as exc:
         raise BadInput(str(exc)) from None
-    except EngineUnavailable:
-        raise
     if args.json:
         print(dumps(summary))
     else:
