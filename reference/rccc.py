@@ -349,6 +349,18 @@ def _solve_wrapped(params: DHParameters, theta1: np.ndarray, sign: float, where:
     return dual.stack([t1, t2, t3, t4], -1)
 
 
+@functools.lru_cache(maxsize=256)
+def _at_zero(params: DHParameters, branch: str) -> tuple[np.ndarray, np.ndarray]:
+    """Joint angles (4,) [rad] and slides (4,) [m] at ``theta_1 = 0`` on a branch (cached).
+
+    Every solve and every pair-frame evaluation of a parameter set needs them; solved once.
+    """
+    angles = _solve_wrapped(params, np.zeros(1), _BRANCH_SIGN[branch], "the reference input angle")
+    theta, slide = angles.re[0].copy(), angles.du[0].copy()
+    theta.flags.writeable = slide.flags.writeable = False  # shared by every caller
+    return theta, slide
+
+
 WINDING_SAMPLES = 1440
 """Input angles per turn at which :func:`solve_positions` checks the windings (0.25 deg apart)."""
 
@@ -366,7 +378,7 @@ def _check_windings(params: DHParameters, branch: str) -> None:
     theta1 = np.linspace(0.0, 2.0 * np.pi, WINDING_SAMPLES + 1)
     sign = _BRANCH_SIGN[branch]
     try:
-        reference = _solve_wrapped(params, np.zeros(1), sign, "the reference input angle").re[0]
+        reference = _at_zero(params, branch)[0]
         raw = _solve_wrapped(params, theta1, sign, "input angles").re
     except LoopClosureError:  # reported by the caller's own solve, at the caller's angles
         return
@@ -407,7 +419,7 @@ def solve_positions(params: DHParameters, theta1, branch: str = "hooke") -> Loop
     theta1 = _samples("theta1", theta1)
     sign = _BRANCH_SIGN[branch]
     _check_windings(params, branch)
-    reference = _solve_wrapped(params, np.zeros(1), sign, "the reference input angle").re[0]
+    reference = _at_zero(params, branch)[0]
     raw = _solve_wrapped(params, theta1, sign, "input angles")
     nominal = reference + _WINDING * theta1[..., None]
     theta = nominal + np.remainder(raw.re - nominal + np.pi, 2.0 * np.pi) - np.pi
@@ -466,7 +478,7 @@ def pair_frames(params: DHParameters, positions: LoopPositions,
     """
     rotation, origin = joint_frames(params, positions)
     axial = np.asarray(_four("axial", axial))
-    start = solve_positions(params, np.zeros(1), positions.branch).s[0]
+    start = _at_zero(params, positions.branch)[1]
     frames = rotation @ _PAIR_IN_F
     origins = origin + (axial + positions.s - start)[..., None] * rotation[..., :, 2]
     return {p: (frames[..., k, :, :], origins[..., k, :]) for k, p in enumerate(PAIR_NAMES)}
