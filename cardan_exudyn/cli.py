@@ -80,6 +80,7 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
         changes["drive"] = {"kind": "speed", "speed": args.rpm * RPM}
     if args.load_torque is not None:
         changes["load.torque"] = args.load_torque
+        changes["load.time"] = None  # a constant torque replaces any history
     for option, pairs in (("friction_spider", ("input_spider", "spider_output")),
                           ("friction_frame", ("frame_input", "output_frame"))):
         value = getattr(args, option)

@@ -303,7 +303,7 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
         cols["torque_in"] = np.full(n, scene.drive.torque)
     else:
         cols["torque_in"] = -_stored(model, "drive_force")[:n, 1]
-    cols["torque_out"] = np.full(n, scene.load.torque)
+    cols["torque_out"] = scene.load.at(t)
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * cols["omega_out"]
 

@@ -261,9 +261,20 @@ def _add_drive(model: ExudynModel, ground) -> None:
 
 def _add_loads(model: ExudynModel) -> None:
     mbs, scene = model.mbs, model.scene
-    if scene.load.torque != 0.0:
+    axis = model.pair_frames["output_frame"][:, 2]  # the output axis, fixed in the ground
+    if not scene.load.constant:  # a measured history: interpolated at each instant
+        load = scene.load
+
+        def load_history(mbs_, t, load_vector):
+            return list(-float(load.at(t)) * axis)
+
+        model.user_functions.append(load_history)
         m_out = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["output"]))
-        vector = -scene.load.torque * model.pair_frames["output_frame"][:, 2]  # the output axis
+        mbs.AddLoad(eii.LoadTorqueVector(markerNumber=m_out, loadVector=[0.0, 0.0, 0.0],
+                                         loadVectorUserFunction=load_history))
+    elif scene.load.torque != 0.0:
+        m_out = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["output"]))
+        vector = -scene.load.torque * axis
         mbs.AddLoad(eii.LoadTorqueVector(markerNumber=m_out, loadVector=list(vector)))
     if scene.has_gravity:
         for name in model.bodies:

@@ -623,6 +623,9 @@ def run(scene: Scene, settings: MujocoSettings | None = None) -> Result:
             "MuJoCo cannot model the paper's friction (eqs. (1)-(5): friction forces "
             "proportional to the pair reactions); its frictionloss is a constant joint friction. "
             "Use the exudyn engine or a '-frictionless' scene")
+    if not scene.load.constant:
+        raise NotImplementedError("the MuJoCo engine takes a constant load torque only; a load "
+                                  "history (measured brake torque) runs on exudyn or reference")
     settings = settings or MujocoSettings()
     start = time.perf_counter()
     dt, why = choose_timestep(scene, settings)

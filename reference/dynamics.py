@@ -157,8 +157,12 @@ def wrench_columns(motion: JointMotion, components: list[tuple[str, str]]) -> np
     return out.reshape(shape + (6 * len(BODY_NAMES), len(components)))
 
 
-def reaction_system(scene: Scene, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
+def reaction_system(scene: Scene, motion: JointMotion,
+                    load_torque: float | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Newton-Euler equations of the three bodies as ``matrix @ unknowns = rhs``.
+
+    ``load_torque`` [N m] (scalar or one per sample) is the output load at these samples; None
+    takes the scene's constant load (a load history needs it given: the motion has no time).
 
     Returns
     -------
@@ -177,9 +181,17 @@ def reaction_system(scene: Scene, motion: JointMotion) -> tuple[np.ndarray, np.n
                                                          np.asarray(scene.gravity)), -1)
                           for name, body in scene.joint.bodies()], -1)
     # the load's moment -T u on the output (u its axis, the output_frame pair's z), to the right
-    rhs[..., rows["output"] + 3:rows["output"] + 6] += (scene.load.torque
+    load = np.asarray(constant_load(scene) if load_torque is None else load_torque, float)
+    rhs[..., rows["output"] + 3:rows["output"] + 6] += (load[..., None]
                                                        * motion.frames["output_frame"][..., :, 2])
     return matrix, rhs
+
+
+def constant_load(scene: Scene) -> float:
+    """The scene's load torque [N m]; a history needs the instants, so it is refused here."""
+    if not scene.load.constant:
+        raise ValueError("the scene's load is a torque history: pass `load_torque` for the samples")
+    return float(scene.load.torque)
 
 
 def friction_slots(scene: Scene) -> list[tuple[str, str]]:
@@ -369,12 +381,14 @@ def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
 def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                    theta_tt: np.ndarray | None = None,
                    torque_in: float | np.ndarray | None = None,
-                   method: str = "auto") -> tuple[JointMotion, FixedPoint]:
+                   method: str = "auto",
+                   load_torque: float | np.ndarray | None = None) -> tuple[JointMotion, FixedPoint]:
     """Reactions, friction and the drive unknown for every sample.
 
     Exactly one of ``theta_tt`` (inverse dynamics: the drive torque is the unknown) and
     ``torque_in`` (forward dynamics: the input acceleration is the unknown) is given.
-    ``method`` chooses the kinematics (:func:`reference.joint_motion.joint_motion`).
+    ``method`` chooses the kinematics (:func:`reference.joint_motion.joint_motion`);
+    ``load_torque`` [N m] the output load per sample (None: the scene's constant load).
 
     Returns
     -------
@@ -390,13 +404,14 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     n = theta.size
     if theta_tt is not None:
         motion = joint_motion(joint, theta, theta_t, np.broadcast_to(theta_tt, theta.shape), method)
-        matrix, rhs = reaction_system(scene, motion)
+        matrix, rhs = reaction_system(scene, motion, load_torque)
         omega_rel, slide_rel = motion.omega_rel, motion.slide_rel
         wrenches = friction_matrix(motion, friction_slots(scene))
     else:  # one batch at accelerations 0 and 1: the right-hand side is affine in theta_tt
         pair = joint_motion(joint, np.tile(theta, 2), np.tile(theta_t, 2), np.repeat([0.0, 1.0], n),
                             method)
-        matrix, rhs = reaction_system(scene, pair)
+        load = None if load_torque is None else np.tile(np.broadcast_to(load_torque, theta.shape), 2)
+        matrix, rhs = reaction_system(scene, pair, load)
         matrix, rhs_one, rhs = matrix[:n], rhs[n:], rhs[:n]
         matrix[..., :, -1] = -(rhs_one - rhs)  # the acceleration's share moves to the left
         rhs[..., DRIVE_ROW] -= torque_in
@@ -421,7 +436,9 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
 def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                      theta_tt: np.ndarray | None = None,
                      torque_in: float | None = None,
-                     method: str = "auto") -> tuple[dict[str, np.ndarray], FixedPoint]:
+                     method: str = "auto",
+                     load_torque: float | np.ndarray | None = None,
+                     ) -> tuple[dict[str, np.ndarray], FixedPoint]:
     """Result-schema columns (without ``t``) for the given motion, with friction.
 
     Inverse dynamics when ``theta_tt`` is given, forward dynamics when ``torque_in`` is (see
@@ -436,7 +453,7 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
         its loss, ``power_loss_<pair>_rotation`` and ``power_loss_<pair>_sliding`` [W].
     fixed_point : FixedPoint
     """
-    motion, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in, method)
+    motion, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in, method, load_torque)
     theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
     locked = fixed.self_locking
     x = np.where(locked[:, None], np.nan, fixed.x)
@@ -450,7 +467,7 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     zero = np.zeros_like(theta_out)
     cols = {"theta_in": theta + zero, "theta_out": theta_out, "omega_in": theta_t + zero,
             "omega_out": omega_out, "torque_in": drive + zero,
-            "torque_out": zero + scene.load.torque}
+            "torque_out": zero + (constant_load(scene) if load_torque is None else load_torque)}
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * omega_out
     cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(scene, motion.bodies)

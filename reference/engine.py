@@ -124,7 +124,8 @@ class InputMotion:
     ode_evaluations : int
         Right-hand-side evaluations of the integrator (torque drive).
     periodic : bool
-        Every input revolution takes the same time and repeats the first (constant speed).
+        Every input revolution takes the same time and repeats the first (constant speed and
+        constant load).
     """
 
     t0: float
@@ -147,7 +148,7 @@ def _speed_motion(scene: Scene, drive: SpeedDrive) -> InputMotion:
     t_end = 2.0 * math.pi * scene.revolutions / abs(w)
     return InputMotion(0.0, t_end, lambda t: (w * np.asarray(t, float),
                                              np.full(np.shape(t), w),
-                                             np.zeros(np.shape(t))), periodic=True)
+                                             np.zeros(np.shape(t))), periodic=scene.load.constant)
 
 
 def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
@@ -170,7 +171,8 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         count["n"] += 1
-        _, fixed = solve_dynamics(scene, y[:1], y[1:], torque_in=drive.torque)
+        _, fixed = solve_dynamics(scene, y[:1], y[1:], torque_in=drive.torque,
+                                  load_torque=scene.load.at(np.array([t])))
         if fixed.self_locking[0]:
             raise SelfLocking(t, float(y[0]))
         return np.array([y[1], fixed.x[0, -1]])
@@ -225,10 +227,11 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np
     theta, theta_t, theta_tt = motion.state(t)
     theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
     theta_t = np.broadcast_to(np.asarray(theta_t, float), np.shape(t))
+    load = scene.load.at(np.asarray(t, float))
     if theta_tt is None:
-        cols, _ = dynamics_columns(scene, theta, theta_t, torque_in=motion.torque_in)
+        cols, _ = dynamics_columns(scene, theta, theta_t, torque_in=motion.torque_in, load_torque=load)
     else:
-        cols, _ = dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt)
+        cols, _ = dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt, load_torque=load)
     return {"t": np.asarray(t, float), **cols}
 
 
@@ -381,7 +384,8 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     repeats = n if motion.periodic else 1
     t_end = t_a + period if motion.periodic else t_b
     kinks = sign_breakpoints(scene, motion, t_a, t_end)
-    knots = motion.knots[(motion.knots > t_a) & (motion.knots < t_end)]
+    knots = np.concatenate([motion.knots, scene.load.knots])  # drive and load histories' knots
+    knots = knots[(knots > t_a) & (knots < t_end)]
     edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
     lo, hi = initial_panels(edges, period / options.panels_per_revolution)
     keys = ["power_in", "power_out", "power_loss", "self_locking",

@@ -439,12 +439,66 @@ DRIVES = {"speed": SpeedDrive, "angle": AngleDrive, "torque": TorqueDrive}
 
 @dataclass(frozen=True)
 class Load:
-    """Resisting torque on the output shaft [N m]; positive opposes positive output rotation."""
+    """Resisting torque on the output shaft [N m]; positive opposes positive output rotation.
 
-    torque: float = 0.0
+    Attributes
+    ----------
+    torque : float or tuple of float
+        A constant torque [N m], or with ``time`` its history: one value per sample,
+        interpolated linearly in between and held at the end values outside (a measured brake
+        torque, :mod:`rigdata`; linear so that the load never overshoots its samples).
+    time : tuple of float or None
+        Sample times [s] of a torque history, strictly increasing, at least 2.
+    """
+
+    torque: float | tuple = 0.0
+    time: tuple | None = None
 
     def __post_init__(self) -> None:
-        _set(self, "torque", _finite("torque", self.torque))
+        if self.time is None:
+            if _is_seq(self.torque):
+                raise SceneError("a torque history (`torque` as a list) needs `time`, one per value")
+            _set(self, "torque", _finite("torque", self.torque))
+            return
+        t = np.asarray(self.time, dtype=float) if _is_seq(self.time) else None
+        v = np.asarray(self.torque, dtype=float) if _is_seq(self.torque) else None
+        if t is None or t.ndim != 1 or t.size < 2:
+            raise SceneError(f"load `time` must be a sequence of at least 2 numbers, got {self.time!r}")
+        if v is None or v.shape != t.shape:
+            raise SceneError(f"load `torque` must have one value per time sample ({t.size}), got "
+                             f"{np.shape(self.torque) if v is not None else self.torque!r}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+            raise SceneError("load `time` and `torque` must be finite")
+        if np.any(np.diff(t) <= 0):
+            i = int(np.argmax(np.diff(t) <= 0))
+            raise SceneError(f"load `time` must be strictly increasing, got {t[i]!r} then {t[i + 1]!r}")
+        _set(self, "time", tuple(t.tolist()))
+        _set(self, "torque", tuple(v.tolist()))
+
+    @property
+    def constant(self) -> bool:
+        """True for a constant torque, False for a history."""
+        return self.time is None
+
+    def at(self, t: Any) -> np.ndarray:
+        """Load torque [N m] at the instants ``t`` [s] (any shape)."""
+        if self.time is None:
+            return np.full(np.shape(t), self.torque)
+        return np.interp(t, self.time, self.torque)
+
+    @property
+    def knots(self) -> np.ndarray:
+        """Instants [s] where a history's slope changes (empty for a constant torque)."""
+        return np.zeros(0) if self.time is None else np.asarray(self.time)
+
+    def mean(self) -> float:
+        """The constant torque, or the time average of the history [N m]."""
+        if self.time is None:
+            return float(self.torque)
+        from scipy.integrate import trapezoid
+
+        t = np.asarray(self.time)
+        return float(trapezoid(np.asarray(self.torque), t) / (t[-1] - t[0]))
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,172 @@
+"""One validated record of a rig measurement: time, the four transducer channels, provenance.
+
+Every reader (:mod:`rigdata.readers`) returns a :class:`RigRecord`, in SI units and radians:
+torques [N m], speeds [rad/s], angles [rad], time [s]. Raw signals (volts at a sensitivity,
+pulse counts at a number of pulses per revolution) are converted by the reader; the conversion
+is kept in :attr:`ChannelSource.conversion` so that nothing is done to the data that the record
+does not say.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.integrate import trapezoid
+
+#: Channels a record may hold; SI units. ``angle_*`` come from pulse counts or an angle channel.
+CHANNELS = {
+    "torque_in": "N m", "torque_out": "N m",
+    "speed_in": "rad/s", "speed_out": "rad/s",
+    "angle_in": "rad", "angle_out": "rad",
+}
+SHAFTS = ("in", "out")
+#: Relative spread of the sampling interval above which a record counts as mixed-rate.
+RATE_TOLERANCE = 1e-3
+
+
+class RigDataError(ValueError):
+    """Bad measured data. The message names the file, the channel (where there is one) and the
+    problem in one line; the CLI prints it and exits with status 2."""
+
+    def __init__(self, problem: str, *, file: Any = None, channel: str | None = None) -> None:
+        self.problem, self.file, self.channel = problem, file, channel
+        where = [f"{file}" if file is not None else None,
+                 f"channel {channel!r}" if channel is not None else None]
+        prefix = ": ".join(w for w in where if w)
+        super().__init__(f"{prefix}: {problem}" if prefix else problem)
+
+
+@dataclass(frozen=True)
+class ChannelSource:
+    """Where a channel of a record came from.
+
+    Attributes
+    ----------
+    column : str
+        Column / channel name in the file.
+    unit : str
+        Unit as stated in the file or given by the user (``"V"``, ``"rpm"``, ``"counts"``, ...).
+    conversion : str
+        How the values were brought to SI, in words (``"V / 0.1 V/(N m)"``, ``"x 2 pi / 60"``).
+    quantum : float
+        Resolution of the converted values in SI (2 pi / pulses per revolution for pulse
+        counts), 0.0 when continuous.
+    """
+
+    column: str
+    unit: str
+    conversion: str = "none"
+    quantum: float = 0.0
+
+
+@dataclass(frozen=True)
+class RigRecord:
+    """A measurement on a uniform time grid.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        Sample times [s], strictly increasing, uniform to :data:`RATE_TOLERANCE`.
+    channels : mapping of str to ndarray, shape (n,)
+        Keys from :data:`CHANNELS`; always ``torque_in``, ``torque_out`` and for each shaft
+        ``speed_*`` or ``angle_*`` (or both). Finite values in SI units.
+    sources : mapping of str to ChannelSource
+        One per channel.
+    provenance : mapping
+        ``file``, ``format``, ``reader`` (name and version), ``sha256`` of the file, the file's
+        own header keys (``header``) and, for synthetic files, ``synthetic`` (generator and
+        settings as written in the file).
+    """
+
+    time: np.ndarray
+    channels: Mapping[str, np.ndarray]
+    sources: Mapping[str, ChannelSource]
+    provenance: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        file = self.provenance.get("file") if isinstance(self.provenance, Mapping) else None
+        t = np.asarray(self.time, dtype=float)
+        if t.ndim != 1 or t.size < 4:
+            raise RigDataError(f"needs at least 4 samples, got {t.size}", file=file, channel="time")
+        if not np.all(np.isfinite(t)):
+            raise RigDataError("time has non-finite values", file=file, channel="time")
+        dt = np.diff(t)
+        if np.any(dt <= 0):
+            i = int(np.argmax(dt <= 0))
+            raise RigDataError(f"time does not increase at sample {i + 1} ({t[i]!r} then {t[i + 1]!r})",
+                               file=file, channel="time")
+        step = float(np.median(dt))
+        spread = float(np.max(np.abs(dt - step)) / step)
+        if spread > RATE_TOLERANCE:
+            i = int(np.argmax(np.abs(dt - step)))
+            raise RigDataError(
+                f"mixed sampling rates: interval {dt[i]:.6g} s at sample {i + 1} against the median "
+                f"{step:.6g} s (the conditioning needs one rate; resample or split the file)",
+                file=file, channel="time")
+        unknown = set(self.channels) - set(CHANNELS)
+        if unknown:
+            raise RigDataError(f"unknown channels {sorted(unknown)}; expected {sorted(CHANNELS)}",
+                               file=file)
+        for need in ("torque_in", "torque_out"):
+            if need not in self.channels:
+                raise RigDataError("missing (a record needs both torques)", file=file, channel=need)
+        for shaft in SHAFTS:
+            if f"speed_{shaft}" not in self.channels and f"angle_{shaft}" not in self.channels:
+                raise RigDataError(f"missing: neither speed_{shaft} nor angle_{shaft} found",
+                                   file=file, channel=f"speed_{shaft}")
+        channels = {}
+        for name, values in self.channels.items():
+            v = np.asarray(values, dtype=float)
+            if v.shape != t.shape:
+                raise RigDataError(f"has {v.size} samples, time has {t.size}", file=file, channel=name)
+            bad = ~np.isfinite(v)
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise RigDataError(f"{int(bad.sum())} non-finite values (NaN or non-numeric), the "
+                                   f"first at t = {t[i]:.6g} s (sample {i})", file=file, channel=name)
+            v.flags.writeable = False
+            channels[name] = v
+        if set(self.sources) != set(channels):
+            raise RigDataError(f"sources {sorted(self.sources)} do not match channels "
+                               f"{sorted(channels)}", file=file)
+        t.flags.writeable = False
+        object.__setattr__(self, "time", t)
+        object.__setattr__(self, "channels", dict(channels))
+        object.__setattr__(self, "sources", dict(self.sources))
+        object.__setattr__(self, "provenance", dict(self.provenance))
+
+    @property
+    def dt(self) -> float:
+        """Sampling interval [s] (median)."""
+        return float(np.median(np.diff(self.time)))
+
+    @property
+    def sample_rate(self) -> float:
+        """Sampling rate [Hz]."""
+        return 1.0 / self.dt
+
+    @property
+    def duration(self) -> float:
+        """Time span [s]."""
+        return float(self.time[-1] - self.time[0])
+
+    @property
+    def file(self) -> Any:
+        return self.provenance.get("file")
+
+    def turned(self, shaft: str = "in") -> float:
+        """Angle turned by a shaft over the record [rad], from its angle channel when there is
+        one, else the trapezoidal integral of its speed."""
+        angle = self.channels.get(f"angle_{shaft}")
+        if angle is not None:
+            return float(angle[-1] - angle[0])
+        speed = self.channels[f"speed_{shaft}"]
+        return float(trapezoid(speed, self.time))
+
+    def revolutions(self, shaft: str = "in") -> float:
+        """Whole and partial revolutions turned by a shaft (absolute value) [-]."""
+        return abs(self.turned(shaft)) / (2.0 * math.pi)
