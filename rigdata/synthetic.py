@@ -1,0 +1,256 @@
+"""A synthetic rig: the model's joint measured by a model of the paper's transducers.
+
+The truth is the reference engine (numpy, no time steps) running the rig case (15 deg,
+f = 0.42, calibrated parameter set by default) driven by a motor whose speed ripples with the
+input angle (so every revolution repeats and the kinetic energy returns each revolution: the
+true efficiency over any whole revolutions is the engine's mean efficiency) and loaded by a
+constant brake torque chosen for a mean input torque of 0.2 N m. The transducer model adds
+what a real acquisition adds: each torque's first-order output filter (lag), accuracy-class
+offset and zero drift (drawn within their limits unless given), white noise, the card's
+quantisation and range; each speed as a cumulative pulse count at 60 pulses per revolution
+(quantised angle; the input encoder starts at an unknown yoke phase), or as a speed channel.
+
+Every file it writes says it is synthetic (metadata ``synthetic = true``, ``generator``,
+``settings`` with every setting, every drawn error and the true efficiency and phase).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, replace
+
+import numpy as np
+
+from rigdata.record import ChannelSource, RigRecord
+from rigdata.transducer import Transducer
+
+GENERATOR = "rigdata.synthetic 1"
+FORMATS = ("csv", "lvm", "tdms")
+
+
+@dataclass(frozen=True)
+class RigSettings:
+    """What the synthetic rig runs and how it measures.
+
+    Attributes
+    ----------
+    scene : str
+        Named scene of the joint (``reference.paper.named_scene``); its drive and load are
+        replaced by the motor and brake below.
+    speed : float
+        Mean input speed [rad/s] (paper: 6).
+    ripple : tuple of float
+        Motor speed ripple: relative amplitudes at 1x and 2x the input angle [-].
+    input_torque : float
+        Target mean input torque [N m] (paper: 0.2); the brake torque is set from it.
+    revolutions : float
+        Input revolutions recorded [-].
+    rate : float
+        Sampling rate [Hz].
+    phase : float
+        True input yoke angle when the input pulse count starts [rad] (unknown to the reader).
+    noise : float
+        Torque noise, standard deviation [N m].
+    lag : float
+        Time constant of each torque output's first-order filter [s].
+    offsets, drifts : tuple of float or None
+        Accuracy-class offsets and zero drifts over the record (input, output) [N m]; None
+        draws them uniformly within the transducer's limits (``seed``).
+    speed_channel : {"pulses", "rpm"}
+        Pulse counts (the rig's 60 per revolution) or a speed channel in rpm.
+    seed : int
+    """
+
+    scene: str = "rig-calibrated"
+    speed: float = 6.0
+    ripple: tuple = (0.01, 0.005)
+    input_torque: float = 0.2
+    revolutions: float = 5.0
+    rate: float = 1000.0
+    phase: float = 0.7
+    noise: float = 0.005
+    lag: float = 5e-4
+    offsets: tuple | None = None
+    drifts: tuple | None = None
+    speed_channel: str = "pulses"
+    seed: int = 1
+
+    def __post_init__(self) -> None:
+        for name in ("speed", "input_torque", "revolutions", "rate"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"`{name}` must be positive, got {value!r}")
+        for name in ("noise", "lag"):
+            if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
+                raise ValueError(f"`{name}` must be >= 0, got {getattr(self, name)!r}")
+        if self.speed_channel not in ("pulses", "rpm"):
+            raise ValueError(f"`speed_channel` must be 'pulses' or 'rpm', got {self.speed_channel!r}")
+        if self.revolutions < 1.6:
+            raise ValueError(f"`revolutions` must be >= 1.6 (one whole revolution after settling), "
+                             f"got {self.revolutions!r}")
+
+
+@dataclass(frozen=True)
+class Truth:
+    """The true signals on the sampling grid and the true efficiency."""
+
+    t: np.ndarray
+    angle_in: np.ndarray
+    angle_out: np.ndarray
+    speed_in: np.ndarray
+    speed_out: np.ndarray
+    torque_in: np.ndarray
+    torque_out: np.ndarray
+    efficiency: float
+    brake_torque: float
+
+
+def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tuple[np.ndarray, np.ndarray]:
+    """Times [s] and input angles [rad] of a motor with speed ``w0 (1 + e1 cos th + e2 cos 2th)``.
+
+    The speed is a function of the angle, so the motion repeats every revolution.
+    """
+    e1, e2 = settings.ripple
+    total = 2 * math.pi * (settings.revolutions + 0.5)
+    theta = np.linspace(0.0, total, int((settings.revolutions + 0.5) * points_per_revolution) + 1)
+    from scipy.integrate import cumulative_trapezoid
+    from scipy.interpolate import CubicSpline
+
+    # t(theta) from d t / d theta = 1 / omega, integrated on a fine grid then sampled
+    fine = np.linspace(0.0, total, 20 * theta.size)
+    th_f = fine + settings.phase
+    inv = 1.0 / (settings.speed * (1.0 + e1 * np.cos(th_f) + e2 * np.cos(2 * th_f)))
+    t_fine = cumulative_trapezoid(inv, fine, initial=0.0)
+    t = CubicSpline(fine, t_fine)(theta)
+    return t, theta + settings.phase
+
+
+def true_signals(settings: RigSettings) -> Truth:
+    """Run the reference engine on the rig driven by the motor; sample on the rig's grid."""
+    from reference.engine import ReferenceOptions, columns_at, input_motion
+    from reference.engine import run as run_reference
+    from reference.paper import named_scene
+    from reference.scene import AngleDrive, Load
+
+    t_knots, angle = motor_angle(settings)
+    base = named_scene(settings.scene)
+    scene = replace(base, drive=AngleDrive(tuple(t_knots), tuple(angle)),
+                    revolutions=1.0, record=replace(base.record, timeseries=False))
+    # the brake torque for the target mean input torque: efficiency barely depends on the load
+    # level (friction is proportional to it), so one correction step is enough
+    brake = settings.input_torque
+    for _ in range(2):
+        summary = run_reference(replace(scene, load=Load(brake))).summary
+        if summary["status"] != "ok":
+            raise ValueError(f"the synthetic rig's model does not run: {summary.get('reason')}")
+        brake *= settings.input_torque / summary["mean_torque_in"]
+    scene = replace(scene, load=Load(brake))
+    summary = run_reference(scene).summary
+    t = np.arange(0.0, t_knots[-1] - 0.25 * 2 * math.pi / settings.speed, 1.0 / settings.rate)
+    motion = input_motion(scene, ReferenceOptions())
+    cols = columns_at(scene, motion, t)
+    return Truth(t=t, angle_in=cols["theta_in"], angle_out=cols["theta_out"],
+                 speed_in=cols["omega_in"], speed_out=cols["omega_out"],
+                 torque_in=cols["torque_in"], torque_out=cols["torque_out"],
+                 efficiency=float(summary["mean_efficiency"]), brake_torque=float(brake))
+
+
+def _errors(settings: RigSettings, transducer: Transducer, rng: np.random.Generator) -> tuple:
+    offsets = settings.offsets if settings.offsets is not None else \
+        tuple(rng.uniform(-1, 1, 2) * transducer.accuracy_limit)
+    drifts = settings.drifts if settings.drifts is not None else \
+        tuple(rng.uniform(-1, 1, 2) * transducer.zero_drift)
+    return tuple(float(x) for x in offsets), tuple(float(x) for x in drifts)
+
+
+def measure(truth: Truth, settings: RigSettings,
+            transducer: Transducer | None = None) -> tuple[dict, dict, dict]:
+    """Apply the transducer model. Returns ``(table, units, settings_used)``: raw columns
+    (time [s], torques [V], pulse counts or speeds [rpm]) as a file holds them."""
+    from scipy import signal
+
+    transducer = transducer or Transducer()
+    rng = np.random.default_rng(settings.seed)
+    offsets, drifts = _errors(settings, transducer, rng)
+    t = truth.t
+    ramp = (t - t[0]) / (t[-1] - t[0])
+    table, units = {"Time": t - t[0]}, {"Time": "s"}
+    for k, (name, torque) in enumerate((("In", truth.torque_in), ("Out", truth.torque_out))):
+        if settings.lag > 0:  # the transducer's output filter: first order, causal, bilinear
+            b, a = signal.bilinear([1.0], [settings.lag, 1.0], fs=settings.rate)
+            torque = signal.lfilter(b, a, torque, zi=signal.lfilter_zi(b, a) * torque[0])[0]
+        measured = torque + offsets[k] + drifts[k] * ramp + rng.normal(0.0, settings.noise, t.size)
+        volts = np.clip(measured * transducer.sensitivity, -transducer.adc_range, transducer.adc_range)
+        step = 2 * transducer.adc_range / 2 ** transducer.adc_bits
+        table[f"Torque {name}"] = np.round(volts / step) * step
+        units[f"Torque {name}"] = "V"
+    q = transducer.pulse_angle
+    encoder_start = rng.uniform(0.0, q)  # where in a pulse interval the counter starts
+    for name, angle, speed in (("In", truth.angle_in, truth.speed_in),
+                               ("Out", truth.angle_out, truth.speed_out)):
+        if settings.speed_channel == "pulses":
+            counts = np.floor((angle - angle[0] + (encoder_start if name == "In" else 0.0)) / q)
+            table[f"Pulses {name}"] = counts.astype(np.int64)
+            units[f"Pulses {name}"] = "counts"
+        else:
+            table[f"Speed {name}"] = speed * 60.0 / (2 * math.pi) + rng.normal(0.0, 0.01, t.size)
+            units[f"Speed {name}"] = "rpm"
+    # at an input edge the count reaches k q where the true angle is k q + angle[0] - start
+    true_phase = float(truth.angle_in[0] - (encoder_start if settings.speed_channel == "pulses" else 0.0))
+    used = {**asdict(settings), "offsets": list(offsets), "drifts": list(drifts),
+            "encoder_start": float(encoder_start), "true_phase": true_phase,
+            "true_efficiency": truth.efficiency, "brake_torque": truth.brake_torque,
+            "transducer": transducer.as_dict()}
+    return table, units, used
+
+
+def metadata(used: dict) -> dict:
+    """The label every synthetic file carries."""
+    return {"synthetic": "true", "generator": GENERATOR, "settings": json.dumps(used, sort_keys=True),
+            "description": "SYNTHETIC rig data: reference-engine joint + transducer model, not a measurement"}
+
+
+def record(settings: RigSettings | None = None, transducer: Transducer | None = None,
+           truth: Truth | None = None) -> tuple[RigRecord, dict]:
+    """A synthetic measurement as a record in memory (no file), and the settings used."""
+    settings = settings or RigSettings()
+    transducer = transducer or Transducer()
+    truth = truth or true_signals(settings)
+    table, units, used = measure(truth, settings, transducer)
+    channels, sources = {}, {}
+    for shaft, name in (("in", "In"), ("out", "Out")):
+        channels[f"torque_{shaft}"] = table[f"Torque {name}"] / transducer.sensitivity
+        sources[f"torque_{shaft}"] = ChannelSource(f"Torque {name}", "V",
+                                                   f"V / {transducer.sensitivity} V/(N m)")
+        if settings.speed_channel == "pulses":
+            channels[f"angle_{shaft}"] = table[f"Pulses {name}"] * transducer.pulse_angle
+            sources[f"angle_{shaft}"] = ChannelSource(f"Pulses {name}", "counts",
+                                                      f"x 2 pi / {transducer.pulses_per_rev}",
+                                                      transducer.pulse_angle)
+        else:
+            channels[f"speed_{shaft}"] = table[f"Speed {name}"] * 2 * math.pi / 60.0
+            sources[f"speed_{shaft}"] = ChannelSource(f"Speed {name}", "rpm", "x 2 pi / 60")
+    prov = {"file": "<synthetic>", "format": "memory", "synthetic": metadata(used)}
+    return RigRecord(table["Time"], channels, sources, prov), used
+
+
+def write(path, fmt: str, settings: RigSettings | None = None, transducer: Transducer | None = None,
+          truth: Truth | None = None) -> dict:
+    """Write a synthetic measurement file (``csv``: comma and point; ``lvm``: LabVIEW with
+    decimal comma; ``tdms``). Returns the settings used (with the true efficiency)."""
+    from rigdata import files
+
+    if fmt not in FORMATS:
+        raise ValueError(f"`fmt` must be one of {FORMATS}, got {fmt!r}")
+    settings = settings or RigSettings()
+    truth = truth or true_signals(settings)
+    table, units, used = measure(truth, settings, transducer)
+    meta = metadata(used)
+    if fmt == "csv":
+        files.write_csv(path, table, units, meta)
+    elif fmt == "lvm":
+        files.write_lvm(path, table, units, meta, decimal=",")
+    else:
+        files.write_tdms(path, table, units, meta)
+    return used

@@ -1,0 +1,91 @@
+"""The rig's torque/speed transducers and acquisition: the numbers the uncertainty rests on.
+
+The paper (section 4.2) states the transducers' full scale (100 N m), torque sensitivity
+(100 mV per N m) and speed resolution (60 pulses per revolution). It does not state their
+accuracy, drift or noise; the defaults below for those are assumptions, each with its reason,
+and every one is a parameter (``cardan rig measure --accuracy-class ... --zero-drift ...``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+#: Where each default comes from.
+PROVENANCE = {
+    "full_scale": "paper section 4.2: Magtrol TMB 210, max torque 100.00 N m",
+    "sensitivity": "paper section 4.2: torque sensitivity 100 mV/N m",
+    "pulses_per_rev": "paper section 4.2: speed sensitivity 60 pulses per rev",
+    "accuracy_class": "assumption: accuracy class 0.1 % of full scale (the class of in-line torque "
+                      "transducers of this size; with it the class alone is half of a 0.2 N m reading, "
+                      "as the issue states); a limit, read as a rectangular distribution",
+    "zero_drift": "assumption: zero drift over one record within +-0.01 N m (0.01 % of full scale: "
+                  "a temperature change of about 1 K in a run of seconds at 0.1 %/10 K); a limit "
+                  "of a linear ramp over the record, rectangular",
+    "adc_range": "assumption: +-10 V input range of the acquisition card",
+    "adc_bits": "assumption: 16-bit acquisition card",
+}
+
+
+@dataclass(frozen=True)
+class Transducer:
+    """One torque/speed transducer with its acquisition channel.
+
+    Attributes
+    ----------
+    full_scale : float
+        Rated torque [N m].
+    sensitivity : float
+        Torque output [V/(N m)].
+    pulses_per_rev : int
+        Speed pulses per revolution [-].
+    accuracy_class : float
+        Limit of the combined torque error (linearity, hysteresis, calibration) as a fraction of
+        full scale [-]; constant over a record, independent between the two transducers.
+    zero_drift : float
+        Limit of the zero's drift over one record [N m], a linear ramp from zero.
+    adc_range : float
+        Acquisition input range +-``adc_range`` [V].
+    adc_bits : int
+        Acquisition resolution [bit].
+    """
+
+    full_scale: float = 100.0
+    sensitivity: float = 0.1
+    pulses_per_rev: int = 60
+    accuracy_class: float = 1e-3
+    zero_drift: float = 0.01
+    adc_range: float = 10.0
+    adc_bits: int = 16
+
+    def __post_init__(self) -> None:
+        for name in ("full_scale", "sensitivity", "adc_range"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"`{name}` must be a positive number, got {value!r}")
+        for name in ("accuracy_class", "zero_drift"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise ValueError(f"`{name}` must be a number >= 0, got {value!r}")
+        for name in ("pulses_per_rev", "adc_bits"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"`{name}` must be an integer >= 1, got {value!r}")
+
+    @property
+    def accuracy_limit(self) -> float:
+        """Limit of the torque error from the accuracy class [N m]."""
+        return self.accuracy_class * self.full_scale
+
+    @property
+    def pulse_angle(self) -> float:
+        """Angle between two speed pulses [rad]."""
+        return 2.0 * math.pi / self.pulses_per_rev
+
+    @property
+    def adc_step(self) -> float:
+        """One step of the acquisition card, in torque [N m]."""
+        return 2.0 * self.adc_range / 2 ** self.adc_bits / self.sensitivity
+
+    def as_dict(self) -> dict:
+        return asdict(self)
