@@ -425,7 +425,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
     _add_scene_options(p)
     p.set_defaults(func=cmd_scene)
+    _add_plugin_commands(sub)
     return parser
+
+
+def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:
+    """Commands other packages register under the ``cardan.commands`` entry-point group (``cardan
+    rig`` from ``rigdata``): imports keep pointing one way, this package never imports them."""
+    from importlib.metadata import entry_points
+
+    for entry in sorted(entry_points(group="cardan.commands"), key=lambda e: e.name):
+        entry.load()(sub)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -190,14 +190,17 @@ def derivatives(angle: np.ndarray, dt: float, cutoff: float, method: str) -> tup
     """Speed [rad/s] and acceleration [rad/s^2] of a filtered angle.
 
     Savitzky-Golay: cubic over a window of half a cut-off period (odd, >= 7 samples), whose own
-    smoothing then stays above the cut-off. Spline: a smoothing spline with its smoothing chosen
-    by generalised cross-validation.
+    smoothing then stays above the cut-off. Spline: a cubic smoothing spline whose penalty puts
+    its half-power frequency at the cut-off.
     """
     if method == "spline":
         from scipy.interpolate import make_smoothing_spline
 
         t = np.arange(angle.size) * dt
-        spline = make_smoothing_spline(t, angle)
+        # the penalty lam int f''^2 makes the spline a low-pass with gain 1 / (1 + lam (2 pi f)^4
+        # / dt) on a uniform grid: half power at the cut-off for this lam (generalised
+        # cross-validation, the default, smooths the 2nd harmonic away on these records)
+        spline = make_smoothing_spline(t, angle, lam=dt / (2 * math.pi * cutoff) ** 4)
         return spline(t, 1), spline(t, 2)
     window = max(7, int(round(0.5 / (cutoff * dt))) | 1)
     if window > angle.size:

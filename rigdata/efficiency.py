@@ -7,8 +7,10 @@ value, so this is also 1 - lost work / input work). The instantaneous one is ``P
 
 The uncertainty follows the GUM's law of propagation (first order, uncorrelated inputs): each
 transducer's accuracy-class error (a constant offset within +-class x full scale, rectangular),
-its zero drift (a linear ramp over the record, rectangular limit), its noise (white, its level
-estimated from the data) and the timing of the window's ends (one sample interval,
+the acquisition's resolution (half a step either way, rectangular: without noise to dither it,
+rounding is a constant error, at 0.2 N m on a 16-bit card 0.8 % of the torque), its zero drift
+(a linear ramp over the record, rectangular limit), its noise (white, its level estimated from
+the data) and the timing of the window's ends (one sample interval,
 rectangular). Monte Carlo (GUM Supplement 1) propagates the same distributions through the
 filter and the integrals as a check on the linearisation; at 0.2 N m the accuracy class makes
 the relative uncertainty of each torque about 30 %, where first order starts to be rough.
@@ -135,6 +137,10 @@ def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transduce
     rows = [
         ("accuracy class, input torque", tin.accuracy_limit / SQRT3, "N m", -eta * angle_in / w_in),
         ("accuracy class, output torque", tout.accuracy_limit / SQRT3, "N m", angle_out / w_in),
+        ("resolution (acquisition step), input torque", tin.adc_step / SQRT12, "N m",
+         -eta * angle_in / w_in),
+        ("resolution (acquisition step), output torque", tout.adc_step / SQRT12, "N m",
+         angle_out / w_in),
         ("zero drift, input torque", tin.zero_drift / SQRT3, "N m",
          -eta * float(weights @ (c.speed_in * ramp)) / w_in),
         ("zero drift, output torque", tout.zero_drift / SQRT3, "N m",
@@ -175,8 +181,8 @@ def _instantaneous(c: Conditioned, transducers, sigma: dict, ramp: np.ndarray) -
         rel = np.zeros_like(eta)
         for (torque, shaft), tr in zip(((c.torque_in, "in"), (c.torque_out, "out")), transducers,
                                        strict=True):
-            u_t2 = (tr.accuracy_limit / SQRT3) ** 2 + (tr.zero_drift * ramp / SQRT3) ** 2 \
-                + (factor * sigma[shaft]) ** 2
+            u_t2 = (tr.accuracy_limit / SQRT3) ** 2 + (tr.adc_step / SQRT12) ** 2 \
+                + (tr.zero_drift * ramp / SQRT3) ** 2 + (factor * sigma[shaft]) ** 2
             rel = rel + u_t2 / torque ** 2
         u = np.abs(eta) * np.sqrt(rel)
     return {"t": c.t, "efficiency": eta, "u": u}
@@ -198,7 +204,8 @@ def _monte_carlo(c: Conditioned, transducers, sigma: dict, samples: int, seed: i
         torques = []
         for torque, shaft, tr in ((c.torque_in, "in", transducers[0]),
                                   (c.torque_out, "out", transducers[1])):
-            offset = rng.uniform(-1, 1, (m, 1)) * tr.accuracy_limit
+            offset = rng.uniform(-1, 1, (m, 1)) * tr.accuracy_limit \
+                + rng.uniform(-0.5, 0.5, (m, 1)) * tr.adc_step
             drift = rng.uniform(-1, 1, (m, 1)) * tr.zero_drift * ramp
             noise = lowpass(rng.standard_normal((m, c.t.size)) * sigma[shaft], c.cutoff, 1.0 / c.dt, order)
             torques.append(torque + offset + drift + noise)

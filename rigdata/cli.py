@@ -1,0 +1,272 @@
+"""``cardan rig``: inspect, measure and validate rig files; write synthetic ones.
+
+Registered into the ``cardan`` command through the ``cardan.commands`` entry point (see
+``pyproject.toml``), so that ``cardan_exudyn`` never imports ``rigdata``.
+
+Exit status: 0 success; 2 bad input (one line naming the file, the channel and the problem);
+3 a model run failed (its status and reason are in the report).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
+
+
+class _BadOption(ValueError):
+    pass
+
+
+def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
+    out = {}
+    for item in values or []:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise _BadOption(f"{option} expects CHANNEL=VALUE, got {item!r}")
+        out[key.strip()] = value.strip()
+    return out
+
+
+def _read(args: argparse.Namespace):
+    from rigdata.readers import read
+
+    return read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
+                units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
+                pulses_per_rev=args.pulses_per_rev)
+
+
+def _transducers(args: argparse.Namespace):
+    from rigdata.transducer import Transducer
+
+    t = Transducer(full_scale=args.full_scale, sensitivity=args.sensitivity,
+                   pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
+                   zero_drift=args.zero_drift)
+    return t, t
+
+
+def _conditioning(args: argparse.Namespace):
+    from rigdata.conditioning import Conditioning
+
+    return Conditioning(cutoff_harmonics=args.cutoff_harmonics, settle_revolutions=args.settle,
+                        derivative=args.derivative)
+
+
+def cmd_inspect(args: argparse.Namespace) -> int:
+    rec = _read(args)
+    info = {
+        "file": str(rec.file), "format": rec.provenance.get("format"),
+        "reader": rec.provenance.get("reader"), "samples": int(rec.time.size),
+        "sample_rate": rec.sample_rate, "duration_s": rec.duration,
+        "revolutions_in": rec.revolutions("in"), "revolutions_out": rec.revolutions("out"),
+        "channels": {name: {"column": s.column, "unit": s.unit, "conversion": s.conversion,
+                            "quantum": s.quantum, "mean": float(rec.channels[name].mean())}
+                     for name, s in rec.sources.items()},
+        "synthetic": bool(rec.provenance.get("synthetic")),
+        "header": {k: str(v) for k, v in (rec.provenance.get("header") or {}).items()},
+    }
+    if args.json:
+        print(json.dumps(info, indent=2))
+        return EXIT_OK
+    print(f"{info['file']}: {info['format']} ({info['reader']}), {info['samples']} samples at "
+          f"{info['sample_rate']:.6g} Hz, {info['duration_s']:.4g} s, input "
+          f"{info['revolutions_in']:.3f} revolutions, output {info['revolutions_out']:.3f}"
+          + ("  [SYNTHETIC]" if info["synthetic"] else ""))
+    for name, c in info["channels"].items():
+        print(f"  {name:<11} <- {c['column']!r} [{c['unit']}] {c['conversion']}"
+              + (f", resolution {math.degrees(c['quantum']):.3g} deg" if c["quantum"] else "")
+              + f"; mean {c['mean']:.6g}")
+    return EXIT_OK
+
+
+def cmd_measure(args: argparse.Namespace) -> int:
+    from rigdata.conditioning import condition
+    from rigdata.efficiency import measured_efficiency
+
+    rec = _read(args)
+    cond = condition(rec, math.radians(args.angle), _conditioning(args))
+    m = measured_efficiency(cond, _transducers(args), monte_carlo=args.mc, seed=args.seed)
+    out = {"file": str(rec.file), **m.as_dict(), "phase_deg": math.degrees(cond.phase),
+           "synthetic": bool(rec.provenance.get("synthetic"))}
+    if args.json:
+        print(json.dumps(out, indent=2))
+    else:
+        mc = m.monte_carlo
+        print(f"{rec.file}: efficiency {m.efficiency:.4f} +- {m.u:.4f} (standard uncertainty) over "
+              f"{out['revolutions']} revolutions at {out['mean_speed_in']:.4g} rad/s, "
+              f"{out['mean_torque_in']:.4g} N m"
+              + (f"; Monte Carlo 95 % [{mc['interval_95'][0]:.4f}, {mc['interval_95'][1]:.4f}]"
+                 if mc else ""))
+    return EXIT_OK
+
+
+def _scene(args: argparse.Namespace):
+    from reference.paper import named_scene
+    from reference.scene import PAIR_NAMES, replace
+
+    scene = named_scene(args.scene)
+    changes = {"joint.geometry.shaft_angle_deg": args.angle}
+    if args.friction is not None:
+        changes.update({f"joint.pairs.{p}.friction_coefficient": args.friction for p in PAIR_NAMES})
+    return replace(scene, **changes)
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from rigdata.report import validate, write_report
+
+    engines = tuple(e.strip() for e in args.engines.split(",") if e.strip())
+    bad = [e for e in engines if e not in ("reference", "exudyn")]
+    if not engines or bad:
+        raise _BadOption(f"--engines takes reference and/or exudyn, got {args.engines!r}")
+    scene = _scene(args)
+    rec = _read(args)
+
+    def progress(line: str) -> None:
+        if not args.json:
+            print(f"cardan rig validate: {line}", file=sys.stderr, flush=True)
+
+    v = validate(rec, scene, engines, _conditioning(args), _transducers(args), monte_carlo=args.mc,
+                 seed=args.seed, progress=progress)
+    s = write_report(v, args.out)
+    if args.json:
+        print(json.dumps(s, indent=2))
+    else:
+        for engine, comp in s["computed"].items():
+            cmp = s["comparisons"].get(engine, {})
+            print(f"{engine}: computed {comp.get('mean_efficiency')}, measured "
+                  f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}; difference "
+                  f"{cmp.get('difference', float('nan')):.4f}, significant (k=2): "
+                  f"{cmp.get('significant_k2', '-')}")
+        print(f"wrote {args.out}/report.md", file=sys.stderr)
+    failed = [e for e, c in s["computed"].items() if c["status"] != "ok"]
+    return EXIT_FAILED if failed else EXIT_OK
+
+
+def cmd_synthetic(args: argparse.Namespace) -> int:
+    from rigdata import synthetic
+
+    exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
+    settings = synthetic.RigSettings(revolutions=args.revolutions, seed=args.seed,
+                                     speed_channel=args.speed_channel, **exact)
+    used = synthetic.write(args.out, args.format, settings)
+    if args.json:
+        print(json.dumps(used, indent=2))
+    else:
+        print(f"wrote {args.out} (SYNTHETIC, {args.format}): true efficiency "
+              f"{used['true_efficiency']:.6f}, offsets {used['offsets']} N m", file=sys.stderr)
+    return EXIT_OK
+
+
+def _number(kind: str, lo: float | None = None, strict: bool = False):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number ({kind}), got {text!r}") from None
+        if not math.isfinite(value) or (lo is not None and (value <= lo if strict else value < lo)):
+            raise argparse.ArgumentTypeError(
+                f"expected a finite number {'>' if strict else '>='} {lo} ({kind}), got {text!r}"
+                if lo is not None else f"expected a finite number ({kind}), got {text!r}")
+        return value
+
+    return parse
+
+
+def _integer(kind: str, lo: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer ({kind}), got {text!r}") from None
+        if value < lo:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {lo} ({kind}), got {text!r}")
+        return value
+
+    return parse
+
+
+def _file_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", metavar="FILE", help="rig file: delimited text, LabVIEW .lvm or NI .tdms")
+    p.add_argument("--format", choices=("auto", "csv", "lvm", "tdms"), default="auto")
+    p.add_argument("--map", action="append", metavar="CHANNEL=COLUMN",
+                   help="map a column to torque_in, torque_out, speed_in, speed_out, angle_in, angle_out")
+    p.add_argument("--unit", action="append", metavar="CHANNEL=UNIT",
+                   help="unit of a channel where the file does not state it, e.g. speed_in=rpm")
+    p.add_argument("--sensitivity", type=_number("V/(N m)", 0, strict=True), default=0.1,
+                   help="torque output of the transducers for columns in volts (default 0.1, paper)")
+    p.add_argument("--pulses-per-rev", type=_integer("--pulses-per-rev", 1), default=60,
+                   help="speed pulses per revolution for count columns (default 60, paper)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+
+
+def _measure_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--angle", type=_number("deg", 0), default=15.0,
+                   help="shaft angle [deg] (default 15, the paper's rig case)")
+    p.add_argument("--cutoff-harmonics", type=_number("-", 2), default=10.0,
+                   help="low-pass cut-off in input shaft harmonics (default 10)")
+    p.add_argument("--settle", type=_number("rev", 0), default=0.25,
+                   help="input revolutions dropped at each end (default 0.25)")
+    p.add_argument("--derivative", choices=("savgol", "spline"), default="savgol")
+    p.add_argument("--full-scale", type=_number("N m", 0, strict=True), default=100.0,
+                   help="transducer full scale [N m] (default 100, paper)")
+    p.add_argument("--accuracy-class", type=_number("%", 0), default=0.1,
+                   help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
+    p.add_argument("--zero-drift", type=_number("N m", 0), default=0.01,
+                   help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
+    p.add_argument("--mc", type=_integer("--mc", 0), default=2000,
+                   help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Monte Carlo draws")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add ``rig`` to the ``cardan`` command's subparsers."""
+    p = sub.add_parser("rig", help="rig measurements: inspect, measure, validate against the model",
+                       description="Measured efficiency from transducer files and its comparison "
+                                   "with the model driven by the measurement (the paper's Figure 10).")
+    rig = p.add_subparsers(dest="rig_command", required=True)
+    q = rig.add_parser("inspect", help="what a file holds: channels, units, rate, duration, revolutions")
+    _file_options(q)
+    q.set_defaults(func=_guarded(cmd_inspect))
+    q = rig.add_parser("measure", help="measured efficiency over whole revolutions with its uncertainty")
+    _file_options(q)
+    _measure_options(q)
+    q.set_defaults(func=_guarded(cmd_measure))
+    q = rig.add_parser("validate", help="measured against computed efficiency: report like Figure 10")
+    _file_options(q)
+    _measure_options(q)
+    q.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
+    q.add_argument("--scene", default="rig-calibrated",
+                   help="named scene of the joint (default rig-calibrated; drive and load replaced)")
+    q.add_argument("--friction", type=_number("-", 0), help="friction coefficient of every pair "
+                   "(default: the scene's, 0.42 for the rig)")
+    q.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")
+    q.set_defaults(func=_guarded(cmd_validate))
+    q = rig.add_parser("synthetic", help="write a synthetic rig file (labelled as such)")
+    q.add_argument("--out", required=True, metavar="FILE")
+    q.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
+    q.add_argument("--revolutions", type=_number("rev", 1.6), default=5.0)
+    q.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
+    q.add_argument("--seed", type=int, default=1, help="seed of the drawn transducer errors and noise")
+    q.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
+    q.add_argument("--json", action="store_true", help="print the settings used as JSON")
+    q.set_defaults(func=_guarded(cmd_synthetic))
+
+
+def _guarded(func):
+    """Bad input of any kind -> one line on stderr, exit 2, no traceback."""
+    def run(args: argparse.Namespace) -> int:
+        from reference.scene import SceneError
+        from rigdata.record import RigDataError
+
+        try:
+            return func(args)
+        except (RigDataError, SceneError, _BadOption, FileNotFoundError, IsADirectoryError,
+                PermissionError) as exc:
+            print(f"cardan rig {args.rig_command}: error: {exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+
+    return run
+
