@@ -57,9 +57,12 @@ def _conditioning(args: argparse.Namespace):
 
 def cmd_inspect(args: argparse.Namespace) -> int:
     rec = _read(args)
+    reader = rec.provenance.get("reader")
+    if isinstance(reader, dict):
+        reader = f"{reader.get('name')} {reader.get('version')}"
     info = {
         "file": str(rec.file), "format": rec.provenance.get("format"),
-        "reader": rec.provenance.get("reader"), "samples": int(rec.time.size),
+        "reader": reader, "samples": int(rec.time.size),
         "sample_rate": rec.sample_rate, "duration_s": rec.duration,
         "revolutions_in": rec.revolutions("in"), "revolutions_out": rec.revolutions("out"),
         "channels": {name: {"column": s.column, "unit": s.unit, "conversion": s.conversion,
@@ -136,7 +139,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     else:
         for engine, comp in s["computed"].items():
             cmp = s["comparisons"].get(engine, {})
-            print(f"{engine}: computed {comp.get('mean_efficiency')}, measured "
+            print(f"{engine}: computed {_fmt(comp.get('mean_efficiency'))}, measured "
                   f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}; difference "
                   f"{cmp.get('difference', float('nan')):.4f}, significant (k=2): "
                   f"{cmp.get('significant_k2', '-')}")
@@ -270,3 +273,7 @@ def _guarded(func):
 
     return run
 
+
+
+def _fmt(x) -> str:
+    return f"{x:.6f}" if isinstance(x, (int, float)) else str(x)

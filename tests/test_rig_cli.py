@@ -1,0 +1,96 @@
+"""``cardan rig``: the commands on synthetic files, and bad input (exit 2, one line, nothing
+half-written)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+CSV_ONE_REV = "time [s],torque_in [N m],torque_out [N m],speed_in [rad/s],speed_out [rad/s]\n" + "".join(
+    f"{k * 0.01:.2f},0.2,0.19,6,6\n" for k in range(110))  # 1.1 s at 6 rad/s: 1.05 revolutions
+
+
+def cardan(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "cardan_exudyn.cli", "rig", *args],
+                          capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def lvm(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rig") / "rig.lvm"
+    proc = cardan("synthetic", "--format", "lvm", "--revolutions", "3", "--out", str(path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    return path, json.loads(proc.stdout)
+
+
+def test_inspect_reports_channels_rate_and_revolutions(lvm):
+    """inspect names every channel with its column and unit, the rate and the revolutions."""
+    path, _ = lvm
+    proc = cardan("inspect", str(path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    info = json.loads(proc.stdout)
+    assert set(info["channels"]) == {"torque_in", "torque_out", "angle_in", "angle_out"}
+    assert info["channels"]["torque_in"]["unit"] == "V"
+    assert info["sample_rate"] == pytest.approx(1000.0)
+    assert info["revolutions_in"] == pytest.approx(3.25, abs=0.02)  # 3.5 driven, the last 0.25 not sampled
+    assert info["synthetic"] is True
+
+
+def test_measure_json_has_the_promised_keys(lvm):
+    """measure --json: efficiency with its standard uncertainty, revolutions, mean speed and
+    torque; the truth lies within the Monte Carlo 95 % interval."""
+    path, used = lvm
+    proc = cardan("measure", str(path), "--json", "--mc", "300")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    for key in ("measured_efficiency", "measured_efficiency_u", "revolutions", "mean_speed_in",
+                "mean_torque_in"):
+        assert isinstance(out[key], (int, float))
+    assert out["revolutions"] == 2
+    assert out["mean_speed_in"] == pytest.approx(6.0, rel=0.01)
+    lo, hi = out["monte_carlo"]["interval_95"]
+    assert lo <= used["true_efficiency"] <= hi
+
+
+def test_validate_writes_the_report(lvm, tmp_path):
+    """validate writes report.md, validation.json, figure10.png and signals.csv."""
+    path, used = lvm
+    out = tmp_path / "report"
+    proc = cardan("validate", str(path), "--angle", "15", "--engines", "reference", "--mc", "200",
+                  "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert {p.name for p in out.iterdir()} == {"report.md", "validation.json", "figure10.png",
+                                               "signals.csv"}
+    s = json.loads((out / "validation.json").read_text())
+    assert s["computed"]["reference"]["mean_efficiency"] == pytest.approx(used["true_efficiency"], abs=2e-3)
+
+
+@pytest.mark.parametrize("args, match", [
+    (["measure", "{missing}"], "no-such.csv"),
+    (["measure", "{lvm}", "--map", "torque_in"], "--map expects CHANNEL=VALUE"),
+    (["measure", "{lvm}", "--unit", "torque_in=furlongs"], "furlongs"),
+    (["validate", "{lvm}", "--engines", "mujoco", "--out", "{out}"], "--engines"),
+    (["validate", "{lvm}", "--scene", "nope", "--out", "{out}"], "unknown scene name"),
+    (["measure", "{short}"], "less than one whole input revolution"),
+    (["measure", "{lvm}", "--angle", "-3"], "--angle"),
+    (["measure", "{lvm}", "--map", "torque_in=Nope"], "Nope"),
+], ids=["missing-file", "map-syntax", "unknown-unit", "engine", "scene", "one-revolution",
+        "angle", "map-column"])
+def test_bad_input_one_line_exit_2_nothing_written(lvm, tmp_path, args, match):
+    """Each bad input: exit 2, one line on stderr naming the problem, no traceback, and the
+    output folder untouched."""
+    path, _ = lvm
+    short = tmp_path / "short.csv"
+    short.write_text(CSV_ONE_REV)
+    out = tmp_path / "out"
+    values = {"missing": str(tmp_path / "no-such.csv"), "lvm": str(path), "out": str(out),
+              "short": str(short)}
+    proc = cardan(*[a.format(**values) for a in args])
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert match in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 or "usage:" in proc.stderr
+    assert not out.exists()
