@@ -1,0 +1,280 @@
+"""Writers of rig files: delimited text, LabVIEW Measurement (.lvm), NI TDMS.
+
+Used by the synthetic rig and the tests; :mod:`rigdata.readers` reads every file written here
+back to the same numbers, units and metadata. A table is a dict of column name -> 1-D array that
+includes a time column [s]; ``units`` gives every column's unit as written into the file;
+``metadata`` (str -> str) goes into the preamble, the LVM header or the TDMS file properties.
+A synthetic file carries ``synthetic = "true"``, ``generator`` and ``settings`` (a JSON string)
+there, and the readers copy them into the record's provenance.
+
+Every writer is atomic: it writes a temporary file in the target folder, flushes it to disk and
+renames it over the target, so a failure leaves either the old file or none, never half a file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as _dt
+import io
+import os
+import secrets
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+from typing import IO
+
+import numpy as np
+import pandas as pd
+
+from rigdata.units import split_header
+
+#: Column names recognised as time by the writers (the first such column is the time axis).
+_TIME_NAMES = ("time", "t", "x_value", "zeit")
+#: LVM header tags the writer sets itself; metadata may not override them.
+_LVM_RESERVED = {"writer_version", "reader_version", "separator", "decimal_separator", "multi_headings",
+                 "x_columns", "time_pref", "channels", "samples", "y_unit_label", "x_dimension", "x0",
+                 "delta_x", "***end_of_header***", "x_value"}
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike, mode: str = "w", **kwargs) -> Iterator[IO]:
+    """Open a temporary file next to ``path``; on success fsync it and rename it to ``path``.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; its folder must exist.
+    mode : {"w", "wb"}
+        Text or binary.
+    **kwargs
+        Passed to :func:`open` (``encoding``, ``newline``).
+
+    Yields
+    ------
+    file object
+        Write to it; on an exception the temporary file is removed and the target untouched.
+    """
+    target = Path(path)
+    tmp = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
+    # os.open applies the umask to 0o666, as open() would; mkstemp would leave the file 0o600
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        with os.fdopen(fd, mode, **kwargs) as f:
+            yield f
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _check(table: Mapping[str, np.ndarray], units: Mapping[str, str],
+           metadata: Mapping[str, str]) -> tuple[dict[str, np.ndarray], str]:
+    """Columns as float arrays of one length, every unit given, metadata one line each;
+    returns the columns and the name of the time column."""
+    columns = {str(k): np.asarray(v, dtype=float).ravel() for k, v in table.items()}
+    lengths = {k: v.size for k, v in columns.items()}
+    if not columns or len(set(lengths.values())) != 1:
+        raise ValueError(f"`table` needs columns of one length, got {lengths}")
+    missing = set(columns) - set(units)
+    if missing:
+        raise ValueError(f"`units` has no unit for columns {sorted(missing)}")
+    for key, value in {**dict(metadata), **dict(units)}.items():
+        text = f"{key}{value}"
+        if any(c in text for c in "\t\r\n"):
+            raise ValueError(f"metadata and units must be one line without tabs, got {key!r}: {value!r}")
+    time = [k for k in columns if split_header(k)[0].strip().lower() in _TIME_NAMES]
+    if not time:
+        raise ValueError(f"`table` needs a time column named one of {_TIME_NAMES}, got {sorted(columns)}")
+    return columns, time[0]
+
+
+def _interval(t: np.ndarray) -> float:
+    """Sampling interval [s] of a uniform time column (span over steps: no rounding build-up)."""
+    return float((t[-1] - t[0]) / (t.size - 1)) if t.size > 1 else 1.0
+
+
+def _numbers(columns: Mapping[str, np.ndarray], sep: str, decimal: str) -> str:
+    """Rows of numbers, shortest repr that reads back to the same float."""
+    buf = io.StringIO()
+    pd.DataFrame(columns).to_csv(buf, sep=sep, decimal=decimal, header=False, index=False,
+                                 lineterminator="\n", na_rep="NaN")
+    return buf.getvalue()
+
+
+def write_csv(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
+              metadata: Mapping[str, str], sep: str = ",", decimal: str = ".", preamble: bool = True,
+              *, units_row: bool = False) -> Path:
+    """Write a delimited text file: preamble, header with units, one row per sample.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file (``.csv``, ``.tsv``, ``.txt``, ``.dat``).
+    table : mapping of str to ndarray, shape (n,)
+        Columns, a time column (``time``, ``t``) among them.
+    units : mapping of str to str
+        Unit of every column, as it should appear in the file (``"N m"``, ``"rpm"``, ``"V"``).
+    metadata : mapping of str to str
+        Written as ``# key: value`` lines before the header when ``preamble`` is true.
+    sep : str
+        Column separator: ``","``, ``";"``, ``"\\t"`` or ``" "``.
+    decimal : {".", ","}
+        Decimal mark; ``","`` needs another separator.
+    preamble : bool
+        Write the metadata lines (the file then starts with the header when false, and the
+        metadata is not in the file).
+    units_row : bool
+        Units in a row of their own under the header instead of ``name [unit]`` headers.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    if decimal not in (".", ",") or sep == decimal or sep not in (",", ";", "\t", " "):
+        raise ValueError(f"`sep` must be one of ',', ';', tab, space and `decimal` '.' or ',' and differ "
+                         f"from it, got sep={sep!r}, decimal={decimal!r}")
+    columns, _ = _check(table, units, metadata)
+    if sep == " " and any(" " in k or " " in units[k] for k in columns):
+        raise ValueError("space-separated files need column names and units without blanks")
+    lines = [f"# {k}: {v}" for k, v in metadata.items()] if preamble else []
+    if units_row:
+        lines += [sep.join(columns), sep.join(units[k] for k in columns)]
+    else:
+        lines.append(sep.join(f"{k} [{units[k]}]" for k in columns))
+    with atomic_write(path, "w", encoding="utf-8", newline="") as f:
+        f.write("\n".join(lines) + "\n")
+        f.write(_numbers(columns, sep, decimal))
+    return Path(path)
+
+
+def _lvm_row(key: str, values: list[str]) -> str:
+    # one value under each Y column and an empty field under Comment, as LabVIEW writes them
+    return "\t".join([key, *values, ""])
+
+
+def write_lvm(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
+              metadata: Mapping[str, str], decimal: str = ",", segments: int = 1,
+              *, x_columns: str = "One") -> Path:
+    """Write a LabVIEW Measurement file (LVM 2.0, tab-separated), one or more segments.
+
+    Layout (NI, *Specification for the LabVIEW Measurement File*): ``LabVIEW Measurement``, the
+    file header (``Writer_Version``, ``Separator``, ``Decimal_Separator``, ``X_Columns``, ``Date``,
+    ``Time``, then the metadata as further tags), ``***End_of_Header***``; per segment an empty
+    line, ``Channels``, ``Samples``, ``Date``, ``Time``, ``Y_Unit_Label``, ``X_Dimension``,
+    ``X0``, ``Delta_X``, ``***End_of_Header***``, the ``X_Value ... Comment`` line and the rows.
+
+    Parameters
+    ----------
+    path : path-like
+        Target ``.lvm`` file.
+    table : mapping of str to ndarray, shape (n,)
+        Columns, a uniform time column [s] among them (the X values).
+    units : mapping of str to str
+        Unit of every column, written as ``Y_Unit_Label``.
+    metadata : mapping of str to str
+        Extra header tags; ``Date``, ``Time``, ``Operator``, ``Description`` replace the
+        writer's own. Without ``Date`` and ``Time`` the current local time is written.
+    decimal : {",", "."}
+        Decimal mark of the numbers, stated as ``Decimal_Separator``.
+    segments : int
+        Number of segments the rows are split into, contiguous in time (X0 of each segment is
+        its first sample time).
+    x_columns : {"One", "No"}
+        ``"One"``: the X values are the first column; ``"No"``: the first field of each row is
+        left empty and readers build the time from ``X0`` and ``Delta_X``.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    if decimal not in (".", ",") or x_columns not in ("One", "No"):
+        raise ValueError(f"`decimal` must be '.' or ',' and `x_columns` 'One' or 'No', "
+                         f"got {decimal!r}, {x_columns!r}")
+    columns, time = _check(table, units, metadata)
+    reserved = {k for k in metadata if k.strip().lower() in _LVM_RESERVED}
+    if reserved:
+        raise ValueError(f"metadata keys {sorted(reserved)} are LVM structure tags")
+    t = columns.pop(time)
+    n = t.size
+    if not 1 <= segments <= n:
+        raise ValueError(f"`segments` must be in [1, {n}], got {segments!r}")
+    dt = _interval(t)
+    now = _dt.datetime.now()
+    date = metadata.get("Date", now.strftime("%Y/%m/%d"))
+    clock = metadata.get("Time", now.strftime("%H:%M:%S.%f"))
+
+    def num(x: float) -> str:
+        return repr(float(x)).replace(".", decimal)
+
+    head = {"Writer_Version": "2", "Reader_Version": "2", "Separator": "Tab", "Decimal_Separator": decimal,
+            "Multi_Headings": "No", "X_Columns": x_columns, "Time_Pref": "Relative",
+            "Operator": metadata.get("Operator", "rigdata"), "Date": date, "Time": clock}
+    extra = {k: v for k, v in metadata.items() if k not in head}
+    out = ["LabVIEW Measurement\t"] + [f"{k}\t{v}" for k, v in {**head, **extra}.items()]
+    out.append("***End_of_Header***\t")
+    names, m = list(columns), len(columns)
+    for rows in np.array_split(np.arange(n), segments):
+        out += ["\t",
+                _lvm_row("Channels", [str(m)] + [""] * (m - 1)),
+                _lvm_row("Samples", [str(rows.size)] * m),
+                _lvm_row("Date", [date] * m),
+                _lvm_row("Time", [clock] * m),
+                _lvm_row("Y_Unit_Label", [units[k] for k in names]),
+                _lvm_row("X_Dimension", ["Time"] * m),
+                _lvm_row("X0", [num(t[rows[0]])] * m),
+                _lvm_row("Delta_X", [num(dt)] * m),
+                "***End_of_Header***" + "\t" * (m + 1),
+                "\t".join(["X_Value", *names, "Comment"])]
+        block = {"X_Value": t[rows] if x_columns == "One" else np.full(rows.size, np.nan),
+                 **{k: columns[k][rows] for k in names}}
+        rows_text = _numbers(block, "\t", decimal).rstrip("\n").split("\n")
+        if x_columns == "No":
+            # the X field stays in every row, empty
+            rows_text = ["\t" + line.split("\t", 1)[1] for line in rows_text]
+        out += rows_text
+    with atomic_write(path, "w", encoding="utf-8", newline="") as f:
+        f.write("\r\n".join(out) + "\r\n")
+    return Path(path)
+
+
+def write_tdms(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
+               metadata: Mapping[str, str]) -> Path:
+    """Write an NI TDMS file with npTDMS: group ``Rig``, one channel per column.
+
+    Every channel, the time column included, carries ``unit_string``, ``wf_start_offset`` (the
+    first sample time [s]), ``wf_increment`` (the sampling interval [s]) and ``wf_samples``;
+    the metadata are the file (root) properties.
+
+    Parameters
+    ----------
+    path : path-like
+        Target ``.tdms`` file (no index file is written).
+    table : mapping of str to ndarray, shape (n,)
+        Columns, a uniform time column [s] among them.
+    units : mapping of str to str
+        Unit of every column (``unit_string``).
+    metadata : mapping of str to str
+        File properties.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
+
+    columns, time = _check(table, units, metadata)
+    t = columns[time]
+    dt = _interval(t)
+    objects = [RootObject(properties=dict(metadata)), GroupObject("Rig")]
+    for name, values in columns.items():
+        props = {"unit_string": units[name], "wf_start_offset": float(t[0]), "wf_increment": dt,
+                 "wf_samples": values.size}
+        objects.append(ChannelObject("Rig", name, values, properties=props))
+    with atomic_write(path, "wb") as f, TdmsWriter(f) as writer:
+        writer.write_segment(objects)
+    return Path(path)

@@ -1,0 +1,363 @@
+"""Units of measured channels: an explicit table of spellings, header parsing, conversion to SI.
+
+The table is written out by hand on purpose. A general unit library reads ``"Nm"`` as nanometre
+(pint does); on a torque rig it is always newton metre. Every spelling a rig file may carry is
+listed in :data:`UNITS` with the quantity it measures and its factor to SI; anything else is an
+error that lists what is accepted.
+
+Quantities and their SI units:
+
+============== ============ ========================================================
+quantity       SI unit      converted to a record channel by
+============== ============ ========================================================
+``time``       s            factor
+``torque``     N m          factor
+``speed``      rad/s        factor
+``angle``      rad          factor
+``voltage``    V            torque = voltage / sensitivity [V/(N m)]
+``counts``     pulses       angle = counts * 2 pi / pulses per revolution (unwrapped)
+``pulse_rate`` pulses/s     speed = pulse rate * 2 pi / pulses per revolution
+============== ============ ========================================================
+
+``Hz`` is refused for speeds: on this rig it could mean revolutions per second or the pulse
+frequency of the 60-pulse speed output, a factor of 60 apart. Write ``rev/s`` or ``pulses/s``.
+
+References
+----------
+The defaults of the raw conversions are the paper's transducers (section 4, experimental set-up):
+two Magtrol TMB 210 torque/speed transducers, 100 N m full scale, torque output 100 mV/(N m)
+(:data:`SENSITIVITY`), speed output 60 pulses per revolution (:data:`PULSES_PER_REV`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigdata.record import RigDataError
+
+#: Torque sensitivity of the Magtrol TMB 210 [V/(N m)]: 100 mV/(N m) (paper, section 4).
+SENSITIVITY = 0.1
+#: Pulses per revolution of the Magtrol TMB 210 speed output (paper, section 4).
+PULSES_PER_REV = 60
+
+#: SI unit of each quantity.
+SI = {"time": "s", "torque": "N m", "speed": "rad/s", "angle": "rad",
+      "voltage": "V", "counts": "pulses", "pulse_rate": "pulses/s"}
+
+#: Quantities a unit may have for each kind of record channel.
+ACCEPTS = {"time": ("time",), "torque": ("torque", "voltage"),
+           "speed": ("speed", "pulse_rate"), "angle": ("angle", "counts")}
+
+_RPM = 2.0 * math.pi / 60.0
+_LBF_IN = 0.1129848290276167      # 1 lbf in = 4.4482216152605 N x 0.0254 m
+_LBF_FT = 1.3558179483314004      # 1 lbf ft = 4.4482216152605 N x 0.3048 m
+_OZF_IN = 0.007061551814226046    # 1 ozf in = 1/16 lbf in
+
+# canonical symbol -> (quantity, factor to SI, other spellings). Spellings are compared after
+# normalise(): lower case, no blanks, no product signs (* · ⋅ ×) or dots, micro as "u".
+_TABLE: dict[str, tuple[str, float, tuple[str, ...]]] = {
+    "s": ("time", 1.0, ("sec", "secs", "second", "seconds")),
+    "ms": ("time", 1e-3, ("msec", "millisecond", "milliseconds")),
+    "us": ("time", 1e-6, ("usec", "microsecond", "microseconds")),
+    "ns": ("time", 1e-9, ("nanosecond", "nanoseconds")),
+    "min": ("time", 60.0, ("minute", "minutes")),
+    "N m": ("torque", 1.0, ("Nm", "N*m", "N·m", "N.m", "N-m", "newton metre", "newton meter",
+                            "newton metres", "newton meters")),
+    "mN m": ("torque", 1e-3, ("mNm", "mN*m", "mN·m", "mN.m", "mN-m")),
+    "N cm": ("torque", 1e-2, ("Ncm", "N*cm", "N·cm", "N.cm", "N-cm")),
+    "N mm": ("torque", 1e-3, ("Nmm", "N*mm", "N·mm", "N.mm", "N-mm")),
+    "kN m": ("torque", 1e3, ("kNm", "kN*m", "kN·m", "kN.m", "kN-m")),
+    "lbf in": ("torque", _LBF_IN, ("lb in", "lb-in", "lbf-in", "in lb", "in-lb", "in lbf", "in-lbf")),
+    "lbf ft": ("torque", _LBF_FT, ("lb ft", "lb-ft", "lbf-ft", "ft lb", "ft-lb", "ft lbf", "ft-lbf")),
+    "ozf in": ("torque", _OZF_IN, ("oz in", "oz-in", "ozf-in", "in oz", "in-oz")),
+    "rad/s": ("speed", 1.0, ("rad/sec", "rad s^-1", "rad s-1", "rad*s^-1", "radian/s",
+                             "radians/s")),
+    "rpm": ("speed", _RPM, ("1/min", "/min", "min^-1", "min-1", "min⁻¹", "r/min", "rev/min",
+                            "revs/min", "U/min", "tr/min", "revolutions per minute")),
+    "rev/s": ("speed", 2.0 * math.pi, ("rps", "r/s", "revs/s", "rev/sec", "revolutions per second")),
+    "deg/s": ("speed", math.pi / 180.0, ("°/s", "degree/s", "degrees/s", "deg/sec")),
+    "rad": ("angle", 1.0, ("radian", "radians")),
+    "deg": ("angle", math.pi / 180.0, ("°", "degree", "degrees")),
+    "rev": ("angle", 2.0 * math.pi, ("revs", "revolution", "revolutions", "turn", "turns")),
+    "V": ("voltage", 1.0, ("volt", "volts")),
+    "mV": ("voltage", 1e-3, ("millivolt", "millivolts")),
+    "counts": ("counts", 1.0, ("count", "cnt", "cnts", "pulses", "pulse", "imp", "impulse",
+                               "impulses", "ticks", "tick")),
+    "pulses/s": ("pulse_rate", 1.0, ("pulse/s", "pulses/sec", "imp/s", "counts/s", "count/s",
+                                     "cnt/s", "cps", "pps")),
+}
+
+#: Spellings refused because they are ambiguous on this rig, with the reason.
+AMBIGUOUS = {
+    "hz": "'Hz' is ambiguous for a speed (revolutions per second or the 60-pulse frequency of "
+          "the speed output); write 'rev/s' or 'pulses/s'",
+    "1/s": "'1/s' is ambiguous for a speed (rad/s, rev/s or pulses/s); write one of those",
+}
+
+
+def normalise(spelling: str) -> str:
+    """Comparison key of a unit spelling: lower case, no blanks, no product signs or dots.
+
+    Parameters
+    ----------
+    spelling : str
+        Unit as written (``"N·m"``, ``" RPM "``, ``"µs"``).
+
+    Returns
+    -------
+    str
+        ``"nm"``, ``"rpm"``, ``"us"``.
+    """
+    s = spelling.strip().lower().replace("µ", "u").replace("μ", "u").replace("⁻¹", "^-1")
+    return re.sub(r"[\s*·⋅×.]", "", s)
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A recognised unit.
+
+    Attributes
+    ----------
+    spelling : str
+        As written in the file or by the user.
+    symbol : str
+        Canonical symbol (``"N m"``, ``"rpm"``).
+    quantity : str
+        One of the keys of :data:`SI`.
+    factor : float
+        Multiplier to the SI unit of the quantity (``rpm`` -> rad/s: 2 pi / 60).
+    """
+
+    spelling: str
+    symbol: str
+    quantity: str
+    factor: float
+
+
+def _build() -> dict[str, tuple[str, str, float]]:
+    table = {}
+    for symbol, (quantity, factor, others) in _TABLE.items():
+        for spelling in (symbol, *others):
+            table[normalise(spelling)] = (symbol, quantity, factor)
+    return table
+
+
+#: Normalised spelling -> (canonical symbol, quantity, factor to SI).
+UNITS: dict[str, tuple[str, str, float]] = _build()
+
+
+def lookup(spelling: str) -> Unit | None:
+    """The unit of a spelling, or None when the table does not know it (no error)."""
+    entry = UNITS.get(normalise(spelling))
+    return None if entry is None else Unit(spelling.strip(), *entry)
+
+
+def accepted(quantities: tuple[str, ...] | None = None) -> str:
+    """Accepted spellings, grouped by quantity, on one line.
+
+    Parameters
+    ----------
+    quantities : tuple of str, optional
+        Restrict the list to these quantities (keys of :data:`SI`); all when None.
+    """
+    groups = []
+    for quantity in quantities or tuple(SI):
+        spellings = [s for sym, (q, _, others) in _TABLE.items() if q == quantity for s in (sym, *others)]
+        groups.append(f"{quantity}: {', '.join(spellings)}")
+    return "; ".join(groups)
+
+
+def parse_unit(spelling: str, *, kind: str | None = None, column: str | None = None,
+               file: object = None, channel: str | None = None) -> Unit:
+    """Recognise a unit spelling, checking that it suits a kind of channel.
+
+    Parameters
+    ----------
+    spelling : str
+        Unit as written (case and blanks do not matter).
+    kind : {"time", "torque", "speed", "angle"}, optional
+        Kind of record channel the unit is for; the unit's quantity must be one of
+        ``ACCEPTS[kind]``.
+    column, file, channel : optional
+        Named in the error message.
+
+    Returns
+    -------
+    Unit
+
+    Raises
+    ------
+    RigDataError
+        Unknown or ambiguous spelling (the message lists the accepted ones), or a unit of the
+        wrong quantity for ``kind``.
+    """
+    where = f" in column {column!r}" if column is not None else ""
+    allowed = ACCEPTS[kind] if kind is not None else None
+    key = normalise(spelling)
+    if key in AMBIGUOUS:
+        raise RigDataError(f"unit {spelling!r}{where}: {AMBIGUOUS[key]}", file=file, channel=channel)
+    unit = lookup(spelling)
+    if unit is None:
+        raise RigDataError(f"unknown unit {spelling!r}{where}; accepted units are {accepted(allowed)}",
+                           file=file, channel=channel)
+    if allowed is not None and unit.quantity not in allowed:
+        raise RigDataError(f"unit {spelling!r}{where} is a {unit.quantity} unit, a {kind} channel needs "
+                           f"{accepted(allowed)}", file=file, channel=channel)
+    return unit
+
+
+_BRACKETED = re.compile(r"^(?P<name>.*?)\s*(?:\[(?P<a>[^\[\]]*)\]|\((?P<b>[^()]*)\)|\{(?P<c>[^{}]*)\}"
+                        r"|<(?P<d>[^<>]*)>)\s*$")
+_SLASHED = re.compile(r"^(?P<name>.*?\S)\s+/\s*(?P<unit>\S.*?)\s*$")
+
+
+def split_header(header: str) -> tuple[str, str | None]:
+    """Split a column header into its bare name and the unit it states.
+
+    Recognised forms: ``Torque In [N m]``, ``torque_in (Nm)``, ``Speed In {rpm}``,
+    ``angle <deg>`` (the last bracket of the header) and ``speed_out / rpm`` (blank before the
+    slash). The unit is returned as written, not checked: see :func:`parse_unit`.
+
+    Parameters
+    ----------
+    header : str
+        Column header as in the file.
+
+    Returns
+    -------
+    name : str
+        Header without the unit annotation, stripped.
+    unit : str or None
+        The unit as written, None when the header states none (or empty brackets).
+    """
+    text = header.strip()
+    m = _BRACKETED.match(text)
+    if m and m.group("name"):
+        unit = next(g for g in m.group("a", "b", "c", "d") if g is not None).strip()
+        return m.group("name").strip(), unit or None
+    m = _SLASHED.match(text)
+    if m:
+        return m.group("name").strip(), m.group("unit")
+    return text, None
+
+
+@dataclass(frozen=True)
+class Converted:
+    """Values of one channel in SI and how they got there.
+
+    Attributes
+    ----------
+    values : ndarray, shape (n,)
+        In the SI unit of the channel kind (N m, rad/s, rad, s).
+    conversion : str
+        The conversion in words, for :class:`rigdata.record.ChannelSource`.
+    quantum : float
+        Resolution in SI (2 pi / pulses per revolution for counts), 0.0 when continuous.
+    notes : tuple of str
+        What was done beyond the factor (counter wraps and resets undone).
+    """
+
+    values: np.ndarray
+    conversion: str
+    quantum: float = 0.0
+    notes: tuple[str, ...] = ()
+
+
+def _factor_text(unit: Unit, si: str) -> str:
+    if unit.factor == 1.0:
+        return "none"
+    return f"x {unit.factor:.10g} ({unit.symbol} -> {si})"
+
+
+def to_si(values: np.ndarray, unit: Unit, *, sensitivity: float = SENSITIVITY,
+          pulses_per_rev: int = PULSES_PER_REV) -> Converted:
+    """Convert a channel to SI, raw signals included.
+
+    Parameters
+    ----------
+    values : ndarray, shape (n,)
+        In ``unit``.
+    unit : Unit
+        From :func:`parse_unit`.
+    sensitivity : float
+        Torque transducer output [V/(N m)] for ``voltage`` units; default 0.1, the paper's
+        Magtrol TMB 210 (100 mV/(N m)).
+    pulses_per_rev : int
+        Pulses per revolution for ``counts`` and ``pulse_rate`` units; default 60, the paper's
+        Magtrol TMB 210 speed output.
+
+    Returns
+    -------
+    Converted
+        Voltage -> torque [N m]; cumulative counts -> angle [rad], unwrapped
+        (:func:`unwrap_counter`), quantum 2 pi / ``pulses_per_rev``; pulse rate -> speed [rad/s];
+        other quantities -> their SI unit by the factor.
+    """
+    v = np.asarray(values, dtype=float) * unit.factor
+    if unit.quantity == "voltage":
+        text = f"{unit.symbol} x {unit.factor:g} / {sensitivity:g} V/(N m)" if unit.factor != 1.0 \
+            else f"V / {sensitivity:g} V/(N m)"
+        return Converted(v / sensitivity, text)
+    step = 2.0 * math.pi / pulses_per_rev
+    if unit.quantity == "pulse_rate":
+        return Converted(v * step, f"pulses/s x 2 pi / {pulses_per_rev} pulses per revolution")
+    if unit.quantity == "counts":
+        counts, notes = unwrap_counter(v, pulses_per_rev)
+        return Converted(counts * step, f"counts x 2 pi / {pulses_per_rev} pulses per revolution",
+                         step, notes)
+    return Converted(v, _factor_text(unit, SI[unit.quantity]))
+
+
+def unwrap_counter(counts: np.ndarray,
+                   pulses_per_rev: int = PULSES_PER_REV) -> tuple[np.ndarray, tuple[str, ...]]:
+    """Undo wraps and resets of a cumulative pulse counter.
+
+    A pulse counter only moves one way while the shaft turns one way, so a step of more than
+    half a revolution against the direction of counting is a discontinuity. When that step is a
+    wrap of a counter of 8 to 32 bits (the jump plus the typical step is a power of two, within
+    two pulses) the power of two is added back exactly; otherwise the counter was reset and
+    the step is replaced by the median of the ten steps around it, so the angle there is known
+    to about one step.
+
+    Parameters
+    ----------
+    counts : ndarray, shape (n,)
+        Counter readings [pulses].
+    pulses_per_rev : int
+        Pulses per revolution.
+
+    Returns
+    -------
+    counts : ndarray, shape (n,)
+        Continuous counter readings [pulses], starting at the first reading.
+    notes : tuple of str
+        One line per wrap or reset undone, for the record's provenance.
+    """
+    c = np.asarray(counts, dtype=float)
+    if c.size < 2 or not np.all(np.isfinite(c)):
+        return c, ()
+    d = np.diff(c)
+    direction = np.sign(np.median(d)) or np.sign(d.sum()) or 1.0
+    jumps = np.flatnonzero(d * direction < -pulses_per_rev / 2.0)
+    if jumps.size == 0:
+        return c, ()
+    fixed, notes = d.copy(), []
+    for k in jumps:
+        near = np.delete(d[max(0, k - 5):k + 6], min(k, 5))
+        near = near[near * direction >= -pulses_per_rev / 2.0]
+        typical = float(np.median(near)) if near.size else 0.0
+        modulus = abs(typical - d[k])
+        bits = round(math.log2(modulus)) if modulus > 0 else 0
+        if 8 <= bits <= 32 and abs(modulus - 2.0 ** bits) <= 2.0:
+            fixed[k] = d[k] + direction * 2.0 ** bits
+            notes.append(f"counter wrapped at 2^{bits} between samples {k} and {k + 1}; undone exactly")
+        else:
+            fixed[k] = typical
+            notes.append(f"counter reset between samples {k} and {k + 1} (jump of {d[k]:g} pulses); "
+                         f"step replaced by the local median {typical:g} pulses (angle known to about "
+                         f"one step from there on)")
+    return np.concatenate(([c[0]], c[0] + np.cumsum(fixed))), tuple(notes)
