@@ -27,14 +27,17 @@ from rigdata.record import RigRecord
 from rigdata.transducer import PROVENANCE, Transducer
 
 K = 2.0  # coverage factor of the significance test
+#: Budget rows that are a constant error of the output torque, which the model's load shares.
+CONSTANT_OUTPUT_ERRORS = ("accuracy class, output torque", "resolution (acquisition step), output torque")
 
 
 def compare(measured: Measured, computed: dict, sensitivities: dict) -> dict:
     """Difference measured - computed, its standard uncertainty and significance (k = 2).
 
-    The output transducer's offset moves the measured efficiency by ``c_meas`` per N m and the
-    computed one (through the load) by ``sensitivities["load"]``: the difference sees
-    ``c_meas - c_model``. The yoke phase's half-turn ambiguity is a rectangular term of half
+    The output transducer's constant errors (class, resolution) move the measured efficiency by
+    ``c_meas`` per N m and the computed one (through the load) by ``sensitivities["load"]``: the
+    difference sees ``c_meas - c_model`` (the drift, a ramp, is left uncorrelated: its share is
+    below 1e-3 of the variance). The yoke phase's half-turn ambiguity is a rectangular term of half
     width |difference| / 2.
     """
     eta_model = computed["mean_efficiency"]
@@ -42,7 +45,7 @@ def compare(measured: Measured, computed: dict, sensitivities: dict) -> dict:
     terms = []
     for row in measured.budget:
         c = row["sensitivity"]
-        if row["quantity"] == "accuracy class, output torque":
+        if row["quantity"] in CONSTANT_OUTPUT_ERRORS:  # the model's load carries them too
             c = c - sensitivities["load"]
         terms.append(c * row["standard_uncertainty"])
     terms.append(0.5 * abs(sensitivities["phase_ambiguity"]) / SQRT3)
