@@ -14,11 +14,24 @@ import json
 import math
 import sys
 
+from cardan_exudyn.cli import _count, _number
+
 EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
 
 
 class _BadOption(ValueError):
     pass
+
+
+class _SettingsError(ValueError):
+    """A settings object (Conditioning, Transducer, RigSettings) refused an option's value."""
+
+
+def _settings(cls, **kwargs):
+    try:
+        return cls(**kwargs)
+    except ValueError as exc:
+        raise _SettingsError(str(exc)) from None
 
 
 def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
@@ -42,16 +55,22 @@ def _read(args: argparse.Namespace):
 def _transducers(args: argparse.Namespace):
     from rigdata.transducer import Transducer
 
-    t = Transducer(full_scale=args.full_scale, sensitivity=args.sensitivity,
+    t = _settings(Transducer, full_scale=args.full_scale, sensitivity=args.sensitivity,
                    pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
                    zero_drift=args.zero_drift)
     return t, t
 
 
+def _draws(args: argparse.Namespace) -> int:
+    if args.mc < 0:
+        raise _BadOption(f"--mc must be >= 0 (0: GUM only), got {args.mc}")
+    return args.mc
+
+
 def _conditioning(args: argparse.Namespace):
     from rigdata.conditioning import Conditioning
 
-    return Conditioning(cutoff_harmonics=args.cutoff_harmonics, settle_revolutions=args.settle,
+    return _settings(Conditioning, cutoff_harmonics=args.cutoff_harmonics, settle_revolutions=args.settle,
                         derivative=args.derivative)
 
 
@@ -91,7 +110,7 @@ def cmd_measure(args: argparse.Namespace) -> int:
 
     rec = _read(args)
     cond = condition(rec, math.radians(args.angle), _conditioning(args))
-    m = measured_efficiency(cond, _transducers(args), monte_carlo=args.mc, seed=args.seed)
+    m = measured_efficiency(cond, _transducers(args), monte_carlo=_draws(args), seed=args.seed)
     out = {"file": str(rec.file), **m.as_dict(), "phase_deg": math.degrees(cond.phase),
            "synthetic": bool(rec.provenance.get("synthetic"))}
     if args.json:
@@ -131,7 +150,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"cardan rig validate: {line}", file=sys.stderr, flush=True)
 
-    v = validate(rec, scene, engines, _conditioning(args), _transducers(args), monte_carlo=args.mc,
+    v = validate(rec, scene, engines, _conditioning(args), _transducers(args), monte_carlo=_draws(args),
                  seed=args.seed, progress=progress)
     s = write_report(v, args.out)
     if args.json:
@@ -152,7 +171,7 @@ def cmd_synthetic(args: argparse.Namespace) -> int:
     from rigdata import synthetic
 
     exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
-    settings = synthetic.RigSettings(revolutions=args.revolutions, seed=args.seed,
+    settings = _settings(synthetic.RigSettings, revolutions=args.revolutions, seed=args.seed,
                                      speed_channel=args.speed_channel, **exact)
     used = synthetic.write(args.out, args.format, settings)
     if args.json:
@@ -163,34 +182,6 @@ def cmd_synthetic(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _number(kind: str, lo: float | None = None, strict: bool = False):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a number ({kind}), got {text!r}") from None
-        if not math.isfinite(value) or (lo is not None and (value <= lo if strict else value < lo)):
-            raise argparse.ArgumentTypeError(
-                f"expected a finite number {'>' if strict else '>='} {lo} ({kind}), got {text!r}"
-                if lo is not None else f"expected a finite number ({kind}), got {text!r}")
-        return value
-
-    return parse
-
-
-def _integer(kind: str, lo: int):
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer ({kind}), got {text!r}") from None
-        if value < lo:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {lo} ({kind}), got {text!r}")
-        return value
-
-    return parse
-
-
 def _file_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", metavar="FILE", help="rig file: delimited text, LabVIEW .lvm or NI .tdms")
     p.add_argument("--format", choices=("auto", "csv", "lvm", "tdms"), default="auto")
@@ -198,28 +189,28 @@ def _file_options(p: argparse.ArgumentParser) -> None:
                    help="map a column to torque_in, torque_out, speed_in, speed_out, angle_in, angle_out")
     p.add_argument("--unit", action="append", metavar="CHANNEL=UNIT",
                    help="unit of a channel where the file does not state it, e.g. speed_in=rpm")
-    p.add_argument("--sensitivity", type=_number("V/(N m)", 0, strict=True), default=0.1,
+    p.add_argument("--sensitivity", type=_number("V/(N m)", positive=True), default=0.1,
                    help="torque output of the transducers for columns in volts (default 0.1, paper)")
-    p.add_argument("--pulses-per-rev", type=_integer("--pulses-per-rev", 1), default=60,
+    p.add_argument("--pulses-per-rev", type=_count("--pulses-per-rev"), default=60,
                    help="speed pulses per revolution for count columns (default 60, paper)")
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
 
 
 def _measure_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--angle", type=_number("deg", 0), default=15.0,
+    p.add_argument("--angle", type=_number("deg", non_negative=True), default=15.0,
                    help="shaft angle [deg] (default 15, the paper's rig case)")
-    p.add_argument("--cutoff-harmonics", type=_number("-", 2), default=10.0,
+    p.add_argument("--cutoff-harmonics", type=_number("-", positive=True), default=10.0,
                    help="low-pass cut-off in input shaft harmonics (default 10)")
-    p.add_argument("--settle", type=_number("rev", 0), default=0.25,
+    p.add_argument("--settle", type=_number("rev", non_negative=True), default=0.25,
                    help="input revolutions dropped at each end (default 0.25)")
     p.add_argument("--derivative", choices=("savgol", "spline"), default="savgol")
-    p.add_argument("--full-scale", type=_number("N m", 0, strict=True), default=100.0,
+    p.add_argument("--full-scale", type=_number("N m", positive=True), default=100.0,
                    help="transducer full scale [N m] (default 100, paper)")
-    p.add_argument("--accuracy-class", type=_number("%", 0), default=0.1,
+    p.add_argument("--accuracy-class", type=_number("%", non_negative=True), default=0.1,
                    help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
-    p.add_argument("--zero-drift", type=_number("N m", 0), default=0.01,
+    p.add_argument("--zero-drift", type=_number("N m", non_negative=True), default=0.01,
                    help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
-    p.add_argument("--mc", type=_integer("--mc", 0), default=2000,
+    p.add_argument("--mc", type=int, default=2000,
                    help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only)")
     p.add_argument("--seed", type=int, default=0, help="seed of the Monte Carlo draws")
 
@@ -243,14 +234,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
     q.add_argument("--scene", default="rig-calibrated",
                    help="named scene of the joint (default rig-calibrated; drive and load replaced)")
-    q.add_argument("--friction", type=_number("-", 0), help="friction coefficient of every pair "
-                   "(default: the scene's, 0.42 for the rig)")
+    q.add_argument("--friction", type=_number("-", non_negative=True),
+                   help="friction coefficient of every pair (default: the scene's, 0.42 for the rig)")
     q.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")
     q.set_defaults(func=_guarded(cmd_validate))
     q = rig.add_parser("synthetic", help="write a synthetic rig file (labelled as such)")
     q.add_argument("--out", required=True, metavar="FILE")
     q.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
-    q.add_argument("--revolutions", type=_number("rev", 1.6), default=5.0)
+    q.add_argument("--revolutions", type=_number("rev", positive=True), default=5.0)
     q.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
     q.add_argument("--seed", type=int, default=1, help="seed of the drawn transducer errors and noise")
     q.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
@@ -266,8 +257,8 @@ def _guarded(func):
 
         try:
             return func(args)
-        except (RigDataError, SceneError, _BadOption, FileNotFoundError, IsADirectoryError,
-                PermissionError) as exc:
+        except (RigDataError, SceneError, _BadOption, _SettingsError, FileNotFoundError,
+                IsADirectoryError, PermissionError) as exc:
             print(f"cardan rig {args.rig_command}: error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
 

@@ -12,13 +12,11 @@ from __future__ import annotations
 import json
 import math
 import os
-import shutil
-import tempfile
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from cardan_exudyn.io import atomic_directory, dumps, to_jsonable
 from reference.scene import Scene
 from rigdata.conditioning import Conditioned, Conditioning, condition
 from rigdata.efficiency import SQRT3, Measured, measured_efficiency
@@ -117,20 +115,6 @@ def accuracy_needed(measured: Measured, target_u: float = 0.01) -> float:
 
 # --------------------------------------------------------------------------- output
 
-def _json_ready(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {k: _json_ready(v) for k, v in x.items() if k != "series"}
-    if isinstance(x, (list, tuple)):
-        return [_json_ready(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    if isinstance(x, (np.floating, np.integer, np.bool_)):
-        return x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def summary(v: dict) -> dict:
     """JSON summary of :func:`validate`'s result."""
     rec, cond, meas = v["record"], v["conditioned"], v["measured"]
@@ -143,12 +127,14 @@ def summary(v: dict) -> dict:
                          "revolutions": cond.revolutions, "phase": cond.phase,
                          "phase_deg": math.degrees(cond.phase), "phase_fit": cond.phase_fit},
         **meas.as_dict(),
-        "computed": v["computed"], "comparisons": v["comparisons"],
+        "computed": {engine: {k: val for k, val in comp.items() if k != "series"}
+                     for engine, comp in v["computed"].items()},
+        "comparisons": v["comparisons"],
         "model_sensitivities": v["sensitivities"],
         "accuracy_class_for_u_0.01": accuracy_needed(meas),
         "assumptions": PROVENANCE,
     }
-    return _json_ready(out)
+    return to_jsonable(out)
 
 
 def figure(v: dict):
@@ -290,12 +276,9 @@ def write_report(v: dict, out: str | os.PathLike) -> dict:
     interrupted or failed run leaves the previous report (or none), never half of one."""
     import pandas as pd
 
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     s = summary(v)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
-        (tmp / "validation.json").write_text(json.dumps(s, indent=2), encoding="utf-8")
+    with atomic_directory(out) as tmp:
+        (tmp / "validation.json").write_text(dumps(s), encoding="utf-8")
         (tmp / "report.md").write_text(markdown(s), encoding="utf-8")
         fig = figure(v)
         fig.savefig(tmp / "figure10.png", dpi=110)
@@ -312,18 +295,4 @@ def write_report(v: dict, out: str | os.PathLike) -> dict:
                                                           comp["series"]["efficiency"], left=np.nan,
                                                           right=np.nan)
         pd.DataFrame(table).to_csv(tmp / "signals.csv", index=False)
-        _swap_in(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return s
-
-
-def _swap_in(new: Path, out: Path) -> None:
-    old = None
-    if out.exists():
-        old = out.with_name(f".{out.name}.old-{os.getpid()}")
-        os.replace(out, old)
-    os.replace(new, out)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)

@@ -24,6 +24,7 @@ import numpy as np
 
 from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
+from rigdata.units import parse_unit, to_si
 
 GENERATOR = "rigdata.synthetic 1"
 FORMATS = ("csv", "lvm", "tdms")
@@ -219,18 +220,17 @@ def record(settings: RigSettings | None = None, transducer: Transducer | None = 
     truth = truth or true_signals(settings)
     table, units, used = measure(truth, settings, transducer)
     channels, sources = {}, {}
-    for shaft, name in (("in", "In"), ("out", "Out")):
-        channels[f"torque_{shaft}"] = table[f"Torque {name}"] / transducer.sensitivity
-        sources[f"torque_{shaft}"] = ChannelSource(f"Torque {name}", "V",
-                                                   f"V / {transducer.sensitivity} V/(N m)")
-        if settings.speed_channel == "pulses":
-            channels[f"angle_{shaft}"] = table[f"Pulses {name}"] * transducer.pulse_angle
-            sources[f"angle_{shaft}"] = ChannelSource(f"Pulses {name}", "counts",
-                                                      f"x 2 pi / {transducer.pulses_per_rev}",
-                                                      transducer.pulse_angle)
-        else:
-            channels[f"speed_{shaft}"] = table[f"Speed {name}"] * 2 * math.pi / 60.0
-            sources[f"speed_{shaft}"] = ChannelSource(f"Speed {name}", "rpm", "x 2 pi / 60")
+    names = {"Torque": "torque", "Pulses": "angle", "Speed": "speed"}
+    for column, values in table.items():
+        if column == "Time":
+            continue
+        kind, side = column.split()
+        unit = parse_unit(units[column], column=column)
+        converted = to_si(values, unit, sensitivity=transducer.sensitivity,
+                          pulses_per_rev=transducer.pulses_per_rev)
+        channel = f"{names[kind]}_{side.lower()}"
+        channels[channel] = converted.values
+        sources[channel] = ChannelSource(column, units[column], converted.conversion, converted.quantum)
     prov = {"file": "<synthetic>", "format": "memory", "synthetic": metadata(used)}
     return RigRecord(table["Time"], channels, sources, prov), used
 
