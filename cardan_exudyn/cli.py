@@ -138,8 +138,43 @@ def _print_summary(s: dict[str, Any], out: str | None) -> None:
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
     from cardan_exudyn.reproduce import reproduce
+    from cardan_exudyn.sweep import SweepError
 
-    return reproduce(args.out, quick=args.quick)
+    try:
+        return reproduce(args.out, quick=args.quick, workers=args.workers, restart=args.restart,
+                         retry_failed=args.retry_failed)
+    except SweepError as exc:
+        raise BadInput(str(exc)) from None
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from cardan_exudyn.bench import SCENES, BenchError, run_bench, write_bench
+
+    def names(text: str | None, default: tuple[str, ...]) -> tuple[str, ...]:
+        return tuple(n.strip() for n in text.split(",") if n.strip()) if text else default
+
+    try:
+        result = run_bench(quick=args.quick, repeats=args.repeats,
+                           scenes=names(args.scenes, tuple(SCENES)),
+                           engines=names(args.engines, ("exudyn", "mujoco", "reference")),
+                           audit=not args.no_audit, paper=not args.no_paper,
+                           progress=not args.json and sys.stderr.isatty())
+    except BenchError as exc:
+        raise BadInput(str(exc)) from None
+    if args.out:
+        write_bench(result, args.out)
+    if args.json:
+        from cardan_exudyn.io import dumps
+
+        print(dumps(result.summary()))
+    else:
+        for t in result.targets:
+            met = "met" if t["met"] else "MISSED"
+            print(f"{t['target']:16s} {t['scene']:20s} {t['variant']:28s} {t['measured']:8.3g} "
+                  f"(limit {t['limit']:g}) {met}")
+        if args.out:
+            print(f"report: {args.out}/report.md")
+    return 0
 
 
 def cmd_study(args: argparse.Namespace) -> int:
@@ -342,7 +377,31 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("reproduce", help="reproduce the paper's studies into a report folder")
     p.add_argument("--out", metavar="DIR", default="reports/reproduce", help="report folder")
     p.add_argument("--quick", action="store_true", help="fewer scenes and a coarser accuracy")
+    p.add_argument("--workers", type=_count("--workers"), metavar="N",
+                   help="local processes (default: all cores; 1 runs in this process)")
+    p.add_argument("--restart", action="store_true",
+                   help="discard the runs recorded in OUT/runs and run every case again")
+    p.add_argument("--retry-failed", action="store_true", help="rerun the cases recorded as failed")
     p.set_defaults(func=cmd_reproduce)
+
+    p = sub.add_parser("bench", help="work-precision benchmark of the engines, targets, skip audit",
+                       description="Error against wall time for every engine configuration on the "
+                                   "frictionless and friction scenes at 10 and 35 deg, 2000 rpm; "
+                                   "the speed targets as ratios from the same run; the paper's "
+                                   "eleven scenes timed; what each skip of the Exudyn build saves.")
+    p.add_argument("--out", metavar="DIR",
+                   help="results folder: bench.csv, targets.csv, audit.csv, bench.json, report.md, "
+                        "work_precision.png")
+    p.add_argument("--quick", action="store_true", help="short ladders, one repeat (< 1 min)")
+    p.add_argument("--repeats", type=_count("--repeats"), metavar="N",
+                   help="timed runs per configuration, median reported (default 3, quick 1)")
+    p.add_argument("--scenes", metavar="A,B", help="subset of frictionless-10deg, frictionless-35deg, "
+                                                    "friction-10deg, friction-35deg")
+    p.add_argument("--engines", metavar="A,B", help="subset of exudyn, mujoco, reference")
+    p.add_argument("--no-audit", action="store_true", help="leave out the skip audit")
+    p.add_argument("--no-paper", action="store_true", help="leave out the paper's eleven scenes")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.set_defaults(func=cmd_bench)
 
     p = sub.add_parser("study", help="numerical studies of the friction model")
     p.add_argument("kind", choices=("coupling", "sign-band"),
