@@ -23,7 +23,7 @@ import exudyn as exu
 import numpy as np
 
 from cardan_exudyn.model import ExudynModel, build_model
-from cardan_exudyn.rotations import rxyz_angular_velocity, rxyz_matrix
+from cardan_exudyn.projection import project_velocities
 from cardan_exudyn.stepsize import choose_step
 from reference.friction import friction_from_columns
 from reference.rccc import LoopClosureError
@@ -37,6 +37,7 @@ from reference.scene import (
     scene_to_dict,
 )
 from reference.schema import (
+    REACTION_SUFFIXES,
     STATUS_NO_CLOSURE,
     STATUS_OK,
     Result,
@@ -46,6 +47,10 @@ from reference.schema import (
 )
 
 ENGINE_NAME = "exudyn"
+
+
+NODE_TYPES = ("Rxyz", "EP", "RotVecLG")
+SENSOR_SCOPES = ("auto", "all")
 
 
 @dataclass(frozen=True)
@@ -58,17 +63,52 @@ class ExudynOptions:
         Generalized-alpha spectral radius at infinity, in [0, 1); lower damps more.
     modified_newton : bool
         Use modified Newton (Jacobian reused) instead of full Newton.
-    newton_relative_tolerance : float
-        Relative tolerance of the Newton iteration.
+    jacobian_every_step : bool
+        With modified Newton: compute the Jacobian once at the start of every step (Exudyn's
+        ``modifiedNewtonJacUpdatePerStep``) instead of only when the iteration stalls.
+    newton_relative_tolerance, newton_absolute_tolerance : float
+        Tolerances of the Newton iteration (relative to the initial residual, and absolute).
+    node_type : str
+        Rigid-body node of the bodies: ``"Rxyz"`` (Tait-Bryan angles), ``"EP"`` (Euler
+        parameters) or ``"RotVecLG"`` (rotation vector, Lie-group integration); see
+        :func:`cardan_exudyn.model.build_model` for which body gets which.
+    sensors : str
+        ``"auto"``: record the pair reactions only when the scene asks for the time table (a
+        summary-only run does not need them); ``"all"``: always.
+    velocity_projection : bool
+        Report velocities projected onto the velocity constraints at the computed positions
+        (post-processing, :mod:`cardan_exudyn.projection`): exact speed ratio for a prescribed
+        input; the drive torque, reactions and friction keep the integrator's error.
     """
 
     spectral_radius: float = 0.6
     modified_newton: bool = False
+    jacobian_every_step: bool = False
     newton_relative_tolerance: float = 1e-10
+    newton_absolute_tolerance: float = 1e-10
+    node_type: str = "Rxyz"
+    sensors: str = "auto"
+    velocity_projection: bool = False
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.spectral_radius < 1.0:
             raise SceneError(f"`spectral_radius` must be in [0, 1), got {self.spectral_radius!r}")
+        for name in ("newton_relative_tolerance", "newton_absolute_tolerance"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and 0.0 < value < 1.0):
+                raise SceneError(f"`{name}` must be in (0, 1), got {value!r}")
+        if self.node_type not in NODE_TYPES:
+            raise SceneError(f"`node_type` must be one of {list(NODE_TYPES)}, got {self.node_type!r}")
+        if self.node_type == "RotVecLG" and self.spectral_radius > 0.8:
+            # measured: at 0.9 friction runs end "ok" with the efficiency 0.2 off, at 0.95 the
+            # frictionless run fails
+            raise SceneError(f"`spectral_radius` must be <= 0.8 with node_type 'RotVecLG', got "
+                             f"{self.spectral_radius!r}")
+        if self.sensors not in SENSOR_SCOPES:
+            raise SceneError(f"`sensors` must be one of {list(SENSOR_SCOPES)}, got {self.sensors!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
 
 def engine_version() -> str:
@@ -108,7 +148,9 @@ def simulation_settings(dt: float, t_start: float, t_end: float,
     ti.automaticStepSize = False
     ti.generalizedAlpha.spectralRadius = options.spectral_radius
     ti.newton.useModifiedNewton = options.modified_newton
+    ti.newton.modifiedNewtonJacUpdatePerStep = options.jacobian_every_step
     ti.newton.relativeTolerance = options.newton_relative_tolerance
+    ti.newton.absoluteTolerance = options.newton_absolute_tolerance
     s.solution.file.write = False
     s.solution.sensors.writePeriod = 0.5 * dt
     s.show.statistics = False
@@ -122,7 +164,8 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene)
     try:
-        model = build_model(scene)
+        model = build_model(scene, reactions=options.sensors == "all" or scene.record.timeseries,
+                            node_type=options.node_type)
     except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
         return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
                              "engine_version": engine_version(), "scene": scene_to_dict(scene),
@@ -162,10 +205,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
         "scene": scene_to_dict(scene),
         "dt": dt,
         "dt_choice": dt_reason,
-        "options": {"spectral_radius": options.spectral_radius,
-                    "modified_newton": options.modified_newton,
-                    "newton_relative_tolerance": options.newton_relative_tolerance,
-                    "node_type": "NodeRigidBodyRxyz", "integrator": "generalized-alpha index 3"},
+        "options": {**options.to_dict(), "integrator": "generalized-alpha index 3"},
         "steps": int(solver.it.currentStepIndex),
         "newton_iterations": int(solver.it.newtonStepsCount),
         "jacobian_evaluations": int(solver.it.newtonJacobiCount),
@@ -175,13 +215,17 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
         summary["friction"] = friction.summary()
     table = None
     try:
-        columns = postprocess(model)
+        columns = postprocess(model, project=options.velocity_projection)
     except Exception as exc:  # no data recorded, e.g. a failure in the first step
         summary.update(status="integration_failure" if status == STATUS_OK else status,
                        reason=reason or f"no usable output: {exc}")
         return Result(None, summary)
     summary.update(constraint_violation(model.pair_kinematics))
-    bad = _first_non_finite(columns)
+    if options.velocity_projection:
+        summary["max_velocity_correction"] = model.velocity_correction
+    unrecorded = set() if f"{PAIR_NAMES[0]}_force" in model.sensors else {
+        f"{p}_{c}" for p in PAIR_NAMES for c in REACTION_SUFFIXES}
+    bad = _first_non_finite({k: v for k, v in columns.items() if k not in unrecorded})
     if bad and status == STATUS_OK:
         status, reason = "diverged", f"non-finite values in `{bad}`"
     if scene.drive.kind == "torque":
@@ -237,20 +281,29 @@ def _stored(model: ExudynModel, key: str) -> np.ndarray:
 
 
 def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
-    """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity."""
+    """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity.
+
+    ``psi`` holds the node's total rotation coordinates (reference included): the Rxyz angles
+    for the input (every node type; the first is the shaft angle), else those of
+    ``model.rotations[name]``.
+    """
     states = {}
     for name in model.nodes:
         q = _stored(model, f"{name}_q")
         q_t = _stored(model, f"{name}_q_t")
         n = min(len(q), len(q_t))
         q, q_t = q[:n], q_t[:n]
+        rot = model.rotations[name]
+        end = 4 + rot.size
+        p = q[:, 4:end] if rot.zero_reference else q[:, 4:end] + np.asarray(rot.reference)
+        a, omega = rot.frame(p, q_t[:, 4:end])
         states[name] = {
             "t": q[:, 0],
             "r": model.com_reference[name] + q[:, 1:4],
             "v": q_t[:, 1:4],
-            "A": rxyz_matrix(q[:, 4:7]),
-            "omega": rxyz_angular_velocity(q[:, 4:7], q_t[:, 4:7]),
-            "psi": q[:, 4:7],
+            "A": a,
+            "omega": omega,
+            "psi": p,
         }
     return states
 
@@ -282,14 +335,21 @@ def _pair_kinematics(model: ExudynModel, states: dict, n: int) -> dict[str, dict
     return out
 
 
-def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
-    """Columns of the result schema from the recorded sensors."""
+def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarray]:
+    """Columns of the result schema from the recorded sensors.
+
+    ``project``: replace the recorded velocities by their projection onto the velocity
+    constraints (:mod:`cardan_exudyn.projection`); the largest correction is left in
+    ``model.velocity_correction``.
+    """
     scene = model.scene
     states = body_states(model)
     n = min(len(s["t"]) for s in states.values())
     t = states["input"]["t"][:n]
     if n < 2:
         raise ValueError("fewer than two recorded steps")
+    if project:
+        states = _projected_states(model, states, n)
     cols: dict[str, np.ndarray] = {"t": t}
     cols["theta_in"] = states["input"]["psi"][:n, 0]
     cols["omega_in"] = states["input"]["omega"][:n, 0]
@@ -308,8 +368,11 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     cols["power_out"] = cols["torque_out"] * cols["omega_out"]
 
     for name in PAIR_NAMES:
-        force = _stored(model, f"{name}_force")[:n, 1:4]
-        torque = _stored(model, f"{name}_torque")[:n, 1:4]
+        if f"{name}_force" in model.sensors:
+            force = _stored(model, f"{name}_force")[:n, 1:4]
+            torque = _stored(model, f"{name}_torque")[:n, 1:4]
+        else:  # reactions not recorded (summary-only run)
+            force = torque = np.full((n, 3), np.nan)
         k = kin[name]
         fx, fy, fz = (-force).T
         # TorqueLocal: 90-degree in-plane swap, sign flip, and components in the frame of body b
@@ -343,6 +406,26 @@ def postprocess(model: ExudynModel) -> dict[str, np.ndarray]:
     cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
     model.pair_kinematics = kin
     return cols
+
+
+def _projected_states(model: ExudynModel, states: dict, n: int) -> dict:
+    """``states`` with velocities projected onto the joint's velocity constraints."""
+    drive = model.scene.drive
+    if isinstance(drive, AngleDrive):
+        spline = drive.spline()
+
+        def input_speed(t):
+            return spline(t, 1)
+    elif drive.kind == "speed":
+        def input_speed(t):
+            return np.full(np.shape(t), drive.speed)
+    else:
+        input_speed = None
+    trimmed = {name: {k: v[:n] for k, v in s.items()} for name, s in states.items()}
+    projected = project_velocities(trimmed, _pair_kinematics(model, trimmed, n), model.mass,
+                                   model.inertia, model.pair_frames["frame_input"][:, 2], input_speed)
+    model.velocity_correction = projected.pop("max_velocity_correction")
+    return projected
 
 
 def _relative_angle(k: dict[str, np.ndarray]) -> np.ndarray:

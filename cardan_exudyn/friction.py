@@ -73,24 +73,6 @@ def _sign(speed: float, band: float) -> float:
     return max(-1.0, min(1.0, speed / band))
 
 
-def _rxyz(psi: np.ndarray) -> np.ndarray:
-    c0, c1, c2 = math.cos(psi[0]), math.cos(psi[1]), math.cos(psi[2])
-    s0, s1, s2 = math.sin(psi[0]), math.sin(psi[1]), math.sin(psi[2])
-    return np.array([
-        [c1 * c2, -c1 * s2, s1],
-        [s0 * s1 * c2 + c0 * s2, -s0 * s1 * s2 + c0 * c2, -s0 * c1],
-        [-c0 * s1 * c2 + s0 * s2, c0 * s1 * s2 + s0 * c2, c0 * c1],
-    ])
-
-
-def _omega(psi: np.ndarray, psi_t: np.ndarray) -> np.ndarray:
-    c0, c1 = math.cos(psi[0]), math.cos(psi[1])
-    s0, s1 = math.sin(psi[0]), math.sin(psi[1])
-    return np.array([psi_t[0] + s1 * psi_t[2],
-                     c0 * psi_t[1] - s0 * c1 * psi_t[2],
-                     s0 * psi_t[1] + c0 * c1 * psi_t[2]])
-
-
 @dataclass
 class _PairData:
     name: str
@@ -174,7 +156,11 @@ class FrictionCoupling:
         """Look up coordinate indices (after ``mbs.Assemble``) and register the user functions."""
         for name, node in self.model.nodes.items():
             start = self.mbs.GetNodeODE2Index(node)
-            self._ode2[name] = start
+            rot = self.model.rotations[name]
+            reference = None if rot.zero_reference else np.asarray(rot.reference)
+            # rotation coordinates [start + 3, end), the node type's frame function and reference
+            # coordinates (None when zero)
+            self._ode2[name] = (start, start + 3 + rot.size, rot.frame_one, reference)
         self._history = [(self.model.start_time, self._pair_coordinates(self._body_states()))]
         self.mbs.SetPostNewtonUserFunction(self.post_newton)
         self.model.user_functions.append(self.post_newton)
@@ -193,9 +179,10 @@ class FrictionCoupling:
         q = sd.GetODE2Coordinates(exu.ConfigurationType.Current)
         q_t = sd.GetODE2Coordinates_t(exu.ConfigurationType.Current)
         states = {}
-        for name, i in self._ode2.items():
-            psi, psi_t = q[i + 3:i + 6], q_t[i + 3:i + 6]
-            states[name] = (_rxyz(psi), _omega(psi, psi_t), np.asarray(q_t[i:i + 3]),
+        for name, (i, end, frame, reference) in self._ode2.items():
+            p = q[i + 3:end]
+            a, omega = frame(p if reference is None else p + reference, q_t[i + 3:end])
+            states[name] = (a, omega, np.asarray(q_t[i:i + 3]),
                             self.model.com_reference[name] + np.asarray(q[i:i + 3]))
         return states
 

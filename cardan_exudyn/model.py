@@ -7,6 +7,10 @@ Modelling choices
   so its first Tait-Bryan angle is the shaft angle (the drive acts on it directly). The spider's
   orientation is ``Rx(theta) Ry(gamma)`` with ``|gamma| <= beta``, and the output's second angle
   stays below ``beta`` too: the parametrisation is regular for every shaft angle below 90 deg.
+  ``build_model(node_type=...)`` gives the spider and the output Euler-parameter
+  (``NodeRigidBodyEP``) or rotation-vector (``NodeRigidBodyRotVecLG``) nodes instead, for
+  comparing node types; the input keeps its Rxyz node (the drive acts on its first angle).
+  Readers of node coordinates go through ``ExudynModel.rotations`` (:mod:`cardan_exudyn.rotations`).
 - Four ``ObjectJointGeneric`` pairs (revolute ``[1,1,1,1,1,0]``, cylindrical ``[1,1,0,1,1,0]``,
   z the pair axis): 17 constraints on 18 coordinates, mobility one, no redundancy.
 - Constant speed: ``ObjectConnectorCoordinate`` at velocity level on the input angle (no Python
@@ -33,7 +37,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from cardan_exudyn.rotations import rxyz_from_matrix, rxyz_rates
+from cardan_exudyn.rotations import ROTATION_COORDINATES, RotationCoordinates
 from reference import rccc
 from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SpeedDrive
 
@@ -147,13 +151,36 @@ class ExudynModel:
     mass: dict[str, float] = field(default_factory=dict)
     inertia: dict[str, np.ndarray] = field(default_factory=dict)
     friction: Any = None  # cardan_exudyn.friction.FrictionCoupling when friction is applied
+    node_type: str = "Rxyz"  # the build_model argument
+    # per body: the node's rotation coordinates (cardan_exudyn.rotations.ROTATION_COORDINATES)
+    rotations: dict[str, RotationCoordinates] = field(default_factory=dict)
 
 
-def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
-    """Assemble the Exudyn system for ``scene`` (no solving), with recording sensors."""
+def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
+                node_type: str = "Rxyz") -> ExudynModel:
+    """Assemble the Exudyn system for ``scene`` (no solving), with recording sensors.
+
+    ``reactions=False`` leaves out the eight pair-reaction sensors (the summary does not need
+    them: friction reads the reactions itself); see :func:`add_sensors`.
+
+    ``node_type`` chooses the rigid-body node of the spider and the output: ``"Rxyz"``
+    (``NodeRigidBodyRxyz``, Tait-Bryan angles), ``"EP"`` (``NodeRigidBodyEP``, Euler parameters
+    with their normalisation constraint: one more coordinate and one algebraic equation per
+    body) or ``"RotVecLG"`` (``NodeRigidBodyRotVecLG``, rotation vector updated by Exudyn's
+    Lie-group generalized-alpha; its velocity coordinates are the local angular velocity). The
+    input keeps ``NodeRigidBodyRxyz`` under every value: the drive (a coordinate connector) and
+    the input angle of the results use its raw first angle (coordinate 3), which no other node
+    type has. Every node's reference rotation is the identity (node axes = global axes at input
+    angle 0). Rotation vectors are kept within ``|nu| <= pi`` between steps
+    (:func:`_wrap_rotation_vectors`). Measured at 35 deg, 200 steps per revolution: ``"RotVecLG"``
+    needs a spectral radius of 0.8 or less (at 0.9 and 0.95 the run with friction ends "ok"
+    with a mean efficiency off by 0.23 and 4.8, and at 0.95 the frictionless run fails).
+    """
+    if node_type not in ROTATION_COORDINATES:
+        raise ValueError(f"node_type must be one of {list(ROTATION_COORDINATES)}, got {node_type!r}")
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    model = ExudynModel(scene=scene, system_container=sc, mbs=mbs)
+    model = ExudynModel(scene=scene, system_container=sc, mbs=mbs, node_type=node_type)
     ground = mbs.AddObject(eii.ObjectGround())
 
     theta0, omega0, t0 = _initial_drive_state(scene)
@@ -169,15 +196,17 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
         model.com_reference[name] = reference_state[name]["origin"] + com
         model.mass[name] = mass
         model.inertia[name] = inertia
+        rot = ROTATION_COORDINATES["Rxyz" if name == "input" else node_type]
+        model.rotations[name] = rot
         a0 = state[name]["A"]
-        psi0 = rxyz_from_matrix(a0)
+        p0 = rot.from_matrix(a0)
         w = state[name]["omega"]
         arm = a0 @ com
         pos0 = state[name]["origin"] + arm
-        node = mbs.AddNode(eii.NodeRigidBodyRxyz(
-            referenceCoordinates=[*model.com_reference[name], 0.0, 0.0, 0.0],
-            initialCoordinates=[*(pos0 - model.com_reference[name]), *psi0],
-            initialVelocities=[*(state[name]["velocity"] + np.cross(w, arm)), *rxyz_rates(psi0, w)],
+        node = mbs.AddNode(getattr(eii, rot.node_class)(
+            referenceCoordinates=[*model.com_reference[name], *rot.reference],
+            initialCoordinates=[*(pos0 - model.com_reference[name]), *(p0 - np.asarray(rot.reference))],
+            initialVelocities=[*(state[name]["velocity"] + np.cross(w, arm)), *rot.rates(p0, w)],
         ))
         model.nodes[name] = node
         model.bodies[name] = mbs.AddObject(eii.ObjectRigidBody(
@@ -214,11 +243,55 @@ def build_model(scene: Scene, sensors: bool = True) -> ExudynModel:
 
         model.friction = FrictionCoupling(model)
     if sensors:
-        add_sensors(model)
+        add_sensors(model, reactions=reactions)
     mbs.Assemble()
     if model.friction is not None:
         model.friction.prepare()
+    _wrap_rotation_vectors(model)
     return model
+
+
+def _wrap_rotation_vectors(model: ExudynModel) -> None:
+    """Keep the rotation vectors of ``NodeRigidBodyRotVecLG`` nodes within ``|nu| <= pi``.
+
+    Exudyn's Lie-group update keeps ``0 <= |nu| <= 2 pi`` and lets a body that turns whole
+    revolutions reach ``|nu| = 2 pi`` (the identity again) once every two revolutions, where the
+    exponential map is singular: measured at 35 deg, Newton needs 6 iterations in that step at
+    200 steps per revolution and fails at 100, and the reactions and drive torque spike. After
+    every step a post-step user function replaces a vector with ``|nu| > pi`` by the same rotation
+    ``nu (1 - 2 pi / |nu|)``. The velocity coordinates (local angular velocity) and the
+    integrator's accelerations do not depend on that choice, so the step sequence is otherwise
+    the same. Node axes turned away from the body (e.g. by a half-turn about z) would keep
+    ``|nu|`` away from ``2 pi`` too, but Exudyn 1.13.6 computes wrong initial accelerations and
+    Lagrange multipliers when a rotation vector is not zero at the start (measured: reactions off
+    by 3e3 N at 35 deg, decaying over about 30 steps; its initial-acceleration solve seems to
+    take the local angular velocity for the rate of ``nu`` in the ``(C_q q_t)_q q_t`` term).
+    The nodes therefore start at the identity, which holds for a drive starting at input angle
+    0; an angle drive starting elsewhere gets that start-up error with ``RotVecLG``.
+    """
+    starts = [model.mbs.GetNodeODE2Index(node) + 3 for name, node in model.nodes.items()
+              if model.rotations[name].name == "RotVecLG"]
+    if not starts:
+        return
+    system_data = model.mbs.systemData
+    current = exu.ConfigurationType.Current
+    two_pi = 2.0 * math.pi
+
+    def post_step(mbs_, t):
+        q = system_data.GetODE2Coordinates(current)
+        changed = False
+        for i in starts:
+            x, y, z = q[i], q[i + 1], q[i + 2]
+            phi = math.sqrt(x * x + y * y + z * z)
+            if phi > math.pi:
+                q[i:i + 3] *= 1.0 - two_pi / phi
+                changed = True
+        if changed:
+            system_data.SetODE2Coordinates(q, current)
+        return True
+
+    model.user_functions.append(post_step)
+    model.mbs.SetPostStepUserFunction(post_step)
 
 
 def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
@@ -282,8 +355,13 @@ def _add_loads(model: ExudynModel) -> None:
             mbs.AddLoad(eii.LoadMassProportional(markerNumber=m, loadVector=list(scene.gravity)))
 
 
-def add_sensors(model: ExudynModel) -> None:
-    """Internal (in-memory) sensors for node states, pair reactions and the drive force."""
+def add_sensors(model: ExudynModel, reactions: bool = True) -> None:
+    """Internal (in-memory) sensors for node states, pair reactions and the drive force.
+
+    Every sensor is stored at every step and costs time: the eight reaction sensors are most of
+    the recording cost of a frictionless run, and are left out with ``reactions=False`` (their
+    table columns are then NaN).
+    """
     out = exu.OutputVariableType
 
     def sensor(key: str, item: Any, variable: Any, node: bool = False) -> None:
@@ -296,7 +374,7 @@ def add_sensors(model: ExudynModel) -> None:
     for name, node in model.nodes.items():
         sensor(f"{name}_q", node, out.Coordinates, node=True)
         sensor(f"{name}_q_t", node, out.Coordinates_t, node=True)
-    for name in PAIR_NAMES:
+    for name in PAIR_NAMES if reactions else ():
         sensor(f"{name}_force", model.joints[name], out.ForceLocal)
         sensor(f"{name}_torque", model.joints[name], out.TorqueLocal)
     if model.drive_connector is not None:
