@@ -60,6 +60,8 @@ LAGGED_GROWTH_LIMIT = 1e3
 # converged scheme: a step whose fixed-point residual shrank less than this after
 # max_iterations is taken as self-locking (no consistent friction state)
 STALL_RATIO = 0.1
+# the loop-gain diagnostic (spectral radius of the secant map) is taken every this many steps
+GAIN_EVERY = 4
 
 
 # state of the ground in the per-body tuples (rotation, angular velocity, velocity, position)
@@ -139,6 +141,8 @@ class FrictionCoupling:
         self._step_gain = 0.0
         self._gains: list[float] = []
         self._broyden_b = None
+        self._load_axes: list | None = None
+        self._accepted_steps = 0
         mask = np.zeros((self.n, 2), dtype=bool)
         self._weight = np.ones((self.n, 2))
         for k, p in enumerate(self.pairs):
@@ -197,8 +201,10 @@ class FrictionCoupling:
             a_a, _, _, r_a = states.get(p.bodies[0], _GROUND)
             a_b, _, _, r_b = states.get(p.bodies[1], _GROUND)
             frame = self.model.pair_frames[p.name]
-            rel = (a_a @ frame).T @ (a_b @ frame)
-            coords[k, 0] = math.atan2(rel[1, 0], rel[0, 0])
+            # (A_a F)^T (A_b F): only its first column is needed, (x_a . x_b, y_a . x_b)
+            x_b = a_b @ frame[:, 0]
+            x_a, y_a = a_a @ frame[:, 0], a_a @ frame[:, 1]
+            coords[k, 0] = math.atan2(float(y_a @ x_b), float(x_a @ x_b))
             if p.kind == "cylindrical":
                 d = (r_b + a_b @ p.local[1]) - (r_a + a_a @ p.local[0])
                 coords[k, 1] = float(d @ (a_a @ p.axis_local))
@@ -294,12 +300,17 @@ class FrictionCoupling:
         return friction, coords
 
     def apply(self, friction: np.ndarray) -> None:
+        """Set every friction load (called once or more per step: plain floats, no arrays)."""
+        if self._load_axes is None:  # (load, column of friction, role times the axis in node axes)
+            self._load_axes = [(load, k, j, tuple(float(role * c) for c in p.axis_local))
+                               for k, p in enumerate(self.pairs)
+                               for j, loads in ((0, p.torque_loads), (1, p.force_loads))
+                               for load, role in loads]
         set_load = self.mbs.SetLoadParameter
-        for k, p in enumerate(self.pairs):
-            for load, role in p.torque_loads:
-                set_load(load, "loadVector", list(role * friction[k, 0] * p.axis_local))
-            for load, role in p.force_loads:
-                set_load(load, "loadVector", list(role * friction[k, 1] * p.axis_local))
+        values = friction.tolist()
+        for load, k, j, (x, y, z) in self._load_axes:
+            value = values[k][j]
+            set_load(load, "loadVector", [value * x, value * y, value * z])
         self.applied = friction.copy()
 
     # ------------------------------------------------------------------ user functions
@@ -396,7 +407,9 @@ class FrictionCoupling:
         about 1e-4 of its fixed point at the default step sizes, so one Broyden correction
         usually meets the tolerance. It only sets the starting guess.
         """
-        if self._broyden_b is not None:
+        self._accepted_steps += 1
+        # the eigenvalues cost as much as a friction evaluation: every GAIN_EVERY-th step
+        if self._broyden_b is not None and self._accepted_steps % GAIN_EVERY == 1:
             g = self._broyden_b + np.eye(self._broyden_b.shape[0])
             self._gains.append(float(np.max(np.abs(np.linalg.eigvals(g)))))
         hist = self._accepted
@@ -444,7 +457,8 @@ class FrictionCoupling:
             "mean_iterations_per_step": float(iterations.mean()) if iterations.size else 0.0,
             "max_iterations_in_a_step": int(iterations.max()) if iterations.size else 0,
             "unconverged_steps": self.unconverged_steps,
-            # spectral radius of the secant estimate of the friction feedback map per accepted
+            # spectral radius of the secant estimate of the friction feedback map, every
+            # GAIN_EVERY-th accepted
             # step (see _accept); the median is robust to the start-up steps
             "loop_gain_estimate": float(np.median(self._gains)) if self._gains else None,
             "loop_gain_estimate_max": float(np.max(self._gains)) if self._gains else None,
