@@ -30,7 +30,6 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import platform
 import subprocess
 import sys
 import tempfile
@@ -297,8 +296,7 @@ def work_precision(scene_keys: Iterable[str], quick: bool, repeats: int,
             if result is not None and result.ok:
                 times[i].append(wall)
             if round_ == 0:
-                record = {"scene": key, **{k: v for k, v in config.describe().items() if k != "options"},
-                          "options": config.describe()["options"]}
+                record = {"scene": key, **config.describe()}
                 if result is None:
                     record.update(status="error", reason=error[:300])
                 else:
@@ -475,7 +473,7 @@ def _solve_only(scene: Scene, options: ExudynOptions,
     from cardan_exudyn.stepsize import choose_step
 
     t0 = time.perf_counter()
-    model = build_model(scene, reactions=options.sensors == "all" or scene.record.timeseries,
+    model = build_model(scene, reactions=options.records_reactions(scene),
                         node_type=options.node_type)
     dt, _ = choose_step(scene)
     settings = simulation_settings(dt, model.start_time, end_time(scene, model.start_time), options)
@@ -639,25 +637,7 @@ def environment() -> dict[str, Any]:
     """Versions, CPU, date and commit (the header of every results file)."""
     from cardan_exudyn.sweep import environment as sweep_environment
 
-    env = sweep_environment()
-    from importlib import metadata
-
-    for package in ("pandas", "mujoco", "matplotlib"):
-        try:
-            env["packages"][package] = metadata.version(package)
-        except metadata.PackageNotFoundError:
-            env["packages"][package] = None
-    env["cpu"] = _cpu_model()
-    env["machine"] = platform.machine()
-    return env
-
-
-def _cpu_model() -> str:
-    with contextlib.suppress(OSError):
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    return platform.processor() or "unknown"
+    return sweep_environment()
 
 
 def _header(env: dict[str, Any]) -> str:

@@ -110,6 +110,10 @@ class ExudynOptions:
     def to_dict(self) -> dict[str, Any]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
+    def records_reactions(self, scene: Scene) -> bool:
+        """Whether the run records the pair-reaction sensors (see ``sensors``)."""
+        return self.sensors == "all" or scene.record.timeseries
+
 
 def engine_version() -> str:
     return exu.config.Version() if hasattr(exu, "config") else exu.GetVersionString()
@@ -164,7 +168,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene)
     try:
-        model = build_model(scene, reactions=options.sensors == "all" or scene.record.timeseries,
+        model = build_model(scene, reactions=options.records_reactions(scene),
                             node_type=options.node_type)
     except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
         return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,

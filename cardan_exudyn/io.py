@@ -39,6 +39,18 @@ def to_jsonable(value: Any) -> Any:
     return value
 
 
+def atomic_write(path: str | os.PathLike, write: Any) -> None:
+    """Write one file atomically and durably: ``write(f)`` fills a binary temporary sibling,
+    which is flushed, fsync'ed and renamed onto ``path``."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "wb") as f:
+        write(f)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
 def dumps(data: Any) -> str:
     return json.dumps(to_jsonable(data), indent=2, allow_nan=False)
 

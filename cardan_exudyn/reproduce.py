@@ -70,8 +70,16 @@ import pandas as pd
 
 from cardan_exudyn.calibrate import in_fit
 from cardan_exudyn.engines import run_scene
-from cardan_exudyn.io import atomic_directory, dumps
-from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, read_records, run_sweep
+from cardan_exudyn.io import atomic_directory, atomic_write, dumps
+from cardan_exudyn.sweep import (
+    CASES_FILE,
+    SweepError,
+    SweepSpec,
+    _flatten,
+    _never_leaf,
+    read_records,
+    run_sweep,
+)
 from reference.paper import (
     PARAMETER_SETS,
     assumption_register,
@@ -137,22 +145,13 @@ def paper_case_outputs(scene: Scene, engine: str) -> dict[str, Any]:
     if root:
         folder = Path(root) / f"{scene.name}-{uuid.uuid4().hex[:12]}"
         folder.mkdir(parents=True, exist_ok=True)
-        _write_synced(folder / "summary.json",
+        atomic_write(folder / "summary.json",
                       lambda f: f.write((dumps(result.summary) + "\n").encode("utf-8")))
         if result.ok and result.table is not None:
             columns = {c: result.table[c].to_numpy(dtype=float) for c in HISTORY_COLUMNS}
-            _write_synced(folder / "history.npz", lambda f: np.savez(f, **columns))
+            atomic_write(folder / "history.npz", lambda f: np.savez(f, **columns))
         out["files"] = folder.name
     return out
-
-
-def _write_synced(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as f:
-        write(f)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
 
 
 def case_row(case: dict, parameters: str, record: dict[str, Any]) -> dict[str, Any]:
@@ -350,16 +349,6 @@ class PaperRun:
     overrides: dict[str, Any]
 
 
-def _leaves(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for key, value in data.items():
-        if isinstance(value, dict):
-            out.update(_leaves(value, f"{prefix}{key}."))
-        else:
-            out[f"{prefix}{key}"] = value
-    return out
-
-
 def selected_cases(quick: bool = False) -> list[dict[str, Any]]:
     """The paper's eleven cases, or the three of ``--quick`` (0 and 10 deg, 500 rpm)."""
     cases = paper_cases()
@@ -384,13 +373,13 @@ def paper_runs(quick: bool = False) -> list[PaperRun]:
     base = base_scene()
     fixed = QUICK_OVERRIDES if quick else {}
     built_base = replace(base, **fixed) if fixed else base
-    base_leaves = _leaves(scene_to_dict(base))
+    base_leaves = _flatten(scene_to_dict(base), _never_leaf)
     sets = [p for p in PARAMETER_SETS if p == "plain" or calibrated_parameters()]
     runs = []
     for parameters in sets:
         for case in selected_cases(quick):
             scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=parameters)
-            leaves = _leaves(scene_to_dict(scene))
+            leaves = _flatten(scene_to_dict(scene), _never_leaf)
             if set(leaves) != set(base_leaves):
                 raise RuntimeError(f"{scene.name}: scene fields {sorted(set(leaves) ^ set(base_leaves))} "
                                    "differ in kind from the base scene's")

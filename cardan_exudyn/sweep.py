@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.io import atomic_write, to_jsonable
 from reference.scene import Scene, SceneError, replace, scene_to_dict
 
 PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE = "plan.json", "cases.jsonl", "results.csv", "sweep.json"
@@ -651,12 +651,7 @@ def _crash_record(case: Case, error_type: str, error: str) -> dict[str, Any]:
 
 
 def _atomic_write_text(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(text)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    atomic_write(path, lambda f: f.write(text.encode("utf-8")))
 
 
 def read_records(path: str | os.PathLike, *, truncate: bool = False) -> dict[str, dict[str, Any]]:
@@ -1106,14 +1101,24 @@ def environment() -> dict[str, Any]:
     from importlib import metadata
 
     versions = {}
-    for package in ("cardan-exudyn", "numpy", "scipy", "exudyn", "distributed"):
+    for package in ("cardan-exudyn", "numpy", "scipy", "exudyn", "distributed", "pandas",
+                    "mujoco", "matplotlib"):
         try:
             versions[package] = metadata.version(package)
         except metadata.PackageNotFoundError:
             versions[package] = None
     return {"python": platform.python_version(), "platform": platform.platform(),
+            "machine": platform.machine(), "cpu": _cpu_model(),
             "cpu_count": os.cpu_count(), "packages": versions, "commit": _git_commit(),
             "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
+
+
+def _cpu_model() -> str:
+    with contextlib.suppress(OSError):
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    return platform.processor() or "unknown"
 
 
 def _git_commit() -> str | None:
