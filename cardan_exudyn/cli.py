@@ -177,6 +177,30 @@ def cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_stress(args: argparse.Namespace) -> int:
+    from cardan_exudyn.stress import StressError, parse_parts, print_summary, run_stress
+    from cardan_exudyn.sweep import SweepError
+
+    try:
+        parts = parse_parts(args.only)
+        say = (lambda text: print(text, file=sys.stderr, flush=True)) if not args.json else None
+        report = run_stress(args.out, quick=args.quick, parts=parts, workers=args.workers,
+                            restart=args.restart, progress=None if not args.json else False,
+                            say=say)
+    except (StressError, SweepError) as exc:
+        raise BadInput(str(exc)) from None
+    if args.json:
+        from cardan_exudyn.io import dumps
+
+        print(dumps(report.summary()))
+    else:
+        print_summary(report, args.out)
+    problems = report.problems()
+    for problem in problems:
+        print(f"  {problem}", file=sys.stderr)
+    return EXIT_FAILED if problems else EXIT_OK
+
+
 def cmd_study(args: argparse.Namespace) -> int:
     from cardan_exudyn.studies import main_study
 
@@ -402,6 +426,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-paper", action="store_true", help="leave out the paper's eleven scenes")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser("stress", help="stability map, long runs, bad-input table into a report folder",
+                       description="Stability map of Exudyn against the reference over shaft angle, "
+                                   "friction, speed, step, coupling and node type (converged, drift, "
+                                   "self-locking, integration failure); 2000-revolution drift and "
+                                   "1000-revolution energy runs; every entry point fed bad input.")
+    p.add_argument("--out", metavar="DIR", default="reports/stress",
+                   help="report folder (report.md, map_cells.csv, stability_map.png, long-run and "
+                        "bad-input files, stress.json); the map's runs are kept in OUT/runs")
+    p.add_argument("--quick", action="store_true", help="coarse map, short long runs (CI variant)")
+    p.add_argument("--only", metavar="A,B", help="subset of map, long, inputs (default all)")
+    p.add_argument("--workers", type=_count("--workers"), metavar="N",
+                   help="local processes for the map (default: all cores; 1 runs in this process)")
+    p.add_argument("--restart", action="store_true",
+                   help="discard the map's runs recorded in OUT/runs and run every cell again")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.set_defaults(func=cmd_stress)
 
     p = sub.add_parser("study", help="numerical studies of the friction model")
     p.add_argument("kind", choices=("coupling", "sign-band"),

@@ -166,7 +166,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     """Simulate ``scene`` with Exudyn and return its time table and summary."""
     options = options or ExudynOptions()
     wall_start = time.perf_counter()
-    dt, dt_reason = choose_step(scene)
+    dt, dt_reason = choose_step(scene, options.node_type)
     try:
         model = build_model(scene, reactions=options.records_reactions(scene),
                             node_type=options.node_type)

@@ -164,3 +164,56 @@ def work_precision(rows, speed_ratio_level: float, efficiency_level: float):
 
 def close(fig) -> None:
     plt.close(fig)
+
+
+CLASS_COLOURS = {"converged": "#4caf50", "drift": "#ff9800", "self_locking": "#5c8fd6",
+                 "integration_failure": "#e53935", "error": "#212121"}
+
+
+def stability_map(cells, panels: list[dict], classes):
+    """``cardan stress`` map: one panel per slice, shaft angle (rows) against the panel's
+    quantity (columns, one cell per value). Colour: Exudyn's class; hatching: the reference
+    self-locks; ``!``: the two disagree; black line: the reference's self-locking boundary."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch, Rectangle
+
+    ncols = min(3, len(panels))
+    nrows = -(-len(panels) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.8 * ncols, 4.0 * nrows), squeeze=False,
+                             constrained_layout=True)
+    cmap = ListedColormap([CLASS_COLOURS[c] for c in classes])
+    index = {c: i for i, c in enumerate(classes)}
+    for ax, panel in zip(axes.flat, panels, strict=False):
+        sel = cells[cells["panel"] == panel["key"]]
+        xs, angles = list(panel["x_values"]), list(panel["angles"])
+        grid = np.full((len(angles), len(xs)), np.nan)
+        locks = np.zeros_like(grid, dtype=bool)
+        for _, r in sel.iterrows():
+            i, j = angles.index(r["angle_deg"]), xs.index(r["x"])
+            grid[i, j] = index[r["cell_class"]]
+            locks[i, j] = r["reference"] == "self_locking"
+            if locks[i, j]:
+                ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///",
+                                       lw=0, color="k", alpha=0.45))
+            if not r["agrees"]:
+                ax.text(j, i, "!", ha="center", va="center", fontsize=11, fontweight="bold")
+        ax.imshow(grid, cmap=cmap, vmin=-0.5, vmax=len(classes) - 0.5, origin="lower",
+                  aspect="auto", zorder=0)
+        for i in range(len(angles)):  # boundary: edges between cells of different reference state
+            for j in range(len(xs)):
+                if j + 1 < len(xs) and locks[i, j] != locks[i, j + 1]:
+                    ax.plot([j + 0.5, j + 0.5], [i - 0.5, i + 0.5], "k", lw=2)
+                if i + 1 < len(angles) and locks[i, j] != locks[i + 1, j]:
+                    ax.plot([j - 0.5, j + 0.5], [i + 0.5, i + 0.5], "k", lw=2)
+        ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs], fontsize=7)
+        ax.set_yticks(range(len(angles)), [f"{a:g}" for a in angles], fontsize=7)
+        ax.set_xlabel(panel["x_label"])
+        ax.set_ylabel("shaft angle [deg]")
+        ax.set_title(f"{panel['key']}: {panel['title']}", fontsize=9)
+    for ax in list(axes.flat)[len(panels):]:
+        ax.axis("off")
+    handles = [Patch(color=CLASS_COLOURS[c], label=c) for c in classes]
+    handles.append(Patch(facecolor="white", hatch="///", edgecolor="k",
+                         label="reference self-locks"))
+    fig.legend(handles=handles, loc="outside lower center", ncol=len(handles), fontsize=8)
+    return fig

@@ -1,0 +1,158 @@
+"""`cardan stress`: cell classification, real cells on both sides of the self-locking boundary,
+the node-type step model the map measured, and the quick command end to end."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cardan_exudyn import stress
+from cardan_exudyn.stress import Panel, base_scene, classify, efficiency_promise, measure_cell
+from reference.scene import replace
+
+
+def record(**changes):
+    """A measured cell where both engines are ok and agree (frictionless-like numbers)."""
+    base = {"status": "ok", "ref_status": "ok", "ref_reason": "", "ref_efficiency": 0.6,
+            "ref_loop_gain_max": 0.4, "exu_status": "ok", "exu_reason": "", "exu_efficiency": 0.6001,
+            "exu_efficiency_half": 0.60005, "half_status": "ok", "exu_loop_gain_max": 0.4,
+            "ratio_error": 1e-6, "ratio_promise": 1e-5, "constraint_violation_m": 1e-12,
+            "constraint_violation_rad": 1e-12}
+    return {**base, **changes}
+
+
+def test_promise_is_the_step_halving_estimate_with_a_floor():
+    r = record(exu_efficiency=0.61, exu_efficiency_half=0.60)
+    assert efficiency_promise(r) == pytest.approx(3.0 * 4.0 / 3.0 * 0.01 + stress.EFFICIENCY_FLOOR)
+    assert math.isnan(efficiency_promise(record(half_status="self_locking")))
+    # the lagged coupling is first order: error(h) = 2 |eta_h - eta_h/2|
+    lagged = record(exu_efficiency=0.61, exu_efficiency_half=0.60, coupling="lagged")
+    assert efficiency_promise(lagged) == pytest.approx(3.0 * 2.0 * 0.01 + stress.EFFICIENCY_FLOOR)
+
+
+@pytest.mark.parametrize("changes, cls, agrees, category", [
+    ({}, "converged", True, "agree: ok"),
+    ({"ratio_error": 2e-5}, "drift", False, "wrong answer with status ok"),
+    ({"exu_efficiency": 0.7, "exu_efficiency_half": 0.7}, "drift", False, "wrong answer with status ok"),
+    ({"exu_efficiency": -0.001, "ref_efficiency": -0.001}, "drift", False,
+     "wrong answer with status ok"),
+    ({"constraint_violation_m": 1e-3}, "drift", False, "wrong answer with status ok"),
+    ({"exu_status": "self_locking"}, "self_locking", False, "Exudyn locks, the reference does not"),
+    ({"exu_status": "integration_failure"}, "integration_failure", False,
+     "numerical failure in a physically valid cell"),
+    ({"ref_status": "self_locking", "exu_status": "self_locking"}, "self_locking", True,
+     "agree: self-locking"),
+    ({"ref_status": "self_locking", "exu_status": "integration_failure"}, "integration_failure",
+     True, "agree: fails where the joint locks"),
+    ({"ref_status": "self_locking", "ref_efficiency": None}, "drift", False,
+     "runs on through a physical self-lock"),
+    ({"status": "error", "reason": "ValueError: boom"}, "error", False, "harness error"),
+])
+def test_classify_every_category(changes, cls, agrees, category):
+    out = classify(record(**changes))
+    assert (out["cell_class"], out["agrees"], out["category"]) == (cls, agrees, category)
+    if not agrees:
+        assert out["explanation"]
+
+
+def test_nan_measurements_never_count_as_within_promise():
+    """A missing speed-ratio error or efficiency is a failed check, not a pass (NaN <= x is
+    False, and the comparisons are written so that it stays so)."""
+    assert classify(record(ratio_error=None))["cell_class"] == "drift"
+    assert classify(record(exu_efficiency=float("nan")))["cell_class"] == "drift"
+
+
+def _cell(panel: Panel, angle: float, x: float) -> dict:
+    scene = replace(base_scene(), **panel.overrides(angle, x))
+    measured = measure_cell(scene, panel.node_type)
+    return {**measured, **classify({"status": "ok", "coupling": panel.coupling, **measured})}
+
+
+def test_cells_either_side_of_the_self_locking_boundary():
+    """At 10 deg and 2000 rpm the reference self-locks between f = 0.42 and 0.6 (loop gain 0.78
+    at 0.42): converged coupling agrees on both sides; the lagged scheme, which never iterates the
+    friction fixed point, runs on through the lock with a meaningless efficiency."""
+    converged = Panel("friction", "", "friction", (), ())
+    lagged = Panel("lagged", "", "friction", (), (), coupling="lagged")
+    inside = _cell(converged, 10.0, 0.42)
+    assert inside["cell_class"] == "converged", inside
+    assert 0.7 < inside["ref_loop_gain_max"] < 1.0
+    locked = _cell(converged, 10.0, 0.6)
+    assert (locked["ref_status"], locked["cell_class"], locked["agrees"]) == (
+        "self_locking", "self_locking", True)
+    runs_on = _cell(lagged, 10.0, 0.6)
+    assert runs_on["ref_status"] == "self_locking"
+    assert runs_on["exu_status"] == "ok"
+    assert runs_on["category"] == "runs on through a physical self-lock"
+
+
+@pytest.mark.parametrize("node_type", ["EP", "RotVecLG"])
+@pytest.mark.parametrize("angle", [0.0, 35.0])
+def test_auto_step_meets_the_accuracy_with_every_node_type(node_type, angle):
+    """The map found Euler parameters 18x over the requested speed-ratio accuracy at 0 deg with
+    the Rxyz step model (K = 0 there); the node-type model now picks the step for each."""
+    from cardan_exudyn.engine import ExudynOptions, run
+    from cardan_exudyn.stepsize import error_coefficient
+    from reference.kinematics import speed_ratio
+
+    accuracy = 2e-5
+    scene = replace(base_scene(), **{"joint.geometry.shaft_angle": math.radians(angle),
+                                     "numerics.accuracy": accuracy})
+    scene = replace(scene, **{f"joint.pairs.{p}.friction_coefficient": 0.0
+                              for p in ("frame_input", "input_spider", "spider_output", "output_frame")})
+    result = run(scene, ExudynOptions(node_type=node_type))
+    t = result.table
+    err = np.max(np.abs(t["omega_out"] / t["omega_in"]
+                        - speed_ratio(t["theta_in"].to_numpy(), scene.joint.geometry.shaft_angle)))
+    assert err <= accuracy, (err, result.summary["dt_choice"])
+    if error_coefficient(scene.joint.geometry.shaft_angle, node_type) > 0:
+        assert err > accuracy / 10  # the step is not wastefully small either
+
+
+def test_quick_command_writes_the_report_atomically(tmp_path, capsys):
+    """`cardan stress --quick --only map`: report, cells, plot; the sweep records are kept in
+    OUT/runs, and a second invocation reuses every cell."""
+    from cardan_exudyn.cli import main
+
+    out = tmp_path / "stress"
+    code = main(["stress", "--quick", "--only", "map", "--out", str(out), "--workers", "2"])
+    assert code == 0, capsys.readouterr().err
+    cells = pd.read_csv(out / "map_cells.csv")
+    assert len(cells) == sum(len(p.angles) * len(p.x_values) for p in stress.panels(quick=True))
+    assert set(cells["cell_class"]) <= set(stress.CLASSES)
+    assert "error" not in set(cells["cell_class"])
+    # the quick map holds both boundary verdicts and the lagged scheme's run-on cell
+    assert {"agree: ok", "agree: self-locking", "runs on through a physical self-lock"} <= set(
+        cells["category"])
+    report = (out / "report.md").read_text()
+    assert "## Stability map" in report and "Every disagreement" in report
+    assert (out / "stability_map.png").stat().st_size > 10_000
+    summary = json.loads((out / "stress.json").read_text())
+    assert summary["map"]["cells"] == len(cells)
+    assert not list(tmp_path.glob(".*"))  # no temporary folder left next to OUT
+    code = main(["stress", "--quick", "--only", "map", "--out", str(out), "--json"])
+    assert code == 0
+    again = json.loads(capsys.readouterr().out)
+    assert all(s["run_now"] == 0 for s in again["map"]["sweeps"].values())
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--only", "map,nothing"], "--only"),
+    (["--only", ""], "--only"),
+    (["--workers", "0"], "--workers"),
+])
+def test_bad_stress_options_exit_2(tmp_path, capsys, argv, word):
+    from cardan_exudyn.cli import main
+
+    code = main(["stress", "--out", str(tmp_path / "o"), *argv]) if argv[0] != "--workers" else None
+    if code is None:
+        with pytest.raises(SystemExit) as exc:
+            main(["stress", "--out", str(tmp_path / "o"), *argv])
+        code = exc.value.code
+    err = capsys.readouterr().err
+    assert code == 2 and word in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
