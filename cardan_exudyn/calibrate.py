@@ -51,13 +51,21 @@ def in_fit(case: dict, fit: tuple[str, ...] | list[str]) -> bool:
 
 
 def efficiency(case: dict, values: dict[str, float], accuracy: float, revolutions: float) -> float:
+    """Mean efficiency of ``case`` with the parameter ``values``; NaN when the run failed."""
+    return run_case(case, values, accuracy, revolutions)[0]
+
+
+def run_case(case: dict, values: dict[str, float], accuracy: float,
+             revolutions: float) -> tuple[float, str, str]:
+    """Mean efficiency (NaN when the run failed), status and reason of ``case``."""
     scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=values)
     scene = replace(scene, **{"numerics.accuracy": accuracy, "revolutions": revolutions,
                               "record.timeseries": False})
     result = run(scene)
+    s = result.summary
     if not result.ok:
-        return float("nan")
-    return float(result.summary["mean_efficiency"])
+        return float("nan"), str(s.get("status")), str(s.get("reason", ""))
+    return float(s["mean_efficiency"]), "ok", ""
 
 
 def calibrate(names: tuple[str, ...] = DEFAULT_PARAMETERS, fit: tuple[str, ...] = DEFAULT_FIT,
@@ -103,10 +111,11 @@ def calibrate(names: tuple[str, ...] = DEFAULT_PARAMETERS, fit: tuple[str, ...] 
     values = values_of(solution.x)
     rows = []
     for case in cases:
-        eta = efficiency(case, values, accuracy, revolutions)
+        eta, status, reason = run_case(case, values, accuracy, revolutions)
         rows.append({"case": _key(case), "used_in_fit": in_fit(case, fit),
                      "paper": case["paper_mean_efficiency"], "model": eta,
-                     "difference": eta - case["paper_mean_efficiency"]})
+                     "difference": eta - case["paper_mean_efficiency"], "status": status,
+                     "reason": reason})
     held = [r["difference"] for r in rows if not r["used_in_fit"]]
     fitted = [r["difference"] for r in rows if r["used_in_fit"]]
     return {
@@ -123,6 +132,10 @@ def calibrate(names: tuple[str, ...] = DEFAULT_PARAMETERS, fit: tuple[str, ...] 
     }
 
 
+def _fmt(value: float, spec: str) -> str:
+    return format(value, spec) if math.isfinite(value) else "-"
+
+
 def main_calibrate(names: list[str] | None, as_json: bool) -> int:
     from cardan_exudyn.io import dumps
 
@@ -130,17 +143,21 @@ def main_calibrate(names: list[str] | None, as_json: bool) -> int:
         print(f"  {msg}", file=sys.stderr, flush=True)
 
     result = calibrate(tuple(names) if names else DEFAULT_PARAMETERS, progress=progress)
+    failed = [r for r in result["rows"] if r.get("status", "ok") != "ok"]
     if as_json:
         print(dumps(result))
-        return 0
+        return 3 if failed else 0
     print("fitted parameters (paste into reference/data/paper.toml [calibrated.parameters]):")
     for n, v in result["parameters"].items():
         print(f"  {n} = {v:.6g} {CALIBRATION_PARAMETERS[n]['unit']}")
     print("\n| case | used in fit | paper | model | difference |\n|---|---|---|---|---|")
     for r in result["rows"]:
+        ok = r.get("status", "ok") == "ok"  # a failed run has no efficiency: its status instead
         print(f"| {r['case']} | {'yes' if r['used_in_fit'] else 'no'} | {r['paper']:.3f} | "
-              f"{r['model']:.4f} | {r['difference']:+.4f} |")
-    print(f"\nfit RMS {result['fit_rms']:.4f}; held-out RMS {result['held_out_rms']:.4f}, "
-          f"max |difference| {result['held_out_max_abs']:.4f}; "
+              f"{_fmt(r['model'], '.4f') if ok else r['status']} | {_fmt(r['difference'], '+.4f')} |")
+    print(f"\nfit RMS {_fmt(result['fit_rms'], '.4f')}; held-out RMS {_fmt(result['held_out_rms'], '.4f')}, "
+          f"max |difference| {_fmt(result['held_out_max_abs'], '.4f')}; "
           f"{result['function_evaluations']} evaluations, {result['wall_time_s']:.0f} s")
-    return 0
+    for r in failed:
+        print(f"status: {r['case']}: {r['status']}: {r['reason']}", file=sys.stderr)
+    return 3 if failed else 0

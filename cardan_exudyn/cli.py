@@ -23,6 +23,27 @@ class BadInput(Exception):
     """Raised for invalid command-line input; printed as one line, exit status 2."""
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's errors as one line on stderr (no usage block), exit status 2."""
+
+    def error(self, message: str):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _out_folder(path: str | None, option: str = "--out", replace: bool = True) -> None:
+    """Refuse an output folder that cannot be one before anything runs (exit 2); ``replace``: the
+    command replaces the folder as a whole (not a sweep, which writes into it)."""
+    from cardan_exudyn.io import OutputError, check_output_folder
+
+    if path is not None and not path.strip():
+        raise BadInput(f"{option} is empty: give a folder")
+    if path:
+        try:
+            check_output_folder(path, replace=replace)
+        except OutputError as exc:
+            raise BadInput(f"{option}: {exc}") from None
+
+
 def _number(kind: str, *, positive: bool = False, non_negative: bool = False):
     def parse(text: str) -> float:
         try:
@@ -72,7 +93,10 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     """The scene named or loaded by the options, with the command-line overrides applied."""
     from reference.paper import named_scene
 
-    scene = load_scene(args.scene) if args.scene else named_scene(args.name or DEFAULT_SCENE)
+    if args.scene is not None:
+        scene = load_scene(args.scene)
+    else:
+        scene = named_scene(DEFAULT_SCENE if args.name is None else args.name)
     changes: dict[str, Any] = {}
     if args.angle is not None:
         changes["joint.geometry.shaft_angle"] = args.angle * DEG
@@ -111,6 +135,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from cardan_exudyn.engines import run_scene
     from cardan_exudyn.io import dumps, write_result
 
+    _out_folder(args.out)
     scene = scene_from_args(args)
     result = run_scene(scene, args.engine)
     if args.out:
@@ -122,15 +147,28 @@ def cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK if result.ok else EXIT_FAILED
 
 
+def _fmt(value: Any, spec: str, missing: str = "-") -> str:
+    """``value`` formatted, or ``missing`` when it is not a finite number (never 'nan')."""
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    return format(value, spec) if ok else missing
+
+
+def _no_work(s: dict[str, Any]) -> str:
+    """What a run with status ok prints for an efficiency that is 0/0 (no input work, e.g. a joint
+    spinning free), instead of 'nan'."""
+    return f"undefined (input work {_fmt(s.get('input_work'), '.3g')} J)"
+
+
 def _print_summary(s: dict[str, Any], out: str | None) -> None:
     err = sys.stderr
     if s.get("status") != "ok":
         print(f"status: {s.get('status')}: {s.get('reason')}", file=err)
         return
     print(f"scene {s['scene']['name']} with {s['engine']} {s['engine_version']}: "
-          f"mean efficiency {s['mean_efficiency']:.6f} "
-          f"(time average of eq. (18): {s['mean_instantaneous_efficiency']:.6f}) over "
-          f"{s['revolutions']} revolutions; dt {s.get('dt', float('nan')):.3g} s, "
+          f"mean efficiency {_fmt(s.get('mean_efficiency'), '.6f', _no_work(s))} "
+          f"(time average of eq. (18): "
+          f"{_fmt(s.get('mean_instantaneous_efficiency'), '.6f', 'undefined, P_in = 0 at some instant')}) "
+          f"over {s['revolutions']} revolutions; dt {_fmt(s.get('dt'), '.3g')} s, "
           f"{s.get('steps')} steps, {s['wall_time_s']:.3g} s wall")
     if out:
         print(f"wrote {out}/timeseries.csv and {out}/summary.json")
@@ -140,6 +178,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from cardan_exudyn.reproduce import reproduce
     from cardan_exudyn.sweep import SweepError
 
+    _out_folder(args.out)
     try:
         return reproduce(args.out, quick=args.quick, workers=args.workers, restart=args.restart,
                          retry_failed=args.retry_failed)
@@ -153,6 +192,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     def names(text: str | None, default: tuple[str, ...]) -> tuple[str, ...]:
         return tuple(n.strip() for n in text.split(",") if n.strip()) if text else default
 
+    _out_folder(args.out)
     try:
         result = run_bench(quick=args.quick, repeats=args.repeats,
                            scenes=names(args.scenes, tuple(SCENES)),
@@ -170,7 +210,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     else:
         for t in result.targets:
             met = "met" if t["met"] else "MISSED"
-            print(f"{t['target']:16s} {t['scene']:20s} {t['variant']:28s} {t['measured']:8.3g} "
+            print(f"{t['target']:16s} {t['scene']:20s} {t['variant']:28s} "
+                  f"{_fmt(t['measured'], '8.3g', '  failed')} "
                   f"(limit {t['limit']:g}) {met}")
         if args.out:
             print(f"report: {args.out}/report.md")
@@ -204,6 +245,7 @@ def cmd_stress(args: argparse.Namespace) -> int:
 def cmd_study(args: argparse.Namespace) -> int:
     from cardan_exudyn.studies import main_study
 
+    _out_folder(args.out)
     return main_study(args.kind, args.out, args.quick, args.json)
 
 
@@ -211,7 +253,12 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from cardan_exudyn.calibrate import main_calibrate
     from reference.paper import CALIBRATION_PARAMETERS
 
-    names = [n.strip() for n in args.parameters.split(",") if n.strip()] if args.parameters else None
+    names = None
+    if args.parameters is not None:
+        names = [n.strip() for n in args.parameters.split(",") if n.strip()]
+    if names == []:
+        raise BadInput(f"--parameters names no parameter, got {args.parameters!r}; choose from "
+                       f"{list(CALIBRATION_PARAMETERS)}")
     unknown = [n for n in names or [] if n not in CALIBRATION_PARAMETERS]
     if unknown:
         raise BadInput(f"--parameters: unknown {unknown}; choose from {list(CALIBRATION_PARAMETERS)}")
@@ -222,6 +269,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from cardan_exudyn.compare import main_compare
 
     engines = [e.strip() for e in args.engines.split(",") if e.strip()]
+    _out_folder(args.out)
     try:
         return main_compare(scene_from_args(args), engines, args.skip_revolutions, args.out,
                             args.json)
@@ -241,14 +289,14 @@ def cmd_scene(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _count(name: str):
+def _count(name: str, minimum: int = 1):
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected an integer ({name}), got {text!r}") from None
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"must be >= 1 ({name}), got {text!r}")
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be >= {minimum} ({name}), got {text!r}")
         return value
 
     return parse
@@ -305,6 +353,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from cardan_exudyn.io import dumps
     from cardan_exudyn.sweep import SweepError, SweepIncomplete, run_sweep
 
+    _out_folder(args.out, replace=False)
     try:
         spec = sweep_spec_from_args(args)
         summary = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler,
@@ -347,6 +396,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
     from cardan_exudyn.io import dumps
     from cardan_exudyn.sweep import SweepError
 
+    _out_folder(args.out, replace=args.study == "paper")
     if args.study == "paper":
         engines = [e.strip() for e in args.engines.split(",") if e.strip()]
         unknown = [e for e in engines if e not in ENGINES]
@@ -357,14 +407,16 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
         def show(row: dict) -> None:
             if not args.json:
                 print(f"  {row['parameters']:10s} {row['coupling']:9s} {row['engine']:9s} "
-                      f"{row['status_errors']:12s} change {row['relative_change']:+.3%}", file=sys.stderr)
+                      f"{row['status_errors']:12s} change {_fmt(row['relative_change'], '+.3%')}",
+                      file=sys.stderr)
 
         summary = paper_report(args.out, engines, progress=show)
         if args.json:
             print(dumps(summary))
         else:
             print(f"wrote {args.out}/report.md", file=sys.stderr)
-        return EXIT_OK
+        failed = [c for c in summary["cases"] if "ok" != c["status_ideal"] or "ok" != c["status_errors"]]
+        return EXIT_FAILED if failed else EXIT_OK
     from cardan_exudyn.tolerance import default_distributions, monte_carlo
 
     scene = scene_from_args(args)
@@ -379,14 +431,17 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
         print(dumps(summary))
     else:
         m = summary["mean_efficiency"]
-        print(f"{summary['status_counts']}; ideal {summary['ideal_mean_efficiency']:.6f}; "
-              f"p5/p50/p95 {m.get('p5', float('nan')):.6f} / {m.get('p50', float('nan')):.6f} / "
-              f"{m.get('p95', float('nan')):.6f}; wrote {args.out}/study/report.md", file=sys.stderr)
-    return EXIT_OK if summary["status_counts"].get("ok", 0) == summary["samples"] else EXIT_FAILED
+        ideal = (_fmt(summary["ideal_mean_efficiency"], ".6f") if summary["ideal_status"] == "ok"
+                 else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}")
+        print(f"{summary['status_counts']}; ideal {ideal}; "
+              f"p5/p50/p95 {_fmt(m.get('p5'), '.6f')} / {_fmt(m.get('p50'), '.6f')} / "
+              f"{_fmt(m.get('p95'), '.6f')}; wrote {args.out}/study/report.md", file=sys.stderr)
+    every_ok = summary["status_counts"].get("ok", 0) == summary["samples"] and summary["ideal_status"] == "ok"
+    return EXIT_OK if every_ok else EXIT_FAILED
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="cardan", description="Mechanical efficiency of Cardan joints with Exudyn.")
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -507,7 +562,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--engines", default="reference,exudyn", help="paper: engines to compare")
     p.add_argument("--engine", default="reference", help="montecarlo: engine (default reference)")
     p.add_argument("--samples", type=_count("--samples"), default=1000, help="montecarlo: N (1000)")
-    p.add_argument("--seed", type=int, default=1, help="montecarlo: seed of the draws (1)")
+    p.add_argument("--seed", type=_count("--seed", minimum=0), default=1,
+                   help="montecarlo: seed of the draws (1)")
     p.add_argument("--method", choices=("lhs", "random"), default="lhs",
                    help="montecarlo: Latin hypercube (default) or independent draws")
     p.add_argument("--error", action="append", metavar="PATH=DIST:...",
@@ -542,10 +598,11 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     from cardan_exudyn.engines import EngineUnavailable
+    from cardan_exudyn.io import OutputError
 
     try:
         return args.func(args)
-    except (SceneError, EngineUnavailable, BadInput) as exc:
+    except (SceneError, EngineUnavailable, BadInput, OutputError) as exc:
         print(f"cardan {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:

@@ -35,6 +35,11 @@ SUMMARY_KEYS = ("mean_efficiency", "mean_instantaneous_efficiency", "work_ratio"
 COMPARED = [c for c in table_columns() if c != "t"]
 
 
+def _finite(value: Any) -> bool:
+    """A finite number (not a bool)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 def _run(engine: str, scene: Scene) -> tuple[Any, float]:
     start = time.perf_counter()
     try:
@@ -110,6 +115,8 @@ def compare(scene: Scene, engines: list[str], skip_revolutions: float = 0.0,
         raise ValueError(f"`--engines` lists an engine twice: {engines!r}")
     if skip_revolutions < 0 or not math.isfinite(skip_revolutions):
         raise ValueError(f"`skip_revolutions` must be >= 0, got {skip_revolutions!r}")
+    for engine in engines:  # every name known before the first engine runs
+        get_engine(engine)
     scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
     results, tables = {}, {}
     base_dt = None
@@ -138,9 +145,9 @@ def compare(scene: Scene, engines: list[str], skip_revolutions: float = 0.0,
             if tables[engine] is None:
                 continue
             joined, how = join_on_input_angle(base, tables[engine])
+            both_ok = results[engine]["status"] == results[base_name]["status"] == "ok"
             means = {k: results[engine][k] - results[base_name][k] for k in SUMMARY_KEYS
-                     if isinstance(results[engine].get(k), float)
-                     and isinstance(results[base_name].get(k), float)}
+                     if both_ok and _finite(results[engine].get(k)) and _finite(results[base_name].get(k))}
             differences[engine] = {"against": base_name, "join": how, "means": means,
                                    "all": column_differences(base, joined, np.ones_like(steady)),
                                    "steady": column_differences(base, joined, steady)}
@@ -155,10 +162,13 @@ def report_markdown(comparison: dict[str, Any]) -> str:
              "|---|---|---|---|---|---|---|"]
     for name, r in comparison["engines"].items():
         def fmt(v: Any, spec: str) -> str:
-            return format(v, spec) if isinstance(v, (int, float)) else "-"
+            return format(v, spec) if _finite(v) else "-"
+
+        ok = r["status"] == "ok"  # a failed run has no efficiency to show
         lines.append(f"| {name} {r.get('engine_version') or ''} | {r['status']} "
                      f"{r['reason'][:60] if r['reason'] else ''} | "
-                     f"{fmt(r.get('mean_efficiency'), '.8f')} | {fmt(r.get('work_ratio'), '.8f')} | "
+                     f"{fmt(r.get('mean_efficiency') if ok else None, '.8f')} | "
+                     f"{fmt(r.get('work_ratio') if ok else None, '.8f')} | "
                      f"{fmt(r.get('dt'), '.3g')} | {fmt(r.get('steps'), 'd')} | "
                      f"{fmt(r['wall_time_s'], '.3f')} |")
     for engine, d in comparison["differences"].items():

@@ -34,6 +34,7 @@ from reference.scene import (
     AngleDrive,
     Scene,
     SceneError,
+    check_steps,
     scene_to_dict,
 )
 from reference.schema import (
@@ -176,6 +177,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
                              "wall_time_s": time.perf_counter() - wall_start})
     t_end = end_time(scene, model.start_time)
     span = t_end - model.start_time
+    check_steps(span / dt, f"{scene.revolutions:g} revolutions at dt = {dt:.3g} s")
     dt = span / steps_for_span(span, dt)  # whole steps end exactly at the span's end
     settings = simulation_settings(dt, model.start_time, t_end, options)
     target = 2.0 * math.pi * scene.revolutions

@@ -21,6 +21,11 @@ import numpy as np
 from reference.schema import Result
 
 
+class OutputError(ValueError):
+    """An output path cannot be written as asked (it exists and is not a folder, or its parent
+    cannot hold it); raised before anything is written. The CLI prints it, exit status 2."""
+
+
 def to_jsonable(value: Any) -> Any:
     """Plain JSON data: numpy scalars and arrays converted, NaN and infinities as null."""
     if isinstance(value, dict):
@@ -44,22 +49,51 @@ def atomic_write(path: str | os.PathLike, write: Any) -> None:
     which is flushed, fsync'ed and renamed onto ``path``."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as f:
-        write(f)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:  # no half-written temporary file left behind
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
 
 
 def dumps(data: Any) -> str:
     return json.dumps(to_jsonable(data), indent=2, allow_nan=False)
 
 
+def check_output_folder(target: str | os.PathLike, replace: bool = True) -> Path:
+    """``target`` as a folder a command may create (and, with ``replace``, replace as a whole): it
+    is a folder or does not exist, and its nearest existing parent is a folder; raises
+    :class:`OutputError` otherwise."""
+    target = Path(target)
+    if replace and target.name in ("", ".", ".."):  # "", ".", "/", "..": a folder above the output's own
+        raise OutputError(f"{str(target)!r} names no folder of its own (the current folder, a parent "
+                          "or the root would be replaced)")
+    if target.exists() and not target.is_dir():
+        raise OutputError(f"{str(target)!r} exists and is not a folder")
+    parent = target.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise OutputError(f"cannot create {str(target)!r}: {str(parent)!r} is not a folder")
+    return target
+
+
 @contextlib.contextmanager
 def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
-    """Yield a temporary folder that replaces ``target`` only when the block succeeds."""
-    target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    """Yield a temporary folder that replaces ``target`` only when the block succeeds.
+
+    Raises :class:`OutputError` before the block runs when ``target`` exists and is not a folder
+    (a file is never replaced by a folder) or its parent cannot be created."""
+    target = check_output_folder(target)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create the folder of {str(target)!r}: {exc.strerror}") from None
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
     try:
         yield tmp
@@ -67,10 +101,16 @@ def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     old = None
-    if target.exists():
-        old = target.with_name(f".{target.name}.old-{os.getpid()}")
-        os.replace(target, old)
-    os.replace(tmp, target)
+    try:
+        if target.exists():
+            old = target.with_name(f".{target.name}.old-{os.getpid()}")
+            os.replace(target, old)
+        os.replace(tmp, target)
+    except BaseException:  # put the previous output back; the new one is dropped
+        if old is not None and not target.exists():
+            os.replace(old, target)
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
 

@@ -158,7 +158,7 @@ def _plot_band(rows: list[dict[str, Any]], path: Path) -> None:
 def _markdown(rows: list[dict[str, Any]], columns: list[str]) -> str:
     def fmt(v: Any) -> str:
         if isinstance(v, float):
-            return "nan" if math.isnan(v) else f"{v:.6g}"
+            return f"{v:.6g}" if math.isfinite(v) else "-"  # a failed run has no value
         return str(v)
 
     lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]

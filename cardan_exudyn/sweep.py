@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.io import atomic_write, to_jsonable
+from cardan_exudyn.io import OutputError, atomic_write, check_output_folder, to_jsonable
 from reference.scene import Scene, SceneError, replace, scene_to_dict
 
 PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE = "plan.json", "cases.jsonl", "results.csv", "sweep.json"
@@ -489,6 +489,9 @@ def read_spec_file(path: str | os.PathLike) -> dict[str, Any]:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise SweepError(f"cannot read sweep spec {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise SweepError(f"sweep spec {str(path)!r} is not UTF-8 text (byte {exc.start}); a spec is a "
+                         "TOML file") from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -940,8 +943,10 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
         raise SweepError(f"`workers` must be an integer >= 1, got {workers!r}")
     plan = make_plan(spec)
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise SweepError(f"--out {str(out)!r} exists and is not a folder")
+    try:
+        check_output_folder(out, replace=False)
+    except OutputError as exc:
+        raise SweepError(f"--out {exc}") from None
     if not restart:
         _existing_records(out, plan)
     client = connect(scheduler) if scheduler is not None else None

@@ -198,7 +198,8 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
     ideal = run_scene(ideal_scene, engine).summary
     table = pd.read_csv(out / "cases" / "results.csv")
     ok = table["status"] == "ok"
-    eta = table.loc[ok, "mean_efficiency"].to_numpy(float)
+    # no column when no case ran to status ok
+    eta = table.loc[ok, "mean_efficiency"].to_numpy(float) if "mean_efficiency" in table else np.zeros(0)
     eta0 = ideal.get("mean_efficiency", float("nan"))
     levels = (1, 5, 25, 50, 75, 95, 99)
     params = list(distributions)
@@ -207,11 +208,13 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
         "scene": scene.name, "engine": engine, "samples": int(samples), "seed": int(seed),
         "method": method, "distributions": distributions,
         "status_counts": {str(k): int(v) for k, v in table["status"].value_counts().items()},
-        "ideal_status": ideal["status"], "ideal_mean_efficiency": eta0,
+        "ideal_status": ideal["status"], "ideal_reason": ideal.get("reason", ""),
+        "ideal_mean_efficiency": eta0,
         "mean_efficiency": {"mean": float(eta.mean()), "std": float(eta.std(ddof=1)) if eta.size > 1 else 0.0,
                             "min": float(eta.min()), "max": float(eta.max()),
                             **{f"p{q}": float(np.percentile(eta, q)) for q in levels}} if eta.size else {},
-        "change": {f"p{q}": float(np.percentile(eta - eta0, q)) for q in levels} if eta.size else {},
+        "change": ({f"p{q}": float(np.percentile(eta - eta0, q)) for q in levels}
+                   if eta.size and math.isfinite(eta0) else {}),
         "sensitivity": sens.to_dict(orient="records"),
         "sweep_wall_time_s": sweep["wall_time_s"], "run_now": sweep["run_now"],
         "executor": sweep.get("executor"),
@@ -232,9 +235,9 @@ def _plots(folder: Path, table, params: Sequence[str], eta0: float) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    eta = table["mean_efficiency"].to_numpy(float)
-    if eta.size == 0:
+    if "mean_efficiency" not in table or table.empty:
         return
+    eta = table["mean_efficiency"].to_numpy(float)
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.hist(eta, bins=max(10, int(math.sqrt(eta.size))), color="0.6")
     ax.axvline(eta0, color="k", ls="--", label=f"ideal joint {eta0:.5f}")
@@ -263,12 +266,15 @@ def _report(summary: Mapping[str, Any], sens) -> str:
     m, c = summary["mean_efficiency"], summary["change"]
     lines = [f"# Monte Carlo tolerance study: {summary['scene']} ({summary['engine']})", "",
              f"{summary['samples']} samples ({summary['method']}, seed {summary['seed']}); "
-             f"statuses {summary['status_counts']}; ideal joint {summary['ideal_mean_efficiency']:.6f}.",
+             f"statuses {summary['status_counts']}; ideal joint "
+             + (f"{summary['ideal_mean_efficiency']:.6f}." if summary["ideal_status"] == "ok"
+                else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}."),
              "", "| parameter | distribution |", "|---|---|"]
     lines += [f"| `{p}` | {d} |" for p, d in summary["distributions"].items()]
     if m:
         lines += ["", "| statistic | mean efficiency | change from ideal |", "|---|---|---|"]
-        lines += [f"| p{q} | {m[f'p{q}']:.6f} | {c[f'p{q}']:+.3e} |" for q in (1, 5, 25, 50, 75, 95, 99)]
+        lines += [f"| p{q} | {m[f'p{q}']:.6f} | "
+                  + (f"{c[f'p{q}']:+.3e} |" if c else "- |") for q in (1, 5, 25, 50, 75, 95, 99)]
         lines += [f"| mean / std | {m['mean']:.6f} / {m['std']:.2e} | |"]
     if len(sens):
         lines += ["", "| parameter | Spearman rho | rho with magnitude | correlation ratio |",

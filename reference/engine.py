@@ -34,7 +34,15 @@ from reference.dynamics import (
 )
 from reference.joint_motion import joint_motion
 from reference.rccc import LoopClosureError
-from reference.scene import PAIR_NAMES, AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
+from reference.scene import (
+    PAIR_NAMES,
+    AngleDrive,
+    Scene,
+    SpeedDrive,
+    TorqueDrive,
+    check_steps,
+    scene_to_dict,
+)
 from reference.schema import (
     STATUS_NO_CLOSURE,
     STATUS_OK,
@@ -289,9 +297,13 @@ def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.
     return np.concatenate(lo), np.concatenate(hi)
 
 
+GROSS_SCALE = 1e-3
+MAX_OPEN_PANELS = 20_000
+
+
 def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
                    nodes: int, rtol: float, scale_key: int = 0,
-                   max_rounds: int = 40) -> tuple[np.ndarray, dict]:
+                   max_rounds: int = 40, scale_floor: float = 0.0) -> tuple[np.ndarray, dict]:
     """Integrals of a vector integrand over the union of panels ``[a, b]``, adaptively.
 
     Every open panel is integrated with the ``nodes``-point Gauss-Legendre rule as a whole and
@@ -299,6 +311,10 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
     total width`` in every component (the halves' value is kept), otherwise it is split and its
     halves are the next round's panels, whose whole-panel values are already known. All open
     panels of a round are evaluated in one call; the integrand maps times (m,) to values (m, k).
+    The scale is at least ``GROSS_SCALE`` times the integral of ``|I[scale_key]|`` and at least
+    ``scale_floor`` (so that an integral that cancels or vanishes, e.g. the input work of a joint
+    with no load and no loss, does not ask for rounding-level accuracy), and at most
+    ``MAX_OPEN_PANELS`` panels stay open.
 
     Returns
     -------
@@ -318,7 +334,9 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
     total_width = float(np.sum(b - a))
     whole = gauss(a, b)
     evaluations = a.size * nodes
-    scale = max(abs(float(np.sum(whole[:, scale_key]))), np.finfo(float).tiny)
+    gross = float(np.sum(np.abs(whole[:, scale_key])))
+    scale = max(abs(float(np.sum(whole[:, scale_key]))), GROSS_SCALE * gross, scale_floor,
+                np.finfo(float).tiny)
     result, error, closed = np.zeros(whole.shape[1]), np.zeros(whole.shape[1]), 0
     for rounds in range(1, max_rounds + 1):
         mid = 0.5 * (a + b)
@@ -330,7 +348,7 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
         # a non-finite panel (NaN from a locked or failed sample) cannot converge: close it and
         # let the NaN reach the result instead of splitting it every round (2^rounds panels)
         done = (np.all(diff <= allowed[:, None], -1) | (rounds == max_rounds)
-                | ~np.all(np.isfinite(left + right), -1))
+                | (2 * a.size > MAX_OPEN_PANELS) | ~np.all(np.isfinite(left + right), -1))
         result += (left + right)[done].sum(0)
         error += diff[done].sum(0)
         closed += int(np.count_nonzero(done))
@@ -395,10 +413,12 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
         cols = columns_at(scene, motion, times)
         return np.stack([np.asarray(cols[k], float) for k in keys], -1)
 
-    with np.errstate(invalid="ignore"):
-        values, info = adaptive_gauss(integrand, lo, hi, options.gauss_nodes,
-                                      options.quadrature_rtol)
     ends = columns_at(scene, motion, np.array([t_a, t_b]))
+    # work below a thousandth of the mechanical energy is at the scale's floor (zero input work)
+    energy_scale = float(np.max(np.abs(ends["energy_kinetic"])) + np.max(np.abs(ends["energy_potential"])))
+    with np.errstate(invalid="ignore"):
+        values, info = adaptive_gauss(integrand, lo, hi, options.gauss_nodes, options.quadrature_rtol,
+                                      scale_floor=GROSS_SCALE * energy_scale)
     work = dict(zip(keys, (repeats * values).tolist(), strict=True))
     out = {"input_work": work["power_in"], "output_work": work["power_out"],
            "loss_work": work["power_loss"]}
@@ -429,10 +449,14 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
 def _table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
     span = motion.t_end - motion.t0
     if options.samples_per_revolution is None and scene.numerics.dt is not None:
+        check_steps(span / scene.numerics.dt,
+                    f"{scene.revolutions:g} revolutions at dt = {scene.numerics.dt:.3g} s")
         steps = max(1, math.ceil(span / scene.numerics.dt - 1e-9))  # as the Exudyn engine
     else:
         spr = options.samples_per_revolution or 360
         theta_a, theta_b = motion.angle(motion.t0), motion.angle(motion.t_end)
+        check_steps(abs(theta_b - theta_a) / (2.0 * math.pi) * spr,
+                    f"{scene.revolutions:g} revolutions at {spr} samples per revolution")
         steps = max(1, round(abs(theta_b - theta_a) / (2.0 * math.pi) * spr))
     return np.linspace(motion.t0, motion.t_end, steps + 1)
 
@@ -461,6 +485,10 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
 
 
 def _run(scene: Scene, options: ReferenceOptions, start: float) -> Result:
+    if scene.drive.kind == "torque":  # the ODE's cost grows with the revolutions: refuse first
+        spr = options.samples_per_revolution or 360
+        check_steps(scene.revolutions * spr,
+                    f"{scene.revolutions:g} revolutions at {spr} samples per revolution")
     motion = input_motion(scene, options)
     summary = {"status": motion.status, "reason": motion.reason, "engine": ENGINE_NAME,
                "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),

@@ -101,7 +101,18 @@ def _vector(name: str, value: Any, shape: tuple[int, ...]) -> tuple:
         raise SceneError(f"`{name}` must have shape {shape}, got shape {arr.shape}: {value!r}")
     if not np.all(np.isfinite(arr)):
         raise SceneError(f"`{name}` must be finite, got {value!r}")
-    return tuple(map(tuple, arr)) if arr.ndim == 2 else tuple(arr.tolist())
+    return tuple(map(tuple, arr.tolist())) if arr.ndim == 2 else tuple(arr.tolist())  # Python floats
+
+
+def _float_array(name: str, value: Any) -> np.ndarray | None:
+    """A sequence as a float array (None when ``value`` is not a sequence); a sample that is not
+    a number is a :class:`SceneError` naming ``name``."""
+    if not _is_seq(value):
+        return None
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise SceneError(f"{name} must be numbers, got {value!r}") from None
 
 
 def _set(obj: Any, name: str, value: Any) -> None:
@@ -356,8 +367,8 @@ class AngleDrive:
     kind: str = field(default="angle", init=False)
 
     def __post_init__(self) -> None:
-        t = np.asarray(self.time, dtype=float) if _is_seq(self.time) else None
-        a = np.asarray(self.angle, dtype=float) if _is_seq(self.angle) else None
+        t = _float_array("`time`", self.time)
+        a = _float_array("`angle`", self.angle)
         if t is None or t.ndim != 1 or t.size < 4:
             raise SceneError(f"`time` must be a sequence of at least 4 numbers, got {self.time!r}")
         if a is None or a.shape != t.shape:
@@ -369,7 +380,8 @@ class AngleDrive:
             raise SceneError("`time` and `angle` must be finite")
         if np.any(np.diff(t) <= 0):
             i = int(np.argmax(np.diff(t) <= 0))
-            raise SceneError(f"`time` must be strictly increasing, got {t[i]!r} then {t[i + 1]!r}")
+            raise SceneError(f"`time` must be strictly increasing, got {float(t[i])!r} "
+                             f"then {float(t[i + 1])!r}")
         _set(self, "time", tuple(t.tolist()))
         _set(self, "angle", tuple(a.tolist()))
 
@@ -460,8 +472,8 @@ class Load:
                 raise SceneError("a torque history (`torque` as a list) needs `time`, one per value")
             _set(self, "torque", _finite("torque", self.torque))
             return
-        t = np.asarray(self.time, dtype=float) if _is_seq(self.time) else None
-        v = np.asarray(self.torque, dtype=float) if _is_seq(self.torque) else None
+        t = _float_array("load `time`", self.time)
+        v = _float_array("load `torque`", self.torque)
         if t is None or t.ndim != 1 or t.size < 2:
             raise SceneError(f"load `time` must be a sequence of at least 2 numbers, got {self.time!r}")
         if v is None or v.shape != t.shape:
@@ -471,7 +483,8 @@ class Load:
             raise SceneError("load `time` and `torque` must be finite")
         if np.any(np.diff(t) <= 0):
             i = int(np.argmax(np.diff(t) <= 0))
-            raise SceneError(f"load `time` must be strictly increasing, got {t[i]!r} then {t[i + 1]!r}")
+            raise SceneError(f"load `time` must be strictly increasing, got {float(t[i])!r} "
+                             f"then {float(t[i + 1])!r}")
         _set(self, "time", tuple(t.tolist()))
         _set(self, "torque", tuple(v.tolist()))
 
@@ -523,6 +536,19 @@ class Numerics:
         if acc >= 1.0:
             raise SceneError(f"`accuracy` must be < 1, got {acc!r}")
         _set(self, "accuracy", acc)
+
+
+MAX_STEPS = 10_000_000
+"""Most time steps (or table rows) one run may take. More is refused as bad input by every engine
+before it starts: e.g. ``dt = 1e-12`` s would take days and more memory than a machine has."""
+
+
+def check_steps(steps: float, what: str) -> None:
+    """Raise :class:`SceneError` when ``steps`` (any number, inf and NaN included) exceeds
+    :data:`MAX_STEPS`; ``what`` says what needs them (e.g. "2 revolutions at dt = 1e-12 s")."""
+    if not steps <= MAX_STEPS:
+        raise SceneError(f"{what} needs {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed: give a "
+                         "larger `numerics.dt` (or `numerics.accuracy`) or fewer `revolutions`")
 
 
 COUPLINGS = ("converged", "lagged", "uncoupled")
@@ -626,6 +652,9 @@ class Scene:
     def __post_init__(self) -> None:
         if not isinstance(self.drive, (SpeedDrive, AngleDrive, TorqueDrive)):
             raise SceneError(f"`drive` must be a speed, angle or torque drive, got {self.drive!r}")
+        for name in ("name", "description"):
+            if not isinstance(getattr(self, name), str):
+                raise SceneError(f"`{name}` must be a string, got {getattr(self, name)!r}")
         _set(self, "gravity", _vector("gravity", self.gravity, (3,)))
         revs = _positive("revolutions", self.revolutions)
         if revs < 1.0 + self.record.skip_revolutions:
@@ -665,19 +694,19 @@ _SECTIONS: dict[type, dict[str, Any]] = {
 
 def _build(cls: type, data: Mapping[str, Any], path: str):
     if not isinstance(data, Mapping):
-        raise SceneError(f"[{path}] must be a table, got {data!r}")
+        raise SceneError(f"[{path or 'scene'}] must be a table, got {data!r}")
     data = dict(data)
     names = {f.name for f in dataclasses.fields(cls) if f.init}
     for key in list(data):
         for base, (suffix, factor) in _UNIT_ALIASES.items():
             if key == base + suffix and base in names:
                 if base in data:
-                    raise SceneError(f"[{path}] give either `{base}` or `{key}`, not both")
+                    raise SceneError(f"[{path or 'scene'}] give either `{base}` or `{key}`, not both")
                 value = data.pop(key)
                 data[base] = _finite(key, value) * factor if not _is_seq(value) else value
     unknown = sorted(set(data) - names - {"kind"})
     if unknown:
-        raise SceneError(f"[{path}] unknown key(s) {unknown}; allowed: {sorted(names)}")
+        raise SceneError(f"[{path or 'scene'}] unknown key(s) {unknown}; allowed: {sorted(names)}")
     kwargs = {}
     for key, value in data.items():
         if key == "kind":
@@ -689,6 +718,11 @@ def _build(cls: type, data: Mapping[str, Any], path: str):
             kwargs[key] = _build(sub, value, f"{path}.{key}".lstrip("."))
         else:
             kwargs[key] = value
+    missing = sorted(f.name for f in dataclasses.fields(cls) if f.init and f.name not in kwargs
+                     and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
+    if missing:
+        raise SceneError(f"[{path or 'scene'}] missing required key(s) {missing}"
+                         + (" (or start from a named scene with `base = \"paper\"`)" if cls is Scene else ""))
     try:
         return cls(**kwargs)
     except SceneError as exc:
@@ -732,7 +766,10 @@ def _merge(base: dict, over: Mapping) -> dict:
         if alias_base + suffix in over:
             out.pop(alias_base, None)  # the override's unit-suffixed value replaces the base's
     for key, value in over.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+        if (key == "drive" and isinstance(value, Mapping) and isinstance(out.get(key), Mapping)
+                and "kind" in value and value["kind"] != out[key].get("kind")):
+            out[key] = dict(value)  # another kind of drive replaces the base's, keys and all
+        elif isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
             out[key] = _merge(out[key], value)
         elif key == "drive" and isinstance(value, Mapping) and "kind" not in value:
             out[key] = _merge(out.get(key, {}), value)
@@ -758,6 +795,9 @@ def load_scene(path) -> Scene:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise SceneError(f"cannot read scene file {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"scene file {str(path)!r} is not UTF-8 text (byte {exc.start}); a scene is a "
+                         "TOML file") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

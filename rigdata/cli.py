@@ -44,12 +44,46 @@ def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
     return out
 
 
+def _seed(text: str) -> int:
+    """A non-negative integer (a seed, a number of draws)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
+    return value
+
+
+def _shaft_angle(text: str) -> float:
+    value = _number("deg", non_negative=True)(text)
+    if value >= 90.0:
+        raise argparse.ArgumentTypeError(f"must be below 90 deg (a joint at 90 deg transmits no motion), "
+                                         f"got {text!r}")
+    return value
+
+
+def _out_folder(path: str) -> None:
+    from cardan_exudyn.io import OutputError, check_output_folder
+
+    try:
+        check_output_folder(path)
+    except OutputError as exc:
+        raise _BadOption(f"--out: {exc}") from None
+
+
 def _read(args: argparse.Namespace):
     from rigdata.readers import read
+    from rigdata.record import RigDataError
 
-    return read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
-                units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
-                pulses_per_rev=args.pulses_per_rev)
+    try:
+        return read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
+                    units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
+                    pulses_per_rev=args.pulses_per_rev)
+    except RigDataError:
+        raise
+    except ValueError as exc:  # read() refuses its arguments (a --map channel, ...) with ValueError
+        raise _BadOption(str(exc)) from None
 
 
 def _transducers(args: argparse.Namespace):
@@ -143,6 +177,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     bad = [e for e in engines if e not in ("reference", "exudyn")]
     if not engines or bad:
         raise _BadOption(f"--engines takes reference and/or exudyn, got {args.engines!r}")
+    _out_folder(args.out)
     scene = _scene(args)
     rec = _read(args)
 
@@ -158,9 +193,13 @@ def cmd_validate(args: argparse.Namespace) -> int:
     else:
         for engine, comp in s["computed"].items():
             cmp = s["comparisons"].get(engine, {})
+            if comp.get("status") != "ok":  # no computed efficiency, no difference
+                print(f"{engine}: status {comp.get('status')}: {comp.get('reason')}; measured "
+                      f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}")
+                continue
             print(f"{engine}: computed {_fmt(comp.get('mean_efficiency'))}, measured "
                   f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}; difference "
-                  f"{cmp.get('difference', float('nan')):.4f}, significant (k=2): "
+                  f"{_fmt(cmp.get('difference'), '.4f')}, significant (k=2): "
                   f"{cmp.get('significant_k2', '-')}")
         print(f"wrote {args.out}/report.md", file=sys.stderr)
     failed = [e for e, c in s["computed"].items() if c["status"] != "ok"]
@@ -168,8 +207,15 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_synthetic(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from rigdata import synthetic
 
+    out = Path(args.out)
+    if out.is_dir():
+        raise _BadOption(f"--out {args.out!r} is a directory; give the name of the file to write")
+    if not out.parent.is_dir():
+        raise _BadOption(f"--out {args.out!r}: the folder {str(out.parent)!r} does not exist")
     exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
     settings = _settings(synthetic.RigSettings, revolutions=args.revolutions, seed=args.seed,
                                      speed_channel=args.speed_channel, **exact)
@@ -197,7 +243,7 @@ def _file_options(p: argparse.ArgumentParser) -> None:
 
 
 def _measure_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--angle", type=_number("deg", non_negative=True), default=15.0,
+    p.add_argument("--angle", type=_shaft_angle, default=15.0,
                    help="shaft angle [deg] (default 15, the paper's rig case)")
     p.add_argument("--cutoff-harmonics", type=_number("-", positive=True), default=10.0,
                    help="low-pass cut-off in input shaft harmonics (default 10)")
@@ -210,9 +256,9 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
                    help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
     p.add_argument("--zero-drift", type=_number("N m", non_negative=True), default=0.01,
                    help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
-    p.add_argument("--mc", type=int, default=2000,
+    p.add_argument("--mc", type=_seed, default=2000,
                    help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the Monte Carlo draws")
+    p.add_argument("--seed", type=_seed, default=0, help="seed of the Monte Carlo draws")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -243,7 +289,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     q.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
     q.add_argument("--revolutions", type=_number("rev", positive=True), default=5.0)
     q.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
-    q.add_argument("--seed", type=int, default=1, help="seed of the drawn transducer errors and noise")
+    q.add_argument("--seed", type=_seed, default=1, help="seed of the drawn transducer errors and noise")
     q.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
     q.add_argument("--json", action="store_true", help="print the settings used as JSON")
     q.set_defaults(func=_guarded(cmd_synthetic))
@@ -252,12 +298,13 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _guarded(func):
     """Bad input of any kind -> one line on stderr, exit 2, no traceback."""
     def run(args: argparse.Namespace) -> int:
+        from cardan_exudyn.io import OutputError
         from reference.scene import SceneError
         from rigdata.record import RigDataError
 
         try:
             return func(args)
-        except (RigDataError, SceneError, _BadOption, _SettingsError, FileNotFoundError,
+        except (RigDataError, SceneError, _BadOption, _SettingsError, OutputError, FileNotFoundError,
                 IsADirectoryError, PermissionError) as exc:
             print(f"cardan rig {args.rig_command}: error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
@@ -266,5 +313,7 @@ def _guarded(func):
 
 
 
-def _fmt(x) -> str:
-    return f"{x:.6f}" if isinstance(x, (int, float)) else str(x)
+def _fmt(x, spec: str = ".6f") -> str:
+    """A finite number formatted, anything else as '-' (never 'nan')."""
+    finite = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    return format(x, spec) if finite else "-"

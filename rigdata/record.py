@@ -97,8 +97,8 @@ class RigRecord:
         dt = np.diff(t)
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0))
-            raise RigDataError(f"time does not increase at sample {i + 1} ({t[i]!r} then {t[i + 1]!r})",
-                               file=file, channel="time")
+            raise RigDataError(f"time does not increase at sample {i + 1} ({float(t[i])!r} then "
+                               f"{float(t[i + 1])!r})", file=file, channel="time")
         step = float(np.median(dt))
         spread = float(np.max(np.abs(dt - step)) / step)
         if spread > RATE_TOLERANCE:

@@ -90,6 +90,14 @@ class RigSettings:
         if self.revolutions < 1.6:
             raise ValueError(f"`revolutions` must be >= 1.6 (one whole revolution after settling), "
                              f"got {self.revolutions!r}")
+        samples = self.revolutions * 2.0 * math.pi / self.speed * self.rate
+        if samples > MAX_SAMPLES:
+            raise ValueError(f"{self.revolutions:g} revolutions at {self.speed:g} rad/s and {self.rate:g} Hz "
+                             f"are {samples:.3g} samples; at most {MAX_SAMPLES:.0e} are written")
+
+
+#: Most samples a synthetic record may have (the model is evaluated at every one of them).
+MAX_SAMPLES = 1_000_000
 
 
 @dataclass(frozen=True)

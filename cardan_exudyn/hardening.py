@@ -1,0 +1,790 @@
+"""Bad input at every entry point: a data-driven list of cases and a runner (issue 8).
+
+Every entry point must reject bad input with one clear line naming what is wrong: the ``cardan``
+command line (every subcommand, ``cardan rig ...`` included) exits with status 2, one line on
+stderr, nothing on stdout, no traceback, and leaves an output folder it was given as it was; the
+Python API raises a documented exception (:class:`~reference.scene.SceneError`,
+:class:`~cardan_exudyn.sweep.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
+:class:`~cardan_exudyn.io.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
+one-line message. A run that fails is not bad input: it exits with status 3 and a status line
+with its reason, and prints no NaN or infinite efficiency (nor does a run with no input work,
+whose efficiency is 0/0: it says "undefined").
+
+:data:`CASES` lists the cases (scene files, command-line options, Python API calls, rig files,
+sweep specifications, run failures); :func:`run_cases` runs each in a fresh folder, the command
+line in this process through :func:`cardan_exudyn.cli.main`, and returns one row per case;
+:func:`markdown` turns the rows into a report table. Every case is fast (no long simulation).
+
+``cardan rig`` is a plugin: this module reaches it only through ``cli.main(["rig", ...])``, never
+by importing ``rigdata`` (imports point one way); cases of ``rigdata``'s own Python API can be
+added by the caller (``run_cases(folder, CASES + more)``, as ``tests/test_hardening.py`` does).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import os
+import re
+import shutil
+import time
+import traceback
+import warnings
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from cardan_exudyn.engines import EngineUnavailable
+from cardan_exudyn.io import OutputError
+from cardan_exudyn.sweep import SweepError
+from reference.scene import SceneError
+
+#: Entry points, in the order of the report.
+ENTRY_POINTS = ("scene file", "cli", "python api", "rig file", "sweep spec", "run failure")
+#: Content of ``Case.files`` that makes a folder instead of a file.
+DIRECTORY = object()
+#: What an output folder (or file) given to a command holds before the command runs.
+MARKER = "previous output\n"
+#: Non-finite numbers as a command would print them (``nan``, ``inf``, ``-inf``, ``infinity``).
+_NON_FINITE = re.compile(r"(?<![\w.])[-+]?(nan|inf|infinity)(?![\w])", re.IGNORECASE)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One bad input and what must happen.
+
+    Attributes
+    ----------
+    id : str
+        Short unique name, also the case's folder.
+    entry : str
+        One of :data:`ENTRY_POINTS`.
+    description : str
+        What is wrong with the input, in words.
+    argv : tuple of str
+        ``cardan`` arguments (run through :func:`cardan_exudyn.cli.main`); ``{d}`` is replaced by
+        the case folder, ``{out}`` by the output given to the command.
+    call : callable, optional
+        Python API case instead of ``argv``: ``call(folder)`` must raise ``expect``.
+    files : mapping of str to str, bytes or DIRECTORY
+        Files the case creates in its folder first.
+    out : {"folder", "file"} or None
+        The command is given ``{out}``: an existing folder holding ``marker.txt`` (or a file)
+        with :data:`MARKER`, which must be left exactly as it was, with no temporary sibling.
+    expect : int or exception type
+        Exit status of the command line (2 bad input, 3 failed run, 0 a run that must print no
+        non-finite number), or the exception type the call must raise.
+    match : str
+        Key word(s) the message must contain (case-insensitive).
+    """
+
+    id: str
+    entry: str
+    description: str
+    argv: tuple[str, ...] = ()
+    call: Callable[[Path], Any] | None = None
+    files: Mapping[str, Any] = field(default_factory=dict)
+    out: str | None = None
+    expect: Any = 2
+    match: str = ""
+
+    def __post_init__(self) -> None:
+        if self.entry not in ENTRY_POINTS:
+            raise ValueError(f"case {self.id}: `entry` must be one of {ENTRY_POINTS}, got {self.entry!r}")
+        if (self.call is None) == (not self.argv):
+            raise ValueError(f"case {self.id}: give either `argv` or `call`")
+        if self.out not in (None, "folder", "file"):
+            raise ValueError(f"case {self.id}: `out` must be 'folder', 'file' or None, got {self.out!r}")
+
+    @property
+    def input(self) -> str:
+        """The input as the report shows it."""
+        if self.argv:
+            return "cardan " + " ".join(a.replace("{d}/", "").replace("{out}", "OUT") for a in self.argv)
+        return self.call.__doc__.strip().splitlines()[0] if self.call.__doc__ else self.call.__name__
+
+
+# ------------------------------------------------------------------------------------ inputs
+
+_PAPER = 'base = "paper"\n'
+_PAPER_FRICTIONLESS = 'base = "paper-frictionless"\n'
+RIG_HEADER = "time [s],torque_in [N m],torque_out [N m],speed_in [rad/s],speed_out [rad/s]\n"
+
+
+def _rig_csv(rows: int = 150, dt: float = 0.01, header: str = RIG_HEADER,
+             row: Callable[[int, float], str] | None = None, end: str = "\n") -> str:
+    """A small rig CSV at 6 rad/s (1.5 s: 1.4 input revolutions); ``row(k, t)`` overrides a line."""
+    lines = [row(k, k * dt) if row is not None else f"{k * dt:.4f},0.2,0.19,6,6" for k in range(rows)]
+    return header + "\n".join(lines) + end
+
+
+def _mixed_rate(k: int, t: float) -> str:
+    t = k * 0.01 if k < 75 else 0.75 + (k - 75) * 0.02
+    return f"{t:.4f},0.2,0.19,6,6"
+
+
+def _scene_toml(text: str) -> dict[str, str]:
+    return {"scene.toml": text}
+
+
+def _spec(text: str) -> dict[str, str]:
+    return {"spec.toml": text}
+
+
+_SWEEP = ("sweep", "{d}/spec.toml", "--out", "{out}", "--workers", "1", "--quiet")
+_RIG_FILE = {"rig.csv": _rig_csv()}
+
+
+# ----------------------------------------------------------------------------- API callables
+
+
+def _api_load_missing(d: Path) -> Any:
+    """reference.scene.load_scene("missing.toml")"""
+    from reference.scene import load_scene
+
+    return load_scene(d / "missing.toml")
+
+
+def _api_empty_dict(d: Path) -> Any:
+    """reference.scene.scene_from_dict({})"""
+    from reference.scene import scene_from_dict
+
+    return scene_from_dict({})
+
+
+def _api_replace_nan(d: Path) -> Any:
+    """replace(scene, **{"joint.geometry.shaft_angle": nan})"""
+    from reference.paper import named_scene
+    from reference.scene import replace
+
+    return replace(named_scene("paper"), **{"joint.geometry.shaft_angle": math.nan})
+
+
+def _api_replace_unknown(d: Path) -> Any:
+    """replace(scene, **{"joint.nope.x": 1})"""
+    from reference.paper import named_scene
+    from reference.scene import replace
+
+    return replace(named_scene("paper"), **{"joint.nope.x": 1})
+
+
+def _api_body_unphysical(d: Path) -> Any:
+    """Body(1.0, diag(1, 1, 5)): violates the triangle inequality of inertia"""
+    from reference.scene import Body
+
+    return Body(1.0, [[1, 0, 0], [0, 1, 0], [0, 0, 5]])
+
+
+def _api_load_text(d: Path) -> Any:
+    """Load(torque=[1, "a"], time=[0, 1])"""
+    from reference.scene import Load
+
+    return Load(torque=[1.0, "a"], time=[0.0, 1.0])
+
+
+def _api_named_unknown(d: Path) -> Any:
+    """reference.paper.named_scene("nope")"""
+    from reference.paper import named_scene
+
+    return named_scene("nope")
+
+
+def _api_engine_unknown(d: Path) -> Any:
+    """cardan_exudyn.engines.get_engine("warp")"""
+    from cardan_exudyn.engines import get_engine
+
+    return get_engine("warp")
+
+
+def _api_tiny_step(d: Path) -> Any:
+    """run_scene(paper-frictionless with numerics.dt = 1e-12, "reference")"""
+    from cardan_exudyn.engines import run_scene
+    from reference.paper import named_scene
+    from reference.scene import replace
+
+    return run_scene(replace(named_scene("paper-frictionless"), **{"numerics.dt": 1e-12}), "reference")
+
+
+def _api_compare_unknown(d: Path) -> Any:
+    """compare(scene, ["exudyn", "warp"]): refused before any engine runs"""
+    from cardan_exudyn.compare import compare
+    from reference.paper import named_scene
+
+    return compare(named_scene("paper-frictionless"), ["exudyn", "warp"])
+
+
+def _api_spec_empty_grid(d: Path) -> Any:
+    """spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})"""
+    from cardan_exudyn.sweep import spec_from_mapping
+
+    return spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})
+
+
+def _api_sweep_out_of_range(d: Path) -> Any:
+    """run_sweep({"scene": "paper", "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, OUT)"""
+    from cardan_exudyn.sweep import run_sweep
+
+    return run_sweep({"scene": "paper", "engine": "reference",
+                      "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, d / "out", workers=1)
+
+
+def _api_distribution(d: Path) -> Any:
+    """Distribution("normal", mean=0, std=0)"""
+    from cardan_exudyn.sweep import Distribution
+
+    return Distribution("normal", mean=0.0, std=0.0)
+
+
+def _api_write_result_file(d: Path) -> Any:
+    """cardan_exudyn.io.write_result(result, "a-file"): the target exists and is not a folder"""
+    from cardan_exudyn.io import write_result
+    from reference.schema import Result
+
+    return write_result(Result(None, {"status": "ok"}), d / "out")
+
+
+def _api_reference_options(d: Path) -> Any:
+    """ReferenceOptions(quadrature_rtol=-1)"""
+    from reference.engine import ReferenceOptions
+
+    return ReferenceOptions(quadrature_rtol=-1.0)
+
+
+def _api_exudyn_options(d: Path) -> Any:
+    """ExudynOptions(node_type="warp")"""
+    from cardan_exudyn.engine import ExudynOptions
+
+    return ExudynOptions(node_type="warp")
+
+
+# ------------------------------------------------------------------------------------- cases
+
+CASES: tuple[Case, ...] = (
+    # ---------------------------------------------------------------- scene files
+    Case("scene-toml-syntax", "scene file", "a table header without its closing bracket",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml('revolutions = 2\n[joint.geometry\nshaft_angle_deg = 3\n'),
+         match="not valid TOML"),
+    Case("scene-unknown-key", "scene file", "a key no scene has (`foo`)",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "foo = 1\n"),
+         match="unknown key(s) ['foo']"),
+    Case("scene-wrong-type", "scene file", "`revolutions` is a string",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + 'revolutions = "two"\n'),
+         match="`revolutions` must be a number"),
+    Case("scene-bool-count", "scene file", "`record.every` is a boolean",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "[record]\nevery = true\n"),
+         match="`every` must be an integer"),
+    Case("scene-negative-mass", "scene file", "negative mass of the input shaft",
+         ("run", "--scene", "{d}/scene.toml", "--out", "{out}"),
+         files=_scene_toml(_PAPER + "[joint.input]\nmass = -1\n"), out="folder",
+         match="`mass` must be positive"),
+    Case("scene-nan-angle", "scene file", "shaft angle NaN",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml(_PAPER + "[joint.geometry]\nshaft_angle_deg = nan\n"), match="must be finite"),
+    Case("scene-inf-load", "scene file", "infinite load torque",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "[load]\ntorque = inf\n"),
+         match="`torque` must be finite"),
+    Case("scene-angle-90", "scene file", "shaft angle 90 deg (the joint cannot transmit motion)",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml(_PAPER + "[joint.geometry]\nshaft_angle_deg = 90\n"), match="[0, 90) deg"),
+    Case("scene-angle-negative", "scene file", "shaft angle -5 deg",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml(_PAPER + "[joint.geometry]\nshaft_angle_deg = -5\n"), match="[0, 90) deg"),
+    Case("scene-missing-file", "scene file", "the scene file does not exist",
+         ("run", "--scene", "{d}/missing.toml", "--out", "{out}"), out="folder",
+         match="cannot read scene file"),
+    Case("scene-directory", "scene file", "a folder where the scene file should be",
+         ("scene", "--scene", "{d}/scene.toml"), files={"scene.toml": DIRECTORY}, match="is a directory"),
+    Case("scene-binary", "scene file", "binary junk instead of TOML text",
+         ("scene", "--scene", "{d}/scene.toml"), files={"scene.toml": b"\xff\xfe\x00\x01\x80junk"},
+         match="not UTF-8 text"),
+    Case("scene-no-joint", "scene file", "no `base` and neither `joint` nor `drive`",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml("revolutions = 2\n"),
+         match="missing required key(s) ['drive', 'joint']"),
+    Case("scene-history-text", "scene file", "a load history with a text sample",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml(_PAPER + '[load]\ntorque = [1, 2]\ntime = [0, "a"]\n'),
+         match="load `time` must be"),
+    Case("scene-unknown-base", "scene file", "`base` names no scene",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml('base = "nope"\n'),
+         match="unknown scene name 'nope'"),
+    Case("scene-drive-kind", "scene file", "drive kind `warp`",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + '[drive]\nkind = "warp"\n'),
+         match="`kind` must be one of"),
+    Case("scene-angle-drive-short", "scene file",
+         "an angle drive (replacing the base's speed drive) with two samples",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml(_PAPER + '[drive]\nkind = "angle"\ntime = [0, 1]\nangle = [0, 7]\n'),
+         match="at least 4 numbers"),
+    Case("scene-name-number", "scene file", "`name` is a number",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "name = 5\n"),
+         match="`name` must be a string"),
+    Case("scene-tiny-step", "scene file", "`numerics.dt` = 1e-12 s: 6e10 steps",
+         ("run", "--scene", "{d}/scene.toml", "--out", "{out}"),
+         files=_scene_toml(_PAPER_FRICTIONLESS + "[numerics]\ndt = 1e-12\n"), out="folder", match="steps"),
+    # ---------------------------------------------------------------- command-line options
+    Case("run-angle-text", "cli", "non-numeric shaft angle", ("run", "--angle", "abc"),
+         match="argument --angle: expected a number"),
+    Case("run-rpm-inf", "cli", "infinite speed", ("run", "--rpm=-inf"), match="expected a finite number"),
+    Case("run-load-overflow", "cli", "a load torque that overflows to inf", ("run", "--load-torque", "1e400"),
+         match="finite"),
+    Case("run-friction-negative", "cli", "negative friction coefficient",
+         ("run", "--friction-spider", "-0.1"),
+         match="must be >= 0"),
+    Case("run-engine-unknown", "cli", "unknown engine", ("run", "--engine", "warp", "--out", "{out}"),
+         out="folder", match="must be one of"),
+    Case("run-engine-friction", "cli", "MuJoCo asked for a scene with friction",
+         ("run", "--name", "paper", "--engine", "mujoco"), match="cannot"),
+    Case("run-name-unknown", "cli", "unknown named scene", ("run", "--name", "nope"),
+         match="unknown scene name"),
+    Case("run-scene-and-name", "cli", "--scene and --name together",
+         ("run", "--scene", "{d}/x.toml", "--name", "paper"), match="not allowed with argument --scene"),
+    Case("run-revolutions-short", "cli", "half a revolution (no whole revolution to average)",
+         ("run", "--revolutions", "0.5"), match="`revolutions` must be at least"),
+    Case("run-tiny-step", "cli", "--dt 1e-12 (6e10 steps)", ("run", "--dt", "1e-12", "--out", "{out}"),
+         out="folder", match="steps"),
+    Case("run-accuracy-range", "cli", "accuracy 2 (must be below 1)", ("run", "--accuracy", "2"),
+         match="`accuracy` must be < 1"),
+    Case("run-out-is-file", "cli", "--out names an existing file",
+         ("run", "--revolutions", "1", "--out", "{out}"), out="file", match="not a folder"),
+    Case("run-out-parent", "cli", "--out names a parent folder (`..`), which would be replaced",
+         ("run", "--revolutions", "1", "--out", "{d}/x/.."), match="names no folder of its own"),
+    Case("scene-name-empty", "cli", "empty scene name", ("scene", "--name", ""), match="unknown scene name"),
+    Case("compare-one-engine", "cli", "one engine to compare", ("compare", "--engines", "exudyn"),
+         match="at least two engines"),
+    Case("compare-engine-unknown", "cli", "an unknown second engine (refused before the first runs)",
+         ("compare", "--engines", "exudyn,warp", "--out", "{out}"), out="folder", match="must be one of"),
+    Case("compare-engine-twice", "cli", "the same engine twice",
+         ("compare", "--engines", "reference,reference"),
+         match="twice"),
+    Case("compare-skip-nan", "cli", "--skip-revolutions nan", ("compare", "--skip-revolutions", "nan"),
+         match="finite"),
+    Case("sweep-no-scene", "cli", "no spec and no --scene", ("sweep", "--out", "{out}"), out="folder",
+         match="`scene` is required"),
+    Case("sweep-grid-syntax", "cli", "--grid without `=`",
+         ("sweep", "--scene", "paper", "--grid", "revolutions", "--out", "{out}"), out="folder",
+         match="must look like PATH=V1,V2"),
+    Case("sweep-out-empty", "cli", "an empty --out (would be the current folder)",
+         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--out", ""), match="--out is empty"),
+    Case("sweep-workers-scheduler", "cli", "--workers and --scheduler together",
+         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--workers", "2", "--scheduler",
+          "tcp://127.0.0.1:1", "--out", "{out}"), match="not allowed with"),
+    Case("sweep-workers-zero", "cli", "zero workers",
+         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--workers", "0", "--out", "{out}"),
+         match="must be >= 1"),
+    Case("tolerance-samples-zero", "cli", "zero Monte Carlo samples",
+         ("tolerance", "montecarlo", "--samples", "0", "--out", "{out}"), match="must be >= 1"),
+    Case("tolerance-error-bounds", "cli", "uniform distribution with low above high",
+         ("tolerance", "montecarlo", "--error", "joint.errors.a1_mm=uniform:1:0", "--out", "{out}"),
+         out="folder", match="`low` must be below `high`"),
+    Case("tolerance-error-dist", "cli", "unknown distribution",
+         ("tolerance", "montecarlo", "--error", "joint.errors.a1_mm=gauss:0:1", "--out", "{out}"),
+         match="uniform:LOW:HIGH"),
+    Case("tolerance-seed-negative", "cli", "negative seed",
+         ("tolerance", "montecarlo", "--seed", "-1", "--samples", "2", "--out", "{out}"), out="folder",
+         match="seed"),
+    Case("tolerance-engines-unknown", "cli", "unknown engine in the paper case",
+         ("tolerance", "paper", "--engines", "warp", "--out", "{out}"), out="folder", match="--engines"),
+    Case("reproduce-workers-zero", "cli", "zero workers", ("reproduce", "--workers", "0", "--out", "{out}"),
+         match="must be >= 1"),
+    Case("reproduce-out-is-file", "cli", "--out names an existing file", ("reproduce", "--out", "{out}"),
+         out="file", match="not a folder"),
+    Case("bench-repeats-zero", "cli", "zero repeats", ("bench", "--repeats", "0"), match="must be >= 1"),
+    Case("bench-scene-unknown", "cli", "unknown benchmark scene", ("bench", "--scenes", "nope"),
+         match="must be among"),
+    Case("bench-out-is-file", "cli", "--out names an existing file (refused before the benchmark runs)",
+         ("bench", "--quick", "--out", "{out}"), out="file", match="not a folder"),
+    Case("calibrate-unknown", "cli", "unknown parameter", ("calibrate", "--parameters", "foo"),
+         match="unknown"),
+    Case("calibrate-empty", "cli", "an empty parameter list", ("calibrate", "--parameters", ","),
+         match="--parameters"),
+    Case("study-unknown", "cli", "unknown study", ("study", "warp"), match="invalid choice"),
+    Case("study-out-parent-file", "cli", "--out inside an existing file (refused before the study runs)",
+         ("study", "coupling", "--quick", "--out", "{out}/sub"), out="file", match="not a folder"),
+    Case("rig-map-channel", "cli", "--map to a channel that does not exist",
+         ("rig", "measure", "{d}/rig.csv", "--map", "foo=bar"), files=_RIG_FILE, match="mapping"),
+    Case("rig-seed-negative", "cli", "negative Monte Carlo seed",
+         ("rig", "measure", "{d}/rig.csv", "--seed", "-3"), files=_RIG_FILE, match="--seed"),
+    Case("rig-angle-range", "cli", "shaft angle 95 deg", ("rig", "measure", "{d}/rig.csv", "--angle", "95"),
+         files=_RIG_FILE, match="--angle"),
+    Case("rig-mc-negative", "cli", "negative Monte Carlo draws",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "-1"),
+         files=_RIG_FILE, match="--mc"),
+    Case("rig-format-unknown", "cli", "unknown file format",
+         ("rig", "inspect", "{d}/rig.csv", "--format", "xlsx"),
+         files=_RIG_FILE, match="invalid choice"),
+    Case("rig-synthetic-out-dir", "cli", "synthetic --out names an existing folder",
+         ("rig", "synthetic", "--out", "{out}"), out="folder", match="is a directory"),
+    Case("rig-synthetic-huge", "cli", "1e9 revolutions of synthetic record",
+         ("rig", "synthetic", "--revolutions", "1e9", "--out", "{out}"), out="file", match="samples"),
+    Case("rig-validate-engine", "cli", "validate with an engine it does not take",
+         ("rig", "validate", "{d}/rig.csv", "--engines", "mujoco", "--out", "{out}"), files=_RIG_FILE,
+         out="folder", match="--engines"),
+    Case("rig-validate-scene", "cli", "validate with an unknown scene",
+         ("rig", "validate", "{d}/rig.csv", "--scene", "nope", "--out", "{out}"), files=_RIG_FILE,
+         out="folder", match="unknown scene name"),
+    Case("rig-validate-out-file", "cli", "validate --out names an existing file",
+         ("rig", "validate", "{d}/rig.csv", "--out", "{out}"), files=_RIG_FILE, out="file",
+         match="not a folder"),
+    # ---------------------------------------------------------------- Python API
+    Case("api-load-missing", "python api", "load a scene file that does not exist", call=_api_load_missing,
+         expect=SceneError, match="cannot read scene file"),
+    Case("api-empty-scene", "python api", "a scene from an empty table", call=_api_empty_dict,
+         expect=SceneError, match="missing required key(s)"),
+    Case("api-replace-nan", "python api", "replace the shaft angle by NaN", call=_api_replace_nan,
+         expect=SceneError, match="must be finite"),
+    Case("api-replace-unknown", "python api", "replace a field that does not exist",
+         call=_api_replace_unknown,
+         expect=SceneError, match="unknown scene field"),
+    Case("api-body-unphysical", "python api", "inertia that no body has", call=_api_body_unphysical,
+         expect=SceneError, match="not physical"),
+    Case("api-load-text", "python api", "a load history with a text sample", call=_api_load_text,
+         expect=SceneError, match="load `torque` must be"),
+    Case("api-named-unknown", "python api", "unknown named scene", call=_api_named_unknown,
+         expect=SceneError, match="unknown scene name"),
+    Case("api-engine-unknown", "python api", "unknown engine", call=_api_engine_unknown,
+         expect=EngineUnavailable, match="must be one of"),
+    Case("api-tiny-step", "python api", "a step that needs 6e10 samples", call=_api_tiny_step,
+         expect=SceneError, match="steps"),
+    Case("api-compare-unknown", "python api", "compare with an unknown engine", call=_api_compare_unknown,
+         expect=EngineUnavailable, match="warp"),
+    Case("api-spec-empty-grid", "python api", "sweep spec with an empty grid", call=_api_spec_empty_grid,
+         expect=SweepError, match="empty list"),
+    Case("api-sweep-out-of-range", "python api", "sweep whose grid leaves the scene's range",
+         call=_api_sweep_out_of_range, out="folder", expect=SceneError, match="[0, 90) deg"),
+    Case("api-distribution", "python api", "normal distribution with zero spread", call=_api_distribution,
+         expect=SweepError, match="`std` must be positive"),
+    Case("api-write-result-file", "python api", "write a result over an existing file",
+         call=_api_write_result_file, out="file", expect=OutputError, match="not a folder"),
+    Case("api-reference-options", "python api", "negative quadrature tolerance", call=_api_reference_options,
+         expect=ValueError, match="quadrature_rtol"),
+    Case("api-exudyn-options", "python api", "unknown node type", call=_api_exudyn_options,
+         expect=SceneError, match="node_type"),
+    # ---------------------------------------------------------------- rig files
+    Case("rig-empty", "rig file", "empty file", ("rig", "inspect", "{d}/rig.csv"), files={"rig.csv": ""},
+         match="empty file"),
+    Case("rig-truncated", "rig file", "the last line cut short, no line end",
+         ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(end="\n1.5000,0.2")}, match="truncated"),
+    Case("rig-wrong-columns", "rig file", "no column names a torque",
+         ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(header="time [s],a [N m],b [N m],c,d\n")},
+         match="missing: no column recognised as torque_in"),
+    Case("rig-time-backwards", "rig file", "time steps back at sample 50", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{t - 0.2 * (k >= 50):.4f},0.2,0.19,6,6")},
+         match="time does not increase at sample 50 (0.49 then 0.3)"),
+    Case("rig-mixed-rate", "rig file", "the sampling interval doubles halfway",
+         ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=_mixed_rate)}, match="mixed sampling rates"),
+    Case("rig-binary", "rig file", "binary junk", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": bytes(range(256)) * 8}, match="not a text file"),
+    Case("rig-extension-tdms", "rig file", "delimited text named .tdms", ("rig", "inspect", "{d}/rig.tdms"),
+         files={"rig.tdms": _rig_csv()}, match="not a TDMS file"),
+    Case("rig-extension-lvm", "rig file", "delimited text named .lvm", ("rig", "inspect", "{d}/rig.lvm"),
+         files={"rig.lvm": _rig_csv()}, match="not a LabVIEW Measurement file"),
+    Case("rig-header-only", "rig file", "a header and no data", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": RIG_HEADER}, match="no data rows"),
+    Case("rig-nan", "rig file", "NaN in the output torque", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{t:.4f},0.2,{'nan' if k == 10 else 0.19},6,6")},
+         match="non-finite"),
+    Case("rig-text-cell", "rig file", "a word in the input torque", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{t:.4f},{'abc' if k == 10 else 0.2},0.19,6,6")},
+         match="'abc'"),
+    Case("rig-ragged", "rig file", "a row with a field missing", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{t:.4f},0.2,0.19,6" + ("" if k == 20 else ",6"))},
+         match="line 22 has 4 fields"),
+    Case("rig-duplicate-columns", "rig file", "two columns of the same name",
+         ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(header=RIG_HEADER.replace("torque_out", "torque_in"))},
+         match="duplicate"),
+    Case("rig-directory", "rig file", "a folder where the file should be", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": DIRECTORY}, match="is a directory"),
+    Case("rig-missing", "rig file", "the file does not exist", ("rig", "measure", "{d}/missing.csv"),
+         match="missing.csv"),
+    Case("rig-unit-mismatch", "rig file", "a speed unit given to a torque channel",
+         ("rig", "inspect", "{d}/rig.csv", "--unit", "torque_in=rpm"), files=_RIG_FILE, match="speed unit"),
+    Case("rig-still", "rig file", "the input shaft does not turn",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "0"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{t:.4f},0.2,0.19,0,0")}, match="does not turn"),
+    Case("rig-one-revolution", "rig file", "less than one whole revolution after settling",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "0"), files={"rig.csv": _rig_csv(rows=110)},
+         match="less than one whole input revolution"),
+    # ---------------------------------------------------------------- sweep specifications
+    Case("spec-unknown-parameter", "sweep spec", "grid over a scene field that does not exist", _SWEEP,
+         files=_spec('scene = "paper"\nengine = "reference"\n[grid]\n"joint.geometry.nope" = [1, 2]\n'),
+         out="folder", match="unknown key(s) ['nope']"),
+    Case("spec-empty-grid", "sweep spec", "a grid parameter with no values", _SWEEP,
+         files=_spec('scene = "paper"\n[grid]\nrevolutions = []\n'), out="folder", match="empty list"),
+    Case("spec-bad-distribution", "sweep spec", "distribution `cauchy`", _SWEEP,
+         files=_spec('scene = "paper"\n[random]\nsamples = 3\nseed = 1\n'
+                     '[random.parameters."joint.errors.a1_mm"]\ndist = "cauchy"\nlow = 0\nhigh = 1\n'),
+         out="folder", match="`dist` must be one of"),
+    Case("spec-toml-syntax", "sweep spec", "unclosed table header", _SWEEP,
+         files=_spec('scene = "paper"\n[grid\n'), out="folder", match="not valid TOML"),
+    Case("spec-unknown-key", "sweep spec", "a top-level key no spec has", _SWEEP,
+         files=_spec('scene = "paper"\nfoo = 1\n[grid]\nrevolutions = [1]\n'), out="folder",
+         match="unknown key(s) ['foo']"),
+    Case("spec-no-seed", "sweep spec", "random samples without a seed", _SWEEP,
+         files=_spec('scene = "paper"\n[random]\nsamples = 3\n'
+                     '[random.parameters.revolutions]\ndist = "uniform"\nlow = 1\nhigh = 2\n'),
+         out="folder", match="`seed` is required"),
+    Case("spec-cases-and-grid", "sweep spec", "explicit cases and a grid", _SWEEP,
+         files=_spec('scene = "paper"\ncases = [{revolutions = 1}]\n[grid]\nrevolutions = [1]\n'),
+         out="folder",
+         match="not both"),
+    Case("spec-linspace-zero", "sweep spec", "linspace with zero points", _SWEEP,
+         files=_spec('scene = "paper"\n[grid]\nrevolutions = {linspace = [1, 2, 0]}\n'), out="folder",
+         match="num must be an integer >= 1"),
+    Case("spec-grid-out-of-range", "sweep spec", "a grid value outside the scene's range", _SWEEP,
+         files=_spec('scene = "paper"\n[grid]\n"joint.geometry.shaft_angle_deg" = [10, 95]\n'), out="folder",
+         match="[0, 90) deg"),
+    Case("spec-binary", "sweep spec", "binary junk instead of TOML", _SWEEP,
+         files={"spec.toml": b"\xff\xfe\x00junk"}, out="folder", match="not UTF-8 text"),
+    Case("spec-directory", "sweep spec", "a folder where the spec should be", _SWEEP,
+         files={"spec.toml": DIRECTORY}, out="folder", match="is a directory"),
+    Case("spec-duplicate-id", "sweep spec", "two cases with one id", _SWEEP,
+         files=_spec('scene = "paper"\ncases = [{id = "a", revolutions = 1}, {id = "a", revolutions = 2}]\n'),
+         out="folder", match="used twice"),
+    Case("spec-missing", "sweep spec", "the spec file does not exist",
+         ("sweep", "{d}/missing.toml", "--out", "{out}"), out="folder", match="cannot read sweep spec"),
+    Case("spec-nothing", "sweep spec", "a scene and nothing to sweep", _SWEEP,
+         files=_spec('scene = "paper"\n'), out="folder", match="nothing to sweep"),
+    Case("spec-engine-fixed", "sweep spec", "engine among the fixed overrides", _SWEEP,
+         files=_spec('scene = "paper"\n[fixed]\nengine = "reference"\n[grid]\nrevolutions = [1]\n'),
+         out="folder", match="`engine` can be set"),
+    Case("spec-scene-missing", "sweep spec", "the spec's scene file does not exist", _SWEEP,
+         files=_spec('scene = "nope.toml"\n[grid]\nrevolutions = [1]\n'), out="folder",
+         match="cannot read scene file"),
+    # ---------------------------------------------------------------- failures inside a run
+    Case("fail-run-reference", "run failure", "self-locking at 50 deg, reference engine",
+         ("run", "--name", "paper-50deg", "--engine", "reference", "--revolutions", "1"), expect=3,
+         match="status: self_locking"),
+    Case("fail-run-exudyn", "run failure", "self-locking at 50 deg, Exudyn",
+         ("run", "--name", "paper-50deg", "--revolutions", "1"), expect=3, match="status: self_locking"),
+    Case("fail-run-json", "run failure", "self-locking with --json: strict JSON, no efficiency",
+         ("run", "--name", "paper-50deg", "--engine", "reference", "--revolutions", "1", "--json"), expect=3,
+         match='"status": "self_locking"'),
+    Case("free-spin", "run failure", "a joint spinning free: no input work, the efficiency is 0/0",
+         ("run", "--scene", "{d}/scene.toml"), expect=0, match="mean efficiency undefined",
+         files=_scene_toml('base = "paper-frictionless"\nrevolutions = 1\n[load]\ntorque = 0.0\n'
+                           '[drive]\nkind = "torque"\ntorque = 0.0\ninitial_speed = 209.4\n')),
+    Case("fail-compare", "run failure", "compare where both engines self-lock",
+         ("compare", "--name", "paper-50deg", "--engines", "reference,exudyn", "--revolutions", "1"),
+         expect=3, match="self_locking"),
+    Case("fail-sweep", "run failure", "a sweep whose case self-locks",
+         ("sweep", "--scene", "paper-50deg", "--engine", "reference", "--grid", "revolutions=1",
+          "--workers", "1", "--out", "{d}/sweep"), expect=3, match="1 self_locking"),
+    Case("fail-tolerance", "run failure", "Monte Carlo on a self-locking scene",
+         ("tolerance", "montecarlo", "--name", "paper-50deg", "--revolutions", "1", "--samples", "2",
+          "--workers", "1", "--out", "{d}/mc"), expect=3, match="self_locking"),
+)
+
+
+# ------------------------------------------------------------------------------------ runner
+
+
+def _materialise(case: Case, folder: Path) -> Path:
+    """Create the case's files and, when the case has one, its pre-populated output; returns the
+    output's path (``{out}``)."""
+    for name, content in case.files.items():
+        path = folder / name
+        if content is DIRECTORY:
+            path.mkdir(parents=True)
+        elif isinstance(content, bytes):
+            path.write_bytes(content)
+        else:
+            path.write_text(content, encoding="utf-8")
+    out = folder / "out"
+    if case.out is None:
+        return out
+    if case.out == "folder":
+        out.mkdir()
+        (out / "marker.txt").write_text(MARKER, encoding="utf-8")
+    else:
+        out.write_text(MARKER, encoding="utf-8")
+    return out
+
+
+def _untouched(out: Path, kind: str) -> tuple[bool, str]:
+    """Whether the output is exactly as :func:`_materialise` left it, with no temporary sibling."""
+    siblings = [p.name for p in out.parent.iterdir() if p.name.startswith(f".{out.name}")]
+    if siblings:
+        return False, f"temporary files left next to the output: {siblings}"
+    if kind == "file":
+        if not out.is_file() or out.read_text(encoding="utf-8") != MARKER:
+            return False, "the output file was replaced or changed"
+        return True, ""
+    if not out.is_dir():
+        return False, "the output folder is gone or replaced"
+    entries = sorted(p.name for p in out.iterdir())
+    if entries != ["marker.txt"] or (out / "marker.txt").read_text(encoding="utf-8") != MARKER:
+        return False, f"the output folder changed: it holds {entries}"
+    return True, ""
+
+
+def run_cli(argv: list[str]) -> tuple[int, str, str]:
+    """``cardan argv`` in this process: exit status, stdout and stderr. An exception the command
+    lets through is printed as the interpreter would (a traceback) with exit status 1."""
+    from cardan_exudyn.cli import main
+
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), warnings.catch_warnings():
+        try:
+            status = main(argv)
+        except SystemExit as exc:  # argparse
+            status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        except BaseException:  # noqa: BLE001 - the point is to see what escapes
+            traceback.print_exc(file=stderr)
+            status = 1
+    return int(status if status is not None else 0), stdout.getvalue(), stderr.getvalue()
+
+
+def _non_finite(text: str) -> list[str]:
+    """Non-finite numbers in printed output, leaving out a friction loop gain (a reason's
+    ``loop gain inf`` says why a run locked; it is not a result)."""
+    text = re.sub(r"loop gain\)?:? ?[-+]?inf", "", text, flags=re.IGNORECASE)
+    return [m.group(0) for m in _NON_FINITE.finditer(text)]
+
+
+def _refuse_constant(name: str) -> None:
+    raise ValueError(f"{name} in the JSON")
+
+
+def _check_cli(case: Case, status: int, stdout: str, stderr: str) -> list[str]:
+    problems = []
+    lines = [line for line in stderr.splitlines() if line.strip()]
+    if status != case.expect:
+        problems.append(f"exit status {status}, expected {case.expect}")
+    if "Traceback (most recent call last)" in stderr:
+        problems.append("traceback")
+    if case.expect == 2:
+        if len(lines) != 1:
+            problems.append(f"{len(lines)} lines on stderr, expected one")
+        if stdout.strip():
+            problems.append("output on stdout")
+        text = stderr
+    else:
+        text = stdout + stderr
+        bad = _non_finite(text)
+        if bad:
+            problems.append(f"non-finite numbers printed: {bad[:3]}")
+        if "--json" in case.argv:
+            try:
+                json.loads(stdout, parse_constant=_refuse_constant)
+            except ValueError as exc:
+                problems.append(f"stdout is not strict JSON: {exc}")
+    if case.match.lower() not in text.lower():
+        problems.append(f"message lacks {case.match!r}")
+    return problems
+
+
+def _run_one(case: Case, folder: Path) -> dict[str, Any]:
+    folder.mkdir(parents=True)
+    out = _materialise(case, folder)
+    row: dict[str, Any] = {"id": case.id, "entry": case.entry, "description": case.description,
+                           "input": case.input, "files": ", ".join(sorted(case.files)) or "-"}
+    start = time.perf_counter()
+    if case.argv:
+        argv = [a.replace("{d}", str(folder)).replace("{out}", str(out)) for a in case.argv]
+        status, stdout, stderr = run_cli(argv)
+        lines = [line for line in stderr.splitlines() if line.strip()]
+        printed = lines + [line for line in stdout.splitlines() if line.strip()]
+        # the line with the key word (a failed run's status may be on stdout), else the first
+        message = next((line for line in printed if case.match.lower() in line.lower()),
+                       printed[0] if printed else "")
+        row.update(expected=f"exit {case.expect}", exit_status=status, exception="", message=message,
+                   stderr_lines=len(lines), traceback="Traceback (most recent call last)" in stderr)
+        problems = _check_cli(case, status, stdout, stderr)
+    else:
+        expect = case.expect
+        problems = []
+        try:
+            case.call(folder)
+        except Exception as exc:  # noqa: BLE001 - every exception is a result here
+            text = str(exc)
+            row.update(exception=type(exc).__name__,
+                       message=text.strip().splitlines()[0] if text.strip() else "",
+                       traceback=False)
+            if not isinstance(exc, expect):
+                problems.append(f"{type(exc).__name__} raised, expected {expect.__name__}")
+                row["traceback"] = True  # a deep error: the caller would see its traceback
+            if len(text.strip().splitlines()) != 1:
+                problems.append("message is not one line")
+            if case.match.lower() not in text.lower():
+                problems.append(f"message lacks {case.match!r}")
+        else:
+            row.update(exception="(none)", message="", traceback=False)
+            problems.append("no exception")
+        row.update(expected=expect.__name__, exit_status=None, stderr_lines=None)
+    row["seconds"] = time.perf_counter() - start
+    row["message"] = row["message"].replace(f"{folder}{os.sep}", "")  # paths as the report shows them
+    if case.out is not None:
+        intact, why = _untouched(out, case.out)
+        row["output_intact"] = intact
+        if not intact:
+            problems.append(why)
+    else:
+        row["output_intact"] = None
+    row["passed"] = not problems
+    row["problems"] = "; ".join(problems)
+    return row
+
+
+def run_cases(workdir: str | os.PathLike, cases: tuple[Case, ...] | list[Case] = CASES):
+    """Run every case in a fresh subfolder of ``workdir`` and return one row per case.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``id``, ``entry``, ``description``, ``input``, ``files``, ``expected`` (exit
+        status or exception type), ``exit_status`` (command line), ``exception`` (API),
+        ``message`` (first line), ``stderr_lines``, ``traceback``, ``output_intact`` (None when
+        the case has no output), ``seconds``, ``passed``, ``problems`` (why not).
+    """
+    import pandas as pd
+
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    ids = [c.id for c in cases]
+    if len(set(ids)) != len(ids):
+        raise ValueError(f"case ids must be unique, repeated: {sorted({i for i in ids if ids.count(i) > 1})}")
+    rows = []
+    for case in cases:
+        folder = workdir / case.id
+        if folder.exists():
+            shutil.rmtree(folder)
+        rows.append(_run_one(case, folder))
+    table = pd.DataFrame(rows)
+    for column in ("exit_status", "stderr_lines"):  # integers, missing for the Python API cases
+        table[column] = table[column].astype("Int64")
+    return table
+
+
+def markdown(table) -> str:
+    """The rows of :func:`run_cases` as a markdown table, grouped by entry point, with a count."""
+    import pandas as pd
+
+    def cell(value: Any) -> str:
+        if value is None or (not isinstance(value, str) and pd.isna(value)):
+            return "-"
+        text = str(value).replace("|", "\\|").replace("\n", " ")
+        return text if len(text) <= 140 else text[:137] + "..."
+
+    passed = int(table["passed"].sum())
+    lines = [f"{passed} of {len(table)} bad-input cases behave as required.", "",
+             "| case | entry point | input | expected | got | message | stderr lines | traceback | "
+             "output intact | result |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    order = {e: k for k, e in enumerate(ENTRY_POINTS)}
+    for row in sorted(table.to_dict(orient="records"), key=lambda r: order.get(r["entry"], len(order))):
+        got = row["exception"] if row.get("exception") else f"exit {row['exit_status']}"
+        intact = row.get("output_intact")
+        result = "pass" if row["passed"] else f"FAIL: {row['problems']}"
+        lines.append(f"| {cell(row['id'])} | {cell(row['entry'])} | `{cell(row['input'])}` | "
+                     f"{cell(row['expected'])} | {cell(got)} | {cell(row['message'])} | "
+                     f"{cell(row['stderr_lines'])} | {'yes' if row['traceback'] else 'no'} | "
+                     f"{'-' if intact is None else ('yes' if intact else 'NO')} | {cell(result)} |")
+    return "\n".join(lines) + "\n"

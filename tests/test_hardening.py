@@ -1,0 +1,373 @@
+"""Hardening (issue 8): bad input at every entry point (the cases of ``cardan_exudyn.hardening``),
+outputs written atomically when a command fails or is interrupted half-way, and no NaN or
+infinite efficiency printed for a failed run."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cardan_exudyn import io as cio
+from cardan_exudyn.cli import main
+from cardan_exudyn.hardening import CASES, ENTRY_POINTS, MARKER, Case, markdown, run_cases
+from reference.schema import Result
+
+# ------------------------------------------------------------------ rigdata's own Python API
+# (cases here, not in cardan_exudyn.hardening: cardan_exudyn never imports rigdata)
+
+
+def _rig_read_empty(d: Path):
+    """rigdata.readers.read("empty.csv")"""
+    from rigdata.readers import read
+
+    return read(d / "empty.csv")
+
+
+def _rig_read_mapping(d: Path):
+    """rigdata.readers.read("rig.csv", mapping={"foo": "bar"})"""
+    from rigdata.readers import read
+
+    return read(d / "rig.csv", mapping={"foo": "bar"})
+
+
+def _rig_record_repeated_time(d: Path):
+    """RigRecord with time 0, 1, 1, 2"""
+    from rigdata.record import ChannelSource, RigRecord
+
+    channels = {c: np.ones(4) for c in ("torque_in", "torque_out", "speed_in", "speed_out")}
+    return RigRecord(np.array([0.0, 1.0, 1.0, 2.0]), channels,
+                     {c: ChannelSource(c, "SI") for c in channels})
+
+
+def _rig_settings_huge(d: Path):
+    """rigdata.synthetic.RigSettings(revolutions=1e9)"""
+    from rigdata.synthetic import RigSettings
+
+    return RigSettings(revolutions=1e9)
+
+
+def _rig_cases() -> list[Case]:
+    from rigdata.record import RigDataError
+
+    rig_csv = ("time [s],torque_in [N m],torque_out [N m],speed_in [rad/s],speed_out [rad/s]\n"
+               + "".join(f"{k * 0.01:.2f},0.2,0.19,6,6\n" for k in range(150)))
+    return [
+        Case("api-rig-empty", "python api", "read an empty rig file", call=_rig_read_empty,
+             files={"empty.csv": ""}, expect=RigDataError, match="empty file"),
+        Case("api-rig-mapping", "python api", "read with a mapping to an unknown channel",
+             call=_rig_read_mapping, files={"rig.csv": rig_csv}, expect=ValueError, match="`mapping` keys"),
+        Case("api-rig-record", "python api", "a record whose time repeats a value",
+             call=_rig_record_repeated_time, expect=RigDataError,
+             match="does not increase at sample 2 (1.0 "),
+        Case("api-rig-settings", "python api", "a synthetic record of 1e12 samples",
+             call=_rig_settings_huge, expect=ValueError, match="samples"),
+    ]
+
+
+@pytest.fixture(scope="module")
+def table(tmp_path_factory):
+    return run_cases(tmp_path_factory.mktemp("hardening"), list(CASES) + _rig_cases())
+
+
+def test_cases_cover_every_entry_point():
+    """At least 40 cases, ids unique, each entry point with several."""
+    assert len(CASES) >= 40
+    assert len({c.id for c in CASES}) == len(CASES)
+    counts = {e: sum(c.entry == e for c in CASES) for e in ENTRY_POINTS}
+    assert all(n >= 5 for n in counts.values()), counts
+    commands = {c.argv[0] if c.argv[0] != "rig" else f"rig {c.argv[1]}" for c in CASES if c.argv}
+    assert {"run", "scene", "compare", "sweep", "tolerance", "reproduce", "bench", "calibrate", "study",
+            "rig inspect", "rig measure", "rig validate", "rig synthetic"} <= commands
+
+
+@pytest.mark.parametrize("case_id", [c.id for c in CASES] + ["api-rig-empty", "api-rig-mapping",
+                                                             "api-rig-record", "api-rig-settings"])
+def test_case_behaves(table, case_id):
+    """Exit 2 with one line naming the problem (or the documented exception), no traceback, the
+    given output untouched; a failed run exits 3 with its status and no non-finite number."""
+    row = table.set_index("id").loc[case_id]
+    assert row["passed"], f"{case_id}: {row['problems']} (message: {row['message']!r})"
+    assert not row["traceback"]
+
+
+def test_markdown_table(table):
+    """The report table has a row per case and says how many pass."""
+    text = markdown(table)
+    assert text.startswith(f"{len(table)} of {len(table)} bad-input cases")
+    assert text.count("\n| ") == len(table) + 1  # header and rows
+    assert "FAIL" not in text
+
+
+def test_runner_flags_misbehaviour(tmp_path):
+    """The runner itself: a case whose expectation is not met fails with the reason."""
+    wrong = [Case("expects-3", "cli", "a bad option expected to fail as a run", ("run", "--angle", "x"),
+                  expect=3, match="anything"),
+             Case("touches-output", "cli", "a run that writes the output it was given",
+                  ("run", "--name", "rig-frictionless", "--engine", "reference", "--revolutions", "1",
+                   "--out", "{out}"), out="folder", expect=0)]
+    rows = run_cases(tmp_path, wrong).set_index("id")
+    assert not rows.loc["expects-3", "passed"] and "exit status 2" in rows.loc["expects-3", "problems"]
+    assert not rows.loc["touches-output", "output_intact"]
+    assert "output folder changed" in rows.loc["touches-output", "problems"]
+
+
+# ------------------------------------------------------------------ atomic outputs
+
+
+def _previous(folder: Path) -> None:
+    folder.mkdir(parents=True)
+    (folder / "marker.txt").write_text(MARKER)
+
+
+def _intact(folder: Path) -> None:
+    """Only the previous output in ``folder``, no temporary sibling left next to it."""
+    assert sorted(p.name for p in folder.iterdir()) == ["marker.txt"]
+    assert (folder / "marker.txt").read_text() == MARKER
+    assert [p.name for p in folder.parent.iterdir() if p.name.startswith(f".{folder.name}")] == []
+
+
+RUN = ["run", "--name", "rig-frictionless", "--engine", "reference", "--revolutions", "1"]
+
+
+@pytest.mark.parametrize("stop", [KeyboardInterrupt, RuntimeError])
+def test_run_out_interrupted_keeps_previous(tmp_path, monkeypatch, stop):
+    """`cardan run --out`: stopped after timeseries.csv is written, before summary.json."""
+    out = tmp_path / "run"
+    _previous(out)
+    real = cio.write_result_files
+
+    def half(result, folder):
+        result.table.to_csv(folder / "timeseries.csv", index=False)
+        raise stop("stopped half-way")
+
+    monkeypatch.setattr(cio, "write_result_files", half)
+    if stop is KeyboardInterrupt:
+        assert main([*RUN, "--out", str(out)]) == 130
+    else:
+        with pytest.raises(RuntimeError):
+            main([*RUN, "--out", str(out)])
+    _intact(out)
+    monkeypatch.setattr(cio, "write_result_files", real)
+    assert main([*RUN, "--out", str(out)]) == 0  # and the next run replaces it whole
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json", "timeseries.csv"]
+
+
+def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
+    """`cardan compare --out`: interrupted while drawing the plots, after the tables."""
+    import cardan_exudyn.compare as compare
+
+    out = tmp_path / "cmp"
+    _previous(out)
+
+    def plots(comparison, folder):
+        (folder / "overlay_kinematics.png").write_bytes(b"half a png")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(compare, "overlay_plots", plots)
+    status = main(["compare", "--name", "rig-frictionless", "--engines", "reference,exudyn",
+                   "--revolutions", "1", "--out", str(out)])
+    assert status == 130
+    _intact(out)
+
+
+def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
+    """`cardan study --out`: the plot fails after the CSV and JSON are written."""
+    import cardan_exudyn.studies as studies
+
+    out = tmp_path / "study"
+    _previous(out)
+    rows = [{"scene": "s", "coupling": "lagged", "steps_per_revolution": 100, "mean_efficiency": 0.5,
+             "error": math.nan, "observed_order": math.nan, "wall_time_s": 0.1,
+             "friction_evaluations_per_step": 1.0, "status": "ok"}]
+    monkeypatch.setattr(studies, "coupling_study", lambda *a, **k: rows)
+    monkeypatch.setattr(studies, "_plot_coupling", lambda rows, path: 1 / 0)
+    with pytest.raises(ZeroDivisionError):
+        main(["study", "coupling", "--quick", "--out", str(out)])
+    _intact(out)
+
+
+def test_tolerance_out_failure_keeps_previous_study(tmp_path, monkeypatch):
+    """`cardan tolerance montecarlo`: the report fails after the samples table is written; the
+    previous study folder stays, the sweep records (resumable by design) are kept."""
+    import cardan_exudyn.tolerance as tolerance
+
+    out = tmp_path / "mc"
+    _previous(out / "study")
+    def plots(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(tolerance, "_plots", plots)
+    status = main(["tolerance", "montecarlo", "--name", "rig-calibrated", "--engine", "reference",
+                   "--revolutions", "1", "--samples", "3", "--workers", "1", "--out", str(out)])
+    assert status == 130
+    _intact(out / "study")
+    assert (out / "cases" / "cases.jsonl").is_file()
+
+
+def test_atomic_write_leaves_no_temporary_file(tmp_path):
+    """A writer that fails half-way leaves the previous file and no temporary file."""
+    path = tmp_path / "a.json"
+    path.write_text("previous")
+
+    def half(f):
+        f.write(b"{\"half\": ")
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        cio.atomic_write(path, half)
+    assert path.read_text() == "previous"
+    assert [p.name for p in tmp_path.iterdir()] == ["a.json"]
+
+
+def test_atomic_directory_restores_previous_when_the_swap_fails(tmp_path, monkeypatch):
+    """If the new folder cannot be renamed into place, the previous one is put back."""
+    out = tmp_path / "out"
+    _previous(out)
+    real = os.replace
+    calls = []
+
+    def replace(src, dst):
+        calls.append((src, dst))
+        if len(calls) == 2:  # the new folder onto the target
+            raise OSError("disk gone")
+        return real(src, dst)
+
+    monkeypatch.setattr(cio.os, "replace", replace)
+    with pytest.raises(OSError), cio.atomic_directory(out) as tmp:
+        (tmp / "new.txt").write_text("new")
+    monkeypatch.setattr(cio.os, "replace", real)
+    _intact(out)
+
+
+def test_atomic_directory_never_replaces_a_file(tmp_path):
+    """A file where the output folder should be is refused before anything is written."""
+    out = tmp_path / "out"
+    out.write_text(MARKER)
+    with pytest.raises(cio.OutputError, match="not a folder"), cio.atomic_directory(out):
+        pytest.fail("the block must not run")
+    assert out.read_text() == MARKER
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+# ------------------------------------------------------------------ no NaN as a result
+
+_NUMBER_NAN = re.compile(r"(?<![\w.])[-+]?(nan|inf)\b", re.IGNORECASE)
+
+
+def _no_efficiency_printed(text: str) -> None:
+    assert "mean efficiency" not in text
+    assert not _NUMBER_NAN.search(re.sub(r"loop gain[^\n]*", "", text)), text
+
+
+def _nan_engine(status: str, **summary):
+    def run(scene):
+        return Result(None, {"status": status, "reason": "forced" if status != "ok" else "",
+                             "engine": "fake", "engine_version": "0", "scene": {"name": scene.name},
+                             "mean_efficiency": math.nan, "mean_instantaneous_efficiency": math.inf,
+                             "work_ratio": math.nan, "input_work": 0.0, "revolutions": 1,
+                             "wall_time_s": 0.0, **summary})
+    return run
+
+
+def test_forced_failure_prints_status_not_nan(tmp_path, monkeypatch, capsys):
+    """An engine that fails with NaN/inf means: exit 3, the status line, no number; --json and
+    summary.json carry null."""
+    import cardan_exudyn.engines as engines
+
+    real = engines.get_engine
+    monkeypatch.setattr(engines, "get_engine",
+                        lambda name: _nan_engine("integration_failure") if name == "fake" else real(name))
+    assert main(["run", "--engine", "fake", "--out", str(tmp_path / "r")]) == 3
+    out, err = capsys.readouterr()
+    _no_efficiency_printed(out + err)
+    assert "status: integration_failure: forced" in err
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text(), parse_constant=pytest.fail)
+    assert summary["mean_efficiency"] is None
+    assert main(["run", "--engine", "fake", "--json"]) == 3
+    out, err = capsys.readouterr()
+    summary = json.loads(out, parse_constant=pytest.fail)  # strict JSON: no NaN
+    assert summary["mean_efficiency"] is None and summary["mean_instantaneous_efficiency"] is None
+
+
+def test_zero_input_work_prints_undefined(monkeypatch, capsys):
+    """A run that is ok but has no input work (0/0) says the efficiency is undefined."""
+    import cardan_exudyn.engines as engines
+
+    real = engines.get_engine
+    monkeypatch.setattr(engines, "get_engine",
+                        lambda name: _nan_engine("ok") if name == "fake" else real(name))
+    assert main(["run", "--engine", "fake"]) == 0
+    out, err = capsys.readouterr()
+    assert "mean efficiency undefined (input work 0 J)" in out
+    assert not _NUMBER_NAN.search(out + err)
+
+
+def test_absurd_friction_self_locks_exit_3(capsys):
+    """A real failure: friction coefficient 1e6 self-locks Exudyn's run at its start."""
+    status = main(["run", "--name", "paper", "--friction-spider", "1e6", "--revolutions", "1"])
+    out, err = capsys.readouterr()
+    assert status == 3
+    assert "status: self_locking" in err
+    _no_efficiency_printed(out + err)
+
+
+def test_compare_with_failed_engines_prints_no_number(capsys):
+    """`cardan compare` where both engines lock: statuses in the table, '-' for the numbers."""
+    status = main(["compare", "--name", "paper-50deg", "--engines", "reference,exudyn", "--revolutions", "1"])
+    out, err = capsys.readouterr()
+    assert status == 3
+    assert out.count("self_locking") >= 2
+    row = next(line for line in out.splitlines() if line.startswith("| reference"))
+    assert row.split("|")[3].strip() == "-"  # mean efficiency column
+    assert not _NUMBER_NAN.search(re.sub(r"loop gain[^|]*", "", out))
+
+
+def test_calibrate_failed_case_prints_status(monkeypatch, capsys):
+    """`cardan calibrate`: a held-out case whose run failed shows its status, exit 3."""
+    import cardan_exudyn.calibrate as calibrate
+
+    rows = [{"case": "table2:0:2000", "used_in_fit": True, "paper": 0.99, "model": 0.98,
+             "difference": -0.01, "status": "ok", "reason": ""},
+            {"case": "table2:45:2000", "used_in_fit": False, "paper": 0.9, "model": math.nan,
+             "difference": math.nan, "status": "self_locking", "reason": "loop gain >= 1"}]
+    result = {"parameters": {"spider_lever": 0.06}, "rows": rows, "fit_rms": 0.01,
+              "held_out_rms": math.nan, "held_out_max_abs": math.nan, "function_evaluations": 3,
+              "wall_time_s": 1.0}
+    monkeypatch.setattr(calibrate, "calibrate", lambda *a, **k: result)
+    assert main(["calibrate"]) == 3
+    out, err = capsys.readouterr()
+    assert "| table2:45:2000 | no | 0.900 | self_locking | - |" in out
+    assert "status: table2:45:2000: self_locking" in err
+    _no_efficiency_printed(out.replace("mean efficiency", ""))
+
+
+def test_reference_zero_input_work_finishes():
+    """No load, no friction, no gravity: the input work cancels to ~0; the quadrature used to
+    split its panels 40 times (2^40 panels: out of memory). Now it closes at once."""
+    from cardan_exudyn.engines import run_scene
+    from reference.paper import named_scene
+    from reference.scene import replace
+
+    for angle in (0.0, 10.0):
+        scene = replace(named_scene("paper-frictionless"), revolutions=1, gravity=[0.0, 0.0, 0.0],
+                        **{"load.torque": 0.0, "joint.geometry.shaft_angle_deg": angle})
+        s = run_scene(scene, "reference").summary
+        assert s["status"] == "ok" and s["mean_efficiency"] == 1.0
+        assert s["quadrature"]["evaluations"] < 5000
+
+
+def test_scene_file_switches_drive_kind(tmp_path):
+    """A scene file on a speed-driven base may give an angle drive (it replaces the base's)."""
+    from reference.scene import load_scene
+
+    path = tmp_path / "s.toml"
+    path.write_text('base = "paper-frictionless"\n[drive]\nkind = "angle"\n'
+                    "time = [0.0, 0.1, 0.2, 0.3]\nangle = [0.0, 7.0, 14.0, 21.0]\n")
+    scene = load_scene(path)
+    assert scene.drive.kind == "angle" and scene.drive.angle[-1] == 21.0
