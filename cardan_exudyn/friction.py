@@ -62,6 +62,12 @@ LAGGED_GROWTH_LIMIT = 1e3
 STALL_RATIO = 0.1
 # the loop-gain diagnostic (spectral radius of the secant map) is taken every this many steps
 GAIN_EVERY = 4
+# the fixed-point tolerance is relative to the largest friction load, but at least to this
+# fraction of the largest load the pairs would carry sliding: when every rubbing pair is at rest
+# (inside its sign ramp, e.g. the spider pairs at 0 deg) the loads are rounding noise of the
+# relative speeds, and a tolerance relative to the noise itself is never met (the step then
+# stalled and was reported as self-locking)
+REST_FLOOR = 1e-6
 
 
 # state of the ground in the per-body tuples (rotation, angular velocity, velocity, position)
@@ -152,6 +158,7 @@ class FrictionCoupling:
         self._mask = mask.ravel()
         self.unconverged_steps = 0
         self.status, self.reason = "ok", ""
+        self.scale_floor = 0.0  # set by evaluate (REST_FLOOR)
         self._growth_steps, self._growth_start = 0, 0.0
         self._ode2 = {}
 
@@ -255,7 +262,7 @@ class FrictionCoupling:
             friction, _ = self.evaluate(None)
             g = friction.ravel()[self._mask]
             r = g - x
-            scale = float((np.abs(friction) * self._weight).max())
+            scale = max(float((np.abs(friction) * self._weight).max()), self.scale_floor)
             weighted = np.abs(r) * self._weight.ravel()[self._mask]
             if scale == 0.0 or weighted.max() <= self.settings.tolerance * scale:
                 self.apply(friction)
@@ -288,6 +295,7 @@ class FrictionCoupling:
         coords = self._pair_coordinates(states)
         speeds = self._velocity_level_speeds(states) if t is None else self._speeds(coords, t)
         friction = np.zeros((self.n, 2))
+        sliding = 0.0  # largest load a pair would carry sliding (forces weighted by d / 2)
         for k, p in enumerate(self.pairs):
             lx, ly, _ = get(p.joint, force_local)
             tx, ty, _ = get(p.joint, torque_local)
@@ -295,8 +303,12 @@ class FrictionCoupling:
             omega_rel, slide = speeds[k]
             torque = p.f * p.d * moment_n / p.lever + 0.5 * p.f * p.d * force_n
             friction[k, 0] = -_sign(0.5 * p.d * omega_rel, self.band) * torque
+            sliding = max(sliding, torque)
             if p.kind == "cylindrical":
-                friction[k, 1] = -_sign(slide, self.band) * p.f * (force_n + 2.0 * moment_n / p.lever)
+                axial = p.f * (force_n + 2.0 * moment_n / p.lever)
+                friction[k, 1] = -_sign(slide, self.band) * axial
+                sliding = max(sliding, 0.5 * p.d * axial)
+        self.scale_floor = REST_FLOOR * sliding
         return friction, coords
 
     def apply(self, friction: np.ndarray) -> None:
@@ -321,7 +333,7 @@ class FrictionCoupling:
         # forces enter as the torque they make at the journal radius, so one relative measure
         # covers both kinds of load
         weighted = np.abs(friction) * self._weight
-        scale = float(weighted.max())
+        scale = max(float(weighted.max()), self.scale_floor)
         change = float((np.abs(friction - self.applied) * self._weight).max())
         error = change / scale if scale > 0.0 else 0.0
         if t != self._step_t:  # first evaluation of a new step
@@ -434,8 +446,8 @@ class FrictionCoupling:
         size = float(np.max(np.abs(friction)))
         before = float(np.max(np.abs(self.applied)))
         if before > 0.0 and size > before:
-            if self._growth_steps == 0:
-                self._growth_start = before
+            if self._growth_steps == 0:  # growth out of rounding noise (pairs at rest) is no locking
+                self._growth_start = max(before, self.scale_floor)
             self._growth_steps += 1
             if size > LAGGED_GROWTH_LIMIT * self._growth_start:
                 self.status = "self_locking"

@@ -500,11 +500,10 @@ class StressReport:
                 out.append(f"{n} map cells raised in the harness")
         if self.inputs is not None:
             failed = self.inputs[~self.inputs["passed"].astype(bool)]
-            out += [f"bad input {r['id']}: {r.get('got', '')}" for _, r in failed.iterrows()]
+            out += [f"bad input {r['id']}: {r['problems']}" for _, r in failed.iterrows()]
         if self.long is not None:
-            checks = self.long.summary.get("checks", {})
-            out += [f"long run: {k} failed" for k, v in checks.items()
-                    if isinstance(v, dict) and v.get("passed") is False]
+            out += [f"long run: {c['check']} ({c['subject']}) failed"
+                    for c in self.long.summary.get("checks", []) if not c["pass"]]
         return out
 
     def summary(self) -> dict[str, Any]:
@@ -614,10 +613,11 @@ def print_summary(report: StressReport, out: str, file=sys.stdout) -> None:
               + f"; {counts['disagreements']} of {counts['cells']} cells disagree with the "
               f"reference", file=file)
     if report.long is not None:
-        checks = report.long.summary.get("checks", {})
-        print("long runs: " + ", ".join(
-            f"{k} {'ok' if v.get('passed') else 'FAILED'}" for k, v in checks.items()
-            if isinstance(v, dict)), file=file)
+        checks = report.long.summary.get("checks", [])
+        failed = [c for c in checks if not c["pass"]]
+        print(f"long runs: {len(checks) - len(failed)} of {len(checks)} checks within their stated "
+              f"tolerance" + "".join(f"; FAILED {c['check']} ({c['subject']})" for c in failed),
+              file=file)
     if report.inputs is not None:
         n, ok = len(report.inputs), int(report.inputs["passed"].astype(bool).sum())
         print(f"bad inputs: {ok} of {n} rejected as expected", file=file)

@@ -353,7 +353,9 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
         error += diff[done].sum(0)
         closed += int(np.count_nonzero(done))
         keep = ~done
-        if not np.any(keep):
+        # nothing open, or a NaN (locked sample) already decides the integral: refining the
+        # steep panels next to a locked arc would only cost (19 s at 47 deg, 2000 rpm)
+        if not np.any(keep) or not np.all(np.isfinite(result)):
             break
         a, b = np.concatenate([a[keep], mid[keep]]), np.concatenate([mid[keep], b[keep]])
         whole = np.concatenate([left[keep], right[keep]])
@@ -520,6 +522,7 @@ def _run(scene: Scene, options: ReferenceOptions, start: float) -> Result:
             if means.pop("self_locking_nodes"):
                 summary.update(status=STATUS_SELF_LOCKING, reason=(
                     "friction self-locks between the table's samples (at quadrature nodes)"))
+                means = {}  # as when it locks at a sample: no means (they were NaN or meaningless)
         summary.update({k: v for k, v in means.items() if k != "mean_status"})
     table = None
     if scene.record.timeseries:
