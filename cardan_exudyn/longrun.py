@@ -28,8 +28,8 @@ What "rotation-parameter drift" means per node type, and what is checked:
 - ``Rxyz``: ``A = Rx Ry Rz`` is orthogonal by construction, so its orthogonality error shows
   rounding only. The angles are unbounded: the input's first angle *is* the input angle (every
   node type keeps an Rxyz input), 12,566 rad after 2000 revolutions. What that costs: the spacing
-  of doubles there, 1.8e-12 rad, must stay below Newton's tolerance (checked; it reaches 1e-10
-  near 1e5 revolutions); and each step's angle update rounds at that spacing, so the angle
+  of doubles there, 1.8e-12 rad, must stay below Newton's tolerance (checked; it passes 1e-10
+  at 2^19 rad, 83,400 revolutions); and each step's angle update rounds at that spacing, so the angle
   wanders from ``omega t`` (the velocity-level drive holds the speed, nothing holds the angle):
   7e-8 rad after 2000 revolutions, growing faster than linearly (reported, harmless for Rxyz
   and EP).
@@ -73,6 +73,7 @@ of an integrator that does not dissipate.
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import time
@@ -154,29 +155,30 @@ TOLERANCES: dict[str, tuple[float, str]] = {
     "velocity_growth_ratio": (1.01, (
         "the velocity-level residual is the O(h^2) error of index-3 generalized-alpha and is "
         "periodic with the motion: its per-revolution maximum over the last window may exceed the "
-        "first window's by 1 % at most (measured: equal to 4 digits)")),
+        "first window's by 1 % at most (measured: equal to 7 digits)")),
     "orthogonality_error": (1e-13, (
         "rounding: A is orthogonal by construction for Rxyz and rotation vectors, and for Euler "
-        "parameters up to 2 (|p|^2 - 1); measured <= 1.3e-15, the bound is 100 x that")),
+        "parameters up to 2 (|p|^2 - 1); measured <= 2e-15, the bound is 50 x that")),
     "ep_norm_error": (NEWTON_TOLERANCE, (
         "the normalisation |p|^2 = 1 is an algebraic constraint solved by Newton like the joints "
-        "(measured: rounding, 2.2e-16)")),
+        "(measured: rounding, 3.3e-16)")),
     "rotvec_norm_excess": (1e-12, (
         "the post-step wrap keeps |nu| <= pi; the stored vectors are those after the wrap, so only "
         "rounding may exceed pi")),
     "input_angle_spacing_rad": (NEWTON_TOLERANCE, (
         "the input's Tait-Bryan angle is the unbounded input angle; its floating-point spacing "
         "grows with it and must stay below Newton's tolerance, or the position constraints cannot "
-        "be resolved (reached near 1e5 revolutions: spacing 1.2e-10 rad at 6e5 rad)")),
+        "be resolved (measured 1.8e-12 rad after 2000 revolutions; it passes 1e-10 at 2^19 rad, "
+        "83,400 revolutions)")),
     "balance_residual_change": (0.01, (
         "W_in - W_out - W_loss - dE per revolution is the O(h^2) error of the work integrals and "
         "of the integrator; it is periodic, so the last window's may differ from the first's by "
-        "1 % at most (measured: 1e-7)")),
+        "1 % at most (measured: 4e-7 for Rxyz and EP, 3e-4 for RotVecLG)")),
     "efficiency_drift": (1e-5, (
         "a drift of the per-revolution efficiency over the run below 1/50 of the discretisation "
         "error of the mean efficiency at this step (5e-4 against the reference engine at 10 deg) "
-        "changes no conclusion drawn from it (measured: 1e-8, the scatter of the converged "
-        "friction iteration)")),
+        "changes no conclusion drawn from it (measured: trend over 2000 revolutions 3e-11 (Rxyz), "
+        "7e-10 (EP); scatter 1.5e-8, that of the converged friction iteration)")),
     "dissipation_order": (0.1, (
         "the damping ratio of generalized-alpha is c(rho) (Omega h)^3, so the energy lost per "
         "revolution should fall as h^3; measured order 2.98 to 3.03 between neighbouring steps "
@@ -237,7 +239,7 @@ def simulate(scene: Scene, options: ExudynOptions,
     if columns:  # a failed run too: the steps it completed
         try:
             cols = engine.postprocess(model)
-        except ValueError:  # fewer than two recorded steps
+        except Exception:  # nothing usable recorded (as engine.run): the run's status says why
             cols = {}
     summary = {"status": status, "reason": reason, "dt": dt, "dt_choice": dt_reason,
                "newton_iterations": int(solver.it.newtonStepsCount),
@@ -632,6 +634,7 @@ def long_runs(quick: bool = False, progress: Callable[[str], None] | None = None
                                           "wall_time_s": float("nan")}
         frames.append(rows)
         runs.append(info)
+        gc.collect()  # the run's model (a reference cycle with its friction) holds ~1 GB
         say(f"drift: {node_type} {info['status']} in {info['wall_time_s']:.1f} s")
     drift_wall = time.perf_counter() - started
     drift = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
@@ -884,8 +887,45 @@ def summarise(drift: pd.DataFrame, runs: list[dict[str, Any]], energy: pd.DataFr
         "tolerances": {k: {"value": v, "reason": r} for k, (v, r) in TOLERANCES.items()},
         "checks": checks,
         "passed": all(c["pass"] for c in checks),
+        "findings": findings(drift_out, cases),
         "wall_time_s": walls,
     }
+
+
+ROTVEC_FAILURE = (
+    "the spider's rotation vector passes the identity at every whole input revolution and the step "
+    "grid lands there; Exudyn's CompositionRotationVector (w = pi - 2 atan2(x, sqrt(|1 - x^2|)), "
+    "x = cos(w/2)) cannot resolve angles below about sqrt(eps) = 1e-8 rad and returns exactly zero, "
+    "so at that step the input-spider pair is misaligned by the input angle's rounding drift "
+    "(theta_in - 2 pi k, growing with the run); once that exceeds what Newton accepts, Newton cannot "
+    "represent the sub-1e-8 rotation that would remove it and the step fails")
+
+
+def findings(drift_out: dict[str, Any], cases: list[dict[str, Any]]) -> list[str]:
+    """Plain sentences for what did not run through, and why where it is known."""
+    out = []
+    for node_type, info in drift_out.items():
+        if info["status"] == STATUS_OK:
+            continue
+        text = (f"{node_type}: {info['status']} at revolution "
+                f"{_g(info.get('ended_at_revolution'), '.2f')} of {info.get('requested_revolutions')} "
+                f"({info['reason']})")
+        misalignment = info.get("measures", {}).get("angle_violation_rad", {})
+        if node_type == "RotVecLG" and misalignment.get("last_window_max_abs", 0.0) > NEWTON_TOLERANCE:
+            text += (f"; before it the axis misalignment grew to "
+                     f"{misalignment['last_window_max_abs']:.2g} rad: " + ROTVEC_FAILURE)
+        out.append(text)
+    for c in cases:
+        if c["status"] != STATUS_OK:
+            text = (f"{c['case']}: {c['status']} after {c.get('completed_revolutions', 0)} "
+                    f"revolutions ({c['reason']})")
+            if c["engine"] == "exudyn" and c["spectral_radius"] >= 0.99:
+                text += ("; almost without numerical damping Exudyn's index-3 Newton iteration "
+                         "fails (not investigated further: at 400 steps per revolution the 35 deg "
+                         "case ran 100 revolutions in a side test; ExudynOptions refuses a spectral "
+                         "radius of 1)")
+            out.append(text)
+    return out
 
 
 # ------------------------------------------------------------------------------ figures, files
@@ -1138,4 +1178,6 @@ def markdown(result: LongRuns) -> str:
                     _g(c["value"]), _g(c["tolerance"]), "yes" if c["pass"] else "**no**"]
                    for c in s["checks"]])
     out += ["", f"All checks passed: {'yes' if s['passed'] else '**no**'}.", ""]
+    if s.get("findings"):
+        out += ["Findings:", ""] + [f"- {text}" for text in s["findings"]] + [""]
     return "\n".join(out)

@@ -177,12 +177,35 @@ def test_write_long_and_markdown(quick, tmp_path):
 @pytest.mark.slow
 def test_full_long_runs():
     """2000 revolutions with friction for every node type, 1000 free-spinning revolutions at
-    10 and 35 deg with the step and spectral-radius ladders: every check within its tolerance."""
+    10 and 35 deg with the step and spectral-radius ladders, the reference for 20: every check
+    within its tolerance, except the measured RotVecLG failure (pinned here: if a later Exudyn
+    resolves rotations near the identity, this test says so and the module's account must change)."""
     result = long_runs(quick=False)
     s = result.summary
     assert s["settings"]["drift_revolutions"] == 2000
     assert set(s["drift"]) == {"Rxyz", "EP", "RotVecLG"}
-    for info in s["drift"].values():
-        assert info["revolutions"] == 2000
-    failed = [c for c in s["checks"] if not c["pass"]]
+    for node_type in ("Rxyz", "EP"):
+        info = s["drift"][node_type]
+        assert info["status"] == "ok" and info["completed_revolutions"] == 2000, info
+    failed = [c for c in s["checks"] if not c["pass"] and c["subject"] != "RotVecLG"]
     assert not failed, failed
+
+    # RotVecLG: stops near revolution 268 (measured 267.99, with and without friction)
+    rv = s["drift"]["RotVecLG"]
+    assert rv["status"] == "integration_failure" and 200 <= rv["completed_revolutions"] <= 400, rv
+    rows = result.drift[result.drift["node_type"] == "RotVecLG"]
+    assert rows["position_violation_m"].max() <= TOLERANCES["position_violation_m"][0]
+    # the axis misalignment before the failure is the input angle's rounding drift, which the
+    # identity step cannot follow (module docstring)
+    late = rows.tail(50)
+    worst = late["angle_violation_rad"].max()
+    assert abs(worst / late["input_angle_error_rad"].abs().max() - 1.0) < 0.1  # measured 1.0000
+    assert worst > TOLERANCES["angle_violation_rad"][0]  # measured 1.3e-9 rad
+    assert any(f.startswith("RotVecLG") for f in s["findings"])
+
+    # energy: every case up to rho 0.95 runs 1000 revolutions; rho 0.99 fails early
+    for c in s["energy"]["cases"]:
+        if c["engine"] == "exudyn" and c["spectral_radius"] >= 0.99:
+            assert c["status"] != "ok" and c["completed_revolutions"] < 50, c
+        else:
+            assert c["status"] == "ok", c
