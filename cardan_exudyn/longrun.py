@@ -340,8 +340,9 @@ def cumulative(y: np.ndarray, t: np.ndarray) -> np.ndarray:
 
 def whole_revolutions(theta: np.ndarray) -> int:
     """Whole input revolutions turned; 1e-6 of a revolution short counts as whole (the input
-    angle of a 2000-revolution run ends 7e-8 rad short of 2000 turns: rounding of the time grid
-    and of the angle, see ``time_grid_error_s`` and ``input_angle_error_rad``)."""
+    angle of a 2000-revolution run ends 7e-8 rad short of 2000 turns: the rounding of its update
+    accumulates, ``input_angle_error_rad``; the step times themselves are exact multiples of dt,
+    ``time_grid_error_s``)."""
     return int(math.floor(abs(theta[-1] - theta[0]) / (2.0 * math.pi) + 1e-6))
 
 
@@ -367,7 +368,7 @@ def drift_rows(model: ExudynModel, cols: dict[str, np.ndarray], node_type: str,
     if drive.kind == "speed":
         error = theta - theta[0] - drive.speed * (t - t[0])
         rows["input_angle_error_rad"] = at_revolutions(error, theta, revs)[1:]
-    # Exudyn's time against i dt: the accumulated rounding of adding dt every step
+    # Exudyn's step times against i dt (would show an accumulated rounding of t; measured zero)
     grid = np.abs(t - t[0] - dt * np.arange(n))
     rows["time_grid_error_s"] = per_revolution_max(grid, index, revs)
     works = {}
@@ -929,6 +930,9 @@ def findings(drift_out: dict[str, Any], cases: list[dict[str, Any]]) -> list[str
 
 
 # ------------------------------------------------------------------------------ figures, files
+NODE_COLOURS = {"Rxyz": "C0", "EP": "C1", "RotVecLG": "C2"}
+
+
 def _figure_constraints(drift: pd.DataFrame):
     import matplotlib.pyplot as plt
 
@@ -947,7 +951,8 @@ def _figure_constraints(drift: pd.DataFrame):
             else:
                 y = g[key].to_numpy(dtype=float)
             if np.isfinite(y).any():
-                ax.semilogy(g["revolution"], np.maximum(np.abs(y), 1e-18), lw=0.8, label=node_type)
+                ax.semilogy(g["revolution"], np.maximum(np.abs(y), 1e-18), lw=0.8, label=node_type,
+                            color=NODE_COLOURS.get(node_type))
         ax.set_xlabel("input revolution")
         ax.set_ylabel(f"per-revolution max: {label}", fontsize=8)
         ax.grid(alpha=0.3, which="both")
@@ -964,11 +969,13 @@ def _figure_efficiency(drift: pd.DataFrame, summary: dict[str, Any]):
         s = summary["drift"].get(node_type, {}).get("efficiency", {})
         steady = g.iloc[STARTUP_REVOLUTIONS:]
         mean = s.get("mean", float(steady["efficiency"].mean()))
-        axes[0].plot(steady["revolution"], steady["efficiency"] - mean, ".", ms=1.5,
+        colour = NODE_COLOURS.get(node_type)
+        axes[0].plot(steady["revolution"], steady["efficiency"] - mean, ".", ms=1.5, color=colour,
                      label=f"{node_type} (mean {mean:.7f})")
-        axes[1].plot(steady["revolution"], steady["balance_residual_j"], lw=0.8, label=node_type)
+        axes[1].plot(steady["revolution"], steady["balance_residual_j"], lw=0.8, color=colour,
+                     label=node_type)
         error = g["input_angle_error_rad"].to_numpy(dtype=float)
-        axes[2].plot(g["revolution"], error, lw=0.8, label=node_type)
+        axes[2].plot(g["revolution"], error, lw=0.8, color=colour, label=node_type)
     axes[0].set_ylabel("per-revolution efficiency minus its mean [-]")
     axes[1].set_ylabel("W_in - W_out - W_loss - dE per revolution [J]")
     axes[2].set_ylabel("theta_in - omega t at whole revolutions [rad]")
@@ -985,16 +992,20 @@ def _figure_energy(energy: pd.DataFrame, summary: dict[str, Any]):
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.4), constrained_layout=True)
-    for case, g in energy.groupby("case", sort=False):
+    for _, g in energy.groupby("case", sort=False):
         y = np.abs(g["relative_energy_deviation"].to_numpy(dtype=float))
         k = g["revolution"].to_numpy()
         keep = (k > 0) & (y > 0)
+        first = g.iloc[0]
+        reference = first["engine"] == "reference"
+        label = (f"ref. {first['shaft_angle_deg']:g} deg" if reference else
+                 f"{first['shaft_angle_deg']:g} deg, {_g(first['steps_per_revolution'], '.0f')}/rev, "
+                 f"rho {first['spectral_radius']:g}")
         if keep.any():
-            axes[0].loglog(k[keep], y[keep], lw=0.8,
-                           ls="--" if g["engine"].iloc[0] == "reference" else "-", label=case)
+            axes[0].loglog(k[keep], y[keep], lw=0.8, ls="--" if reference else "-", label=label)
     axes[0].set_xlabel("input revolution")
     axes[0].set_ylabel("|E(2 pi k) - E(0)| / E(0) [-]")
-    axes[0].legend(fontsize=5.5)
+    axes[0].legend(fontsize=5, ncol=2, loc="upper left")
     cases = summary["energy"]["cases"]
     for angle in sorted({c["shaft_angle_deg"] for c in cases}):
         ok = [c for c in cases if c["engine"] == "exudyn" and c["shaft_angle_deg"] == angle
@@ -1016,6 +1027,11 @@ def _figure_energy(energy: pd.DataFrame, summary: dict[str, Any]):
                 grid = np.linspace(0.0, 0.99, 60)
                 spr = float(np.mean([c["steps_per_revolution"] for c in rhos]))
                 axes[2].semilogy(grid, [model_loss(angle, x, spr) for x in grid], "k:", lw=0.8)
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+    axes[1].set_xticks([100, 200, 400, 700])
+    axes[1].xaxis.set_major_formatter(ScalarFormatter())
+    axes[1].xaxis.set_minor_formatter(NullFormatter())
     axes[1].set_xlabel("steps per revolution (at the mean speed)")
     axes[1].set_ylabel(f"energy lost per revolution, rho {DEFAULT_RHO:g} [-]")
     axes[1].set_title("dotted: K c(rho) h^3", fontsize=8)
@@ -1060,7 +1076,11 @@ def _g(x: Any, fmt: str = ".3g") -> str:
         x = float(x)
     except (TypeError, ValueError):
         return str(x)
-    return "-" if not math.isfinite(x) else format(x, fmt)
+    if not math.isfinite(x):
+        return "-"
+    if fmt == ".3g" and x == int(x) and abs(x) < 1e7:
+        return str(int(x))
+    return format(x, fmt)
 
 
 def _table(header: list[str], rows: list[list[str]]) -> list[str]:
