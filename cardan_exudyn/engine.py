@@ -163,18 +163,29 @@ def simulation_settings(dt: float, t_start: float, t_end: float,
     return s
 
 
-def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
-    """Simulate ``scene`` with Exudyn and return its time table and summary."""
-    options = options or ExudynOptions()
+@dataclass
+class Solved:
+    """A finished (or failed) Exudyn solve of a scene: the model with its sensors, the solver's
+    counters, the status and reason, the step used and how it was chosen, the solve's wall time."""
+
+    model: ExudynModel
+    solver: Any
+    status: str
+    reason: str
+    dt: float
+    dt_reason: str
+    wall_time_s: float
+
+
+def solve(scene: Scene, options: ExudynOptions, reactions: bool) -> Solved:
+    """Build the model of ``scene`` and integrate it: the step choice, solver settings, friction
+    set-up and stop function of every Exudyn run (:func:`run`, ``cardan_exudyn.longrun``).
+
+    Raises :class:`LoopClosureError` when the mounting errors cannot be assembled.
+    """
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene, options.node_type)
-    try:
-        model = build_model(scene, reactions=options.records_reactions(scene),
-                            node_type=options.node_type)
-    except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
-        return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
-                             "engine_version": engine_version(), "scene": scene_to_dict(scene),
-                             "wall_time_s": time.perf_counter() - wall_start})
+    model = build_model(scene, reactions=reactions, node_type=options.node_type)
     t_end = end_time(scene, model.start_time)
     span = t_end - model.start_time
     check_steps(span / dt, f"{scene.revolutions:g} revolutions at dt = {dt:.3g} s")
@@ -201,6 +212,22 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
         status, reason = "integration_failure", str(exc).strip().splitlines()[0][:300]
     if friction is not None and friction.status != STATUS_OK:
         status, reason = friction.status, friction.reason
+    return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
+
+
+def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
+    """Simulate ``scene`` with Exudyn and return its time table and summary."""
+    options = options or ExudynOptions()
+    wall_start = time.perf_counter()
+    try:
+        solved = solve(scene, options, reactions=options.records_reactions(scene))
+    except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
+        return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
+                             "engine_version": engine_version(), "scene": scene_to_dict(scene),
+                             "wall_time_s": time.perf_counter() - wall_start})
+    model, solver, status, reason = solved.model, solved.solver, solved.status, solved.reason
+    dt, dt_reason, friction = solved.dt, solved.dt_reason, model.friction
+    target = 2.0 * math.pi * scene.revolutions
     wall = time.perf_counter() - wall_start
 
     summary: dict[str, Any] = {

@@ -82,19 +82,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import exudyn as exu
 import numpy as np
 import pandas as pd
 
 from cardan_exudyn import engine
 from cardan_exudyn.engine import ExudynOptions
 from cardan_exudyn.io import to_jsonable
-from cardan_exudyn.model import ExudynModel, build_model
-from cardan_exudyn.stepsize import choose_step
+from cardan_exudyn.model import ExudynModel
 from reference.engine import ReferenceOptions
 from reference.engine import run as reference_run
 from reference.paper import named_scene
-from reference.scene import PAIR_KIND, Scene, check_steps, replace
+from reference.scene import PAIR_KIND, Scene, replace
 from reference.schema import STATUS_OK
 
 DRIFT_SCENE = "paper-10deg-2000rpm"
@@ -196,45 +194,20 @@ TOLERANCES: dict[str, tuple[float, str]] = {
 # ------------------------------------------------------------------------------ solving
 def simulate(scene: Scene, options: ExudynOptions,
              columns: bool = True) -> tuple[dict[str, Any], ExudynModel, dict[str, np.ndarray]]:
-    """Solve ``scene`` as :func:`cardan_exudyn.engine.run` does, keeping the model.
+    """Solve ``scene`` with :func:`cardan_exudyn.engine.solve` (as ``engine.run`` does), keeping
+    the model.
 
-    The steps are those of ``engine.run`` (same step choice, settings, friction set-up, stop
-    function); what differs is what comes back: the model, whose sensors hold every step, and
+    What differs from ``engine.run`` is what comes back: the model, whose sensors hold every step, and
     (``columns=True``) the result-schema columns of every step from
     :func:`cardan_exudyn.engine.postprocess`, with ``model.pair_kinematics`` filled (also for a
     failed run: the steps it completed). No table, no reaction sensors (friction reads the
     reactions itself).
     """
     wall_start = time.perf_counter()
-    dt, dt_reason = choose_step(scene, options.node_type)
-    model = build_model(scene, reactions=False, node_type=options.node_type)
-    t_end = engine.end_time(scene, model.start_time)
-    span = t_end - model.start_time
-    check_steps(span / dt, f"{scene.revolutions:g} revolutions at dt = {dt:.3g} s")
-    dt = span / engine.steps_for_span(span, dt)
-    settings = engine.simulation_settings(dt, model.start_time, t_end, options)
-    target = 2.0 * math.pi * scene.revolutions
-    friction = model.friction
-    if friction is not None:
-        friction.configure(settings)
-    engine._set_pre_step(model, target if scene.drive.kind == "torque" else None)
-    solver = exu.MainSolverImplicitSecondOrder()
-    status, reason = STATUS_OK, ""
-    try:
-        if friction is None:
-            ok = solver.SolveSystem(model.mbs, settings)
-        else:
-            solver.InitializeSolver(model.mbs, settings)
-            friction.initialise(solver, settings)
-            ok = friction.status != STATUS_OK or solver.SolveSteps(model.mbs, settings)
-            solver.FinalizeSolver(model.mbs, settings)
-        if not ok:
-            status, reason = "integration_failure", solver.GetErrorString() or "solver failed"
-    except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
-        status, reason = "integration_failure", str(exc).strip().splitlines()[0][:300]
-    if friction is not None and friction.status != STATUS_OK:
-        status, reason = friction.status, friction.reason
-    solve_wall = time.perf_counter() - wall_start
+    solved = engine.solve(scene, options, reactions=False)
+    model, solver, friction = solved.model, solved.solver, solved.model.friction
+    status, reason, dt, dt_reason = solved.status, solved.reason, solved.dt, solved.dt_reason
+    solve_wall = solved.wall_time_s
     cols: dict[str, np.ndarray] = {}
     if columns:  # a failed run too: the steps it completed
         try:
