@@ -12,15 +12,22 @@ import math
 import sys
 from typing import Any
 
-from reference.scene import DEG, RPM, Scene, SceneError, load_scene, replace
-
-EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
-EXIT_INCOMPLETE = 4
-DEFAULT_SCENE = "paper-10deg-frictionless"
-
-
-class BadInput(Exception):
-    """Raised for invalid command-line input; printed as one line, exit status 2."""
+from cardan_exudyn.arguments import (
+    EXIT_BAD_INPUT,
+    EXIT_FAILED,
+    EXIT_INCOMPLETE,
+    EXIT_OK,
+    BadInput,
+    add_scene_options,
+    cli_value,
+    count,
+    number,
+    out_folder,
+    path_value,
+    scene_from_args,
+)
+from reference.scene import SceneError
+from reference.schema import OptionsError
 
 
 class _Parser(argparse.ArgumentParser):
@@ -30,121 +37,22 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def _out_folder(path: str | None, option: str = "--out", replace: bool = True) -> None:
-    """Refuse an output folder that cannot be one before anything runs (exit 2); ``replace``: the
-    command replaces the folder as a whole (not a sweep, which writes into it)."""
-    from cardan_exudyn.io import OutputError, check_output_folder
-
-    if path is not None and not path.strip():
-        raise BadInput(f"{option} is empty: give a folder")
-    if path:
-        try:
-            check_output_folder(path, replace=replace)
-        except OutputError as exc:
-            raise BadInput(f"{option}: {exc}") from None
-
-
-def _number(kind: str, *, positive: bool = False, non_negative: bool = False):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a number ({kind}), got {text!r}") from None
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(f"expected a finite number ({kind}), got {text!r}")
-        if positive and value <= 0:
-            raise argparse.ArgumentTypeError(f"must be positive ({kind}), got {text!r}")
-        if non_negative and value < 0:
-            raise argparse.ArgumentTypeError(f"must be >= 0 ({kind}), got {text!r}")
-        return value
-
-    return parse
-
-
-def _add_scene_options(p: argparse.ArgumentParser) -> None:
-    src = p.add_mutually_exclusive_group()
-    src.add_argument("--scene", metavar="FILE", help="scene TOML file")
-    src.add_argument("--name", metavar="NAME",
-                     help=f"named scene, e.g. paper-10deg-2000rpm, rig (default {DEFAULT_SCENE})")
-    p.add_argument("--angle", metavar="DEG", type=_number("deg"), help="shaft angle [deg]")
-    p.add_argument("--rpm", metavar="RPM", type=_number("rpm"),
-                   help="constant input speed [rpm] (makes the drive a constant-speed drive)")
-    p.add_argument("--load-torque", metavar="NM", type=_number("N m"),
-                   help="resisting torque on the output shaft [N m]")
-    p.add_argument("--friction-spider", metavar="F", type=_number("-", non_negative=True),
-                   help="friction coefficient of the two spider pairs (the paper's f1)")
-    p.add_argument("--friction-frame", metavar="F", type=_number("-", non_negative=True),
-                   help="friction coefficient of the two frame pairs (the paper's f2)")
-    p.add_argument("--coupling", choices=("converged", "lagged"),
-                   help="friction coupling: converged per step (default) or lagged one step "
-                        "(the paper's)")
-    p.add_argument("--sign-band", metavar="M_S", type=_number("m/s", non_negative=True),
-                   help="surface speed [m/s] below which sign() of eqs. (3), (5) is a linear ramp")
-    p.add_argument("--no-gravity", action="store_true", help="switch gravity off")
-    p.add_argument("--dt", metavar="S", type=_number("s", positive=True),
-                   help="time step [s] (default: chosen from the scene to meet --accuracy)")
-    p.add_argument("--accuracy", metavar="E", type=_number("-", positive=True),
-                   help="target max error of omega_out/omega_in when --dt is not given")
-    p.add_argument("--revolutions", metavar="N", type=_number("-", positive=True),
-                   help="input revolutions to simulate")
-
-
-def scene_from_args(args: argparse.Namespace) -> Scene:
-    """The scene named or loaded by the options, with the command-line overrides applied."""
-    from reference.paper import named_scene
-
-    if args.scene is not None:
-        scene = load_scene(args.scene)
-    else:
-        scene = named_scene(DEFAULT_SCENE if args.name is None else args.name)
-    changes: dict[str, Any] = {}
-    if args.angle is not None:
-        changes["joint.geometry.shaft_angle"] = args.angle * DEG
-    if args.rpm is not None:
-        changes["drive"] = {"kind": "speed", "speed": args.rpm * RPM}
-    if args.load_torque is not None:
-        changes["load.torque"] = args.load_torque
-        changes["load.time"] = None  # a constant torque replaces any history
-    for option, pairs in (("friction_spider", ("input_spider", "spider_output")),
-                          ("friction_frame", ("frame_input", "output_frame"))):
-        value = getattr(args, option)
-        if value is not None:
-            for pair in pairs:
-                changes[f"joint.pairs.{pair}.friction_coefficient"] = value
-    if args.coupling is not None:
-        changes["friction.coupling"] = args.coupling
-    if args.sign_band is not None:
-        changes["friction.sign_band"] = args.sign_band
-    if args.no_gravity:
-        changes["gravity"] = [0.0, 0.0, 0.0]
-    if args.dt is not None:
-        changes["numerics.dt"] = args.dt
-    if args.accuracy is not None:
-        changes["numerics.accuracy"] = args.accuracy
-    if args.revolutions is not None:
-        changes["revolutions"] = args.revolutions
-    if not changes:
-        return scene
-    try:
-        return replace(scene, **changes)
-    except SceneError as exc:
-        raise SceneError(f"{exc} (after the command-line overrides)") from None
-
-
 def cmd_run(args: argparse.Namespace) -> int:
-    from cardan_exudyn.engines import run_scene
+    from cardan_exudyn.engines import ENGINES, run
     from cardan_exudyn.io import dumps, write_result
 
-    _out_folder(args.out)
+    if args.engine not in ENGINES:
+        raise BadInput(f"`--engine` must be one of {sorted(ENGINES)}, got {args.engine!r}")
+    out_folder(args.out)
     scene = scene_from_args(args)
-    result = run_scene(scene, args.engine)
+    result = run(scene, args.engine)
     if args.out:
         write_result(result, args.out)
     if args.json:
         print(dumps(result.summary))
     else:
         _print_summary(result.summary, args.out)
-    return EXIT_OK if result.ok else EXIT_FAILED
+    return EXIT_OK if result.success else EXIT_FAILED
 
 
 def _fmt(value: Any, spec: str, missing: str = "-") -> str:
@@ -175,10 +83,10 @@ def _print_summary(s: dict[str, Any], out: str | None) -> None:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from cardan_exudyn.reproduce import reproduce
-    from cardan_exudyn.sweep import SweepError
+    from cardan_exudyn.studies.reproduce import reproduce
+    from cardan_exudyn.sweep.runner import SweepError
 
-    _out_folder(args.out)
+    out_folder(args.out)
     try:
         return reproduce(args.out, quick=args.quick, workers=args.workers, restart=args.restart,
                          retry_failed=args.retry_failed)
@@ -187,12 +95,12 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from cardan_exudyn.bench import SCENES, BenchError, run_bench, write_bench
+    from cardan_exudyn.studies.bench import SCENES, BenchError, run_bench, write_bench
 
     def names(text: str | None, default: tuple[str, ...]) -> tuple[str, ...]:
         return tuple(n.strip() for n in text.split(",") if n.strip()) if text else default
 
-    _out_folder(args.out)
+    out_folder(args.out)
     try:
         result = run_bench(quick=args.quick, repeats=args.repeats,
                            scenes=names(args.scenes, tuple(SCENES)),
@@ -219,8 +127,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def cmd_stress(args: argparse.Namespace) -> int:
-    from cardan_exudyn.stress import StressError, parse_parts, print_summary, run_stress
-    from cardan_exudyn.sweep import SweepError
+    from cardan_exudyn.studies.stress import StressError, parse_parts, print_summary, run_stress
+    from cardan_exudyn.sweep.runner import SweepError
 
     try:
         parts = parse_parts(args.only)
@@ -243,14 +151,14 @@ def cmd_stress(args: argparse.Namespace) -> int:
 
 
 def cmd_study(args: argparse.Namespace) -> int:
-    from cardan_exudyn.studies import main_study
+    from cardan_exudyn.studies.coupling import main_study
 
-    _out_folder(args.out)
+    out_folder(args.out)
     return main_study(args.kind, args.out, args.quick, args.json)
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    from cardan_exudyn.calibrate import main_calibrate
+    from cardan_exudyn.studies.calibrate import main_calibrate
     from reference.paper import CALIBRATION_PARAMETERS
 
     names = None
@@ -269,7 +177,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from cardan_exudyn.compare import main_compare
 
     engines = [e.strip() for e in args.engines.split(",") if e.strip()]
-    _out_folder(args.out)
+    out_folder(args.out)
     try:
         return main_compare(scene_from_args(args), engines, args.skip_revolutions, args.out,
                             args.json)
@@ -289,43 +197,11 @@ def cmd_scene(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _count(name: str, minimum: int = 1):
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer ({name}), got {text!r}") from None
-        if value < minimum:
-            raise argparse.ArgumentTypeError(f"must be >= {minimum} ({name}), got {text!r}")
-        return value
-
-    return parse
-
-
-def _cli_value(text: str) -> Any:
-    """A TOML value (number, boolean, quoted string, array), else the text itself."""
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # Python 3.10
-        import tomli as tomllib
-    try:
-        return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
-        return text
-
-
-def _path_value(option: str, text: str, form: str) -> tuple[str, str]:
-    path, sep, value = text.partition("=")
-    if not sep or not path.strip() or not value.strip():
-        raise BadInput(f"{option} must look like {form}, got {text!r}")
-    return path.strip(), value
-
-
 def sweep_spec_from_args(args: argparse.Namespace) -> Any:
     """The sweep spec of ``cardan sweep``: the SPEC file, with the command-line options applied."""
     import os
 
-    from cardan_exudyn.sweep import SweepError, looks_like_path, read_spec_file, spec_from_mapping
+    from cardan_exudyn.sweep.runner import SweepError, looks_like_path, read_spec_file, spec_from_mapping
 
     data = read_spec_file(args.spec) if args.spec else {}
     if args.scene is not None:
@@ -337,9 +213,9 @@ def sweep_spec_from_args(args: argparse.Namespace) -> Any:
     for option, key, items, form in (("--grid", "grid", args.grid, "PATH=V1,V2,..."),
                                      ("--set", "fixed", args.set, "PATH=VALUE")):
         for text in items or ():
-            path, value = _path_value(option, text, form)
+            path, value = path_value(option, text, form)
             table = data.setdefault(key, {})
-            table[path] = [_cli_value(v) for v in value.split(",")] if key == "grid" else _cli_value(value)
+            table[path] = [cli_value(v) for v in value.split(",")] if key == "grid" else cli_value(value)
     data.setdefault("scene", None)
     if not args.spec:
         return spec_from_mapping(data)
@@ -351,9 +227,9 @@ def sweep_spec_from_args(args: argparse.Namespace) -> Any:
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from cardan_exudyn.io import dumps
-    from cardan_exudyn.sweep import SweepError, SweepIncomplete, run_sweep
+    from cardan_exudyn.sweep.runner import SweepError, SweepIncomplete, run_sweep
 
-    _out_folder(args.out, replace=False)
+    out_folder(args.out, replace=False)
     try:
         spec = sweep_spec_from_args(args)
         summary = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler,
@@ -376,9 +252,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 def _distribution(text: str) -> tuple[str, dict[str, Any]]:
     """``PATH=uniform:LOW:HIGH`` or ``PATH=normal:MEAN:STD[:LOW:HIGH]`` for ``--error``."""
-    from cardan_exudyn.sweep import Distribution, SweepError
+    from cardan_exudyn.sweep.runner import Distribution, SweepError
 
-    path, value = _path_value("--error", text, "PATH=uniform:LOW:HIGH or PATH=normal:MEAN:STD[:LOW:HIGH]")
+    path, value = path_value("--error", text, "PATH=uniform:LOW:HIGH or PATH=normal:MEAN:STD[:LOW:HIGH]")
     kind, *numbers = value.split(":")
     names = {"uniform": ("low", "high"), "normal": ("mean", "std", "low", "high")}.get(kind)
     if names is None or not (2 <= len(numbers) <= len(names)) or (kind == "normal" and len(numbers) == 3):
@@ -394,15 +270,15 @@ def _distribution(text: str) -> tuple[str, dict[str, Any]]:
 def cmd_tolerance(args: argparse.Namespace) -> int:
     from cardan_exudyn.engines import ENGINES
     from cardan_exudyn.io import dumps
-    from cardan_exudyn.sweep import SweepError
+    from cardan_exudyn.sweep.runner import SweepError
 
-    _out_folder(args.out, replace=args.study == "paper")
+    out_folder(args.out, replace=args.study == "paper")
     if args.study == "paper":
         engines = [e.strip() for e in args.engines.split(",") if e.strip()]
         unknown = [e for e in engines if e not in ENGINES]
         if not engines or unknown:
             raise BadInput(f"--engines must name engines of {sorted(ENGINES)}, got {args.engines!r}")
-        from cardan_exudyn.tolerance import paper_report
+        from cardan_exudyn.studies.tolerance import paper_report
 
         def show(row: dict) -> None:
             if not args.json:
@@ -417,7 +293,7 @@ def cmd_tolerance(args: argparse.Namespace) -> int:
             print(f"wrote {args.out}/report.md", file=sys.stderr)
         failed = [c for c in summary["cases"] if "ok" != c["status_ideal"] or "ok" != c["status_errors"]]
         return EXIT_FAILED if failed else EXIT_OK
-    from cardan_exudyn.tolerance import default_distributions, monte_carlo
+    from cardan_exudyn.studies.tolerance import default_distributions, monte_carlo
 
     scene = scene_from_args(args)
     distributions = dict(_distribution(t) for t in args.error) if args.error else default_distributions()
@@ -446,7 +322,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("run", help="simulate one scene")
-    _add_scene_options(p)
+    add_scene_options(p)
     p.add_argument("--engine", default="exudyn",
                    help="exudyn (default), reference, or mujoco (frictionless; optional extra)")
     p.add_argument("--out", metavar="DIR", help="write timeseries.csv and summary.json here")
@@ -456,7 +332,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("reproduce", help="reproduce the paper's studies into a report folder")
     p.add_argument("--out", metavar="DIR", default="reports/reproduce", help="report folder")
     p.add_argument("--quick", action="store_true", help="fewer scenes and a coarser accuracy")
-    p.add_argument("--workers", type=_count("--workers"), metavar="N",
+    p.add_argument("--workers", type=count("--workers"), metavar="N",
                    help="local processes (default: all cores; 1 runs in this process)")
     p.add_argument("--restart", action="store_true",
                    help="discard the runs recorded in OUT/runs and run every case again")
@@ -472,7 +348,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="results folder: bench.csv, targets.csv, audit.csv, bench.json, report.md, "
                         "work_precision.png")
     p.add_argument("--quick", action="store_true", help="short ladders, one repeat (< 1 min)")
-    p.add_argument("--repeats", type=_count("--repeats"), metavar="N",
+    p.add_argument("--repeats", type=count("--repeats"), metavar="N",
                    help="timed runs per configuration, median reported (default 3, quick 1)")
     p.add_argument("--scenes", metavar="A,B", help="subset of frictionless-10deg, frictionless-35deg, "
                                                     "friction-10deg, friction-35deg")
@@ -492,7 +368,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "bad-input files, stress.json); the map's runs are kept in OUT/runs")
     p.add_argument("--quick", action="store_true", help="coarse map, short long runs (CI variant)")
     p.add_argument("--only", metavar="A,B", help="subset of map, long, inputs (default all)")
-    p.add_argument("--workers", type=_count("--workers"), metavar="N",
+    p.add_argument("--workers", type=count("--workers"), metavar="N",
                    help="local processes for the map (default: all cores; 1 runs in this process)")
     p.add_argument("--restart", action="store_true",
                    help="discard the map's runs recorded in OUT/runs and run every cell again")
@@ -515,11 +391,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_calibrate)
 
     p = sub.add_parser("compare", help="run several engines on one scene and compare them")
-    _add_scene_options(p)
+    add_scene_options(p)
     p.add_argument("--engines", default="exudyn,reference", metavar="A,B",
                    help="engines, the first is the base (default exudyn,reference; mujoco needs "
                         "the optional extra and a frictionless scene)")
-    p.add_argument("--skip-revolutions", type=_number("--skip-revolutions", non_negative=True),
+    p.add_argument("--skip-revolutions", type=number("--skip-revolutions", non_negative=True),
                    default=0.0, metavar="N",
                    help="leave the first N revolutions out of the 'steady' statistics")
     p.add_argument("--out", metavar="DIR",
@@ -542,7 +418,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", metavar="PATH=VALUE",
                    help="override applied to every case, repeatable")
     where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=_count("--workers"), metavar="N",
+    where.add_argument("--workers", type=count("--workers"), metavar="N",
                        help="local processes (default: all cores; 1 runs in this process)")
     where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                        help="run on this Dask distributed scheduler instead")
@@ -561,8 +437,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     p.add_argument("--engines", default="reference,exudyn", help="paper: engines to compare")
     p.add_argument("--engine", default="reference", help="montecarlo: engine (default reference)")
-    p.add_argument("--samples", type=_count("--samples"), default=1000, help="montecarlo: N (1000)")
-    p.add_argument("--seed", type=_count("--seed", minimum=0), default=1,
+    p.add_argument("--samples", type=count("--samples"), default=1000, help="montecarlo: N (1000)")
+    p.add_argument("--seed", type=count("--seed", minimum=0), default=1,
                    help="montecarlo: seed of the draws (1)")
     p.add_argument("--method", choices=("lhs", "random"), default="lhs",
                    help="montecarlo: Latin hypercube (default) or independent draws")
@@ -570,19 +446,30 @@ def build_parser() -> argparse.ArgumentParser:
                    help="montecarlo: e.g. joint.errors.a1_mm=uniform:-0.5:0.5, "
                         "joint.errors.alpha2_deg=normal:0:0.002:-0.006:0.006; repeatable")
     where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=_count("--workers"), metavar="N",
+    where.add_argument("--workers", type=count("--workers"), metavar="N",
                        help="local processes (default: all cores; 1 runs in this process)")
     where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="Dask scheduler to run on")
     p.add_argument("--restart", action="store_true", help="montecarlo: discard earlier samples in --out")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
-    _add_scene_options(p)
+    add_scene_options(p)
     p.set_defaults(func=cmd_tolerance, name="rig-calibrated")
 
     p = sub.add_parser("scene", help="print the fully resolved scene as TOML")
-    _add_scene_options(p)
+    add_scene_options(p)
     p.set_defaults(func=cmd_scene)
+    _add_study_commands(sub)
     _add_plugin_commands(sub)
     return parser
+
+
+def _add_study_commands(sub: argparse._SubParsersAction) -> None:
+    """The subcommands the study modules register (:data:`cardan_exudyn.studies.COMMANDS`)."""
+    import importlib
+
+    from cardan_exudyn.studies import COMMANDS
+
+    for name in COMMANDS:
+        importlib.import_module(f"cardan_exudyn.studies.{name}").register(sub)
 
 
 def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:
@@ -602,7 +489,7 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         return args.func(args)
-    except (SceneError, EngineUnavailable, BadInput, OutputError) as exc:
+    except (SceneError, OptionsError, EngineUnavailable, BadInput, OutputError) as exc:
         print(f"cardan {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:

@@ -195,7 +195,7 @@ def overlay_plots(comparison: dict[str, Any], folder: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cardan_exudyn.plots import save
+    from cardan_exudyn.report.plots import save
 
     tables = {k: v for k, v in comparison["tables"].items() if v is not None}
     groups = {

@@ -1,19 +1,40 @@
-"""Engine registry: every engine takes a :class:`reference.scene.Scene` and returns a
-:class:`reference.schema.Result` with the same columns and summary keys."""
+"""The one engine dispatch: every engine takes a :class:`reference.scene.Scene` and options, and
+returns a :class:`reference.schema.Result` with the same columns and summary fields.
+
+Like scipy's ``solve_ivp(method=...)`` over its ``METHODS`` table: callers name an engine (or
+pass options of an engine's class) and never import an engine module themselves. Engines are
+imported on first use, so a missing optional engine (MuJoCo) costs nothing until asked for.
+"""
 
 from __future__ import annotations
 
 import importlib
 from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
 
 from reference.scene import Scene
-from reference.schema import Result
+from reference.schema import OptionsError, Result
 
-# name -> "module:function"; imported on first use so that a missing optional engine costs nothing
-ENGINES = {
-    "exudyn": "cardan_exudyn.engine:run",
-    "reference": "reference.engine:run",
-    "mujoco": "cardan_exudyn.mujoco_engine:run",  # optional extra; frictionless scenes only
+
+@dataclass(frozen=True)
+class Engine:
+    """An entry of :data:`ENGINES`: where its run function and options class live."""
+
+    name: str
+    module: str
+    options: str
+    description: str
+
+
+ENGINES: dict[str, Engine] = {
+    "exudyn": Engine("exudyn", "cardan_exudyn.model.solve", "ExudynOptions",
+                     "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
+    "reference": Engine("reference", "reference.engine", "ReferenceOptions",
+                        "independent numpy/scipy engine: closed-form or dual-number kinematics, "
+                        "minimal-coordinate dynamics, adaptive work quadrature"),
+    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco_engine", "MujocoOptions",
+                     "MuJoCo (optional extra): frictionless scenes with a constant load only"),
 }
 
 
@@ -21,20 +42,84 @@ class EngineUnavailable(ValueError):
     """The engine is unknown, not installed, or cannot run this kind of scene."""
 
 
-def get_engine(name: str) -> Callable[[Scene], Result]:
-    if name not in ENGINES:
-        raise EngineUnavailable(f"`--engine` must be one of {sorted(ENGINES)}, got {name!r}")
-    module, func = ENGINES[name].split(":")
+def _entry(name: str) -> Engine:
+    if not isinstance(name, str) or name not in ENGINES:
+        raise EngineUnavailable(f"`engine` must be one of {sorted(ENGINES)}, got {name!r}")
+    return ENGINES[name]
+
+
+def _module(name: str) -> Any:
+    entry = _entry(name)
     try:
-        return getattr(importlib.import_module(module), func)
-    except (ImportError, AttributeError) as exc:
+        return importlib.import_module(entry.module)
+    except ImportError as exc:
         raise EngineUnavailable(f"engine {name!r} is not available: {exc}") from None
 
 
-def run_scene(scene: Scene, engine: str = "exudyn") -> Result:
-    """Run ``scene`` with the named engine."""
-    run = get_engine(engine)
+def options_class(engine: str) -> type:
+    """The options class of ``engine`` (a frozen dataclass validated on construction)."""
+    return getattr(_module(engine), _entry(engine).options)
+
+
+def make_options(engine: str, **values: Any) -> Any:
+    """Options of ``engine`` from keyword values; unknown names raise :class:`OptionsError`."""
+    cls = options_class(engine)
+    unknown = sorted(set(values) - set(cls.__dataclass_fields__))
+    if unknown:
+        raise OptionsError(f"unknown option(s) {unknown} for engine {engine!r}; "
+                           f"known: {sorted(cls.__dataclass_fields__)}")
+    return cls(**values)
+
+
+def get_engine(name: str) -> Callable[..., Result]:
+    """The run function ``run(scene, options=None) -> Result`` of the named engine."""
+    return _module(name).run
+
+
+def engine_of(options: Any) -> str:
+    """The engine whose options class ``options`` is an instance of."""
+    for name, entry in ENGINES.items():
+        if type(options).__name__ == entry.options:
+            return name
+    raise OptionsError(f"`options` must be the options of an engine in {sorted(ENGINES)}, "
+                       f"got {type(options).__name__}")
+
+
+def run(scene: Scene, engine: str | None = None, options: Any = None, **option_values: Any) -> Result:
+    """Run ``scene`` with an engine.
+
+    Parameters
+    ----------
+    scene : Scene
+    engine : str, optional
+        A key of :data:`ENGINES`; by default the engine of ``options``, else ``"exudyn"``.
+    options : optional
+        An instance of the engine's options class (``ExudynOptions``, ``ReferenceOptions``,
+        ``MujocoOptions``); or give its fields as keywords (``node_type="EP"``).
+
+    Raises
+    ------
+    EngineUnavailable
+        Unknown or uninstalled engine, or a scene the engine cannot express.
+    OptionsError
+        Options of another engine's class, unknown or out-of-range option values.
+    """
+    if engine is None:
+        engine = engine_of(options) if options is not None else "exudyn"
+    if options is not None and option_values:
+        raise OptionsError("give `options` or option keywords, not both")
+    if options is None and option_values:
+        options = make_options(engine, **option_values)
+    if options is not None and engine_of(options) != engine:
+        raise OptionsError(f"`options` are {type(options).__name__}, not the options of "
+                           f"engine {engine!r}")
+    run_function = get_engine(engine)
     try:
-        return run(scene)
+        return run_function(scene, options)
     except NotImplementedError as exc:
         raise EngineUnavailable(f"engine {engine!r} cannot run scene {scene.name!r}: {exc}") from None
+
+
+def run_scene(scene: Scene, engine: str = "exudyn", options: Any = None) -> Result:
+    """Run ``scene`` with the named engine (same as :func:`run`)."""
+    return run(scene, engine, options)

@@ -4,7 +4,7 @@ Every entry point must reject bad input with one clear line naming what is wrong
 command line (every subcommand, ``cardan rig ...`` included) exits with status 2, one line on
 stderr, nothing on stdout, no traceback, and leaves an output folder it was given as it was; the
 Python API raises a documented exception (:class:`~reference.scene.SceneError`,
-:class:`~cardan_exudyn.sweep.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
+:class:`~cardan_exudyn.sweep.runner.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
 :class:`~cardan_exudyn.io.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
 one-line message. A run that fails is not bad input: it exits with status 3 and a status line
 with its reason, and prints no NaN or infinite efficiency (nor does a run with no input work,
@@ -39,8 +39,9 @@ from typing import Any
 
 from cardan_exudyn.engines import EngineUnavailable
 from cardan_exudyn.io import OutputError
-from cardan_exudyn.sweep import SweepError
+from cardan_exudyn.sweep.runner import SweepError
 from reference.scene import SceneError
+from reference.schema import OptionsError
 
 #: Entry points, in the order of the report.
 ENTRY_POINTS = ("scene file", "cli", "python api", "rig file", "sweep spec", "run failure")
@@ -218,14 +219,14 @@ def _api_compare_unknown(d: Path) -> Any:
 
 def _api_spec_empty_grid(d: Path) -> Any:
     """spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})"""
-    from cardan_exudyn.sweep import spec_from_mapping
+    from cardan_exudyn.sweep.runner import spec_from_mapping
 
     return spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})
 
 
 def _api_sweep_out_of_range(d: Path) -> Any:
     """run_sweep({"scene": "paper", "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, OUT)"""
-    from cardan_exudyn.sweep import run_sweep
+    from cardan_exudyn.sweep.runner import run_sweep
 
     return run_sweep({"scene": "paper", "engine": "reference",
                       "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, d / "out", workers=1)
@@ -233,7 +234,7 @@ def _api_sweep_out_of_range(d: Path) -> Any:
 
 def _api_distribution(d: Path) -> Any:
     """Distribution("normal", mean=0, std=0)"""
-    from cardan_exudyn.sweep import Distribution
+    from cardan_exudyn.sweep.runner import Distribution
 
     return Distribution("normal", mean=0.0, std=0.0)
 
@@ -255,7 +256,7 @@ def _api_reference_options(d: Path) -> Any:
 
 def _api_exudyn_options(d: Path) -> Any:
     """ExudynOptions(node_type="warp")"""
-    from cardan_exudyn.engine import ExudynOptions
+    from cardan_exudyn.model.solve import ExudynOptions
 
     return ExudynOptions(node_type="warp")
 
@@ -462,7 +463,7 @@ CASES: tuple[Case, ...] = (
     Case("api-reference-options", "python api", "negative quadrature tolerance", call=_api_reference_options,
          expect=ValueError, match="quadrature_rtol"),
     Case("api-exudyn-options", "python api", "unknown node type", call=_api_exudyn_options,
-         expect=SceneError, match="node_type"),
+         expect=OptionsError, match="node_type"),
     # ---------------------------------------------------------------- rig files
     Case("rig-empty", "rig file", "empty file", ("rig", "inspect", "{d}/rig.csv"), files={"rig.csv": ""},
          match="empty file"),

@@ -12,13 +12,14 @@ import math
 import os
 import shutil
 import tempfile
+from enum import Enum
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from reference.schema import Result
+from reference.schema import Result, Summary
 
 
 class OutputError(ValueError):
@@ -28,6 +29,10 @@ class OutputError(ValueError):
 
 def to_jsonable(value: Any) -> Any:
     """Plain JSON data: numpy scalars and arrays converted, NaN and infinities as null."""
+    if isinstance(value, Summary):
+        return to_jsonable(value.to_dict())
+    if isinstance(value, Enum):
+        return value.value
     if isinstance(value, dict):
         return {str(k): to_jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

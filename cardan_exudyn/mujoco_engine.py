@@ -3,7 +3,7 @@
 MuJoCo cannot express the paper's friction law (friction forces proportional to the pair
 reactions, eqs. (1)-(5)): its friction loss is a constant-magnitude joint friction. This engine
 therefore runs frictionless scenes only and refuses the others. ``docs/mujoco.md`` holds the
-settings study behind :class:`MujocoSettings`' defaults. Importing this module needs MuJoCo; the
+settings study behind :class:`MujocoOptions`' defaults. Importing this module needs MuJoCo; the
 engine registry imports it on first use, so a missing MuJoCo makes only this engine unavailable.
 
 Model
@@ -81,8 +81,10 @@ from reference.scene import (
     scene_to_dict,
 )
 from reference.schema import (
-    STATUS_OK,
+    OptionsError,
     Result,
+    Status,
+    Summary,
     instantaneous_efficiency,
     mean_values,
     table_columns,
@@ -107,13 +109,13 @@ def _floats(name: str, value: Any) -> tuple[float, ...]:
     try:
         return tuple(float(v) for v in value)
     except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be a sequence of numbers, got {value!r}") from None
+        raise OptionsError(f"`{name}` must be a sequence of numbers, got {value!r}") from None
 
 
 def _solref(name: str, value: Any) -> tuple[float, ...]:
     ref = _floats(name, value)
     if len(ref) != 2 or not (min(ref) > 0.0 or (ref[0] < 0.0 and ref[1] <= 0.0)):
-        raise ValueError(f"`{name}` must be (timeconst > 0, dampratio > 0) or "
+        raise OptionsError(f"`{name}` must be (timeconst > 0, dampratio > 0) or "
                          f"(-stiffness < 0, -damping <= 0), got {value!r}")
     return ref
 
@@ -121,12 +123,12 @@ def _solref(name: str, value: Any) -> tuple[float, ...]:
 def _solimp(name: str, value: Any) -> tuple[float, ...]:
     imp = _floats(name, value)
     if len(imp) != 5 or not (0.0 < imp[0] < 1.0 and 0.0 < imp[1] < 1.0):
-        raise ValueError(f"`{name}` must be 5 numbers with 0 < d0, dwidth < 1, got {value!r}")
+        raise OptionsError(f"`{name}` must be 5 numbers with 0 < d0, dwidth < 1, got {value!r}")
     return imp
 
 
 @dataclass(frozen=True)
-class MujocoSettings:
+class MujocoOptions:
     """Solver settings of the MuJoCo engine; the defaults are the recommended ones.
 
     Attributes
@@ -179,12 +181,12 @@ class MujocoSettings:
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATORS:
-            raise ValueError(f"`integrator` must be one of {list(INTEGRATORS)}, got {self.integrator!r}")
+            raise OptionsError(f"`integrator` must be one of {list(INTEGRATORS)}, got {self.integrator!r}")
         for name in ("timeconst_steps", "dampratio", "reference_inertia"):
             if not getattr(self, name) > 0.0:
-                raise ValueError(f"`{name}` must be positive, got {getattr(self, name)!r}")
+                raise OptionsError(f"`{name}` must be positive, got {getattr(self, name)!r}")
         if self.timestep is not None and not self.timestep > 0.0:
-            raise ValueError(f"`timestep` must be positive or None, got {self.timestep!r}")
+            raise OptionsError(f"`timestep` must be positive or None, got {self.timestep!r}")
         for name, check in (("solref", _solref), ("o_solref", _solref), ("o_solimp", _solimp)):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, check(name, getattr(self, name)))
@@ -192,17 +194,17 @@ class MujocoSettings:
         for name in ("iterations", "noslip_iterations"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < (name == "iterations"):
-                raise ValueError(f"`{name}` must be a non-negative integer (iterations >= 1), "
+                raise OptionsError(f"`{name}` must be a non-negative integer (iterations >= 1), "
                                  f"got {value!r}")
         if not self.tolerance >= 0.0:
-            raise ValueError(f"`tolerance` must be >= 0, got {self.tolerance!r}")
+            raise OptionsError(f"`tolerance` must be >= 0, got {self.tolerance!r}")
 
     def solref_for(self, dt: float) -> tuple[float, float]:
         """The ``solref`` used at time step ``dt`` [s]."""
         return self.solref if self.solref is not None else (self.timeconst_steps * dt, self.dampratio)
 
 
-MUJOCO_DEFAULTS = MujocoSettings(integrator="Euler", timestep=MUJOCO_DEFAULT_TIMESTEP,
+MUJOCO_DEFAULTS = MujocoOptions(integrator="Euler", timestep=MUJOCO_DEFAULT_TIMESTEP,
                                  solref=MUJOCO_DEFAULT_SOLREF, solimp=MUJOCO_DEFAULT_SOLIMP)
 
 # Error model of the recommended settings (RK4, solref None): the largest error of
@@ -223,7 +225,7 @@ def engine_version() -> str:
     return mujoco.__version__
 
 
-def speed_ratio_error_model(scene: Scene, settings: MujocoSettings, steps: int) -> float:
+def speed_ratio_error_model(scene: Scene, settings: MujocoOptions, steps: int) -> float:
     """Predicted largest speed-ratio error [-] of a run with ``steps`` steps per revolution.
 
     Valid for the recommended integrator and constraint settings (RK4, ``solref`` from
@@ -238,7 +240,7 @@ def speed_ratio_error_model(scene: Scene, settings: MujocoSettings, steps: int) 
             + ERROR_CONSTANT_GRAVITY * gravity * timeconst / omega)
 
 
-def choose_timestep(scene: Scene, settings: MujocoSettings) -> tuple[float, str]:
+def choose_timestep(scene: Scene, settings: MujocoOptions) -> tuple[float, str]:
     """Time step [s] and a sentence saying how it was chosen.
 
     Without a given step, the fewest whole steps per revolution (at the drive's highest speed),
@@ -256,7 +258,7 @@ def choose_timestep(scene: Scene, settings: MujocoSettings) -> tuple[float, str]
     if scene.numerics.dt is not None:
         return scene.numerics.dt, "given (scene)"
     if settings.integrator != "RK4" or settings.solref is not None:
-        raise ValueError("the automatic time step is measured for RK4 with `solref` from "
+        raise OptionsError("the automatic time step is measured for RK4 with `solref` from "
                          f"`timeconst_steps` only; give `timestep` for integrator "
                          f"{settings.integrator!r} and solref {settings.solref!r}")
     accuracy = scene.numerics.accuracy
@@ -285,7 +287,7 @@ def _inertial(scene: Scene, name: str) -> str:
     return f'<inertial pos="{_numbers(com)}" mass="{mass!r}" fullinertia="{_numbers(full)}"/>'
 
 
-def mjcf(scene: Scene, settings: MujocoSettings, dt: float) -> str:
+def mjcf(scene: Scene, settings: MujocoOptions, dt: float) -> str:
     """The MJCF model of ``scene`` (see the module docstring) with time step ``dt`` [s]."""
     geo = scene.joint.geometry
     half = 0.5 * geo.shaft_angle
@@ -450,7 +452,7 @@ def _integrate(m: Any, d: Any) -> None:
         mujoco.mj_step(m, d)
 
 
-def simulate(scene: Scene, settings: MujocoSettings, dt: float) -> tuple[_Record, str, str]:
+def simulate(scene: Scene, settings: MujocoOptions, dt: float) -> tuple[_Record, str, str]:
     """Run the MuJoCo model of ``scene``; per-step records, status and reason.
 
     Every step runs ``mj_forward`` and ``mj_rnePostConstraint`` at the current state, records,
@@ -474,7 +476,7 @@ def simulate(scene: Scene, settings: MujocoSettings, dt: float) -> tuple[_Record
     record = _Record(steps + 1)
     drive_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "drive")
     drive_row = None
-    status, reason = STATUS_OK, ""
+    status, reason = Status.OK, ""
     for k in range(steps + 1):
         d.time = plan.start + k * dt
         if plan.motion is not None:
@@ -488,14 +490,14 @@ def simulate(scene: Scene, settings: MujocoSettings, dt: float) -> tuple[_Record
                                            & (d.efc_id == drive_id))[0])
         record.take(d, drive_row, torque)
         if not math.isfinite(d.qvel @ d.qvel + d.qacc @ d.qacc):
-            status, reason = "diverged", f"non-finite state at t = {d.time:.6g} s (step {k})"
+            status, reason = Status.DIVERGED, f"non-finite state at t = {d.time:.6g} s (step {k})"
             break
         if abs(d.qpos[0] - plan.theta0) >= plan.turn - 1e-12 or k == steps:
             break
         _integrate(m, d)
     turned = abs(d.qpos[0] - plan.theta0)
-    if status == STATUS_OK and turned < plan.turn - 1e-9:
-        status = "incomplete"
+    if status == Status.OK and turned < plan.turn - 1e-9:
+        status = Status.INCOMPLETE
         reason = (f"the input turned {turned / (2 * math.pi):.6g} of {scene.revolutions:g} "
                   "revolutions in the time allowed")
     return record.trimmed(), status, reason
@@ -597,14 +599,14 @@ def constraint_violation(scene: Scene, record: _Record) -> dict[str, float]:
             "max_drive_error_rad": float(np.max(lag)) if np.all(np.isfinite(lag)) else float("nan")}
 
 
-def run(scene: Scene, settings: MujocoSettings | None = None) -> Result:
+def run(scene: Scene, settings: MujocoOptions | None = None) -> Result:
     """Simulate the frictionless ``scene`` with MuJoCo and return its time table and summary.
 
     Parameters
     ----------
     scene : Scene
         A scene with every friction coefficient zero.
-    settings : MujocoSettings, optional
+    settings : MujocoOptions, optional
         Solver settings; the defaults are the recommended ones (``docs/mujoco.md``).
 
     Returns
@@ -626,35 +628,36 @@ def run(scene: Scene, settings: MujocoSettings | None = None) -> Result:
     if not scene.load.constant:
         raise NotImplementedError("the MuJoCo engine takes a constant load torque only; a load "
                                   "history (measured brake torque) runs on exudyn or reference")
-    settings = settings or MujocoSettings()
+    settings = settings or MujocoOptions()
     start = time.perf_counter()
     dt, why = choose_timestep(scene, settings)
     record, status, reason = simulate(scene, settings, dt)
     cols = columns(scene, record)
-    summary: dict[str, Any] = {
-        "status": status, "reason": reason, "engine": ENGINE_NAME,
-        "engine_version": engine_version(), "scene": scene_to_dict(scene), "dt": dt,
-        "dt_choice": why, "steps": int(record.t.size - 1),
-        "options": {**asdict(settings), "solref": list(settings.solref_for(dt))},
-        **constraint_violation(scene, record),
-    }
-    if status == STATUS_OK:
+    summary = Summary(status, reason, engine=ENGINE_NAME, engine_version=engine_version(),
+                      scene=scene_to_dict(scene), dt=dt, dt_choice=why, steps=int(record.t.size - 1),
+                      options={**asdict(settings), "solref": list(settings.solref_for(dt))})
+    violation = constraint_violation(scene, record)
+    summary.max_constraint_violation_m = violation["max_constraint_violation_m"]
+    summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
+    summary.extras["max_drive_error_rad"] = violation["max_drive_error_rad"]
+    if summary.success:
         means = mean_values(cols, scene.record.skip_revolutions)
         if means.get("revolutions", 0) < 1:
-            summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))
-        elif summary["max_constraint_violation_rad"] > VIOLATION_LIMIT_RAD:
-            summary.update(status="constraint_violated", reason=(
+            summary.fail(Status.NO_WHOLE_REVOLUTION, means.get("mean_status", ""))
+        elif summary.max_constraint_violation_rad > VIOLATION_LIMIT_RAD:
+            summary.fail(Status.CONSTRAINT_VIOLATED, (
                 f"the output axis left its bearing by up to "
-                f"{summary['max_constraint_violation_rad']:.3g} rad (limit {VIOLATION_LIMIT_RAD:g}):"
+                f"{summary.max_constraint_violation_rad:.3g} rad (limit {VIOLATION_LIMIT_RAD:g}):"
                 " the loop closure is too soft for this time step and these settings"))
-        summary.update({k: v for k, v in means.items() if k != "mean_status"})
+        else:
+            summary.set_means(means)
     table = None
     if scene.record.timeseries:
         import pandas as pd
 
         every = scene.record.every
         table = pd.DataFrame({c: cols[c][::every] for c in table_columns()})
-    summary["wall_time_s"] = time.perf_counter() - start
+    summary.wall_time_s = time.perf_counter() - start
     return Result(table, summary)
 
 
@@ -695,12 +698,12 @@ def accuracy(scene: Scene, result: Result) -> dict[str, float]:
         np.max(np.abs(table["torque_in"].to_numpy() - ref)) / np.max(np.abs(ref)),
         abs(summary["mean_torque_in"] - scene.load.torque),
         summary["max_constraint_violation_rad"], summary["max_constraint_violation_m"],
-        summary["max_drive_error_rad"],
+        summary.extras["max_drive_error_rad"],
     )
     return {k: float(v) for k, v in zip(keys, values, strict=True)}
 
 
-def study_cases(timesteps: Iterable[float] = STUDY_TIMESTEPS) -> list[tuple[str, MujocoSettings]]:
+def study_cases(timesteps: Iterable[float] = STUDY_TIMESTEPS) -> list[tuple[str, MujocoOptions]]:
     """The settings compared in ``docs/mujoco.md``: ``(label, settings)`` pairs.
 
     MuJoCo's defaults as they come (Euler, 2 ms); then for every time step the default
@@ -713,15 +716,15 @@ def study_cases(timesteps: Iterable[float] = STUDY_TIMESTEPS) -> list[tuple[str,
     cases = [("MuJoCo defaults", MUJOCO_DEFAULTS)]
     timesteps = list(timesteps)
     for dt in timesteps:
-        cases += [(f"default solref/solimp, {i}", MujocoSettings(integrator=i, timestep=dt, **soft))
+        cases += [(f"default solref/solimp, {i}", MujocoOptions(integrator=i, timestep=dt, **soft))
                   for i in ("Euler", "RK4")]
-        cases += [(f"{i}, tc 2 dt", MujocoSettings(integrator=i, timestep=dt, timeconst_steps=2, **stiff))
+        cases += [(f"{i}, tc 2 dt", MujocoOptions(integrator=i, timestep=dt, timeconst_steps=2, **stiff))
                   for i in INTEGRATORS]
-        cases += [(f"RK4, tc {n:g} dt", MujocoSettings(timestep=dt, timeconst_steps=n))
+        cases += [(f"RK4, tc {n:g} dt", MujocoOptions(timestep=dt, timeconst_steps=n))
                   for n in (5, 20, 50)]
     dt = timesteps[0]
     tc = 20 * dt
-    recommended = MujocoSettings(timestep=dt)
+    recommended = MujocoOptions(timestep=dt)
     cases += [
         ("RK4, tc 20 dt, direct solref", replace(recommended, solref=(-1.0 / tc**2, -2.0 / tc))),
         ("RK4, tc 20 dt, dampratio 0.5", replace(recommended, dampratio=0.5)),
@@ -743,18 +746,18 @@ def study_cases(timesteps: Iterable[float] = STUDY_TIMESTEPS) -> list[tuple[str,
     return cases
 
 
-def low_speed_cases(timesteps: Iterable[float] = (1e-3, 3e-4, 1e-4)) -> list[tuple[str, MujocoSettings]]:
+def low_speed_cases(timesteps: Iterable[float] = (1e-3, 3e-4, 1e-4)) -> list[tuple[str, MujocoOptions]]:
     """RK4 with constraint time constants of 5 and 20 steps, for the slow rig scene.
 
     At low speed gravity, not inertia, loads the loop closure, and the drift the impedance cap
     lets it cause grows with the time constant (the error model's second term).
     """
-    return [(f"RK4, tc {n} dt", MujocoSettings(timestep=dt, timeconst_steps=n))
+    return [(f"RK4, tc {n} dt", MujocoOptions(timestep=dt, timeconst_steps=n))
             for dt in timesteps for n in (5, 20)]
 
 
 def settings_study(scenes: Iterable[str] = STUDY_SCENES,
-                   cases: Iterable[tuple[str, MujocoSettings]] | None = None,
+                   cases: Iterable[tuple[str, MujocoOptions]] | None = None,
                    repeats: int = 3) -> Any:
     """Error and cost of MuJoCo settings on frictionless constant-speed scenes.
 
@@ -762,7 +765,7 @@ def settings_study(scenes: Iterable[str] = STUDY_SCENES,
     ----------
     scenes : iterable of str
         Named scenes (:func:`reference.paper.named_scene`), frictionless, constant speed.
-    cases : iterable of (str, MujocoSettings), optional
+    cases : iterable of (str, MujocoOptions), optional
         Labelled settings; default :func:`study_cases`.
     repeats : int
         Runs per case; the wall time is their median [-].

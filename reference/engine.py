@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -44,9 +45,10 @@ from reference.scene import (
     scene_to_dict,
 )
 from reference.schema import (
-    STATUS_NO_CLOSURE,
-    STATUS_OK,
+    OptionsError,
     Result,
+    Status,
+    Summary,
     mean_values,
     table_columns,
     whole_revolution_window,
@@ -54,7 +56,6 @@ from reference.schema import (
 
 ENGINE_NAME = "reference"
 ENGINE_VERSION = "reference-0.2"
-STATUS_SELF_LOCKING = "self_locking"
 EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
                  *(f"{p}_slide" for p in PAIR_NAMES),
                  *(f"power_loss_{p}_{part}" for p in PAIR_NAMES for part in ("rotation", "sliding")))
@@ -93,15 +94,15 @@ class ReferenceOptions:
         spr = self.samples_per_revolution
         if spr is not None and (isinstance(spr, bool) or not isinstance(spr, (int, np.integer))
                                 or spr < 1):
-            raise ValueError(f"`samples_per_revolution` must be a positive integer, got {spr!r}")
+            raise OptionsError(f"`samples_per_revolution` must be a positive integer, got {spr!r}")
         for name in ("panels_per_revolution", "gauss_nodes"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-                raise ValueError(f"`{name}` must be a positive integer, got {v!r}")
+                raise OptionsError(f"`{name}` must be a positive integer, got {v!r}")
         for name in ("ode_rtol", "ode_atol", "quadrature_rtol"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and 0.0 < v < 1.0):
-                raise ValueError(f"`{name}` must be in (0, 1), got {v!r}")
+                raise OptionsError(f"`{name}` must be in (0, 1), got {v!r}")
 
 
 class SelfLocking(Exception):
@@ -141,7 +142,7 @@ class InputMotion:
     state: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray | None]]
     torque_in: float | None = None
     knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    status: str = STATUS_OK
+    status: Status = Status.OK
     reason: str = ""
     ode_evaluations: int = 0
     periodic: bool = False
@@ -195,13 +196,13 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
                         atol=[options.ode_atol, options.ode_atol * abs(w0)])
     except SelfLocking as exc:
         return InputMotion(0.0, exc.t, lambda t: (np.nan, np.nan, None), drive.torque,
-                           status=STATUS_SELF_LOCKING,
+                           status=Status.SELF_LOCKING,
                            reason=(f"friction self-locks at t = {exc.t:.6g} s, input angle "
                                    f"{math.degrees(exc.theta):.6g} deg: no consistent friction"),
                            ode_evaluations=count["n"])
     if not sol.success:
         return InputMotion(0.0, float(sol.t[-1]), sol.sol, drive.torque,
-                           status="integration_failure", reason=sol.message,
+                           status=Status.INTEGRATION_FAILURE, reason=sol.message,
                            ode_evaluations=count["n"])
     t_end = float(sol.t_events[0][0]) if sol.t_events[0].size else float(sol.t[-1])
     dense = sol.sol
@@ -212,7 +213,7 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
     motion = InputMotion(0.0, t_end, state, drive.torque, ode_evaluations=count["n"])
     if not sol.t_events[0].size:
-        motion.status = "incomplete"
+        motion.status = Status.INCOMPLETE
         motion.reason = (f"torque drive turned {abs(sol.y[0, -1]) / (2 * math.pi):.3g} of "
                          f"{scene.revolutions:g} revolutions in the time allowed")
     return motion
@@ -478,52 +479,45 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
     """
     options = options or ReferenceOptions()
     start = time.perf_counter()
+    summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=ENGINE_VERSION,
+                      scene=scene_to_dict(scene),
+                      options={k: getattr(options, k) for k in options.__dataclass_fields__})
     try:
-        return _run(scene, options, start)
+        table = _run(scene, options, summary)
     except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
-        return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
-                             "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),
-                             "wall_time_s": time.perf_counter() - start})
+        summary.fail(Status.LOOP_DOES_NOT_CLOSE, str(exc))
+        table = None
+    summary.wall_time_s = time.perf_counter() - start
+    return Result(table, summary)
 
 
-def _run(scene: Scene, options: ReferenceOptions, start: float) -> Result:
+def _run(scene: Scene, options: ReferenceOptions, summary: Summary) -> Any:
+    """Fill ``summary``; return the time table (or None)."""
     if scene.drive.kind == "torque":  # the ODE's cost grows with the revolutions: refuse first
         spr = options.samples_per_revolution or 360
         check_steps(scene.revolutions * spr,
                     f"{scene.revolutions:g} revolutions at {spr} samples per revolution")
     motion = input_motion(scene, options)
-    summary = {"status": motion.status, "reason": motion.reason, "engine": ENGINE_NAME,
-               "engine_version": ENGINE_VERSION, "scene": scene_to_dict(scene),
-               "options": {k: getattr(options, k) for k in options.__dataclass_fields__}}
+    summary.status, summary.reason = Status(motion.status), motion.reason
     if scene.drive.kind == "torque":
-        summary["ode_evaluations"] = motion.ode_evaluations
-    if motion.status == STATUS_SELF_LOCKING:
-        summary["wall_time_s"] = time.perf_counter() - start
-        return Result(None, summary)
+        summary.ode_evaluations = motion.ode_evaluations
+    if motion.status == Status.SELF_LOCKING:
+        return None
     t = _table_times(scene, motion, options)
     columns = columns_at(scene, motion, t)
     locked = columns["self_locking"]
-    summary.update(dt=float(t[1] - t[0]), steps=int(t.size - 1),
-                   self_locking_samples=int(np.count_nonzero(locked)),
-                   max_friction_loop_gain=float(np.max(columns["friction_loop_gain"])))
-    if np.any(locked) and summary["status"] == STATUS_OK:
+    summary.dt, summary.steps = float(t[1] - t[0]), int(t.size - 1)
+    summary.extras["self_locking_samples"] = int(np.count_nonzero(locked))
+    summary.max_friction_loop_gain = float(np.max(columns["friction_loop_gain"]))
+    if np.any(locked) and summary.success:
         first = int(np.argmax(locked))
-        summary.update(status=STATUS_SELF_LOCKING, reason=(
+        summary.fail(Status.SELF_LOCKING, (
             f"friction self-locks at {int(np.count_nonzero(locked))} of {locked.size} samples, "
             f"first at t = {t[first]:.6g} s, input angle "
             f"{math.degrees(columns['theta_in'][first]):.6g} deg (loop gain "
             f"{columns['friction_loop_gain'][first]:.3g}): no consistent friction"))
-    if summary["status"] == STATUS_OK:
-        means = mean_values(columns, scene.record.skip_revolutions)
-        if means.get("revolutions", 0) < 1:
-            summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))
-        else:
-            means.update(work_quadrature(scene, motion, columns, options))
-            if means.pop("self_locking_nodes"):
-                summary.update(status=STATUS_SELF_LOCKING, reason=(
-                    "friction self-locks between the table's samples (at quadrature nodes)"))
-                means = {}  # as when it locks at a sample: no means (they were NaN or meaningless)
-        summary.update({k: v for k, v in means.items() if k != "mean_status"})
+    if summary.success:
+        _means(scene, motion, columns, options, summary)
     table = None
     if scene.record.timeseries:
         import pandas as pd
@@ -531,5 +525,20 @@ def _run(scene: Scene, options: ReferenceOptions, start: float) -> Result:
         every = scene.record.every
         table = pd.DataFrame({c: columns[c][::every]
                               for c in table_columns() + list(EXTRA_COLUMNS)})
-    summary["wall_time_s"] = time.perf_counter() - start
-    return Result(table, summary)
+    return table
+
+
+def _means(scene: Scene, motion: InputMotion, columns: dict[str, np.ndarray],
+           options: ReferenceOptions, summary: Summary) -> None:
+    """The means over whole revolutions, the works from :func:`work_quadrature`."""
+    means = mean_values(columns, scene.record.skip_revolutions)
+    if means.get("revolutions", 0) < 1:
+        summary.fail(Status.NO_WHOLE_REVOLUTION, means.get("mean_status", ""))
+        return
+    means.update(work_quadrature(scene, motion, columns, options))
+    if means.pop("self_locking_nodes"):
+        # as when it locks at a sample: no means (they were NaN or meaningless)
+        summary.fail(Status.SELF_LOCKING,
+                     "friction self-locks between the table's samples (at quadrature nodes)")
+        return
+    summary.set_means(means)

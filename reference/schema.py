@@ -24,7 +24,9 @@ part excludes the applied friction; friction appears in ``<pair>_friction_torque
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from enum import Enum
 from typing import Any
 
 import numpy as np
@@ -51,20 +53,239 @@ def table_columns() -> list[str]:
     return cols
 
 
-STATUS_OK = "ok"
-STATUS_NO_CLOSURE = "loop_does_not_close"  # mounting errors the loop cannot be assembled with
+SCHEMA_VERSION = 2
+"""Version of the summary written to disk (``summary.json``, sweep records): 2 adds
+``schema_version`` and writes every common key (``null`` where a run has no value)."""
+
+
+class Status(str, Enum):
+    """How a run ended. Only :attr:`OK` carries mean values; every other status has a ``reason``.
+
+    A ``str`` enum: ``Status.OK == "ok"`` and JSON writes the plain value.
+    """
+
+    OK = "ok"
+    SELF_LOCKING = "self_locking"  # friction has no consistent value (loop gain >= 1)
+    INTEGRATION_FAILURE = "integration_failure"  # the solver stopped (Newton, step size)
+    DIVERGED = "diverged"  # the solver finished but produced non-finite values
+    INCOMPLETE = "incomplete"  # a torque drive did not turn the asked revolutions in time
+    NO_WHOLE_REVOLUTION = "no_whole_revolution"  # nothing to average over after the skip
+    LOOP_DOES_NOT_CLOSE = "loop_does_not_close"  # mounting errors the loop cannot assemble with
+    CONSTRAINT_VIOLATED = "constraint_violated"  # a soft constraint (MuJoCo) left its tolerance
+
+    def __str__(self) -> str:
+        return self.value
+
+
+class OptionsError(ValueError):
+    """An engine's options are out of range or of the wrong type (the message names the option)."""
+
+
+MEAN_KEYS = ("revolutions", "window_start_s", "window_duration_s", "input_work", "output_work",
+             "loss_work", "mean_efficiency", "mean_instantaneous_efficiency", "work_ratio",
+             "mean_torque_in", "mean_speed_in")
+COST_KEYS = ("steps", "newton_iterations", "jacobian_evaluations", "ode_evaluations")
+
+
+@dataclass
+class Summary:
+    """What every engine reports about a run, with the same fields for every engine.
+
+    Modelled on scipy's ``OdeResult``: the outcome (:attr:`status`, :attr:`reason`), the solution's
+    mean values over whole input revolutions (``None`` unless the status is ``ok``; definitions
+    in :func:`mean_values`), the cost counters next to them (``None`` where an engine has no
+    such counter), and engine-specific diagnostics in :attr:`extras` (Exudyn's ``friction``,
+    the reference's ``quadrature``, ...).
+
+    Attributes
+    ----------
+    status : Status
+    reason : str
+        Why the run did not end ``ok`` (empty when it did).
+    engine, engine_version : str
+    scene, options : dict
+        The scene as :func:`reference.scene.scene_to_dict` gives it, and the engine's options.
+    wall_time_s : float
+        Wall time of the whole run [s].
+    dt : float or None
+        Time step [s] (the reference engine: the table's sample spacing).
+    dt_choice : str or None
+        How the step was chosen.
+    steps, newton_iterations, jacobian_evaluations, ode_evaluations : int or None
+        Cost counters: time steps, Newton iterations and Jacobian evaluations (Exudyn), right-hand
+        side evaluations of an ODE (the reference engine's torque-driven scenes).
+    max_constraint_violation_m, max_constraint_violation_rad : float or None
+        Largest violation of the pair constraints over the run [m], [rad].
+    max_friction_loop_gain : float or None
+        Largest gain of the friction feedback loop (>= 1: no consistent friction).
+    revolutions : int
+        Whole input revolutions averaged over.
+    window_start_s, window_duration_s : float or None
+        The averaging window [s].
+    input_work, output_work, loss_work : float or None
+        Works over the window [J].
+    mean_efficiency : float or None
+        One minus lost over input work, the headline number.
+    mean_instantaneous_efficiency : float or None
+        Time average of eq. (18) over the window.
+    work_ratio : float or None
+        Output over input work.
+    mean_torque_in : float or None
+        Input work over input angle [N m].
+    mean_speed_in : float or None
+        Input angle over time [rad/s].
+    pair_loss_work : dict[str, float]
+        Loss work per pair [J] (``loss_work_<pair>`` on disk).
+    pair_sliding_loss_work : dict[str, float]
+        Its part from axial friction [J] (``loss_work_<pair>_sliding`` on disk).
+    extras : dict
+        Engine-specific diagnostics, written at the top level of the JSON.
+    """
+
+    status: Status
+    reason: str = ""
+    engine: str = ""
+    engine_version: str = ""
+    scene: dict[str, Any] = field(default_factory=dict)
+    options: dict[str, Any] = field(default_factory=dict)
+    wall_time_s: float = math.nan
+    dt: float | None = None
+    dt_choice: str | None = None
+    steps: int | None = None
+    newton_iterations: int | None = None
+    jacobian_evaluations: int | None = None
+    ode_evaluations: int | None = None
+    max_constraint_violation_m: float | None = None
+    max_constraint_violation_rad: float | None = None
+    max_friction_loop_gain: float | None = None
+    revolutions: int = 0
+    window_start_s: float | None = None
+    window_duration_s: float | None = None
+    input_work: float | None = None
+    output_work: float | None = None
+    loss_work: float | None = None
+    mean_efficiency: float | None = None
+    mean_instantaneous_efficiency: float | None = None
+    work_ratio: float | None = None
+    mean_torque_in: float | None = None
+    mean_speed_in: float | None = None
+    pair_loss_work: dict[str, float] = field(default_factory=dict)
+    pair_sliding_loss_work: dict[str, float] = field(default_factory=dict)
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.status = Status(self.status)
+
+    @property
+    def success(self) -> bool:
+        """True when the run ended ``ok`` (its means are defined)."""
+        return self.status is Status.OK
+
+    def set_means(self, means: Mapping[str, Any]) -> None:
+        """Take the keys of :func:`mean_values` (or the same keys from another integration)."""
+        for key, value in means.items():
+            if key in MEAN_KEYS:
+                setattr(self, key, value)
+            elif key.startswith("loss_work_") and key.endswith("_sliding"):
+                self.pair_sliding_loss_work[key[len("loss_work_"):-len("_sliding")]] = value
+            elif key.startswith("loss_work_"):
+                self.pair_loss_work[key[len("loss_work_"):]] = value
+            elif key != "mean_status":
+                self.extras[key] = value
+
+    def clear_means(self) -> None:
+        """Forget the means (a run that turned out not ``ok`` after averaging)."""
+        for key in MEAN_KEYS:
+            setattr(self, key, 0 if key == "revolutions" else None)
+        self.pair_loss_work.clear()
+        self.pair_sliding_loss_work.clear()
+
+    def fail(self, status: Status | str, reason: str) -> None:
+        """End the run with ``status`` and ``reason`` and forget its means."""
+        self.status, self.reason = Status(status), reason
+        self.clear_means()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON shape written to disk: flat keys, ``schema_version`` first."""
+        out: dict[str, Any] = {"schema_version": SCHEMA_VERSION}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "status":
+                out["status"] = value.value
+            elif f.name == "pair_loss_work":
+                out.update({f"loss_work_{p}": v for p, v in value.items()})
+            elif f.name == "pair_sliding_loss_work":
+                out.update({f"loss_work_{p}_sliding": v for p, v in value.items()})
+            elif f.name == "extras":
+                out.update(value)
+            else:
+                out[f.name] = value
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Summary:
+        """Inverse of :meth:`to_dict` (also reads version-1 summaries, which had no version)."""
+        names = {f.name for f in fields(cls)} - {"pair_loss_work", "pair_sliding_loss_work", "extras"}
+        summary = cls(status=Status(data["status"]))
+        for key, value in data.items():
+            if key == "schema_version":
+                continue
+            if key in names:
+                setattr(summary, key, value)
+            else:
+                summary.set_means({key: value})
+        summary.status = Status(summary.status)
+        return summary
+
+    # Read access by key, as for the version-1 dictionaries: absent keys are those without a value.
+    def _flat(self) -> dict[str, Any]:
+        return {k: v for k, v in self.to_dict().items() if v is not None and k != "schema_version"}
+
+    def __getitem__(self, key: str) -> Any:
+        return self._flat()[key]
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return self._flat().get(key, default)
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._flat()
 
 
 @dataclass
 class Result:
-    """What every engine returns: a time table (or None) and a summary dictionary."""
+    """What every engine returns: a time table (or None) and a :class:`Summary`.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame or None
+        The columns of :func:`table_columns` (and engine extras), every ``record.every``-th row;
+        None when the scene does not record the time series or the run failed.
+    summary : Summary
+    """
 
     table: Any  # pandas.DataFrame or None
-    summary: dict[str, Any] = field(default_factory=dict)
+    summary: Summary
 
     @property
-    def ok(self) -> bool:
-        return self.summary.get("status") == STATUS_OK
+    def status(self) -> Status:
+        return self.summary.status
+
+    @property
+    def success(self) -> bool:
+        """True when the run ended ``ok``."""
+        return self.summary.success
+
+    @property
+    def message(self) -> str:
+        """Why the run did not end ``ok`` (empty when it did)."""
+        return self.summary.reason
+
+    @property
+    def mean_efficiency(self) -> float | None:
+        """One minus lost over input work over whole revolutions (None unless ``ok``)."""
+        return self.summary.mean_efficiency
+
+    ok = success  # version-1 name
 
 
 def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tuple[float, float, int]:

@@ -14,7 +14,7 @@ import json
 import math
 import sys
 
-from cardan_exudyn.cli import _count, _number
+from cardan_exudyn.arguments import count as _count, number as _number
 
 EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
 

@@ -81,7 +81,7 @@ def run_engine(engine: str, scene: Scene):
     if engine == "reference":
         from reference.engine import run
     elif engine == "exudyn":
-        from cardan_exudyn.engine import run
+        from cardan_exudyn.model.solve import run
     else:
         raise ValueError(f"`engine` must be 'reference' or 'exudyn', got {engine!r}")
     return run(scene)

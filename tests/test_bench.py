@@ -14,9 +14,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn import bench
+from cardan_exudyn.studies import bench
 from cardan_exudyn.cli import main
-from cardan_exudyn.engine import run
+from cardan_exudyn.model.solve import run
 from reference.paper import named_scene
 from reference.scene import replace
 

@@ -33,7 +33,7 @@ def test_calibrated_scene_applies_the_stored_parameters():
 def test_stored_calibration_is_what_the_fit_finds():
     """Re-run `cardan calibrate` (about 30 s): the stored values agree to 2 %, and the held-out
     cases stay as reported (RMS 0.0053, the 35 deg case 0.012 too high)."""
-    from cardan_exudyn.calibrate import calibrate
+    from cardan_exudyn.studies.calibrate import calibrate
 
     result = calibrate()
     stored = {p["name"]: p["value"] for p in calibrated_parameters()}

@@ -16,7 +16,7 @@ import pytest
 from cardan_exudyn import io as cio
 from cardan_exudyn.cli import main
 from cardan_exudyn.hardening import CASES, ENTRY_POINTS, MARKER, Case, markdown, run_cases
-from reference.schema import Result
+from reference.schema import Result, Summary
 
 # ------------------------------------------------------------------ rigdata's own Python API
 # (cases here, not in cardan_exudyn.hardening: cardan_exudyn never imports rigdata)
@@ -178,7 +178,7 @@ def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
 
 def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
     """`cardan study --out`: the plot fails after the CSV and JSON are written."""
-    import cardan_exudyn.studies as studies
+    import cardan_exudyn.studies.coupling as studies
 
     out = tmp_path / "study"
     _previous(out)
@@ -195,7 +195,7 @@ def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
 def test_tolerance_out_failure_keeps_previous_study(tmp_path, monkeypatch):
     """`cardan tolerance montecarlo`: the report fails after the samples table is written; the
     previous study folder stays, the sweep records (resumable by design) are kept."""
-    import cardan_exudyn.tolerance as tolerance
+    import cardan_exudyn.studies.tolerance as tolerance
 
     out = tmp_path / "mc"
     _previous(out / "study")
@@ -266,12 +266,12 @@ def _no_efficiency_printed(text: str) -> None:
 
 
 def _nan_engine(status: str, **summary):
-    def run(scene):
-        return Result(None, {"status": status, "reason": "forced" if status != "ok" else "",
+    def run(scene, options=None):
+        return Result(None, Summary.from_dict({"status": status, "reason": "forced" if status != "ok" else "",
                              "engine": "fake", "engine_version": "0", "scene": {"name": scene.name},
                              "mean_efficiency": math.nan, "mean_instantaneous_efficiency": math.inf,
                              "work_ratio": math.nan, "input_work": 0.0, "revolutions": 1,
-                             "wall_time_s": 0.0, **summary})
+                             "wall_time_s": 0.0, **summary}))
     return run
 
 
@@ -281,6 +281,8 @@ def test_forced_failure_prints_status_not_nan(tmp_path, monkeypatch, capsys):
     import cardan_exudyn.engines as engines
 
     real = engines.get_engine
+    monkeypatch.setitem(engines.ENGINES, "fake",
+                        engines.Engine("fake", "reference.engine", "ReferenceOptions", "test double"))
     monkeypatch.setattr(engines, "get_engine",
                         lambda name: _nan_engine("integration_failure") if name == "fake" else real(name))
     assert main(["run", "--engine", "fake", "--out", str(tmp_path / "r")]) == 3
@@ -300,6 +302,8 @@ def test_zero_input_work_prints_undefined(monkeypatch, capsys):
     import cardan_exudyn.engines as engines
 
     real = engines.get_engine
+    monkeypatch.setitem(engines.ENGINES, "fake",
+                        engines.Engine("fake", "reference.engine", "ReferenceOptions", "test double"))
     monkeypatch.setattr(engines, "get_engine",
                         lambda name: _nan_engine("ok") if name == "fake" else real(name))
     assert main(["run", "--engine", "fake"]) == 0
@@ -330,7 +334,7 @@ def test_compare_with_failed_engines_prints_no_number(capsys):
 
 def test_calibrate_failed_case_prints_status(monkeypatch, capsys):
     """`cardan calibrate`: a held-out case whose run failed shows its status, exit 3."""
-    import cardan_exudyn.calibrate as calibrate
+    import cardan_exudyn.studies.calibrate as calibrate
 
     rows = [{"case": "table2:0:2000", "used_in_fit": True, "paper": 0.99, "model": 0.98,
              "difference": -0.01, "status": "ok", "reason": ""},

@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cardan_exudyn.engine import run as run_exudyn
+from cardan_exudyn.model.solve import run as run_exudyn
 from reference.engine import run as run_reference
 from reference.paper import named_scene
 from reference.scene import AngleDrive, Load, SceneError, load_scene, scene_from_dict, scene_to_dict

@@ -1,4 +1,4 @@
-"""Long runs (issue 8, ``cardan_exudyn.longrun``): drift over thousands of revolutions with friction,
+"""Long runs (issue 8, ``cardan_exudyn.studies.longrun``): drift over thousands of revolutions with friction,
 and energy conservation of the free-spinning frictionless joint.
 
 The fast tests run the quick variant once (20 revolutions with friction for Rxyz and EP nodes;
@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn import longrun
-from cardan_exudyn.longrun import (
+from cardan_exudyn.studies import longrun
+from cardan_exudyn.studies.longrun import (
     DEFAULT_RHO,
     DISSIPATION_MARGIN,
     TOLERANCES,

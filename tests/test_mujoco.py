@@ -22,7 +22,7 @@ pytest.importorskip("mujoco")
 
 from cardan_exudyn.mujoco_engine import (  # noqa: E402 (after the optional-import skip)
     MUJOCO_DEFAULTS,
-    MujocoSettings,
+    MujocoOptions,
     accuracy,
     run,
     settings_study,
@@ -64,7 +64,7 @@ def test_speed_ratio_matches_hooke(runs, deg):
     """omega_out / omega_in follows Hooke's formula within the documented error model."""
     scene, result = runs[deg]
     assert result.ok, result.summary["reason"]
-    bound = speed_ratio_error_model(scene, MujocoSettings(), STEPS_PER_REVOLUTION)
+    bound = speed_ratio_error_model(scene, MujocoOptions(), STEPS_PER_REVOLUTION)
     assert accuracy(scene, result)["speed_ratio_error"] <= bound
 
 
@@ -180,7 +180,7 @@ def test_torque_drive_balances_energy():
 def test_invalid_settings_are_rejected(kwargs, match):
     """Bad settings raise ValueError naming the argument."""
     with pytest.raises(ValueError, match=match):
-        MujocoSettings(**kwargs)
+        MujocoOptions(**kwargs)
 
 
 def test_settings_study_table():

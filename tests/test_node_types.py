@@ -1,6 +1,6 @@
 """Rigid-body node types of the Exudyn model (``ExudynOptions.node_type``): Rxyz, EP, RotVecLG.
 
-The readers of node coordinates (``cardan_exudyn.rotations``) are checked against Exudyn's own
+The readers of node coordinates (``cardan_exudyn.model.rotations``) are checked against Exudyn's own
 node outputs, and every node type against Hooke's speed ratio and the reference engine's mean
 efficiency. Bounds come from the measured errors (generalized-alpha, spectral radius 0.6):
 
@@ -20,10 +20,10 @@ import exudyn.rigidBodyUtilities as rbu
 import numpy as np
 import pytest
 
-import cardan_exudyn.engine as engine
-from cardan_exudyn.engine import ExudynOptions, body_states, run
-from cardan_exudyn.model import build_model
-from cardan_exudyn.rotations import ROTATION_COORDINATES
+import cardan_exudyn.model.solve as engine
+from cardan_exudyn.model.solve import ExudynOptions, body_states, run
+from cardan_exudyn.model.build import build_model
+from cardan_exudyn.model.rotations import ROTATION_COORDINATES
 from reference.engine import run as reference_run
 from reference.kinematics import speed_ratio
 from reference.paper import named_scene

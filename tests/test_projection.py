@@ -1,4 +1,4 @@
-"""Velocity projection of Exudyn's recorded states (cardan_exudyn.projection).
+"""Velocity projection of Exudyn's recorded states (cardan_exudyn.model.projection).
 
 Index-3 generalized-alpha keeps positions on the constraint manifold but misses the velocity
 constraints by O(h^2); the projection must give the exact velocities of the computed positions
@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from cardan_exudyn.engine import ExudynOptions, run
+from cardan_exudyn.model.solve import ExudynOptions, run
 from reference.engine import run as reference_run
 from reference.kinematics import speed_ratio
 from reference.paper import named_scene
@@ -72,8 +72,8 @@ def test_projection_with_mounting_errors_matches_the_reference_engine():
 def test_torque_drive_projection_satisfies_the_constraints_and_is_idempotent():
     """With a torque drive one degree of freedom is left: the projection is the closest
     consistent velocity in the kinetic-energy metric; projecting it again changes nothing."""
-    from cardan_exudyn import engine as eng
-    from cardan_exudyn.projection import constraint_jacobian, project_velocities
+    from cardan_exudyn.model import solve as eng
+    from cardan_exudyn.model.projection import constraint_jacobian, project_velocities
 
     scene = replace(named_scene("paper-20deg-frictionless"),
                     drive={"kind": "torque", "torque": 2.0, "initial_speed": 100.0},

@@ -53,7 +53,7 @@ Status at the locking boundary
 Tolerances and their reasons
 ----------------------------
 ``h = omega dt`` is the input-angle step, ``K(beta) = 0.19 tan^2 / cos^2`` the step-size model's
-coefficient (:mod:`cardan_exudyn.stepsize`), ``S`` the energy scale of the run:
+coefficient (:mod:`cardan_exudyn.model.stepsize`), ``S`` the energy scale of the run:
 ``int(|P_in| + |P_out| + |P_loss|) dt`` plus the largest kinetic energy (work integrals and the
 integrator's energy err relative to what flows and what is stored; the kinetic energy matters
 where unbalanced inertia forces do no net work: at 3.9 deg, 2601 rpm with gravity the power flow
@@ -100,9 +100,9 @@ from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from test_energy import balance_residual
 
-from cardan_exudyn.engine import NODE_TYPES, ExudynOptions
-from cardan_exudyn.engine import run as exudyn_run
-from cardan_exudyn.stepsize import error_coefficient
+from cardan_exudyn.model.solve import NODE_TYPES, ExudynOptions
+from cardan_exudyn.model.solve import run as exudyn_run
+from cardan_exudyn.model.stepsize import error_coefficient
 from reference.engine import ReferenceOptions
 from reference.engine import run as reference_run
 from reference.paper import named_scene
@@ -291,7 +291,7 @@ def check_finite(result, engine: str) -> None:
     # eq. (18) overflows (test_uncoupled_without_load_has_no_efficiency, a known defect)
     overflow_allowed = uncoupled_without_work(result)
     assert overflow_allowed or np.all(np.isfinite(eta[~undefined]))
-    numbers = {k: v for k, v in s.items()
+    numbers = {k: v for k, v in s.to_dict().items()
                if isinstance(v, (int, float, np.floating)) and not isinstance(v, bool)}
     for key in ("mean_efficiency", "mean_instantaneous_efficiency", "input_work", "output_work",
                 "loss_work", "work_ratio"):

@@ -170,7 +170,7 @@ def test_result_follows_the_schema():
     assert table["t"].iloc[0] == 0.0
     assert table["theta_in"].iloc[-1] == pytest.approx(4 * np.pi, rel=1e-15)
     assert s["status"] == "ok" and s["engine"] == "reference" and s["scene"]["name"] == scene.name
-    assert {"engine_version", "wall_time_s", "input_work", "mean_efficiency"} <= s.keys()
+    assert {"engine_version", "wall_time_s", "input_work", "mean_efficiency"} <= s.to_dict().keys()
     # no friction, no sliding, and no axial force / torque in the cylindrical pairs
     zero_suffixes = ("_mz", "friction_torque", "friction_force", "slide_rel")
     zero_cols = [c for c in table_columns() if c.startswith("power_loss") or c.endswith(zero_suffixes)

@@ -11,13 +11,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn import reproduce as rep
+from cardan_exudyn.studies import reproduce as rep
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run_scene
-from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
+from cardan_exudyn.sweep.runner import CASES_FILE, make_plan, read_records
 from reference.paper import paper_scene
 from reference.scene import replace
-from reference.schema import Result
+from reference.schema import Result, Status, Summary
 
 QUICK_IDS = [f"{p}-{c}" for p in ("plain", "calibrated")
              for c in ("table2-0deg-2000rpm", "table2-10deg-2000rpm", "speed-10deg-500rpm")]
@@ -43,7 +43,7 @@ class Counting:
         if action == "raise":
             raise RuntimeError("boom in the engine")
         if action == "self_locking":
-            return Result(None, {"status": "self_locking", "reason": "friction loop gain 1.3 >= 1"})
+            return Result(None, Summary(Status.SELF_LOCKING, "friction loop gain 1.3 >= 1"))
         return run_scene(scene, engine)
 
 
@@ -53,7 +53,7 @@ def no_drawing(monkeypatch):
     report's time, and the tests using this look at numbers and text."""
     import matplotlib.pyplot as plt
 
-    from cardan_exudyn import plots
+    from cardan_exudyn.report import plots
 
     def save(fig, path):
         plt.close(fig)

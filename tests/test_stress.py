@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn import stress
-from cardan_exudyn.stress import Panel, base_scene, classify, efficiency_promise, measure_cell
+from cardan_exudyn.studies import stress
+from cardan_exudyn.studies.stress import Panel, base_scene, classify, efficiency_promise, measure_cell
 from reference.scene import replace
 
 
@@ -95,8 +95,8 @@ def test_cells_either_side_of_the_self_locking_boundary():
 def test_auto_step_meets_the_accuracy_with_every_node_type(node_type, angle):
     """The map found Euler parameters 18x over the requested speed-ratio accuracy at 0 deg with
     the Rxyz step model (K = 0 there); the node-type model now picks the step for each."""
-    from cardan_exudyn.engine import ExudynOptions, run
-    from cardan_exudyn.stepsize import error_coefficient
+    from cardan_exudyn.model.solve import ExudynOptions, run
+    from cardan_exudyn.model.stepsize import error_coefficient
     from reference.kinematics import speed_ratio
 
     accuracy = 2e-5

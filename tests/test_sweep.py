@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from cardan_exudyn.cli import main
-from cardan_exudyn.sweep import (
+from cardan_exudyn.sweep.runner import (
     Distribution,
     RandomSpec,
     SweepError,

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from cardan_exudyn.cli import main
-from cardan_exudyn.tolerance import correlation_ratio, monte_carlo, paper_case, sensitivities
+from cardan_exudyn.studies.tolerance import correlation_ratio, monte_carlo, paper_case, sensitivities
 from reference.paper import named_scene
 from reference.scene import replace
 

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.engine import run
+from cardan_exudyn.model.solve import run
 from cardan_exudyn.io import atomic_directory, dumps
 from reference.paper import named_scene
 from reference.scene import Scene, replace

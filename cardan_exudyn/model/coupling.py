@@ -54,6 +54,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.schema import Status
 
 # geometric growth of the friction (lagged scheme) taken as self-locking
 LAGGED_GROWTH_LIMIT = 1e3
@@ -157,7 +158,7 @@ class FrictionCoupling:
             self._weight[k, 1] = 0.5 * p.d
         self._mask = mask.ravel()
         self.unconverged_steps = 0
-        self.status, self.reason = "ok", ""
+        self.status, self.reason = Status.OK, ""
         self.scale_floor = 0.0  # set by evaluate (REST_FLOOR)
         self._growth_steps, self._growth_start = 0, 0.0
         self._ode2 = {}
@@ -282,7 +283,7 @@ class FrictionCoupling:
             full[self._mask] = x
             self.apply(full.reshape(self.n, 2))
             solver.InitializeSolverInitialConditions(self.mbs, settings)
-        self.status = "self_locking"
+        self.status = Status.SELF_LOCKING
         self.reason = (f"no consistent friction state at the start: the fixed-point iteration "
                        f"did not converge in {max_iterations} iterations (loop gain >= 1)")
 
@@ -365,7 +366,7 @@ class FrictionCoupling:
             self.unconverged_steps += 1
             shrink = np.linalg.norm(residuals[-1]) / max(np.linalg.norm(residuals[0]), 1e-300)
             if shrink >= STALL_RATIO:
-                self.status = "self_locking"
+                self.status = Status.SELF_LOCKING
                 self.reason = (f"no consistent friction state at t = {t:.6g} s: the fixed-point "
                                f"iteration stalled (residual ratio {shrink:.3g} after "
                                f"{len(residuals)} iterations, contraction of the plain map "
@@ -450,7 +451,7 @@ class FrictionCoupling:
                 self._growth_start = max(before, self.scale_floor)
             self._growth_steps += 1
             if size > LAGGED_GROWTH_LIMIT * self._growth_start:
-                self.status = "self_locking"
+                self.status = Status.SELF_LOCKING
                 self.reason = (f"lagged friction grew geometrically by more than "
                                f"{LAGGED_GROWTH_LIMIT:g}x over {self._growth_steps} steps up to "
                                f"t = {self._step_t:.6g} s: the friction feedback loop gain is >= 1"

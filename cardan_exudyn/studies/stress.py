@@ -7,7 +7,7 @@ coefficient (0 to 1, the same in all four pairs) for each coupling scheme and no
 speed (10 to 10,000 rpm) and the step (steps per input revolution). Every cell is one revolution
 of the paper's scene (table 1 bodies, 2 N m load) from the assembled start at constant input
 speed, run by the reference engine and by Exudyn at the cell's step ``h`` and at ``h / 2``. The
-runs go through the sweep runner (:mod:`cardan_exudyn.sweep`, one sweep per node type in
+runs go through the sweep runner (:mod:`cardan_exudyn.sweep.runner`, one sweep per node type in
 ``OUT/runs/``), so an interrupted map resumes where it stopped.
 
 A cell is classified from its measurements alone (:func:`classify`):
@@ -15,7 +15,7 @@ A cell is classified from its measurements alone (:func:`classify`):
 ``converged``
     Exudyn's status is ok and its answer is within what the step promises: the largest error of
     ``omega_out / omega_in`` against Hooke's closed form is at most ``SAFETY * K(beta) h^2 +
-    RATIO_FLOOR`` (the a-priori error model of :mod:`cardan_exudyn.stepsize`), the mean
+    RATIO_FLOOR`` (the a-priori error model of :mod:`cardan_exudyn.model.stepsize`), the mean
     efficiency is within ``SAFETY * 2^p / (2^p - 1) |eta_h - eta_h/2| + EFFICIENCY_FLOOR`` of the
     reference's (the step-halving estimate of an error of order ``p``: 2 with the converged
     friction coupling, 1 with the lagged one, as ``cardan study coupling`` measures), it lies in
@@ -24,7 +24,7 @@ A cell is classified from its measurements alone (:func:`classify`):
     Exudyn's status is ok but one of those checks fails: an answer that looks valid and is not.
 ``self_locking``
     Exudyn stopped the run because its friction fixed point does not converge (the engine's
-    detection, :mod:`cardan_exudyn.friction`).
+    detection, :mod:`cardan_exudyn.model.coupling`).
 ``integration_failure``
     Newton or the integrator failed (or the run diverged, ended early).
 ``error``
@@ -163,8 +163,8 @@ def cell_id(panel: Panel, angle: float, x: float) -> str:
 def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
     """Run the reference and Exudyn (at ``h`` and, when it is ok with friction, ``h / 2``) on
     one cell's scene and return the raw measurements (flat scalars)."""
-    from cardan_exudyn.engine import ExudynOptions
-    from cardan_exudyn.engine import run as exudyn_run
+    from cardan_exudyn.model.solve import ExudynOptions
+    from cardan_exudyn.model.solve import run as exudyn_run
 
     out: dict[str, Any] = {}
     ref = reference_run(replace(scene, **{"record.timeseries": False}), REFERENCE_OPTIONS).summary
@@ -184,7 +184,7 @@ def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
                constraint_violation_rad=s.get("max_constraint_violation_rad"))
     beta = scene.joint.geometry.shaft_angle
     h = scene.drive.speed * scene.numerics.dt
-    from cardan_exudyn.stepsize import error_coefficient
+    from cardan_exudyn.model.stepsize import error_coefficient
 
     out["ratio_promise"] = SAFETY * error_coefficient(beta, node_type) * h * h + RATIO_FLOOR
     if result.table is not None and len(result.table):
@@ -220,8 +220,8 @@ def cell_rotveclg(scene: Scene, engine: str) -> dict[str, Any]:
     return _cell(scene, engine, "RotVecLG")
 
 
-CELL_FUNCTIONS = {"Rxyz": "cardan_exudyn.stress:cell_rxyz", "EP": "cardan_exudyn.stress:cell_ep",
-                  "RotVecLG": "cardan_exudyn.stress:cell_rotveclg"}
+CELL_FUNCTIONS = {"Rxyz": "cardan_exudyn.studies.stress:cell_rxyz", "EP": "cardan_exudyn.studies.stress:cell_ep",
+                  "RotVecLG": "cardan_exudyn.studies.stress:cell_rotveclg"}
 
 
 # ----------------------------------------------------------------------------- classification
@@ -339,7 +339,7 @@ class StressMap:
 
 def sweep_specs(quick: bool = False) -> dict[str, Any]:
     """One explicit-case sweep spec per node type (the map's panels grouped by node type)."""
-    from cardan_exudyn.sweep import SweepSpec
+    from cardan_exudyn.sweep.runner import SweepSpec
 
     base = base_scene()
     groups: dict[str, list[dict[str, Any]]] = {}
@@ -356,7 +356,7 @@ def sweep_specs(quick: bool = False) -> dict[str, Any]:
 def run_map(runs: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
             restart: bool = False, progress: bool | None = None) -> StressMap:
     """Run (or resume) the map's sweeps into ``runs/<node type>/`` and classify every cell."""
-    from cardan_exudyn.sweep import CASES_FILE, read_records, run_sweep
+    from cardan_exudyn.sweep.runner import CASES_FILE, read_records, run_sweep
 
     runs = Path(runs)
     chosen = panels(quick)
@@ -472,7 +472,7 @@ def markdown(stress: StressMap) -> str:
 def plot_map(stress: StressMap):
     """One image per panel: cell colour = class, hatched = reference self-locks, ``!`` =
     disagreement; the reference's self-locking boundary drawn as a black line."""
-    from cardan_exudyn import plots
+    from cardan_exudyn.report import plots
 
     return plots.stability_map(stress.cells, [
         {"key": p.key, "title": p.title, "x": p.x, "x_label": X_LABELS[p.x],
@@ -549,7 +549,7 @@ def run_stress(out: str | os.PathLike, *, quick: bool = False, parts: Sequence[s
         report.map = run_map(runs, quick, workers=workers, restart=restart, progress=progress)
         report.wall_s["map"] = time.perf_counter() - t0
     if "long" in parts:
-        from cardan_exudyn.longrun import long_runs
+        from cardan_exudyn.studies.longrun import long_runs
 
         t0 = time.perf_counter()
         say("long runs ...")
@@ -573,9 +573,9 @@ def run_stress(out: str | os.PathLike, *, quick: bool = False, parts: Sequence[s
 
 
 def write_report(report: StressReport, folder: Path, quick: bool) -> None:
-    from cardan_exudyn import plots
+    from cardan_exudyn.report import plots
     from cardan_exudyn.io import dumps
-    from cardan_exudyn.sweep import environment
+    from cardan_exudyn.sweep.runner import environment
 
     env = environment()
     sections = [f"# Stress report{' (--quick)' if quick else ''}", "",
@@ -591,8 +591,8 @@ def write_report(report: StressReport, folder: Path, quick: bool) -> None:
         plots.save(plot_map(report.map), folder / "stability_map.png")
         sections += [markdown(report.map), "![stability map](stability_map.png)", ""]
     if report.long is not None:
-        from cardan_exudyn.longrun import markdown as long_markdown
-        from cardan_exudyn.longrun import write_long
+        from cardan_exudyn.studies.longrun import markdown as long_markdown
+        from cardan_exudyn.studies.longrun import write_long
 
         write_long(report.long, folder)
         sections += [long_markdown(report.long), ""]

@@ -16,7 +16,7 @@ calibrate`` from a subset of the paper's numbers) the report has
 How the runs are made
 ---------------------
 The runs (the eleven cases under each parameter set: 22; 6 with ``--quick``) are one sweep of
-:mod:`cardan_exudyn.sweep` with an explicit case list, in ``OUT/runs/``. The base scene is
+:mod:`cardan_exudyn.sweep.runner` with an explicit case list, in ``OUT/runs/``. The base scene is
 ``paper_scene(10 deg, 2000 rpm)``; each case's overrides are the leaf-by-leaf difference between
 its own scene (:func:`reference.paper.paper_scene`, either parameter set) and the base, and
 :func:`paper_runs` checks that the runner rebuilds exactly that scene. Case ids read like
@@ -49,7 +49,7 @@ folder's name in its record (``files``). Why this way:
   the runner's workers are this process or processes spawned from it, which inherit its
   environment (``reproduce`` offers no Dask cluster, whose workers would not). Without the
   variable the function writes nothing and returns the numbers, so it also serves
-  ``cardan sweep --function cardan_exudyn.reproduce:paper_case_outputs``;
+  ``cardan sweep --function cardan_exudyn.studies.reproduce:paper_case_outputs``;
 - ``.npz`` keeps float64 exactly (whether a CSV reads back bit for bit depends on the pandas
   version's parser), so the figures are drawn from exactly the engine's numbers, as before.
 """
@@ -68,10 +68,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn.calibrate import in_fit
+from cardan_exudyn.studies.calibrate import in_fit
 from cardan_exudyn.engines import run_scene
 from cardan_exudyn.io import atomic_directory, atomic_write, dumps
-from cardan_exudyn.sweep import (
+from cardan_exudyn.sweep.runner import (
     CASES_FILE,
     SweepError,
     SweepSpec,
@@ -100,7 +100,7 @@ def fit_case_keys() -> list[str]:
 
 RUNS_DIR, FILES_DIR = "runs", "files"
 FILES_ENV = "CARDAN_REPRODUCE_FILES"
-CASE_FUNCTION = "cardan_exudyn.reproduce:paper_case_outputs"
+CASE_FUNCTION = "cardan_exudyn.studies.reproduce:paper_case_outputs"
 HISTORY_COLUMNS = ("t", "efficiency", *(f"power_loss_{pair}" for pair in PAIR_NAMES))
 QUICK_OVERRIDES = {"numerics.accuracy": 1e-4, "revolutions": 1.0}
 # the numbers of a run, in the order of the report's results.csv (after difference_to_paper)
@@ -219,7 +219,7 @@ def write_report(folder: Path, rows: pd.DataFrame, histories: dict, quick: bool,
                  wall: float, reused: int = 0) -> None:
     """``report.md``, ``results.csv``, ``assumptions.csv`` and the figures into ``folder``;
     ``reused``: runs taken from an earlier invocation's records (said in the report's head)."""
-    from cardan_exudyn import plots
+    from cardan_exudyn.report import plots
 
     rows.to_csv(folder / "results.csv", index=False)
     register = pd.DataFrame(assumption_register())

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.engine import run
+from cardan_exudyn.model.solve import run
 from reference.paper import CALIBRATION_PARAMETERS, paper_cases, paper_scene
 from reference.scene import replace
 

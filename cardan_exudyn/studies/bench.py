@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn.engine import ExudynOptions
+from cardan_exudyn.model.solve import ExudynOptions
 from cardan_exudyn.io import atomic_directory, dumps
 from reference.engine import ReferenceOptions, columns_at, input_motion
 from reference.engine import run as reference_run
@@ -118,7 +118,7 @@ class Config:
 
     def run(self, scene: Scene):
         if self.engine == "exudyn":
-            from cardan_exudyn.engine import run
+            from cardan_exudyn.model.solve import run
 
             return run(scene, self.options)
         if self.engine == "mujoco":
@@ -148,7 +148,7 @@ def _mujoco_available() -> bool:
 
 def _node_types() -> tuple[str, ...]:
     """Node types of the spider and output (the Rxyz default first)."""
-    from cardan_exudyn.engine import NODE_TYPES
+    from cardan_exudyn.model.solve import NODE_TYPES
 
     return NODE_TYPES
 
@@ -181,11 +181,11 @@ def configurations(scene_key: str, quick: bool = False,
                 steps = steps[:2]
             out += [Config("exudyn", label, n, options, coupling) for n in steps]
     if "mujoco" in engines and not friction and _mujoco_available():
-        from cardan_exudyn.mujoco_engine import MujocoSettings
+        from cardan_exudyn.mujoco_engine import MujocoOptions
 
         for tc in ((10.0,) if quick else (10.0, 20.0)):
             label = f"mujoco RK4 tc {tc:g} dt" + (" (recommended)" if tc == 20.0 else "")
-            out += [Config("mujoco", label, n, MujocoSettings(timeconst_steps=tc))
+            out += [Config("mujoco", label, n, MujocoOptions(timeconst_steps=tc))
                     for n in ladder["mujoco"]]
     if "reference" in engines:
         for rtol in ((1e-6,) if quick else (1e-9, 1e-6, 1e-4)):
@@ -429,7 +429,7 @@ def paper_scenes_timing(repeats: int = 3, exudyn_steps: int = PAPER_EXUDYN_STEPS
     say = _progress(progress)
     scenes = paper_scenes()
     exact = [yardstick(s).summary["mean_efficiency"] for s in scenes]
-    from cardan_exudyn.engine import run as exudyn_run
+    from cardan_exudyn.model.solve import run as exudyn_run
 
     def exudyn_one(scene: Scene):
         period = 2.0 * math.pi / scene.drive.max_speed()
@@ -468,9 +468,9 @@ def _solve_only(scene: Scene, options: ExudynOptions,
     """Wall time of build + solve (no post-processing), with ``tweak(model, settings)``."""
     import exudyn as exu
 
-    from cardan_exudyn.engine import end_time, simulation_settings
-    from cardan_exudyn.model import build_model
-    from cardan_exudyn.stepsize import choose_step
+    from cardan_exudyn.model.solve import end_time, simulation_settings
+    from cardan_exudyn.model.build import build_model
+    from cardan_exudyn.model.stepsize import choose_step
 
     t0 = time.perf_counter()
     model = build_model(scene, reactions=options.records_reactions(scene),
@@ -518,8 +518,8 @@ def _fast_module_time(scene_name: str, steps: int, revolutions: float, runs: int
         "import contextlib, io\n"
         "with contextlib.redirect_stdout(io.StringIO()):\n"
         "    import exudyn\n"
-        "from cardan_exudyn.engine import run\n"
-        "from cardan_exudyn.bench import EXUDYN_TUNED\n"
+        "from cardan_exudyn.model.solve import run\n"
+        "from cardan_exudyn.studies.bench import EXUDYN_TUNED\n"
         "from reference.paper import named_scene\n"
         "from reference.scene import replace\n"
         f"s = named_scene({scene_name!r})\n"
@@ -556,7 +556,7 @@ def skip_audit(repeats: int = 5, steps: int = 200, revolutions: float = 10.0,
     base = replace(base, **{"numerics.dt": period / steps, "record.timeseries": False,
                             "revolutions": revolutions})
     tuned = EXUDYN_TUNED
-    from cardan_exudyn.engine import run as exudyn_run
+    from cardan_exudyn.model.solve import run as exudyn_run
 
     folder = tempfile.mkdtemp(prefix="cardan-audit-")
 
@@ -635,7 +635,7 @@ def _timed_run(run: Callable, scene: Scene, options: ExudynOptions) -> float:
 # ------------------------------------------------------------------------------ environment
 def environment() -> dict[str, Any]:
     """Versions, CPU, date and commit (the header of every results file)."""
-    from cardan_exudyn.sweep import environment as sweep_environment
+    from cardan_exudyn.sweep.runner import environment as sweep_environment
 
     return sweep_environment()
 
@@ -705,7 +705,7 @@ def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[
 
 def write_bench(result: BenchResult, out: str | os.PathLike) -> Path:
     """The results folder, atomically."""
-    from cardan_exudyn import plots
+    from cardan_exudyn.report import plots
 
     header = _header(result.environment)
     with atomic_directory(out) as tmp:

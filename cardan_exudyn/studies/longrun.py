@@ -47,7 +47,7 @@ misaligned by the input's rounding drift ``theta_in - 2 pi k`` (1e-11 rad after 
 rotation that would remove it, and the step fails.
 
 The whole history of every step is kept in memory (node-state sensors, the friction log) and
-post-processed once per run with :func:`cardan_exudyn.engine.postprocess` (the engine's own
+post-processed once per run with :func:`cardan_exudyn.model.solve.postprocess` (the engine's own
 definitions): 312,000 steps per run peak at about 1 GB, affordable; keeping every n-th step
 (``record.every``) would miss the per-step maxima and coarsen the per-revolution work
 integrals, and running in chunks would restart the integrator and the friction iteration at every
@@ -85,15 +85,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn import engine
-from cardan_exudyn.engine import ExudynOptions
+from cardan_exudyn.model import solve as engine
+from cardan_exudyn.model.solve import ExudynOptions
 from cardan_exudyn.io import to_jsonable
-from cardan_exudyn.model import ExudynModel
+from cardan_exudyn.model.build import ExudynModel
 from reference.engine import ReferenceOptions
 from reference.engine import run as reference_run
 from reference.paper import named_scene
 from reference.scene import PAIR_KIND, Scene, replace
-from reference.schema import STATUS_OK
+from reference.schema import Status
 
 DRIFT_SCENE = "paper-10deg-2000rpm"
 DRIFT_REVOLUTIONS = 2000
@@ -194,12 +194,12 @@ TOLERANCES: dict[str, tuple[float, str]] = {
 # ------------------------------------------------------------------------------ solving
 def simulate(scene: Scene, options: ExudynOptions,
              columns: bool = True) -> tuple[dict[str, Any], ExudynModel, dict[str, np.ndarray]]:
-    """Solve ``scene`` with :func:`cardan_exudyn.engine.solve` (as ``engine.run`` does), keeping
+    """Solve ``scene`` with :func:`cardan_exudyn.model.solve.solve` (as ``engine.run`` does), keeping
     the model.
 
     What differs from ``engine.run`` is what comes back: the model, whose sensors hold every step, and
     (``columns=True``) the result-schema columns of every step from
-    :func:`cardan_exudyn.engine.postprocess`, with ``model.pair_kinematics`` filled (also for a
+    :func:`cardan_exudyn.model.solve.postprocess`, with ``model.pair_kinematics`` filled (also for a
     failed run: the steps it completed). No table, no reaction sensors (friction reads the
     reactions itself).
     """
@@ -226,7 +226,7 @@ def simulate(scene: Scene, options: ExudynOptions,
 def pair_violations(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
     """Per step, the largest violation over the four pairs at each constraint level.
 
-    Position [m] and angle [rad] as :func:`cardan_exudyn.engine.constraint_violation` (marker
+    Position [m] and angle [rad] as :func:`cardan_exudyn.model.solve.constraint_violation` (marker
     distance, or distance of marker b from the axis for a cylindrical pair; misalignment of the
     axes). Velocity level: the constrained components of the relative velocity of the marker
     points [m/s] (all three for the revolute, those normal to the axis for a cylindrical pair)
@@ -516,7 +516,7 @@ def energy_case_exudyn(shaft_angle_deg: float, revolutions: int, steps_per_revol
     info["nominal_steps_per_revolution"] = (steps_per_revolution if steps_per_revolution
                                             else round(2 * math.pi / scene.drive.initial_speed
                                                        / summary["dt"]))
-    if info["status"] == STATUS_OK and done < revolutions:
+    if info["status"] == Status.OK and done < revolutions:
         info.update(status="incomplete", reason=f"{done} of {revolutions} revolutions")
     return info, relative
 
@@ -670,8 +670,8 @@ def _drift_summary(rows: pd.DataFrame, info: dict[str, Any], checks: list) -> di
     requested = info.get("requested_revolutions", float("nan"))
     done = info.get("completed_revolutions", 0)
     _check(checks, "the run completes its revolutions (completed of requested)", node_type,
-           float(done), float(requested), passed=info["status"] == STATUS_OK and done == requested,
-           detail=("" if info["status"] == STATUS_OK else
+           float(done), float(requested), passed=info["status"] == Status.OK and done == requested,
+           detail=("" if info["status"] == Status.OK else
                    f"{info['status']} at revolution {_g(info.get('ended_at_revolution'), '.2f')}: "
                    f"{info['reason']}"))
     if len(rows) < STARTUP_REVOLUTIONS + 3:
@@ -750,7 +750,7 @@ def _drift_summary(rows: pd.DataFrame, info: dict[str, Any], checks: list) -> di
 def _fit_dissipation(cases: list[dict[str, Any]], angle: float) -> dict[str, Any]:
     """Order in h at the default spectral radius, and K of ``loss = K c(rho) h^3``."""
     ok = [c for c in cases if c["engine"] == "exudyn" and c["shaft_angle_deg"] == angle
-          and c["status"] == STATUS_OK and c.get("loss_per_revolution", 0) > 0]
+          and c["status"] == Status.OK and c.get("loss_per_revolution", 0) > 0]
     out: dict[str, Any] = {"shaft_angle_deg": angle}
     ladder = sorted((c for c in ok if c["spectral_radius"] == DEFAULT_RHO),
                     key=lambda c: c["steps_per_revolution"])
@@ -805,13 +805,13 @@ def _energy_summary(cases: list[dict[str, Any]], checks: list) -> dict[str, Any]
             if c["shaft_angle_deg"] != angle:
                 continue
             if c["engine"] == "reference":
-                if c["status"] == STATUS_OK:
+                if c["status"] == Status.OK:
                     per_rev = abs(c["relative_drift"]) / c["completed_revolutions"]
                     _check(checks, "reference engine: abs(relative energy drift) per revolution",
                            subject, per_rev, TOLERANCES["reference_drift_per_revolution"][0])
                 continue
             if c.get("dt_choice", "given") != "given" and c["spectral_radius"] == DEFAULT_RHO:
-                if c["status"] != STATUS_OK or angle not in DISSIPATION_MODEL:
+                if c["status"] != Status.OK or angle not in DISSIPATION_MODEL:
                     _check(checks, "default settings: relative energy drift", subject,
                            float("nan"), 0.0, passed=False, detail=f"{c['status']}: {c['reason']}")
                     continue
@@ -879,7 +879,7 @@ def findings(drift_out: dict[str, Any], cases: list[dict[str, Any]]) -> list[str
     """Plain sentences for what did not run through, and why where it is known."""
     out = []
     for node_type, info in drift_out.items():
-        if info["status"] == STATUS_OK:
+        if info["status"] == Status.OK:
             continue
         text = (f"{node_type}: {info['status']} at revolution "
                 f"{_g(info.get('ended_at_revolution'), '.2f')} of {info.get('requested_revolutions')} "
@@ -890,7 +890,7 @@ def findings(drift_out: dict[str, Any], cases: list[dict[str, Any]]) -> list[str
                      f"{misalignment['last_window_max_abs']:.2g} rad: " + ROTVEC_FAILURE)
         out.append(text)
     for c in cases:
-        if c["status"] != STATUS_OK:
+        if c["status"] != Status.OK:
             text = (f"{c['case']}: {c['status']} after {c.get('completed_revolutions', 0)} "
                     f"revolutions ({c['reason']})")
             if c["engine"] == "exudyn" and c["spectral_radius"] >= 0.99:
@@ -982,7 +982,7 @@ def _figure_energy(energy: pd.DataFrame, summary: dict[str, Any]):
     cases = summary["energy"]["cases"]
     for angle in sorted({c["shaft_angle_deg"] for c in cases}):
         ok = [c for c in cases if c["engine"] == "exudyn" and c["shaft_angle_deg"] == angle
-              and c["status"] == STATUS_OK and c.get("loss_per_revolution", 0) > 0]
+              and c["status"] == Status.OK and c.get("loss_per_revolution", 0) > 0]
         ladder = sorted((c for c in ok if c["spectral_radius"] == DEFAULT_RHO),
                         key=lambda c: c["steps_per_revolution"])
         if ladder:
@@ -1021,7 +1021,7 @@ def _figure_energy(energy: pd.DataFrame, summary: dict[str, Any]):
 
 def write_long(result: LongRuns, folder: Path) -> list[str]:
     """CSV tables, the summary as JSON and the figures into an existing ``folder``; file names."""
-    from cardan_exudyn.plots import save
+    from cardan_exudyn.report.plots import save
 
     folder = Path(folder)
     names = []

@@ -9,7 +9,7 @@ couplings: ``converged`` (friction applied to the dynamics, the model of this pr
 with the per-pair breakdown of where the change comes from and the sliding work of eq. (5).
 
 Monte Carlo (:func:`monte_carlo`): each error drawn from a stated distribution
-(:class:`cardan_exudyn.sweep.Distribution`), N samples reproducible from a seed, run through the
+(:class:`cardan_exudyn.sweep.runner.Distribution`), N samples reproducible from a seed, run through the
 sweep runner (resumable, local cores or a Dask cluster). Output: the distribution of the mean
 efficiency and its percentiles, and per error three sensitivity measures: Spearman's rank
 correlation with the error and with its magnitude (an effect that depends on the size but not the
@@ -174,7 +174,7 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
         Folder: ``cases/`` (the sweep: one record per sample as it finishes), ``samples.csv``,
         ``tolerance.json``, ``sensitivity.csv``, ``report.md`` and plots.
     method, workers, scheduler, restart, progress
-        Passed to :func:`cardan_exudyn.sweep.run_sweep` (``method``: ``lhs`` or ``random``).
+        Passed to :func:`cardan_exudyn.sweep.runner.run_sweep` (``method``: ``lhs`` or ``random``).
 
     Returns
     -------
@@ -185,7 +185,7 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
     import pandas as pd
 
     from cardan_exudyn.io import atomic_directory, dumps
-    from cardan_exudyn.sweep import run_sweep
+    from cardan_exudyn.sweep.runner import run_sweep
 
     distributions = dict(distributions or default_distributions())
     out = Path(out)

@@ -47,11 +47,12 @@ import numpy as np
 
 from cardan_exudyn.io import OutputError, atomic_write, check_output_folder, to_jsonable
 from reference.scene import Scene, SceneError, replace, scene_to_dict
+from reference.schema import Summary
 
 PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE = "plan.json", "cases.jsonl", "results.csv", "sweep.json"
 SWEEP_FILES = (PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE)
 PLAN_FORMAT = "cardan-sweep/1"
-DEFAULT_FUNCTION = "cardan_exudyn.sweep:summary_outputs"
+DEFAULT_FUNCTION = "cardan_exudyn.sweep.runner:summary_outputs"
 # keys of a record that the runner sets; a case function must not return them
 RECORD_KEYS = ("id", "engine", "overrides", "status", "reason", "error_type", "error", "case_wall_s")
 RESERVED_OUTPUTS = frozenset({"id", "overrides", "error_type", "error", "case_wall_s", "traceback"})
@@ -588,12 +589,14 @@ def _check_scene(base: Scene, overrides: dict[str, Any], what: str) -> None:
 
 
 
-def scalar_summary(summary: Mapping[str, Any]) -> dict[str, Any]:
+def scalar_summary(summary: Summary | Mapping[str, Any]) -> dict[str, Any]:
     """The scalar values of an engine summary: numbers, strings, booleans and None at the top
     level, and those of nested tables as ``table.key``; the scene and lists are dropped."""
     out: dict[str, Any] = {}
+    if isinstance(summary, Summary):
+        summary = summary.to_dict()
     for key, value in summary.items():
-        if key == "scene":
+        if key in ("scene", "schema_version"):
             continue
         if isinstance(value, Mapping):
             out.update({f"{key}.{k}": v for k, v in value.items() if _is_scalar(v)})

@@ -16,15 +16,16 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import exudyn as exu
 import numpy as np
 
-from cardan_exudyn.model import ExudynModel, build_model
-from cardan_exudyn.projection import project_velocities
-from cardan_exudyn.stepsize import choose_step
+from cardan_exudyn.model.build import ExudynModel, build_model
+from cardan_exudyn.model.projection import project_velocities
+from cardan_exudyn.model.stepsize import choose_step
 from reference.friction import friction_from_columns
 from reference.rccc import LoopClosureError
 from reference.scene import (
@@ -33,15 +34,15 @@ from reference.scene import (
     PAIR_NAMES,
     AngleDrive,
     Scene,
-    SceneError,
     check_steps,
     scene_to_dict,
 )
 from reference.schema import (
     REACTION_SUFFIXES,
-    STATUS_NO_CLOSURE,
-    STATUS_OK,
+    OptionsError,
     Result,
+    Status,
+    Summary,
     instantaneous_efficiency,
     mean_values,
     table_columns,
@@ -72,13 +73,13 @@ class ExudynOptions:
     node_type : str
         Rigid-body node of the bodies: ``"Rxyz"`` (Tait-Bryan angles), ``"EP"`` (Euler
         parameters) or ``"RotVecLG"`` (rotation vector, Lie-group integration); see
-        :func:`cardan_exudyn.model.build_model` for which body gets which.
+        :func:`cardan_exudyn.model.build.build_model` for which body gets which.
     sensors : str
         ``"auto"``: record the pair reactions only when the scene asks for the time table (a
         summary-only run does not need them); ``"all"``: always.
     velocity_projection : bool
         Report velocities projected onto the velocity constraints at the computed positions
-        (post-processing, :mod:`cardan_exudyn.projection`): exact speed ratio for a prescribed
+        (post-processing, :mod:`cardan_exudyn.model.projection`): exact speed ratio for a prescribed
         input; the drive torque, reactions and friction keep the integrator's error.
     """
 
@@ -93,20 +94,20 @@ class ExudynOptions:
 
     def __post_init__(self) -> None:
         if not 0.0 <= self.spectral_radius < 1.0:
-            raise SceneError(f"`spectral_radius` must be in [0, 1), got {self.spectral_radius!r}")
+            raise OptionsError(f"`spectral_radius` must be in [0, 1), got {self.spectral_radius!r}")
         for name in ("newton_relative_tolerance", "newton_absolute_tolerance"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and 0.0 < value < 1.0):
-                raise SceneError(f"`{name}` must be in (0, 1), got {value!r}")
+                raise OptionsError(f"`{name}` must be in (0, 1), got {value!r}")
         if self.node_type not in NODE_TYPES:
-            raise SceneError(f"`node_type` must be one of {list(NODE_TYPES)}, got {self.node_type!r}")
+            raise OptionsError(f"`node_type` must be one of {list(NODE_TYPES)}, got {self.node_type!r}")
         if self.node_type == "RotVecLG" and self.spectral_radius > 0.8:
             # measured: at 0.9 friction runs end "ok" with the efficiency 0.2 off, at 0.95 the
             # frictionless run fails
-            raise SceneError(f"`spectral_radius` must be <= 0.8 with node_type 'RotVecLG', got "
+            raise OptionsError(f"`spectral_radius` must be <= 0.8 with node_type 'RotVecLG', got "
                              f"{self.spectral_radius!r}")
         if self.sensors not in SENSOR_SCOPES:
-            raise SceneError(f"`sensors` must be one of {list(SENSOR_SCOPES)}, got {self.sensors!r}")
+            raise OptionsError(f"`sensors` must be one of {list(SENSOR_SCOPES)}, got {self.sensors!r}")
 
     def to_dict(self) -> dict[str, Any]:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
@@ -170,16 +171,20 @@ class Solved:
 
     model: ExudynModel
     solver: Any
-    status: str
+    status: Status
     reason: str
     dt: float
     dt_reason: str
     wall_time_s: float
 
 
-def solve(scene: Scene, options: ExudynOptions, reactions: bool) -> Solved:
+def solve(scene: Scene, options: ExudynOptions, reactions: bool,
+          tweak: Callable[[ExudynModel, Any], None] | None = None) -> Solved:
     """Build the model of ``scene`` and integrate it: the step choice, solver settings, friction
-    set-up and stop function of every Exudyn run (:func:`run`, ``cardan_exudyn.longrun``).
+    set-up and stop function of every Exudyn run (:func:`run`, the long runs, the benchmark).
+
+    ``tweak(model, settings)``, when given, is called once the model and its simulation settings
+    are made and before the solver starts (the benchmark's skip audit adds or removes one thing).
 
     Raises :class:`LoopClosureError` when the mounting errors cannot be assembled.
     """
@@ -196,21 +201,23 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool) -> Solved:
     if friction is not None:
         friction.configure(settings)
     _set_pre_step(model, target if scene.drive.kind == "torque" else None)
+    if tweak is not None:
+        tweak(model, settings)
     solver = exu.MainSolverImplicitSecondOrder()
-    status, reason = STATUS_OK, ""
+    status, reason = Status.OK, ""
     try:
         if friction is None:
             ok = solver.SolveSystem(model.mbs, settings)
         else:
             solver.InitializeSolver(model.mbs, settings)
             friction.initialise(solver, settings)
-            ok = friction.status != STATUS_OK or solver.SolveSteps(model.mbs, settings)
+            ok = friction.status != Status.OK or solver.SolveSteps(model.mbs, settings)
             solver.FinalizeSolver(model.mbs, settings)
         if not ok:
-            status, reason = "integration_failure", solver.GetErrorString() or "solver failed"
+            status, reason = Status.INTEGRATION_FAILURE, solver.GetErrorString() or "solver failed"
     except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
-        status, reason = "integration_failure", str(exc).strip().splitlines()[0][:300]
-    if friction is not None and friction.status != STATUS_OK:
+        status, reason = Status.INTEGRATION_FAILURE, str(exc).strip().splitlines()[0][:300]
+    if friction is not None and friction.status != Status.OK:
         status, reason = friction.status, friction.reason
     return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
 
@@ -219,66 +226,67 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     """Simulate ``scene`` with Exudyn and return its time table and summary."""
     options = options or ExudynOptions()
     wall_start = time.perf_counter()
+    summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=engine_version(),
+                      scene=scene_to_dict(scene),
+                      options={**options.to_dict(), "integrator": "generalized-alpha index 3"})
     try:
         solved = solve(scene, options, reactions=options.records_reactions(scene))
     except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
-        return Result(None, {"status": STATUS_NO_CLOSURE, "reason": str(exc), "engine": ENGINE_NAME,
-                             "engine_version": engine_version(), "scene": scene_to_dict(scene),
-                             "wall_time_s": time.perf_counter() - wall_start})
-    model, solver, status, reason = solved.model, solved.solver, solved.status, solved.reason
-    dt, dt_reason, friction = solved.dt, solved.dt_reason, model.friction
-    target = 2.0 * math.pi * scene.revolutions
-    wall = time.perf_counter() - wall_start
-
-    summary: dict[str, Any] = {
-        "status": status,
-        "reason": reason,
-        "engine": ENGINE_NAME,
-        "engine_version": engine_version(),
-        "scene": scene_to_dict(scene),
-        "dt": dt,
-        "dt_choice": dt_reason,
-        "options": {**options.to_dict(), "integrator": "generalized-alpha index 3"},
-        "steps": int(solver.it.currentStepIndex),
-        "newton_iterations": int(solver.it.newtonStepsCount),
-        "jacobian_evaluations": int(solver.it.newtonJacobiCount),
-        "wall_time_s": wall,
-    }
-    if friction is not None:
-        summary["friction"] = friction.summary()
-    table = None
+        summary.fail(Status.LOOP_DOES_NOT_CLOSE, str(exc))
+        summary.wall_time_s = time.perf_counter() - wall_start
+        return Result(None, summary)
+    model, solver = solved.model, solved.solver
+    summary.status, summary.reason = Status(solved.status), solved.reason
+    summary.dt, summary.dt_choice = solved.dt, solved.dt_reason
+    summary.steps = int(solver.it.currentStepIndex)
+    summary.newton_iterations = int(solver.it.newtonStepsCount)
+    summary.jacobian_evaluations = int(solver.it.newtonJacobiCount)
+    summary.wall_time_s = time.perf_counter() - wall_start
+    if model.friction is not None:
+        friction = model.friction.summary()
+        summary.extras["friction"] = friction
+        summary.max_friction_loop_gain = friction["loop_gain_estimate_max"]
     try:
         columns = postprocess(model, project=options.velocity_projection)
-    except Exception as exc:  # no data recorded, e.g. a failure in the first step
-        summary.update(status="integration_failure" if status == STATUS_OK else status,
-                       reason=reason or f"no usable output: {exc}")
+    except ValueError as exc:  # no data recorded, e.g. a failure in the first step
+        if summary.success:
+            summary.fail(Status.INTEGRATION_FAILURE, f"no usable output: {exc}")
         return Result(None, summary)
-    summary.update(constraint_violation(model.pair_kinematics))
-    if options.velocity_projection:
-        summary["max_velocity_correction"] = model.velocity_correction
-    unrecorded = set() if f"{PAIR_NAMES[0]}_force" in model.sensors else {
-        f"{p}_{c}" for p in PAIR_NAMES for c in REACTION_SUFFIXES}
-    bad = _first_non_finite({k: v for k, v in columns.items() if k not in unrecorded})
-    if bad and status == STATUS_OK:
-        status, reason = "diverged", f"non-finite values in `{bad}`"
-    if scene.drive.kind == "torque":
-        turned = abs(columns["theta_in"][-1] - columns["theta_in"][0])
-        if turned + 1e-6 < target and status == STATUS_OK:
-            status = "incomplete"
-            reason = (f"torque drive turned {turned / (2 * math.pi):.3g} of "
-                      f"{scene.revolutions:g} revolutions in the time allowed")
-    summary.update(status=status, reason=reason)
-    if status == STATUS_OK:
-        means = mean_values(columns, scene.record.skip_revolutions)
-        if means.get("revolutions", 0) < 1:
-            summary.update(status="no_whole_revolution", reason=means.get("mean_status", ""))
-        summary.update({k: v for k, v in means.items() if k != "mean_status"})
+    _check_columns(scene, model, columns, summary, options)
+    table = None
     if scene.record.timeseries:
         import pandas as pd
 
         every = scene.record.every
         table = pd.DataFrame({c: columns[c][::every] for c in table_columns()})
     return Result(table, summary)
+
+
+def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarray],
+                   summary: Summary, options: ExudynOptions) -> None:
+    """Constraint violations, finiteness, the torque drive's turn, and the means into ``summary``."""
+    violation = constraint_violation(model.pair_kinematics)
+    summary.max_constraint_violation_m = violation["max_constraint_violation_m"]
+    summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
+    if options.velocity_projection:
+        summary.extras["max_velocity_correction"] = model.velocity_correction
+    unrecorded = set() if f"{PAIR_NAMES[0]}_force" in model.sensors else {
+        f"{p}_{c}" for p in PAIR_NAMES for c in REACTION_SUFFIXES}
+    bad = _first_non_finite({k: v for k, v in columns.items() if k not in unrecorded})
+    if bad and summary.success:
+        summary.fail(Status.DIVERGED, f"non-finite values in `{bad}`")
+    target = 2.0 * math.pi * scene.revolutions
+    if scene.drive.kind == "torque" and summary.success:
+        turned = abs(columns["theta_in"][-1] - columns["theta_in"][0])
+        if turned + 1e-6 < target:
+            summary.fail(Status.INCOMPLETE, f"torque drive turned {turned / (2 * math.pi):.3g} of "
+                                            f"{scene.revolutions:g} revolutions in the time allowed")
+    if summary.success:
+        means = mean_values(columns, scene.record.skip_revolutions)
+        if means.get("revolutions", 0) < 1:
+            summary.fail(Status.NO_WHOLE_REVOLUTION, means.get("mean_status", ""))
+        else:
+            summary.set_means(means)
 
 
 def _set_pre_step(model: ExudynModel, target: float | None) -> None:
@@ -290,7 +298,7 @@ def _set_pre_step(model: ExudynModel, target: float | None) -> None:
     start = {}
 
     def pre_step(mbs_, t):
-        if friction is not None and friction.status != STATUS_OK:
+        if friction is not None and friction.status != Status.OK:
             return False
         if target is None:
             return True
@@ -310,7 +318,10 @@ def _first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
 
 
 def _stored(model: ExudynModel, key: str) -> np.ndarray:
-    return np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
+    data = np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
+    if data.ndim != 2:  # nothing recorded, e.g. a failure in the first step
+        raise ValueError(f"sensor `{key}` recorded no data")
+    return data
 
 
 def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
@@ -372,7 +383,7 @@ def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarr
     """Columns of the result schema from the recorded sensors.
 
     ``project``: replace the recorded velocities by their projection onto the velocity
-    constraints (:mod:`cardan_exudyn.projection`); the largest correction is left in
+    constraints (:mod:`cardan_exudyn.model.projection`); the largest correction is left in
     ``model.velocity_correction``.
     """
     scene = model.scene

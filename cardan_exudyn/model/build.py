@@ -10,14 +10,14 @@ Modelling choices
   ``build_model(node_type=...)`` gives the spider and the output Euler-parameter
   (``NodeRigidBodyEP``) or rotation-vector (``NodeRigidBodyRotVecLG``) nodes instead, for
   comparing node types; the input keeps its Rxyz node (the drive acts on its first angle).
-  Readers of node coordinates go through ``ExudynModel.rotations`` (:mod:`cardan_exudyn.rotations`).
+  Readers of node coordinates go through ``ExudynModel.rotations`` (:mod:`cardan_exudyn.model.rotations`).
 - Four ``ObjectJointGeneric`` pairs (revolute ``[1,1,1,1,1,0]``, cylindrical ``[1,1,0,1,1,0]``,
   z the pair axis): 17 constraints on 18 coordinates, mobility one, no redundancy.
 - Constant speed: ``ObjectConnectorCoordinate`` at velocity level on the input angle (no Python
   user function). Prescribed angle: the same connector at position level with an offset user
   function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``.
 - Gravity loads and the output load only when they are non-zero; friction loads and their user
-  function only for pairs with a non-zero coefficient (``cardan_exudyn.friction``).
+  function only for pairs with a non-zero coefficient (``cardan_exudyn.model.coupling``).
 - Mounting errors (``scene.joint.errors``): each pair's marker frames are displaced and rotated
   to the joint's Denavit-Hartenberg geometry (the pair axes no longer meet at one point, so the
   cylindrical pairs slide). The marker frames and the initial assembled state are taken from
@@ -37,7 +37,7 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from cardan_exudyn.rotations import ROTATION_COORDINATES, RotationCoordinates
+from cardan_exudyn.model.rotations import ROTATION_COORDINATES, RotationCoordinates
 from reference import rccc
 from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SpeedDrive
 
@@ -150,9 +150,9 @@ class ExudynModel:
     pair_kinematics: dict = field(default_factory=dict)
     mass: dict[str, float] = field(default_factory=dict)
     inertia: dict[str, np.ndarray] = field(default_factory=dict)
-    friction: Any = None  # cardan_exudyn.friction.FrictionCoupling when friction is applied
+    friction: Any = None  # cardan_exudyn.model.coupling.FrictionCoupling when friction is applied
     node_type: str = "Rxyz"  # the build_model argument
-    # per body: the node's rotation coordinates (cardan_exudyn.rotations.ROTATION_COORDINATES)
+    # per body: the node's rotation coordinates (cardan_exudyn.model.rotations.ROTATION_COORDINATES)
     rotations: dict[str, RotationCoordinates] = field(default_factory=dict)
 
 
@@ -239,7 +239,7 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
     _add_drive(model, ground)
     _add_loads(model)
     if scene.has_friction and scene.friction.coupling != "uncoupled":
-        from cardan_exudyn.friction import FrictionCoupling
+        from cardan_exudyn.model.coupling import FrictionCoupling
 
         model.friction = FrictionCoupling(model)
     if sensors:

@@ -1,0 +1,70 @@
+"""The one number and table formatter of every report and of the CLI.
+
+A value that is not a finite number (None, NaN, infinity, a string where a number belongs)
+prints as ``missing`` ("-" by default), never as "nan": a report never shows an undefined number
+as if it were one.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+__all__ = ["is_number", "number", "markdown_table"]
+
+
+def is_number(value: Any) -> bool:
+    """True for a finite int or float (numpy scalars included), False for bool, None, NaN, inf."""
+    if isinstance(value, bool) or value is None:
+        return False
+    try:
+        return math.isfinite(value)
+    except TypeError:
+        return False
+
+
+def number(value: Any, spec: str = ".4g", missing: str = "-") -> str:
+    """``value`` formatted with ``spec``, or ``missing`` when it is not a finite number."""
+    return format(value, spec) if is_number(value) else missing
+
+
+def _cell(value: Any, spec: str | None, missing: str) -> str:
+    if spec is not None:
+        return number(value, spec, missing) if not isinstance(value, str) else value
+    if isinstance(value, float) or (not isinstance(value, (str, bool, int)) and is_number(value)):
+        return number(value, ".4g", missing)
+    if value is None:
+        return missing
+    return str(value).replace("|", "\\|").replace("\n", " ")
+
+
+def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[str],
+                   formats: Mapping[str, str] | None = None, headers: Sequence[str] | None = None,
+                   missing: str = "-") -> str:
+    """A GitHub-flavoured markdown table.
+
+    Parameters
+    ----------
+    rows : iterable of mappings, or a pandas DataFrame
+        One mapping (or DataFrame row) per table row.
+    columns : sequence of str
+        Keys to show, in order.
+    formats : mapping, optional
+        Format spec per column (``{"mean_efficiency": ".4f"}``); floats default to ``.4g``.
+    headers : sequence of str, optional
+        Column titles (default: the keys).
+    missing : str
+        What a value that is not a finite number prints as.
+    """
+    if hasattr(rows, "to_dict") and hasattr(rows, "columns"):  # a DataFrame
+        rows = rows.to_dict("records")
+    formats = formats or {}
+    titles = list(headers) if headers is not None else list(columns)
+    if len(titles) != len(columns):
+        raise ValueError(f"`headers` must have {len(columns)} entries, got {len(titles)}")
+    lines = ["| " + " | ".join(titles) + " |", "|" + "---|" * len(columns)]
+    for row in rows:
+        cells = [_cell(row.get(c), formats.get(c), missing) for c in columns]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
