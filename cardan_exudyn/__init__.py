@@ -1,4 +1,54 @@
-"""The RCCC Cardan joint in Exudyn, the engine registry, result writers, reports and the CLI.
+"""cardan-exudyn: the mechanical efficiency of Cardan (universal) joints with the Exudyn engine.
 
-The only package of the project that imports exudyn.
+The public face. Run a scene with any engine and read one typed result::
+
+    import cardan_exudyn
+    from reference import named_scene
+
+    result = cardan_exudyn.run(named_scene("paper-10deg"), engine="reference")
+    if result.success:
+        print(result.summary.mean_efficiency)
+
+Names are imported on first use (PEP 562), so ``import cardan_exudyn`` stays cheap: Exudyn,
+pandas and matplotlib load only when a run or a report needs them.
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__all__ = [
+    "run", "make_options", "options_class", "ENGINES", "EngineUnavailable",
+    "ExudynOptions", "compare", "Comparison", "sweep",
+    "Result", "Summary", "Status", "OptionsError",
+]
+
+_LAZY = {
+    "run": "cardan_exudyn.engines",
+    "make_options": "cardan_exudyn.engines",
+    "options_class": "cardan_exudyn.engines",
+    "ENGINES": "cardan_exudyn.engines",
+    "EngineUnavailable": "cardan_exudyn.engines",
+    "ExudynOptions": "cardan_exudyn.model.options",
+    "compare": "cardan_exudyn.comparison",
+    "Comparison": "cardan_exudyn.comparison",
+    "Result": "reference.schema",
+    "Summary": "reference.schema",
+    "Status": "reference.schema",
+    "OptionsError": "reference.schema",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name == "sweep":
+        return importlib.import_module("cardan_exudyn.sweep")
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'cardan_exudyn' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

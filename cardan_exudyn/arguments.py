@@ -21,7 +21,9 @@ else:  # Python 3.10
 
 from cardan_exudyn.io import OutputError, check_output_folder
 from reference.paper import named_scene
-from reference.scene import DEG, RPM, Scene, SceneError, load_scene, replace
+from reference.scene import Scene, replace
+from reference.scene_files import load_scene
+from reference.validation import DEG, RPM, SceneError
 
 __all__ = ["EXIT_OK", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_INCOMPLETE", "EXIT_INTERRUPTED",
            "DEFAULT_SCENE", "BadInput", "out_folder", "number", "count", "cli_value",

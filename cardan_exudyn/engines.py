@@ -19,21 +19,26 @@ from reference.schema import OptionsError, Result
 
 @dataclass(frozen=True)
 class Engine:
-    """An entry of :data:`ENGINES`: where its run function and options class live."""
+    """An entry of :data:`ENGINES`: the module whose ``run(scene, options)`` runs a scene, and
+    its options class as ``"module:Class"``."""
 
     name: str
     module: str
     options: str
     description: str
 
+    @property
+    def options_name(self) -> str:
+        return self.options.rpartition(":")[2]
+
 
 ENGINES: dict[str, Engine] = {
-    "exudyn": Engine("exudyn", "cardan_exudyn.model.solve", "ExudynOptions",
+    "exudyn": Engine("exudyn", "cardan_exudyn.model.solve", "cardan_exudyn.model.options:ExudynOptions",
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
-    "reference": Engine("reference", "reference.engine", "ReferenceOptions",
+    "reference": Engine("reference", "reference.engine", "reference.engine:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "
                         "minimal-coordinate dynamics, adaptive work quadrature"),
-    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco_engine", "MujocoOptions",
+    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco_engine", "cardan_exudyn.mujoco_engine:MujocoOptions",
                      "MuJoCo (optional extra): frictionless scenes with a constant load only"),
 }
 
@@ -48,17 +53,17 @@ def _entry(name: str) -> Engine:
     return ENGINES[name]
 
 
-def _module(name: str) -> Any:
-    entry = _entry(name)
+def _import(name: str, module: str) -> Any:
     try:
-        return importlib.import_module(entry.module)
+        return importlib.import_module(module)
     except ImportError as exc:
         raise EngineUnavailable(f"engine {name!r} is not available: {exc}") from None
 
 
 def options_class(engine: str) -> type:
     """The options class of ``engine`` (a frozen dataclass validated on construction)."""
-    return getattr(_module(engine), _entry(engine).options)
+    module, _, cls = _entry(engine).options.partition(":")
+    return getattr(_import(engine, module), cls)
 
 
 def make_options(engine: str, **values: Any) -> Any:
@@ -73,13 +78,13 @@ def make_options(engine: str, **values: Any) -> Any:
 
 def get_engine(name: str) -> Callable[..., Result]:
     """The run function ``run(scene, options=None) -> Result`` of the named engine."""
-    return _module(name).run
+    return _import(name, _entry(name).module).run
 
 
 def engine_of(options: Any) -> str:
     """The engine whose options class ``options`` is an instance of."""
     for name, entry in ENGINES.items():
-        if type(options).__name__ == entry.options:
+        if type(options).__name__ == entry.options_name:
             return name
     raise OptionsError(f"`options` must be the options of an engine in {sorted(ENGINES)}, "
                        f"got {type(options).__name__}")

@@ -12,8 +12,8 @@ import math
 import os
 import shutil
 import tempfile
-from enum import Enum
 from collections.abc import Iterator
+from enum import Enum
 from pathlib import Path
 from typing import Any
 

@@ -1,50 +1,15 @@
-"""Optional MuJoCo engine for the frictionless Cardan joint (``pip install mujoco``).
+"""The MuJoCo engine (optional: ``pip install mujoco``) for the frictionless Cardan joint.
 
-MuJoCo cannot express the paper's friction law (friction forces proportional to the pair
-reactions, eqs. (1)-(5)): its friction loss is a constant-magnitude joint friction. This engine
-therefore runs frictionless scenes only and refuses the others. ``docs/mujoco.md`` holds the
-settings study behind :class:`MujocoOptions`' defaults. Importing this module needs MuJoCo; the
-engine registry imports it on first use, so a missing MuJoCo makes only this engine unavailable.
+MuJoCo's friction loss is a constant-magnitude joint friction; it cannot express the paper's
+friction forces proportional to the pair reactions (eqs. (1)-(5)), so this engine refuses scenes
+with friction. Importing this module needs MuJoCo; :mod:`cardan_exudyn.engines` imports it on
+first use, so a missing MuJoCo makes only this engine unavailable.
 
-Model
------
-- Body frames are the canonical frames of :mod:`reference.scene` (origin at the joint centre O),
-  so :meth:`reference.scene.Body.canonical` gives each body's inertial element directly.
-- Kinematic tree, all three hinges through O: ``input`` (hinge about global x) -> ``spider``
-  (hinge about the input yoke, the spider's y axis) -> ``output`` (hinge about the output yoke,
-  the output's z axis; the output body frame is turned by the shaft angle about z).
-- Loop closure: one ``connect`` equality between a site on the output axis at the output
-  bearing (``output_bearing * a2``) and the same point fixed to the ground. In the tree the
-  output's origin is already held at O, so only its orientation is free; holding one more point
-  of its axis removes the two tilts and leaves the spin. Of the connect's three rows, the one
-  along ``a2`` is redundant: the point can only move on a sphere about O, so that row's Jacobian
-  vanishes on the constraint manifold. MuJoCo's primal solver regularises every row, so the
-  redundant row costs nothing and carries (almost) no force. A ``weld`` would also fix the spin
-  and lock the mechanism; two connects (two points of the axis) would add three more redundant
-  rows and nothing else.
-- Constant speed and prescribed angle: a heavy ``drive_reference`` hinge about x in its own tree
-  (its centre of mass on its axis, so only the drive acts on it) is reset to the prescribed angle
-  and speed before every step and pushed with ``inertia * acceleration`` during the step; a joint
-  equality ``q_input = q_reference`` couples the input to it. The constraint's velocity error is
-  then the input's speed error, and its force is the drive torque. The alternatives are worse:
-  a velocity servo is integrated explicitly by RK4 (stable only for ``kv < ~2.8 J / dt``, far
-  too soft), and a joint equality whose target is moved by hand every step damps the speed
-  towards zero (``a_ref = -b qdot - k r``), a lag of ``2 timeconst * omega``.
-- Torque drive: a generalized force on the input hinge. Load: the constant world torque
-  ``-T a2`` on the output (``xfrc_applied``), as in :mod:`reference.dynamics`.
-
-Reactions
----------
-The tree joints are revolute (with an axial force) and the closure is a point, where the schema's
-RCCC has cylindrical spider pairs (no axial force) and a cylindrical output bearing (with bending
-moments): MuJoCo solves a different, also statically determinate, support structure, so its pair
-forces and both frame-pair reactions are not the schema's and are left NaN. The spider-pair
-moments are the same in both structures and are filled: the moment balance of the spider about O
-(both spider-pair forces pass through O) fixes the components of the two moments along the other
-arm, and the input's moment balance about its axis, ``torque_in`` being the same for any support
-(virtual work), fixes the rest. They come from ``mjData.cfrc_int`` (the wrench the parent body
-exerts on a body, about the tree's centre of mass, world axes), moved to O and rotated into the
-pair frame of body ``a``.
+The model (``docs/mujoco.md``): three hinges through the joint centre O; one ``connect`` at the
+output bearing closes the loop; a prescribed input follows a heavy ``drive_reference`` hinge
+through a joint equality whose force is the drive torque. MuJoCo's supports are not the schema's
+RCCC, so its pair forces and frame-pair reactions are NaN; the spider-pair moments, the same in
+both, are filled. Defaults: the settings study of :mod:`cardan_exudyn.studies.mujoco_settings`.
 
 References
 ----------
@@ -59,27 +24,16 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import mujoco
 import numpy as np
+import pandas as pd
 
-from reference.kinematics import (
-    body_motions,
-    pair_frames_in_body_a,
-    rot_z,
-    speed_ratio,
-)
-from reference.scene import (
-    PAIR_BODIES,
-    PAIR_NAMES,
-    AngleDrive,
-    Scene,
-    SpeedDrive,
-    TorqueDrive,
-    scene_to_dict,
-)
+from reference.joint import PAIR_BODIES, PAIR_NAMES
+from reference.kinematics import body_motions, pair_frames_in_body_a, rot_z
+from reference.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.schema import (
     OptionsError,
     Result,
@@ -92,8 +46,7 @@ from reference.schema import (
 
 ENGINE_NAME = "mujoco"
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast", "discrete")
-# MuJoCo's own defaults (option timestep and integrator, solref, solimp), for the study
-MUJOCO_DEFAULT_TIMESTEP = 0.002
+# MuJoCo's own solref and solimp: the contact override's when not given, and the study's
 MUJOCO_DEFAULT_SOLREF = (0.02, 1.0)
 MUJOCO_DEFAULT_SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
 # Impedance at MuJoCo's cap mjMAXIMP = 0.9999 (larger values are clamped to it).
@@ -103,6 +56,9 @@ BODY_IDS = {"input": 1, "spider": 2, "output": 3}
 VIOLATION_LIMIT_RAD = 1e-2
 # Pairs whose moments (mx, my, mz) are filled; see the module docstring.
 _FILLED_REACTIONS = ("input_spider", "spider_output")
+# Per-step shapes of the recorded mjData fields (:meth:`_Record.take` says what each holds).
+RECORD_SHAPES = {"t": (), "q": (3,), "qd": (3,), "reference": (), "xmat": (3, 3, 3), "cvel": (3, 6),
+                 "centre": (3,), "sites": (2, 3), "cfrc_int": (3, 6), "torque_in": ()}
 
 
 def _floats(name: str, value: Any) -> tuple[float, ...]:
@@ -116,7 +72,7 @@ def _solref(name: str, value: Any) -> tuple[float, ...]:
     ref = _floats(name, value)
     if len(ref) != 2 or not (min(ref) > 0.0 or (ref[0] < 0.0 and ref[1] <= 0.0)):
         raise OptionsError(f"`{name}` must be (timeconst > 0, dampratio > 0) or "
-                         f"(-stiffness < 0, -damping <= 0), got {value!r}")
+                           f"(-stiffness < 0, -damping <= 0), got {value!r}")
     return ref
 
 
@@ -195,7 +151,7 @@ class MujocoOptions:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < (name == "iterations"):
                 raise OptionsError(f"`{name}` must be a non-negative integer (iterations >= 1), "
-                                 f"got {value!r}")
+                                   f"got {value!r}")
         if not self.tolerance >= 0.0:
             raise OptionsError(f"`tolerance` must be >= 0, got {self.tolerance!r}")
 
@@ -204,19 +160,8 @@ class MujocoOptions:
         return self.solref if self.solref is not None else (self.timeconst_steps * dt, self.dampratio)
 
 
-MUJOCO_DEFAULTS = MujocoOptions(integrator="Euler", timestep=MUJOCO_DEFAULT_TIMESTEP,
-                                 solref=MUJOCO_DEFAULT_SOLREF, solimp=MUJOCO_DEFAULT_SOLIMP)
-
-# Error model of the recommended settings (RK4, solref None): the largest error of
-# omega_out / omega_in is about
-#     C_H tan(b)^2 / cos(b)^2 h^1.5  +  C_G |g| timeconst / omega
-# with h = omega dt the input angle per step [rad]. The first term is the integration error at
-# speed (the paper scenes at 10-75 deg, 2000 rpm: C_H bounds the measured values by 1.2-8x), the
-# second the drift that the impedance cap lets gravity cause within one constraint time constant
-# (the rig scene, 6 rad/s: the measured values are half of it). Measured by `settings_study`,
-# see docs/mujoco.md.
-ERROR_CONSTANT_SPEED = 1.5e-4  # [-]
-ERROR_CONSTANT_GRAVITY = 1e-4  # [1/m]
+ERROR_CONSTANT_SPEED = 1.5e-4  # C_H of speed_ratio_error_model [-]
+ERROR_CONSTANT_GRAVITY = 1e-4  # C_G of speed_ratio_error_model [1/m]
 MIN_STEPS_PER_REVOLUTION = 100
 MAX_STEPS_PER_REVOLUTION = 2_000_000
 
@@ -225,22 +170,27 @@ def engine_version() -> str:
     return mujoco.__version__
 
 
-def speed_ratio_error_model(scene: Scene, settings: MujocoOptions, steps: int) -> float:
+def speed_ratio_error_model(scene: Scene, options: MujocoOptions, steps: int) -> float:
     """Predicted largest speed-ratio error [-] of a run with ``steps`` steps per revolution.
 
-    Valid for the recommended integrator and constraint settings (RK4, ``solref`` from
-    ``timeconst_steps``); see the constants above.
+    Valid for the recommended settings (RK4, ``solref`` from ``timeconst_steps``): the largest
+    error of ``omega_out / omega_in`` is about ``C_H tan(b)^2 / cos(b)^2 h^1.5 + C_G |g| tc /
+    omega``, with ``h = omega dt`` the input angle per step [rad] and ``tc`` the constraint time
+    constant [s]. The first term is the integration error at speed (the paper scenes at 10-75 deg,
+    2000 rpm: ``C_H`` bounds the measured values by 1.2-8x), the second the drift that the
+    impedance cap lets gravity cause within one time constant (the rig scene, 6 rad/s: the
+    measured values are half of it). Measured by the settings study, see ``docs/mujoco.md``.
     """
     beta = scene.joint.geometry.shaft_angle
     omega = scene.drive.max_speed()
     h = 2.0 * math.pi / steps
-    timeconst = settings.timeconst_steps * h / omega
+    timeconst = options.timeconst_steps * h / omega
     gravity = float(np.linalg.norm(scene.gravity))
     return (ERROR_CONSTANT_SPEED * (math.tan(beta) / math.cos(beta)) ** 2 * h**1.5
             + ERROR_CONSTANT_GRAVITY * gravity * timeconst / omega)
 
 
-def choose_timestep(scene: Scene, settings: MujocoOptions) -> tuple[float, str]:
+def choose_timestep(scene: Scene, options: MujocoOptions) -> tuple[float, str]:
     """Time step [s] and a sentence saying how it was chosen.
 
     Without a given step, the fewest whole steps per revolution (at the drive's highest speed),
@@ -249,25 +199,25 @@ def choose_timestep(scene: Scene, settings: MujocoOptions) -> tuple[float, str]:
 
     Raises
     ------
-    ValueError
+    OptionsError
         When no step is given and the settings are not the ones the error model was measured
         with (another integrator or an explicit ``solref``).
     """
-    if settings.timestep is not None:
-        return settings.timestep, "given (engine settings)"
+    if options.timestep is not None:
+        return options.timestep, "given (engine settings)"
     if scene.numerics.dt is not None:
         return scene.numerics.dt, "given (scene)"
-    if settings.integrator != "RK4" or settings.solref is not None:
+    if options.integrator != "RK4" or options.solref is not None:
         raise OptionsError("the automatic time step is measured for RK4 with `solref` from "
-                         f"`timeconst_steps` only; give `timestep` for integrator "
-                         f"{settings.integrator!r} and solref {settings.solref!r}")
+                           f"`timeconst_steps` only; give `timestep` for integrator "
+                           f"{options.integrator!r} and solref {options.solref!r}")
     accuracy = scene.numerics.accuracy
     low, high = MIN_STEPS_PER_REVOLUTION, MIN_STEPS_PER_REVOLUTION
-    while speed_ratio_error_model(scene, settings, high) > accuracy and high < MAX_STEPS_PER_REVOLUTION:
+    while speed_ratio_error_model(scene, options, high) > accuracy and high < MAX_STEPS_PER_REVOLUTION:
         low, high = high, 2 * high
     while high - low > 1:  # the smallest count in (low, high] that meets the accuracy
         middle = (low + high) // 2
-        if speed_ratio_error_model(scene, settings, middle) <= accuracy:
+        if speed_ratio_error_model(scene, options, middle) <= accuracy:
             high = middle
         else:
             low = middle
@@ -287,28 +237,28 @@ def _inertial(scene: Scene, name: str) -> str:
     return f'<inertial pos="{_numbers(com)}" mass="{mass!r}" fullinertia="{_numbers(full)}"/>'
 
 
-def mjcf(scene: Scene, settings: MujocoOptions, dt: float) -> str:
+def mjcf(scene: Scene, options: MujocoOptions, dt: float) -> str:
     """The MJCF model of ``scene`` (see the module docstring) with time step ``dt`` [s]."""
     geo = scene.joint.geometry
     half = 0.5 * geo.shaft_angle
-    solref = f'solref="{_numbers(settings.solref_for(dt))}" solimp="{_numbers(settings.solimp)}"'
+    solref = f'solref="{_numbers(options.solref_for(dt))}" solimp="{_numbers(options.solimp)}"'
     prescribed = not isinstance(scene.drive, TorqueDrive)
-    i_ref = settings.reference_inertia
+    i_ref = options.reference_inertia
     reference_body = (
         f'<body name="drive_reference"><joint name="drive_reference" axis="1 0 0"/>'
         f'<inertial pos="0 0 0" mass="1" diaginertia="{i_ref!r} {i_ref!r} {i_ref!r}"/></body>'
         if prescribed else "")
     drive = (f'<joint name="drive" joint1="input" joint2="drive_reference" polycoef="0 1 0 0 0" '
              f'{solref}/>' if prescribed else "")
-    override = settings.o_solref is not None or settings.o_solimp is not None
-    o_solref = settings.o_solref if settings.o_solref is not None else MUJOCO_DEFAULT_SOLREF
-    o_solimp = settings.o_solimp if settings.o_solimp is not None else MUJOCO_DEFAULT_SOLIMP
+    override = options.o_solref is not None or options.o_solimp is not None
+    o_solref = options.o_solref if options.o_solref is not None else MUJOCO_DEFAULT_SOLREF
+    o_solimp = options.o_solimp if options.o_solimp is not None else MUJOCO_DEFAULT_SOLIMP
     return f"""<mujoco model="cardan">
-  <option timestep="{dt!r}" integrator="{settings.integrator}" gravity="{_numbers(scene.gravity)}"
-          solver="Newton" jacobian="dense" iterations="{settings.iterations}"
-          tolerance="{settings.tolerance!r}" noslip_iterations="{settings.noslip_iterations}"
+  <option timestep="{dt!r}" integrator="{options.integrator}" gravity="{_numbers(scene.gravity)}"
+          solver="Newton" jacobian="dense" iterations="{options.iterations}"
+          tolerance="{options.tolerance!r}" noslip_iterations="{options.noslip_iterations}"
           o_solref="{_numbers(o_solref)}" o_solimp="{_numbers(o_solimp)}">
-    <flag refsafe="{'enable' if settings.refsafe else 'disable'}" autoreset="disable"
+    <flag refsafe="{'enable' if options.refsafe else 'disable'}" autoreset="disable"
           override="{'enable' if override else 'disable'}"/>
   </option>
   <worldbody>
@@ -357,14 +307,12 @@ def joint_state(scene: Scene, theta: float, theta_t: float) -> tuple[np.ndarray,
 
 @dataclass(frozen=True)
 class DrivePlan:
-    """How the input is driven: start, longest span, prescribed motion and stop angle.
+    """How the input is driven.
 
     Attributes
     ----------
-    start : float
-        Start time [s].
-    span : float
-        Longest simulated time [s].
+    start, span : float
+        Start time and longest simulated time [s].
     motion : callable or None
         ``t -> (angle [rad], speed [rad/s], acceleration [rad/s^2])`` of a prescribed input;
         None for the torque drive.
@@ -398,28 +346,22 @@ def drive_plan(scene: Scene) -> DrivePlan:
                          float(spline(start)), float(rates[1](start)), turn)
     if isinstance(drive, TorqueDrive):
         # as the Exudyn engine: four times the time at the initial speed, stopped at `turn`
-        return DrivePlan(0.0, drive.time_allowed(turn), None, 0.0,
-                         drive.initial_speed, turn)
+        return DrivePlan(0.0, drive.time_allowed(turn), None, 0.0, drive.initial_speed, turn)
     raise NotImplementedError(f"the MuJoCo engine cannot run a {type(drive).__name__}")
 
 
 class _Record:
-    """Per-step copies of the mjData fields the result table is computed from."""
+    """Per-step copies of the mjData fields the result table is computed from (arrays of
+    :data:`RECORD_SHAPES`, one row per step)."""
+
 
     def __init__(self, n: int) -> None:
-        self.t = np.zeros(n)
-        self.q = np.zeros((n, 3))
-        self.qd = np.zeros((n, 3))
-        self.reference = np.zeros(n)
-        self.xmat = np.zeros((n, 3, 3, 3))
-        self.cvel = np.zeros((n, 3, 6))
-        self.centre = np.zeros((n, 3))
-        self.sites = np.zeros((n, 2, 3))
-        self.cfrc_int = np.zeros((n, 3, 6))
-        self.torque_in = np.zeros(n)
+        for name, shape in RECORD_SHAPES.items():
+            setattr(self, name, np.zeros((n, *shape)))
         self.size = 0
 
     def take(self, d: Any, drive_row: int | None, torque: float) -> None:
+        """Append the state of ``d`` (after ``mj_forward`` and ``mj_rnePostConstraint``)."""
         k, bodies = self.size, slice(1, 4)
         self.t[k] = d.time
         self.q[k], self.qd[k] = d.qpos[:3], d.qvel[:3]
@@ -452,14 +394,14 @@ def _integrate(m: Any, d: Any) -> None:
         mujoco.mj_step(m, d)
 
 
-def simulate(scene: Scene, settings: MujocoOptions, dt: float) -> tuple[_Record, str, str]:
+def simulate(scene: Scene, options: MujocoOptions, dt: float) -> tuple[_Record, Status, str]:
     """Run the MuJoCo model of ``scene``; per-step records, status and reason.
 
     Every step runs ``mj_forward`` and ``mj_rnePostConstraint`` at the current state, records,
     and integrates, so that every record (state, drive torque, reactions) belongs to one instant.
     """
     plan = drive_plan(scene)
-    m = mujoco.MjModel.from_xml_string(mjcf(scene, settings, dt))
+    m = mujoco.MjModel.from_xml_string(mjcf(scene, options, dt))
     d = mujoco.MjData(m)
     q0, qd0 = joint_state(scene, plan.theta0, plan.omega0)
     d.qpos[:3], d.qvel[:3] = q0, qd0
@@ -482,7 +424,7 @@ def simulate(scene: Scene, settings: MujocoOptions, dt: float) -> tuple[_Record,
         if plan.motion is not None:
             angle, speed, acceleration = plan.motion(d.time)
             d.qpos[3], d.qvel[3] = angle, speed
-            d.qfrc_applied[3] = settings.reference_inertia * acceleration
+            d.qfrc_applied[3] = options.reference_inertia * acceleration
         mujoco.mj_forward(m, d)
         mujoco.mj_rnePostConstraint(m, d)
         if plan.motion is not None and drive_row is None:  # equality rows keep their place
@@ -550,16 +492,14 @@ def pair_columns(scene: Scene, record: _Record) -> dict[str, np.ndarray]:
                     for body in (a, b)}
         cols[f"{pair}_omega_rel"] = np.sum((omega[b] - omega[a]) * frame[:, :, 2], 1)
         cols[f"{pair}_slide_rel"] = np.sum((velocity[b] - velocity[a]) * frame[:, :, 2], 1)
-        for key in (f"power_loss_{pair}", f"{pair}_friction_torque", f"{pair}_friction_force"):
-            cols[key] = np.zeros(n)
-        for component in ("fx", "fy", "fz", "mx", "my", "mz"):
-            cols[f"{pair}_{component}"] = np.full(n, np.nan)
+        cols.update({key: np.zeros(n) for key in (f"power_loss_{pair}", f"{pair}_friction_torque",
+                                                  f"{pair}_friction_force")})
+        cols.update({f"{pair}_{c}": np.full(n, np.nan) for c in ("fx", "fy", "fz", "mx", "my", "mz")})
         if pair in _FILLED_REACTIONS:  # the wrench a exerts on b, moved to the pair origin
             wrench = record.cfrc_int[:, BODY_IDS[b] - 1]
             moment = wrench[:, :3] + np.cross(record.centre - points[pair], wrench[:, 3:])
             local_moment = np.einsum("nji,nj->ni", frame, moment)
-            for i, component in enumerate(("mx", "my", "mz")):
-                cols[f"{pair}_{component}"] = local_moment[:, i]
+            cols.update({f"{pair}_{c}": local_moment[:, i] for i, c in enumerate(("mx", "my", "mz"))})
     return cols
 
 
@@ -599,14 +539,14 @@ def constraint_violation(scene: Scene, record: _Record) -> dict[str, float]:
             "max_drive_error_rad": float(np.max(lag)) if np.all(np.isfinite(lag)) else float("nan")}
 
 
-def run(scene: Scene, settings: MujocoOptions | None = None) -> Result:
+def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
     """Simulate the frictionless ``scene`` with MuJoCo and return its time table and summary.
 
     Parameters
     ----------
     scene : Scene
         A scene with every friction coefficient zero.
-    settings : MujocoOptions, optional
+    options : MujocoOptions, optional
         Solver settings; the defaults are the recommended ones (``docs/mujoco.md``).
 
     Returns
@@ -628,14 +568,14 @@ def run(scene: Scene, settings: MujocoOptions | None = None) -> Result:
     if not scene.load.constant:
         raise NotImplementedError("the MuJoCo engine takes a constant load torque only; a load "
                                   "history (measured brake torque) runs on exudyn or reference")
-    settings = settings or MujocoOptions()
+    options = options or MujocoOptions()
     start = time.perf_counter()
-    dt, why = choose_timestep(scene, settings)
-    record, status, reason = simulate(scene, settings, dt)
+    dt, why = choose_timestep(scene, options)
+    record, status, reason = simulate(scene, options, dt)
     cols = columns(scene, record)
     summary = Summary(status, reason, engine=ENGINE_NAME, engine_version=engine_version(),
                       scene=scene_to_dict(scene), dt=dt, dt_choice=why, steps=int(record.t.size - 1),
-                      options={**asdict(settings), "solref": list(settings.solref_for(dt))})
+                      options={**asdict(options), "solref": list(options.solref_for(dt))})
     violation = constraint_violation(scene, record)
     summary.max_constraint_violation_m = violation["max_constraint_violation_m"]
     summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
@@ -653,148 +593,7 @@ def run(scene: Scene, settings: MujocoOptions | None = None) -> Result:
             summary.set_means(means)
     table = None
     if scene.record.timeseries:
-        import pandas as pd
-
         every = scene.record.every
         table = pd.DataFrame({c: cols[c][::every] for c in table_columns()})
     summary.wall_time_s = time.perf_counter() - start
     return Result(table, summary)
-
-
-
-STUDY_SCENES = ("paper-10deg-frictionless", "paper-30deg-frictionless")
-STUDY_TIMESTEPS = (1e-4, 5e-5, 2e-5, 1e-5)
-
-
-def accuracy(scene: Scene, result: Result) -> dict[str, float]:
-    """The study's error measures of one constant-speed run (defined here once).
-
-    Returns
-    -------
-    dict
-        ``speed_ratio_error``: largest ``|omega_out / omega_in - Hooke's ratio at theta_in|`` [-];
-        ``torque_in_error``: largest ``|torque_in - reference|`` over the largest ``|reference|``
-        [-], the reference being :func:`reference.dynamics.inverse_dynamics` at the prescribed
-        motion and the run's times; ``mean_torque_in_error``: ``|mean_torque_in - T|`` [N m]
-        (over whole revolutions of a frictionless joint the mean input torque is exactly the load
-        torque ``T``); ``axis_misalignment_rad``, ``bearing_drift_m``, ``drive_error_rad``: the
-        summary's constraint violations. NaN when the run has no mean values (it diverged or
-        did not finish).
-    """
-    from reference.dynamics import inverse_dynamics  # the study's yardstick, not the engine's
-
-    keys = ("speed_ratio_error", "torque_in_error", "mean_torque_in_error",
-            "axis_misalignment_rad", "bearing_drift_m", "drive_error_rad")
-    if "mean_torque_in" not in result.summary:
-        return dict.fromkeys(keys, float("nan"))
-    table, summary = result.table, result.summary
-    beta = scene.joint.geometry.shaft_angle
-    ratio = table["omega_out"].to_numpy() / table["omega_in"].to_numpy()
-    t = table["t"].to_numpy()
-    w = scene.drive.speed
-    ref = inverse_dynamics(scene, w * t, np.full_like(t, w), np.zeros_like(t))["torque_in"]
-    values = (
-        np.max(np.abs(ratio - speed_ratio(table["theta_in"].to_numpy(), beta))),
-        np.max(np.abs(table["torque_in"].to_numpy() - ref)) / np.max(np.abs(ref)),
-        abs(summary["mean_torque_in"] - scene.load.torque),
-        summary["max_constraint_violation_rad"], summary["max_constraint_violation_m"],
-        summary.extras["max_drive_error_rad"],
-    )
-    return {k: float(v) for k, v in zip(keys, values, strict=True)}
-
-
-def study_cases(timesteps: Iterable[float] = STUDY_TIMESTEPS) -> list[tuple[str, MujocoOptions]]:
-    """The settings compared in ``docs/mujoco.md``: ``(label, settings)`` pairs.
-
-    MuJoCo's defaults as they come (Euler, 2 ms); then for every time step the default
-    ``solref``/``solimp``, each integrator with the stiffest constraint ``refsafe`` allows
-    (time constant 2 dt, impedance 0.9999), and RK4 with longer time constants; then, at the
-    first time step, the knobs that should not matter or that trade one error for another.
-    """
-    stiff = {"solimp": STIFF_SOLIMP}
-    soft = {"solref": MUJOCO_DEFAULT_SOLREF, "solimp": MUJOCO_DEFAULT_SOLIMP}
-    cases = [("MuJoCo defaults", MUJOCO_DEFAULTS)]
-    timesteps = list(timesteps)
-    for dt in timesteps:
-        cases += [(f"default solref/solimp, {i}", MujocoOptions(integrator=i, timestep=dt, **soft))
-                  for i in ("Euler", "RK4")]
-        cases += [(f"{i}, tc 2 dt", MujocoOptions(integrator=i, timestep=dt, timeconst_steps=2, **stiff))
-                  for i in INTEGRATORS]
-        cases += [(f"RK4, tc {n:g} dt", MujocoOptions(timestep=dt, timeconst_steps=n))
-                  for n in (5, 20, 50)]
-    dt = timesteps[0]
-    tc = 20 * dt
-    recommended = MujocoOptions(timestep=dt)
-    cases += [
-        ("RK4, tc 20 dt, direct solref", replace(recommended, solref=(-1.0 / tc**2, -2.0 / tc))),
-        ("RK4, tc 20 dt, dampratio 0.5", replace(recommended, dampratio=0.5)),
-        ("RK4, tc 20 dt, dampratio 2", replace(recommended, dampratio=2.0)),
-        ("RK4, tc 20 dt, d 0.99", replace(recommended, solimp=(0.99, 0.99, 0.001, 0.5, 2.0))),
-        ("RK4, tc 20 dt, d 0.9", replace(recommended, solimp=(0.9, 0.9, 0.001, 0.5, 2.0))),
-        ("RK4, tc 0.5 dt, refsafe on", replace(recommended, timeconst_steps=0.5)),
-        ("RK4, tc 0.5 dt, refsafe off", replace(recommended, timeconst_steps=0.5, refsafe=False)),
-        ("Euler, tc 0.5 dt, refsafe off",
-         replace(recommended, integrator="Euler", timeconst_steps=0.5, refsafe=False)),
-        ("discrete, tc 0.1 dt, refsafe off",
-         replace(recommended, integrator="discrete", timeconst_steps=0.1, refsafe=False)),
-        ("RK4, tc 20 dt, noslip 10", replace(recommended, noslip_iterations=10)),
-        ("RK4, tc 20 dt, contact override (soft o_solref/o_solimp)",
-         replace(recommended, o_solref=MUJOCO_DEFAULT_SOLREF, o_solimp=MUJOCO_DEFAULT_SOLIMP)),
-        ("RK4, tc 20 dt, 1 solver iteration", replace(recommended, iterations=1)),
-        ("RK4, tc 20 dt, reference inertia 1e3", replace(recommended, reference_inertia=1e3)),
-    ]
-    return cases
-
-
-def low_speed_cases(timesteps: Iterable[float] = (1e-3, 3e-4, 1e-4)) -> list[tuple[str, MujocoOptions]]:
-    """RK4 with constraint time constants of 5 and 20 steps, for the slow rig scene.
-
-    At low speed gravity, not inertia, loads the loop closure, and the drift the impedance cap
-    lets it cause grows with the time constant (the error model's second term).
-    """
-    return [(f"RK4, tc {n} dt", MujocoOptions(timestep=dt, timeconst_steps=n))
-            for dt in timesteps for n in (5, 20)]
-
-
-def settings_study(scenes: Iterable[str] = STUDY_SCENES,
-                   cases: Iterable[tuple[str, MujocoOptions]] | None = None,
-                   repeats: int = 3) -> Any:
-    """Error and cost of MuJoCo settings on frictionless constant-speed scenes.
-
-    Parameters
-    ----------
-    scenes : iterable of str
-        Named scenes (:func:`reference.paper.named_scene`), frictionless, constant speed.
-    cases : iterable of (str, MujocoOptions), optional
-        Labelled settings; default :func:`study_cases`.
-    repeats : int
-        Runs per case; the wall time is their median [-].
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per scene and case: ``scene``, ``case``, ``integrator``, ``dt`` [s],
-        ``steps_per_revolution`` [-], ``solref``, ``solimp``, ``status``, the measures of
-        :func:`accuracy` and ``wall_time_s`` [s] (median, model compilation included).
-    """
-    import pandas as pd
-
-    from reference.paper import named_scene
-    from reference.scene import replace as replace_scene
-
-    cases = study_cases() if cases is None else list(cases)
-    rows = []
-    for name in scenes:
-        scene = replace_scene(named_scene(name), **{"record.timeseries": True, "record.every": 1})
-        run(scene, cases[0][1])  # import and warm up outside the timings
-        for label, settings in cases:
-            results = [run(scene, settings) for _ in range(repeats)]
-            dt = results[0].summary["dt"]
-            rows.append({
-                "scene": name, "case": label, "integrator": settings.integrator, "dt": dt,
-                "steps_per_revolution": 2.0 * math.pi / abs(scene.drive.speed) / dt,
-                "solref": settings.solref_for(dt), "solimp": settings.solimp,
-                "status": results[0].summary["status"], **accuracy(scene, results[0]),
-                "wall_time_s": float(np.median([r.summary["wall_time_s"] for r in results])),
-            })
-    return pd.DataFrame(rows)

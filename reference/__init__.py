@@ -1,2 +1,56 @@
-"""numpy/scipy only: the paper's data, the scene format, the result schema, and an independent
-engine for the whole joint. Never imports exudyn, cardan_exudyn or rigdata."""
+"""reference: the paper's data, the scene format, the result schema and an independent engine.
+
+numpy/scipy only: never imports exudyn, cardan_exudyn or rigdata, so everything here works
+without Exudyn. The public face: describe a scene, run it with the reference engine, read one
+typed result::
+
+    import reference
+
+    scene = reference.named_scene("paper-10deg")          # or reference.load_scene("my.toml")
+    scene = reference.replace(scene, **{"load.torque": 1.0})
+    result = reference.run(scene)                          # the reference engine
+    if result.success:
+        print(result.summary.mean_efficiency)
+
+To run the same scene with Exudyn or MuJoCo, use ``cardan_exudyn.run(scene, engine=...)``.
+
+Modules, bottom up: ``validation`` (SceneError, unit constants), ``joint`` (bodies, geometry,
+pairs, mounting errors), ``scene`` (drives, load, numerics, the scene and its dictionary form),
+``paper`` (the paper's data as named scenes), ``scene_files`` (TOML files, ``base = "..."``),
+``schema`` (the result), and the engine: ``kinematics``, ``dual``, ``loop_closure``, ``rccc``,
+``joint_motion``, ``friction``, ``dynamics``, ``engine``.
+
+Names are imported on first use (PEP 562): every ``import reference.<module>`` runs this file
+first, so it imports nothing itself (the engine's modules and scipy load only when needed).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_HOMES = {
+    "reference.validation": ("SceneError", "DEG", "RPM"),
+    "reference.joint": ("PAIR_NAMES", "Body", "Geometry", "Pair", "Pairs", "MountingErrors", "Joint"),
+    "reference.scene": ("Scene", "SpeedDrive", "AngleDrive", "TorqueDrive", "Load", "Numerics",
+                        "FrictionSettings", "Record", "replace", "scene_to_dict", "scene_from_dict"),
+    "reference.scene_files": ("load_scene", "scene_from_mapping"),
+    "reference.paper": ("named_scene", "paper_scene", "rig_scene"),
+    "reference.schema": ("Status", "Result", "Summary", "OptionsError"),
+    "reference.engine": ("ReferenceOptions", "run"),
+}
+_LAZY = {name: module for module, names in _HOMES.items() for name in names}
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'reference' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

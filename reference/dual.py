@@ -57,6 +57,7 @@ class Dual:
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """Shape of both parts."""
         return self.re.shape
 
     @property
@@ -103,7 +104,7 @@ class Dual:
         return Dual(self.re @ other.re, self.re @ other.du + self.du @ other.re)
 
 
-def as_dual(value) -> Dual:
+def as_dual(value: Dual | np.ndarray | float) -> Dual:
     """``value`` itself if it is a :class:`Dual`, else a dual with zero dual part."""
     return value if isinstance(value, Dual) else Dual(value)
 

@@ -44,16 +44,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.friction import friction_magnitudes, pair_power_loss, regularised_sign
+from reference.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
 from reference.joint_motion import JointMotion, joint_motion
 from reference.rccc import BodyMotion
-from reference.scene import (
-    BODY_NAMES,
-    PAIR_BODIES,
-    PAIR_KIND,
-    PAIR_NAMES,
-    Body,
-    Scene,
-)
+from reference.scene import Scene
 from reference.schema import (
     PAIR_SUFFIXES,
     instantaneous_efficiency,
@@ -318,6 +312,7 @@ class FixedPoint:
 
     @property
     def self_locking(self) -> np.ndarray:
+        """Per sample: no converged fixed point, or a loop gain of 1 or more (bool array)."""
         return ~self.converged | ~(self.loop_gain < 1.0)
 
 

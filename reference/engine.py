@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -33,17 +33,10 @@ from reference.dynamics import (
     slot_speeds,
     solve_dynamics,
 )
+from reference.joint import PAIR_NAMES
 from reference.joint_motion import joint_motion
-from reference.rccc import LoopClosureError
-from reference.scene import (
-    PAIR_NAMES,
-    AngleDrive,
-    Scene,
-    SpeedDrive,
-    TorqueDrive,
-    check_steps,
-    scene_to_dict,
-)
+from reference.loop_closure import LoopClosureError
+from reference.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.schema import (
     OptionsError,
     Result,
@@ -53,6 +46,7 @@ from reference.schema import (
     table_columns,
     whole_revolution_window,
 )
+from reference.validation import check_steps
 
 ENGINE_NAME = "reference"
 ENGINE_VERSION = "reference-0.2"
@@ -171,7 +165,7 @@ def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
 
 
 def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) -> InputMotion:
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import solve_ivp  # scipy.integrate takes ~0.5 s to import
 
     target = 2.0 * math.pi * scene.revolutions
     w0 = drive.initial_speed
@@ -365,7 +359,7 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
 
 
 def _time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> float:
-    from scipy.optimize import brentq
+    from scipy.optimize import brentq  # scipy.optimize takes ~0.5 s to import
 
     def f(t: float) -> float:
         return motion.angle(t) - theta
@@ -378,28 +372,72 @@ def _time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> f
     return brentq(f, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
 
-def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarray],
-                    options: ReferenceOptions) -> dict:
-    """Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature.
+WORK_KEYS = ("power_in", "power_out", "power_loss", "self_locking",
+             *(f"power_loss_{p}" for p in PAIR_NAMES), *(f"power_loss_{p}_sliding" for p in PAIR_NAMES))
+"""The columns :func:`work_quadrature` integrates over time, in this order."""
 
-    Returns the summary keys ``input_work``, ``output_work``, ``loss_work``, ``loss_work_<pair>``
-    and its axial-friction part ``loss_work_<pair>_sliding`` (zero in the ideal joint),
-    ``mean_efficiency``, ``work_ratio``, ``mean_torque_in``, ``energy_balance_residual``
-    (W_in - W_out - W_loss - change of mechanical energy [J], zero up to rounding for an exact
-    solution) and ``quadrature`` (how it was done); empty when there is no whole revolution.
-    """
-    theta, t = table["theta_in"], table["t"]
-    theta_0, theta_1, n = whole_revolution_window(theta, scene.record.skip_revolutions)
-    if n < 1:
-        return {}
+
+def _window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
+                  theta_0: float, theta_1: float) -> tuple[float, float]:
+    """Instants [s] at which the input passes ``theta_0`` and ``theta_1`` [rad], each solved
+    between the table rows that bracket it."""
     sign = 1.0 if theta[-1] >= theta[0] else -1.0
 
     def bracket(angle: float) -> tuple[float, float]:
         k = min(max(int(np.searchsorted(sign * theta, sign * angle)), 1), t.size - 1)
         return float(t[k - 1]), float(t[k])
 
-    t_a = _time_at_angle(motion, theta_0, *bracket(theta_0))
-    t_b = _time_at_angle(motion, theta_1, *bracket(theta_1))
+    return (_time_at_angle(motion, theta_0, *bracket(theta_0)),
+            _time_at_angle(motion, theta_1, *bracket(theta_1)))
+
+
+def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.ndarray,
+                      ends: dict[str, np.ndarray], options: ReferenceOptions) -> tuple[np.ndarray, dict]:
+    """:data:`WORK_KEYS` integrated over the panels ``[lo, hi]`` [s] (:func:`adaptive_gauss`)."""
+    def integrand(times: np.ndarray) -> np.ndarray:
+        cols = columns_at(scene, motion, times)
+        return np.stack([np.asarray(cols[k], float) for k in WORK_KEYS], -1)
+
+    # work below a thousandth of the mechanical energy is at the scale's floor (zero input work)
+    energy_scale = float(np.max(np.abs(ends["energy_kinetic"])) + np.max(np.abs(ends["energy_potential"])))
+    with np.errstate(invalid="ignore"):
+        return adaptive_gauss(integrand, lo, hi, options.gauss_nodes, options.quadrature_rtol,
+                              scale_floor=GROSS_SCALE * energy_scale)
+
+
+def _work_means(work: dict[str, float], angle: float, ends: dict[str, np.ndarray]) -> dict[str, Any]:
+    """Summary keys from the works [J] over the window of input ``angle`` [rad]."""
+    out = {"input_work": work["power_in"], "output_work": work["power_out"],
+           "loss_work": work["power_loss"]}
+    for pair in PAIR_NAMES:
+        out[f"loss_work_{pair}"] = work[f"power_loss_{pair}"]
+        out[f"loss_work_{pair}_sliding"] = work[f"power_loss_{pair}_sliding"]
+    w_in = out["input_work"]
+    out["mean_efficiency"] = 1.0 - out["loss_work"] / w_in if w_in != 0 else float("nan")
+    out["work_ratio"] = out["output_work"] / w_in if w_in != 0 else float("nan")
+    out["mean_torque_in"] = w_in / angle
+    energy = ends["energy_kinetic"] + ends["energy_potential"]
+    out["energy_balance_residual"] = float(w_in - out["output_work"] - out["loss_work"]
+                                           - (energy[1] - energy[0]))
+    return out
+
+
+def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarray],
+                    options: ReferenceOptions) -> dict:
+    """Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature.
+
+    Returns the summary keys ``input_work``, ``output_work``, ``loss_work`` [J],
+    ``loss_work_<pair>`` and its axial-friction part ``loss_work_<pair>_sliding`` [J] (zero in
+    the ideal joint), ``mean_efficiency``, ``work_ratio`` [-], ``mean_torque_in`` [N m],
+    ``energy_balance_residual`` (W_in - W_out - W_loss - change of mechanical energy [J], zero up
+    to rounding for an exact solution), ``quadrature`` (how it was done) and
+    ``self_locking_nodes`` (friction locks at some node); empty when there is no whole revolution.
+    """
+    theta, t = table["theta_in"], table["t"]
+    theta_0, theta_1, n = whole_revolution_window(theta, scene.record.skip_revolutions)
+    if n < 1:
+        return {}
+    t_a, t_b = _window_times(motion, theta, t, theta_0, theta_1)
     period = (t_b - t_a) / n
     # at constant speed every revolution repeats the first exactly: integrate one, times n
     repeats = n if motion.periodic else 1
@@ -409,32 +447,10 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     knots = knots[(knots > t_a) & (knots < t_end)]
     edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
     lo, hi = initial_panels(edges, period / options.panels_per_revolution)
-    keys = ["power_in", "power_out", "power_loss", "self_locking",
-            *(f"power_loss_{p}" for p in PAIR_NAMES), *(f"power_loss_{p}_sliding" for p in PAIR_NAMES)]
-
-    def integrand(times: np.ndarray) -> np.ndarray:
-        cols = columns_at(scene, motion, times)
-        return np.stack([np.asarray(cols[k], float) for k in keys], -1)
-
     ends = columns_at(scene, motion, np.array([t_a, t_b]))
-    # work below a thousandth of the mechanical energy is at the scale's floor (zero input work)
-    energy_scale = float(np.max(np.abs(ends["energy_kinetic"])) + np.max(np.abs(ends["energy_potential"])))
-    with np.errstate(invalid="ignore"):
-        values, info = adaptive_gauss(integrand, lo, hi, options.gauss_nodes, options.quadrature_rtol,
-                                      scale_floor=GROSS_SCALE * energy_scale)
-    work = dict(zip(keys, (repeats * values).tolist(), strict=True))
-    out = {"input_work": work["power_in"], "output_work": work["power_out"],
-           "loss_work": work["power_loss"]}
-    for pair in PAIR_NAMES:
-        out[f"loss_work_{pair}"] = work[f"power_loss_{pair}"]
-        out[f"loss_work_{pair}_sliding"] = work[f"power_loss_{pair}_sliding"]
-    w_in = out["input_work"]
-    out["mean_efficiency"] = 1.0 - out["loss_work"] / w_in if w_in != 0 else float("nan")
-    out["work_ratio"] = out["output_work"] / w_in if w_in != 0 else float("nan")
-    out["mean_torque_in"] = w_in / (theta_1 - theta_0)
-    energy = ends["energy_kinetic"] + ends["energy_potential"]
-    out["energy_balance_residual"] = float(w_in - out["output_work"] - out["loss_work"]
-                                           - (energy[1] - energy[0]))
+    values, info = _integrate_powers(scene, motion, lo, hi, ends, options)
+    work = dict(zip(WORK_KEYS, (repeats * values).tolist(), strict=True))
+    out = _work_means(work, theta_1 - theta_0, ends)
     out["quadrature"] = {"method": "adaptive Gauss-Legendre panels",
                          "nodes_per_panel": options.gauss_nodes,
                          "rtol": options.quadrature_rtol,
@@ -445,7 +461,7 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
                          "input_work_error_estimate": info["error_estimate"][0],
                          "loss_work_error_estimate": info["error_estimate"][2]}
     # a locked node makes its panel's values NaN; the self_locking column integrates to > 0
-    out["self_locking_nodes"] = bool(work["self_locking"] != 0 or not np.isfinite(w_in))
+    out["self_locking_nodes"] = bool(work["self_locking"] != 0 or not np.isfinite(out["input_work"]))
     return out
 
 
@@ -466,6 +482,16 @@ def _table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -
 
 def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
     """Solve ``scene`` with the reference engine.
+
+    Scripts should usually call ``cardan_exudyn.run(scene, engine="reference")``, the same for
+    every engine; this is the engine itself, for users without Exudyn.
+
+    Parameters
+    ----------
+    scene : Scene
+        Any scene: constant-speed, angle-history or torque drive, with or without mounting errors.
+    options : ReferenceOptions or None
+        Resolution; None: the defaults.
 
     Returns
     -------
@@ -520,7 +546,7 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary) -> Any:
         _means(scene, motion, columns, options, summary)
     table = None
     if scene.record.timeseries:
-        import pandas as pd
+        import pandas as pd  # pandas takes ~0.5 s to import; only a recorded table needs it
 
         every = scene.record.every
         table = pd.DataFrame({c: columns[c][::every]

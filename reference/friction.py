@@ -31,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from reference.scene import PAIR_KIND, PAIR_NAMES, Pair, Scene
+from reference.joint import PAIR_KIND, PAIR_NAMES, Pair
+from reference.scene import Scene
 
 
 def regularised_sign(speed: Any, band: float) -> np.ndarray:

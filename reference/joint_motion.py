@@ -4,7 +4,7 @@ Two sources give the same :class:`JointMotion`:
 
 - the ideal joint (no mounting errors): the closed form of :mod:`reference.kinematics`; every
   body turns about the joint centre O and no pair slides;
-- a joint with mounting errors (:class:`reference.scene.MountingErrors`): the dual-number RCCC
+- a joint with mounting errors (:class:`reference.joint.MountingErrors`): the dual-number RCCC
   loop of :mod:`reference.rccc` from the Denavit-Hartenberg parameters. The bodies' frames now
   translate, the pair axes no longer meet, and the cylindrical pairs slide.
 
@@ -12,10 +12,10 @@ Two sources give the same :class:`JointMotion`:
 and the loop otherwise; ``"loop"`` forces the loop, which for the ideal joint agrees with the
 closed form to rounding (a test checks it, reactions included).
 
-Conventions shared by both: a body's mass properties (:meth:`reference.scene.Body.canonical`) are
+Conventions shared by both: a body's mass properties (:meth:`reference.joint.Body.canonical`) are
 given in its canonical frame, whose origin is the body's D-H link-frame origin (the joint centre O
 for the ideal joint). Each pair's frame is attached to body ``a`` of the pair
-(:data:`reference.scene.PAIR_BODIES`), z along the pair axis; its origin, the point about which
+(:data:`reference.joint.PAIR_BODIES`), z along the pair axis; its origin, the point about which
 reaction moments are taken, is where the bearing sits (:func:`reference.rccc.axial_positions`) and
 moves with body ``b`` when the pair slides (:func:`reference.rccc.pair_frames`).
 """
@@ -25,9 +25,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from reference import kinematics, rccc
-from reference.scene import PAIR_NAMES, Geometry, Joint
+from reference.joint import PAIR_NAMES, Geometry, Joint
 
 METHODS = ("auto", "closed_form", "loop")
 
@@ -104,7 +105,8 @@ def _loop(joint: Joint, theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.nda
     )
 
 
-def joint_motion(joint: Joint, theta, theta_t, theta_tt, method: str = "auto") -> JointMotion:
+def joint_motion(joint: Joint, theta: ArrayLike, theta_t: ArrayLike, theta_tt: ArrayLike,
+                 method: str = "auto") -> JointMotion:
     """The joint's motion for input angles, speeds and accelerations (broadcast together).
 
     Parameters
@@ -118,7 +120,7 @@ def joint_motion(joint: Joint, theta, theta_t, theta_tt, method: str = "auto") -
 
     Raises
     ------
-    reference.rccc.LoopClosureError
+    reference.loop_closure.LoopClosureError
         The loop with these errors does not close at some input angle.
     """
     if method not in METHODS:

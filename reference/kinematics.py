@@ -1,6 +1,6 @@
 """Closed-form kinematics of the ideal Cardan (Hooke's) joint, vectorised over time.
 
-Conventions are those of :mod:`reference.scene`: input axis global x, output axis
+Conventions are those of :mod:`reference.joint`: input axis global x, output axis
 ``a2 = (cos b, sin b, 0)``; at input angle 0 the input yoke's trunnions lie along global y and
 the output yoke's along global z. With these conventions the canonical body frames are
 
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.scene import PAIR_BODIES, PAIR_NAMES
+from reference.joint import PAIR_BODIES, PAIR_NAMES
 
 
 def rot_x(angle: np.ndarray) -> np.ndarray:

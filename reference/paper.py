@@ -14,7 +14,8 @@ Named scenes
 References
 ----------
 Cavacece, Stefanelli, Valentini, Vita: A multibody dynamic model of a Cardan joint with
-experimental validation (shared/paper/cardan-joint-multibody-paper.md).
+experimental validation (not part of this repository; sections, tables and equations cited
+here are the paper's).
 """
 
 from __future__ import annotations
@@ -26,20 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from reference.scene import (
-    DEG,
-    RPM,
-    Body,
-    Geometry,
-    Joint,
-    Load,
-    Pair,
-    Pairs,
-    Record,
-    Scene,
-    SceneError,
-    SpeedDrive,
-)
+from reference.joint import Body, Geometry, Joint, Pair, Pairs
+from reference.scene import Load, Record, Scene, SpeedDrive, replace
+from reference.validation import DEG, RPM, SceneError
 
 try:
     import tomllib
@@ -55,7 +45,8 @@ def paper_data() -> dict[str, Any]:
 
 
 def value(path: str) -> Any:
-    """Value of a dotted entry of the data file, e.g. ``value("bearings.frame.length")``."""
+    """Value of a dotted entry of the data file, e.g. ``value("bearings.frame.length")``, in the
+    entry's own ``unit`` (mostly SI; angles in [deg], the multibody speeds in [rpm])."""
     node: Any = paper_data()
     for key in path.split("."):
         node = node[key]
@@ -83,7 +74,7 @@ def stated_values() -> list[dict[str, Any]]:
     return out
 
 
-# Columns: local x, y, z axes in canonical coordinates (see reference.scene for the frames).
+# Columns: local x, y, z axes in canonical coordinates (see reference.joint for the frames).
 _E = np.eye(3)
 LOCAL_AXES = {
     # input: local y is the shaft axis pointing away from the joint (canonical -x); local z kept.
@@ -97,7 +88,8 @@ SHAFT_AXIS_LOCAL = {"input": 1, "spider": 2, "output": 2}
 
 
 def com_from_static_moments(static_moments: np.ndarray, mass: float) -> np.ndarray:
-    """Centre of mass from Table 1 read as S_k = m * (distance of the centre of mass from axis k).
+    """Centre of mass [m] from Table 1's static moments ``S_k`` [kg m] and the mass [kg], read as
+    S_k = m * (distance of the centre of mass from axis k).
 
     Solves d_k^2 = r^2 - r_k^2 for the squared coordinates; a coordinate whose square comes out
     slightly negative from rounding in Table 1 is set to zero. Signs are taken positive (the
@@ -136,7 +128,18 @@ def table1_body(name: str, reading: str = "origin", com_at_centre: bool = False)
 
 def paper_joint(shaft_angle_deg: float = 10.0, reading: str = "origin",
                 friction: bool = True) -> Joint:
-    """The Section 4.1 joint under the assumption register's choices."""
+    """The Section 4.1 joint under the assumption register's choices.
+
+    Parameters
+    ----------
+    shaft_angle_deg : float
+        Shaft angle [deg].
+    reading : {"origin", "com"}
+        Reference point of Table 1's inertia tensors (:func:`table1_body`).
+    friction : bool
+        The case's friction coefficients (f1 = 0.42 in the spider pairs, f2 = 0.20 in the frame
+        pairs) or none.
+    """
     bodies = {
         "input": table1_body("input", reading),
         "spider": table1_body("spider", reading, com_at_centre=True),
@@ -200,9 +203,22 @@ def calibrated_choices() -> dict[str, Any]:
 
 
 def apply_parameters(scene: Scene, values: dict[str, float], choices: dict | None = None) -> Scene:
-    """``scene`` with calibration parameters (see :data:`CALIBRATION_PARAMETERS`) applied."""
-    from reference.scene import replace
+    """``scene`` with calibration parameters (see :data:`CALIBRATION_PARAMETERS`) applied.
 
+    Parameters
+    ----------
+    scene : Scene
+    values : dict of str to float
+        Parameter name to value, in the unit :data:`CALIBRATION_PARAMETERS` gives (all [m]).
+    choices : dict or None
+        Discrete choices (:func:`calibrated_choices`): ``gravity`` [m/s^2] and
+        ``spider_com_offset`` [m], each as ``{"value": ...}``.
+
+    Raises
+    ------
+    SceneError
+        An unknown parameter or choice.
+    """
     changes: dict[str, Any] = {}
     for name, v in values.items():
         if name not in CALIBRATION_PARAMETERS:
@@ -243,9 +259,20 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
                 parameters: str | dict[str, float] = "plain") -> Scene:
     """Section 4.1 scene: constant input speed, 2 N m resisting torque, gravity on.
 
-    ``parameters``: ``"plain"`` (the register), ``"calibrated"`` (the stored calibrated set,
-    with its discrete choices), or a dictionary of calibration parameter values (applied with
-    the calibrated set's discrete choices; used by ``cardan calibrate``).
+    Parameters
+    ----------
+    shaft_angle_deg : float
+        Shaft angle [deg].
+    speed_rpm : float or None
+        Input speed [rpm]; None: the case's 2000 rpm.
+    friction : bool
+        The case's friction coefficients or none (``-frictionless``).
+    reading : {"origin", "com"}
+        Reference point of Table 1's inertia tensors (:func:`table1_body`).
+    parameters : {"plain", "calibrated"} or dict of str to float
+        ``"plain"`` (the register), ``"calibrated"`` (the stored calibrated set, with its
+        discrete choices), or calibration parameter values [m] (applied with the calibrated
+        set's discrete choices; used by ``cardan calibrate``).
     """
     if isinstance(parameters, str) and parameters not in PARAMETER_SETS:
         raise SceneError(f"parameter set must be one of {list(PARAMETER_SETS)}, got {parameters!r}")
@@ -288,13 +315,12 @@ def rig_scene(friction: bool = True, parameters: str = "plain", errors: bool = F
     Parameters
     ----------
     friction : bool
+        f = 0.42 in every pair, or none (``-frictionless``).
     parameters : {"plain", "calibrated"}
         The plain reading, or the calibrated lever, eccentricity and choices of the multibody case.
     errors : bool
         Apply the section's tolerances (:func:`paper_errors`); otherwise the ideal geometry.
     """
-    from reference.scene import replace
-
     joint = paper_joint(value("case.rig.shaft_angle"), friction=False)
     f = value("case.rig.friction") if friction else 0.0
     pairs = Pairs(**{n: Pair(f, p.journal_diameter, p.moment_lever) for n, p in joint.pairs.items()})
@@ -325,7 +351,19 @@ _NAME = re.compile(r"^paper(?P<cal>-calibrated)?(?:-(?P<deg>\d+(?:\.\d+)?)deg)?"
 
 
 def named_scene(name: str) -> Scene:
-    """A scene by name (see the module docstring for the names)."""
+    """A scene by name (see the module docstring for the names).
+
+    Parameters
+    ----------
+    name : str
+        ``paper[-calibrated][-<A>deg][-<R>rpm][-frictionless]`` (shaft angle ``A`` [deg], input
+        speed ``R`` [rpm]; default 10 deg, 2000 rpm) or ``rig[-calibrated][-errors][-frictionless]``.
+
+    Raises
+    ------
+    SceneError
+        An unknown name.
+    """
     rig = _RIG.match(name) if isinstance(name, str) else None
     if rig:
         return rig_scene(friction=not rig["fl"], parameters="calibrated" if rig["cal"] else "plain",

@@ -1,6 +1,6 @@
 """The Cardan joint as an RCCC loop, solved in dual numbers from Denavit-Hartenberg parameters.
 
-The four joints, in chain order, are the pairs of :data:`reference.scene.PAIR_NAMES`: joint 1
+The four joints, in chain order, are the pairs of :data:`reference.joint.PAIR_NAMES`: joint 1
 ``frame_input`` (revolute), 2 ``input_spider``, 3 ``spider_output``, 4 ``output_frame``
 (cylindrical). Link k carries joints k and k + 1 (joint 5 is joint 1): link 1 is the input,
 2 the spider, 3 the output and 4 the frame (ground), so joint k joins link k - 1 (body ``a`` of
@@ -31,9 +31,8 @@ common normal) global z, its origin the global origin. The ideal joint with shaf
 
 Assembly branches and continuity
 --------------------------------
-The real part of the loop is a spherical four-bar whose input-output equation
-``A cos theta_4 + B sin theta_4 = C`` (quadratic in ``tan(theta_4 / 2)``) has the two roots
-``atan2(B, A) -+ atan2(sqrt(A^2 + B^2 - C^2), C)``. Branch ``"hooke"`` takes the minus sign: for
+The real part of the loop is a spherical four-bar whose input-output equation has two roots
+(:mod:`reference.loop_closure`, which solves it). Branch ``"hooke"`` takes the minus sign: for
 the ideal joint it is the project's configuration (``theta_4 = 90 deg`` at ``theta_1 = 0``), and
 under mounting errors it continues it as long as the discriminant stays positive. ``"flipped"``
 is the other assembly (for the ideal joint: the spider turned by half a turn about the input yoke
@@ -60,25 +59,20 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from reference import dual
 from reference.dual import Dual
-from reference.scene import PAIR_NAMES, Geometry, Joint
+from reference.joint import PAIR_NAMES, Geometry, Joint
+from reference.loop_closure import E_Z, LoopClosureError, angle_listing, solve_wrapped
 
 LINK_NAMES = ("input", "spider", "output", "ground")
 BRANCHES = ("hooke", "flipped")
-MIN_BRANCH_SEPARATION = 1e-6
-"""Smallest ``sin`` of the half-angle between the two branches' ``theta_4`` that is solved [-].
-
-Below it the branches (nearly) meet: the slides and rates grow like its inverse, and the real
-solution has lost about half of its digits to the discriminant's cancellation."""
-
 _BRANCH_SIGN = {"hooke": -1.0, "flipped": 1.0}
 _WINDING = np.array([1.0, 0.0, 0.0, -1.0])
-_E_Z = Dual(np.array([0.0, 0.0, 1.0]))
 # Global components of F_1's axes (columns): x_F1 = e_z, y_F1 = -e_y, z_F1 = e_x.
 _GLOBAL_FROM_F1 = np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
-# Canonical body axes (reference.scene) in the link's own D-H frame F_k Z(theta_hat_k), chosen so
+# Canonical body axes (reference.joint) in the link's own D-H frame F_k Z(theta_hat_k), chosen so
 # that both coincide for the ideal joint: input (z_F, -y_F, x_F), spider (x_F, z_F, -y_F),
 # output (-y_F, x_F, z_F).
 _CANONICAL_IN_LINK = {
@@ -86,20 +80,6 @@ _CANONICAL_IN_LINK = {
     "spider": np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]),
     "output": np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
 }
-
-
-class LoopClosureError(ValueError):
-    """The loop cannot close, or its two branches meet, at some input angles.
-
-    Attributes
-    ----------
-    angles : ndarray
-        The offending input angles ``theta_1`` [rad].
-    """
-
-    def __init__(self, message: str, angles: np.ndarray) -> None:
-        super().__init__(message)
-        self.angles = angles
 
 
 def _finite(name: str, value) -> float:
@@ -229,7 +209,7 @@ class LoopRates:
 
 @dataclass(frozen=True)
 class BodyPose:
-    """Canonical body frame (:mod:`reference.scene`) of one link, global components.
+    """Canonical body frame (:mod:`reference.joint`) of one link, global components.
 
     Attributes
     ----------
@@ -302,51 +282,9 @@ def _samples(name: str, value, shape: tuple[int, ...] | None = None) -> np.ndarr
                          f"got shape {arr.shape}") from None
 
 
-def _listing(angles: np.ndarray) -> str:
-    shown = ", ".join(f"{v:.6g}" for v in angles[:8])
-    return f"[{shown}{', ...' if angles.size > 8 else ''}] rad ({angles.size} sample(s))"
-
-
-def _check_closure(disc: np.ndarray, radius2: np.ndarray, theta1: np.ndarray, where: str) -> None:
-    open_ = disc < -MIN_BRANCH_SEPARATION**2 * radius2
-    meet = ~open_ & (disc <= MIN_BRANCH_SEPARATION**2 * radius2)
-    if open_.any():
-        bad = theta1[open_]
-        raise LoopClosureError(f"the RCCC loop cannot close (discriminant < 0) at {where} "
-                               f"theta_1 = {_listing(bad)}", bad)
-    if meet.any():
-        bad = theta1[meet]
-        raise LoopClosureError(f"the two assembly branches meet (singular configuration, sin of "
-                               f"their half-separation < {MIN_BRANCH_SEPARATION:g}) at {where} "
-                               f"theta_1 = {_listing(bad)}", bad)
-
-
-def _angle_about_z(v: Dual) -> Dual:
-    """Dual angle ``t`` of the line ``Z(t) X(alpha) e_z = (sin t sin alpha, -cos t sin alpha, .)``."""
-    return dual.atan2(v[..., 0], -v[..., 1])
-
-
-def _solve_wrapped(params: DHParameters, theta1: np.ndarray, sign: float, where: str) -> Dual:
-    """Dual joint angles (..., 4) with real parts in (-pi, pi] (``theta_1`` as given)."""
-    tw = params.twists()
-    t1 = Dual(theta1, np.full_like(theta1, params.s1))
-    # joint 2 in F_4 Z(theta_4) coordinates, against joint 3 = X(-alpha_4) Z(-theta_4) (0, w_y, w_z)
-    z2 = dual.matvec(dual.rot_x(tw[3]) @ dual.screw_transform(t1, tw[0]), _E_Z)
-    w_y, w_z = dual.sin(tw[2]), dual.cos(tw[2])
-    a, b, c = z2[..., 1] * w_y, z2[..., 0] * w_y, dual.cos(tw[1]) - z2[..., 2] * w_z
-    radius2 = a.re**2 + b.re**2
-    disc = radius2 - c.re**2
-    _check_closure(disc, radius2, theta1, where)
-    x = np.arctan2(b.re, a.re) + sign * np.arctan2(np.sqrt(np.maximum(disc, 0.0)), c.re)
-    cx, sx = np.cos(x), np.sin(x)
-    # eps part of A cos t4 + B sin t4 = C, linear in s_4; the coefficient is -+sqrt(disc) != 0
-    s4 = (c.du - a.du * cx - b.du * sx) / (b.re * cx - a.re * sx)
-    t4 = Dual(np.arctan2(sx, cx), s4)
-    z3_in_f1 = dual.matvec(dual.rot_x(-tw[3]) @ dual.rot_z(-t4) @ dual.rot_x(-tw[2]), _E_Z)
-    t2 = _angle_about_z(dual.matvec(dual.rot_x(-tw[0]) @ dual.rot_z(-t1), z3_in_f1))
-    z4_in_f2 = dual.matvec(dual.rot_x(-tw[0]) @ dual.rot_z(-t1) @ dual.rot_x(-tw[3]), _E_Z)
-    t3 = _angle_about_z(dual.matvec(dual.rot_x(-tw[1]) @ dual.rot_z(-t2), z4_in_f2))
-    return dual.stack([t1, t2, t3, t4], -1)
+def _solve(params: DHParameters, theta1: np.ndarray, branch: str, where: str) -> Dual:
+    """:func:`reference.loop_closure.solve_wrapped` for ``params`` on ``branch``."""
+    return solve_wrapped(params.twists(), params.s1, theta1, _BRANCH_SIGN[branch], where)
 
 
 @functools.lru_cache(maxsize=256)
@@ -355,7 +293,7 @@ def _at_zero(params: DHParameters, branch: str) -> tuple[np.ndarray, np.ndarray]
 
     Every solve and every pair-frame evaluation of a parameter set needs them; solved once.
     """
-    angles = _solve_wrapped(params, np.zeros(1), _BRANCH_SIGN[branch], "the reference input angle")
+    angles = _solve(params, np.zeros(1), branch, "the reference input angle")
     theta, slide = angles.re[0].copy(), angles.du[0].copy()
     theta.flags.writeable = slide.flags.writeable = False  # shared by every caller
     return theta, slide
@@ -376,10 +314,9 @@ def _check_windings(params: DHParameters, branch: str) -> None:
     angles. Checked once per parameter set on a fine grid.
     """
     theta1 = np.linspace(0.0, 2.0 * np.pi, WINDING_SAMPLES + 1)
-    sign = _BRANCH_SIGN[branch]
     try:
         reference = _at_zero(params, branch)[0]
-        raw = _solve_wrapped(params, theta1, sign, "input angles").re
+        raw = _solve(params, theta1, branch, "input angles").re
     except LoopClosureError:  # reported by the caller's own solve, at the caller's angles
         return
     nominal = reference + _WINDING * theta1[:, None]
@@ -390,10 +327,10 @@ def _check_windings(params: DHParameters, branch: str) -> None:
         raise LoopClosureError(
             "with these mounting errors the loop is not a Cardan joint's double crank: a joint "
             "angle does not follow the input turn for turn (it jumps by a full turn near input "
-            f"angle(s) {_listing(at)})", at)
+            f"angle(s) {angle_listing(at)})", at)
 
 
-def solve_positions(params: DHParameters, theta1, branch: str = "hooke") -> LoopPositions:
+def solve_positions(params: DHParameters, theta1: ArrayLike, branch: str = "hooke") -> LoopPositions:
     """Joint angles and slides closing the loop for given input angles.
 
     Parameters
@@ -417,10 +354,9 @@ def solve_positions(params: DHParameters, theta1, branch: str = "hooke") -> Loop
     if branch not in BRANCHES:
         raise ValueError(f"`branch` must be one of {list(BRANCHES)}, got {branch!r}")
     theta1 = _samples("theta1", theta1)
-    sign = _BRANCH_SIGN[branch]
     _check_windings(params, branch)
     reference = _at_zero(params, branch)[0]
-    raw = _solve_wrapped(params, theta1, sign, "input angles")
+    raw = _solve(params, theta1, branch, "input angles")
     nominal = reference + _WINDING * theta1[..., None]
     theta = nominal + np.remainder(raw.re - nominal + np.pi, 2.0 * np.pi) - np.pi
     theta[..., 0] = theta1
@@ -490,7 +426,7 @@ def joint_screws(params: DHParameters, positions: LoopPositions) -> Dual:
     The direction is each pair's z axis of :func:`reference.kinematics.pair_frames` [-]; the
     moment is about the global origin [m].
     """
-    return dual.matvec(_joint_frames(params, positions), _E_Z)
+    return dual.matvec(_joint_frames(params, positions), E_Z)
 
 
 def pair_axes(params: DHParameters, positions: LoopPositions) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -526,7 +462,8 @@ def _screw_rates(screws: Dual, joint_rates: Dual) -> Dual:
     return dual.cross((joint_rates[..., None] * screws).cumsum(-2), screws)
 
 
-def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t, theta1_tt) -> LoopRates:
+def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t: ArrayLike,
+                theta1_tt: ArrayLike) -> LoopRates:
     """Joint speeds and accelerations for a given input motion (analytic, no differencing).
 
     The relative velocity screws close the loop, ``sum_k (theta_k_t + eps s_k_t) S_k = 0``, six
@@ -558,7 +495,7 @@ def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t, theta1
     return LoopRates(theta_t=rates.re, s_t=rates.du, theta_tt=accels.re, s_tt=accels.du)
 
 
-def solve_motion(params: DHParameters, theta1, theta1_t, theta1_tt,
+def solve_motion(params: DHParameters, theta1: ArrayLike, theta1_t: ArrayLike, theta1_tt: ArrayLike,
                  branch: str = "hooke") -> tuple[LoopPositions, LoopRates]:
     """:func:`solve_positions` and :func:`solve_rates` in one call (same arguments)."""
     positions = solve_positions(params, theta1, branch)

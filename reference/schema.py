@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from reference.scene import PAIR_NAMES
+from reference.joint import PAIR_NAMES
 
 KINEMATIC_COLUMNS = ("t", "theta_in", "theta_out", "omega_in", "omega_out")
 POWER_COLUMNS = ("torque_in", "torque_out", "power_in", "power_out", "power_loss", "efficiency",

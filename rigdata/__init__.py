@@ -1,5 +1,17 @@
 """Measured data from the test rig: readers, conditioning, measured efficiency (issue 5).
 
+The public face::
+
+    import rigdata
+
+    record = rigdata.read("rig.lvm")                    # file -> RigRecord (SI units)
+    m = rigdata.measure(record, shaft_angle_deg=15)     # measured efficiency +- u
+    v = rigdata.validate("rig.lvm", "rig-calibrated")   # measured against computed, per engine
+    rigdata.write_report(v, "out/rig")                  # report.md, figure10.png, ...
+    used = rigdata.synthetic.write("rig.csv", "csv", rigdata.RigSettings(revolutions=5))
+
+Modules:
+
 - ``record``: :class:`RigRecord`, the validated measurement (SI units), and :class:`RigDataError`.
 - ``units``: the explicit table of unit spellings, header unit parsing, raw conversions to SI.
 - ``readers``: ``read`` (file -> RigRecord) and ``read_table`` for delimited text, LVM and TDMS.
@@ -8,6 +20,45 @@
 - ``conditioning``: angles from pulse edges, zero-phase low-pass, derivatives, whole-revolution
   window, input yoke phase.
 - ``efficiency``: measured efficiency with its GUM budget and Monte Carlo.
-- ``model``: the engines driven by the measurement; ``report``: Figure 10 and the comparison.
+- ``model``: the engines driven by the measurement; ``validation``: ``measure`` and
+  ``validate``; ``report``: Figure 10 and the report folder.
 - ``synthetic``: the synthetic rig; ``cli``: ``cardan rig``. See ``docs/rigdata.md``.
+
+The names below are loaded on first use (PEP 562): ``import rigdata`` costs nothing more than
+the package, so ``cardan``, which imports ``rigdata.cli`` at every start, stays quick; the
+modules behind them pull in scipy, pandas and the engines (about a second).
 """
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__all__ = ["read", "read_table", "measure", "Measurement", "validate", "Validation", "MODEL_ENGINES",
+           "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer", "Conditioning",
+           "RigSettings", "synthetic"]
+
+#: Public name -> the module that defines it (a name that is a module maps to itself).
+_WHERE = {
+    "read": "rigdata.readers", "read_table": "rigdata.readers",
+    "measure": "rigdata.validation", "Measurement": "rigdata.validation",
+    "validate": "rigdata.validation", "Validation": "rigdata.validation",
+    "MODEL_ENGINES": "rigdata.validation", "write_report": "rigdata.report",
+    "RigRecord": "rigdata.record", "RigDataError": "rigdata.record", "ChannelSource": "rigdata.record",
+    "Transducer": "rigdata.transducer", "Conditioning": "rigdata.conditioning",
+    "RigSettings": "rigdata.synthetic", "synthetic": "rigdata.synthetic",
+}
+
+
+def __getattr__(name: str) -> Any:
+    module_name = _WHERE.get(name)
+    if module_name is None:
+        raise AttributeError(f"module 'rigdata' has no attribute {name!r}")
+    module = importlib.import_module(module_name)
+    value = module if module_name.endswith(f".{name}") else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

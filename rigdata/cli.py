@@ -1,7 +1,9 @@
 """``cardan rig``: inspect, measure and validate rig files; write synthetic ones.
 
 Registered into the ``cardan`` command through the ``cardan.commands`` entry point (see
-``pyproject.toml``), so that ``cardan_exudyn`` never imports ``rigdata``.
+``pyproject.toml``), so that ``cardan_exudyn`` never imports ``rigdata``. ``cardan`` imports
+this module at every start, so it reaches rigdata's own modules (scipy, pandas: about a second)
+through the lazy package (``rigdata.read`` ...), loaded when a ``rig`` command runs.
 
 Exit status: 0 success; 2 bad input (one line naming the file, the channel and the problem);
 3 a model run failed (its status and reason are in the report).
@@ -13,25 +15,35 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
-from cardan_exudyn.arguments import count as _count, number as _number
+import rigdata
+from cardan_exudyn import arguments
+from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInput
+from cardan_exudyn.engines import EngineUnavailable
+from cardan_exudyn.io import OutputError
+from cardan_exudyn.report.format import number
+from reference.joint import PAIR_NAMES
+from reference.paper import named_scene
+from reference.scene import Scene, replace
+from reference.schema import Status
+from reference.validation import SceneError
 
-EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
+__all__ = ["register", "cmd_inspect", "cmd_measure", "cmd_validate", "cmd_synthetic"]
+
+#: The input errors a ``rig`` command reports in one line with exit status 2.
+BAD_INPUT = (SceneError, BadInput, OutputError, EngineUnavailable, FileNotFoundError, IsADirectoryError,
+             PermissionError)
 
 
-class _BadOption(ValueError):
-    pass
-
-
-class _SettingsError(ValueError):
-    """A settings object (Conditioning, Transducer, RigSettings) refused an option's value."""
-
-
-def _settings(cls, **kwargs):
+def _settings(cls: type, **kwargs: Any) -> Any:
+    """A settings object (Conditioning, Transducer, RigSettings); a value it refuses is bad input."""
     try:
         return cls(**kwargs)
     except ValueError as exc:
-        raise _SettingsError(str(exc)) from None
+        raise BadInput(str(exc)) from None
 
 
 def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
@@ -39,7 +51,7 @@ def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
     for item in values or []:
         key, sep, value = item.partition("=")
         if not sep or not key.strip() or not value.strip():
-            raise _BadOption(f"{option} expects CHANNEL=VALUE, got {item!r}")
+            raise BadInput(f"{option} expects CHANNEL=VALUE, got {item!r}")
         out[key.strip()] = value.strip()
     return out
 
@@ -56,64 +68,48 @@ def _seed(text: str) -> int:
 
 
 def _shaft_angle(text: str) -> float:
-    value = _number("deg", non_negative=True)(text)
+    value = arguments.number("deg", non_negative=True)(text)
     if value >= 90.0:
         raise argparse.ArgumentTypeError(f"must be below 90 deg (a joint at 90 deg transmits no motion), "
                                          f"got {text!r}")
     return value
 
 
-def _out_folder(path: str) -> None:
-    from cardan_exudyn.io import OutputError, check_output_folder
-
+def _read(args: argparse.Namespace) -> rigdata.RigRecord:
     try:
-        check_output_folder(path)
-    except OutputError as exc:
-        raise _BadOption(f"--out: {exc}") from None
-
-
-def _read(args: argparse.Namespace):
-    from rigdata.readers import read
-    from rigdata.record import RigDataError
-
-    try:
-        return read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
-                    units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
-                    pulses_per_rev=args.pulses_per_rev)
-    except RigDataError:
+        return rigdata.read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
+                            units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
+                            pulses_per_rev=args.pulses_per_rev)
+    except rigdata.RigDataError:
         raise
     except ValueError as exc:  # read() refuses its arguments (a --map channel, ...) with ValueError
-        raise _BadOption(str(exc)) from None
+        raise BadInput(str(exc)) from None
 
 
-def _transducers(args: argparse.Namespace):
-    from rigdata.transducer import Transducer
-
-    t = _settings(Transducer, full_scale=args.full_scale, sensitivity=args.sensitivity,
-                   pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
-                   zero_drift=args.zero_drift)
+def _transducers(args: argparse.Namespace) -> tuple[rigdata.Transducer, rigdata.Transducer]:
+    t = _settings(rigdata.Transducer, full_scale=args.full_scale, sensitivity=args.sensitivity,
+                  pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
+                  zero_drift=args.zero_drift)
     return t, t
 
 
 def _draws(args: argparse.Namespace) -> int:
     if args.mc < 0:
-        raise _BadOption(f"--mc must be >= 0 (0: GUM only), got {args.mc}")
+        raise BadInput(f"--mc must be >= 0 (0: GUM only), got {args.mc}")
     return args.mc
 
 
-def _conditioning(args: argparse.Namespace):
-    from rigdata.conditioning import Conditioning
-
-    return _settings(Conditioning, cutoff_harmonics=args.cutoff_harmonics, settle_revolutions=args.settle,
-                        derivative=args.derivative)
+def _conditioning(args: argparse.Namespace) -> rigdata.Conditioning:
+    return _settings(rigdata.Conditioning, cutoff_harmonics=args.cutoff_harmonics,
+                     settle_revolutions=args.settle, derivative=args.derivative)
 
 
-def cmd_inspect(args: argparse.Namespace) -> int:
-    rec = _read(args)
+def _inspection(rec: rigdata.RigRecord) -> dict[str, Any]:
+    """What ``inspect`` reports about a record."""
     reader = rec.provenance.get("reader")
     if isinstance(reader, dict):
         reader = f"{reader.get('name')} {reader.get('version')}"
-    info = {
+    return {
         "file": str(rec.file), "format": rec.provenance.get("format"),
         "reader": reader, "samples": int(rec.time.size),
         "sample_rate": rec.sample_rate, "duration_s": rec.duration,
@@ -124,6 +120,11 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         "synthetic": bool(rec.provenance.get("synthetic")),
         "header": {k: str(v) for k, v in (rec.provenance.get("header") or {}).items()},
     }
+
+
+def cmd_inspect(args: argparse.Namespace) -> int:
+    """``cardan rig inspect``: channels, units, rate, duration, revolutions of a file."""
+    info = _inspection(_read(args))
     if args.json:
         print(json.dumps(info, indent=2))
         return EXIT_OK
@@ -139,87 +140,86 @@ def cmd_inspect(args: argparse.Namespace) -> int:
 
 
 def cmd_measure(args: argparse.Namespace) -> int:
-    from rigdata.conditioning import condition
-    from rigdata.efficiency import measured_efficiency
-
+    """``cardan rig measure``: measured efficiency with its uncertainty (:func:`rigdata.measure`)."""
     rec = _read(args)
-    cond = condition(rec, math.radians(args.angle), _conditioning(args))
-    m = measured_efficiency(cond, _transducers(args), monte_carlo=_draws(args), seed=args.seed)
-    out = {"file": str(rec.file), **m.as_dict(), "phase_deg": math.degrees(cond.phase),
-           "synthetic": bool(rec.provenance.get("synthetic"))}
+    m = rigdata.measure(rec, args.angle, conditioning=_conditioning(args), transducers=_transducers(args),
+                        monte_carlo=_draws(args), seed=args.seed)
+    out = m.as_dict()
     if args.json:
         print(json.dumps(out, indent=2))
-    else:
-        mc = m.monte_carlo
-        print(f"{rec.file}: efficiency {m.efficiency:.4f} +- {m.u:.4f} (standard uncertainty) over "
-              f"{out['revolutions']} revolutions at {out['mean_speed_in']:.4g} rad/s, "
-              f"{out['mean_torque_in']:.4g} N m"
-              + (f"; Monte Carlo 95 % [{mc['interval_95'][0]:.4f}, {mc['interval_95'][1]:.4f}]"
-                 if mc else ""))
+        return EXIT_OK
+    mc = m.measured.monte_carlo
+    print(f"{rec.file}: efficiency {m.efficiency:.4f} +- {m.u:.4f} (standard uncertainty) over "
+          f"{out['revolutions']} revolutions at {out['mean_speed_in']:.4g} rad/s, "
+          f"{out['mean_torque_in']:.4g} N m"
+          + (f"; Monte Carlo 95 % [{mc['interval_95'][0]:.4f}, {mc['interval_95'][1]:.4f}]" if mc else ""))
     return EXIT_OK
 
 
-def _scene(args: argparse.Namespace):
-    from reference.paper import named_scene
-    from reference.scene import PAIR_NAMES, replace
-
-    scene = named_scene(args.scene)
+def _scene(args: argparse.Namespace) -> Scene:
     changes = {"joint.geometry.shaft_angle_deg": args.angle}
     if args.friction is not None:
         changes.update({f"joint.pairs.{p}.friction_coefficient": args.friction for p in PAIR_NAMES})
-    return replace(scene, **changes)
+    return replace(named_scene(args.scene), **changes)
 
 
-def cmd_validate(args: argparse.Namespace) -> int:
-    from rigdata.report import validate, write_report
+def _engines(text: str) -> tuple[str, ...]:
+    engines = tuple(e.strip() for e in text.split(",") if e.strip())
+    if not engines or any(e not in rigdata.MODEL_ENGINES for e in engines):
+        raise BadInput(f"--engines takes reference and/or exudyn, got {text!r}")
+    return engines
 
-    engines = tuple(e.strip() for e in args.engines.split(",") if e.strip())
-    bad = [e for e in engines if e not in ("reference", "exudyn")]
-    if not engines or bad:
-        raise _BadOption(f"--engines takes reference and/or exudyn, got {args.engines!r}")
-    _out_folder(args.out)
-    scene = _scene(args)
-    rec = _read(args)
 
-    def progress(line: str) -> None:
+def _progress(args: argparse.Namespace) -> Callable[[str], None]:
+    def say(line: str) -> None:
         if not args.json:
             print(f"cardan rig validate: {line}", file=sys.stderr, flush=True)
 
-    v = validate(rec, scene, engines, _conditioning(args), _transducers(args), monte_carlo=_draws(args),
-                 seed=args.seed, progress=progress)
-    s = write_report(v, args.out)
+    return say
+
+
+def _print_validation(s: dict[str, Any]) -> None:
+    measured = f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}"
+    for engine, comp in s["computed"].items():
+        cmp = s["comparisons"].get(engine, {})
+        if comp.get("status") != Status.OK:  # no computed efficiency, no difference
+            print(f"{engine}: status {comp.get('status')}: {comp.get('reason')}; measured {measured}")
+            continue
+        print(f"{engine}: computed {number(comp.get('mean_efficiency'), '.6f')}, measured {measured}; "
+              f"difference {number(cmp.get('difference'), '.4f')}, significant (k=2): "
+              f"{cmp.get('significant_k2', '-')}")
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """``cardan rig validate``: measured against computed efficiency, the report folder
+    (:func:`rigdata.validate`, :func:`rigdata.write_report`)."""
+    engines = _engines(args.engines)
+    arguments.out_folder(args.out)
+    scene = _scene(args)
+    rec = _read(args)
+    v = rigdata.validate(rec, scene, engines, conditioning=_conditioning(args),
+                         transducers=_transducers(args), monte_carlo=_draws(args), seed=args.seed,
+                         progress=_progress(args))
+    s = rigdata.write_report(v, args.out)
     if args.json:
         print(json.dumps(s, indent=2))
     else:
-        for engine, comp in s["computed"].items():
-            cmp = s["comparisons"].get(engine, {})
-            if comp.get("status") != "ok":  # no computed efficiency, no difference
-                print(f"{engine}: status {comp.get('status')}: {comp.get('reason')}; measured "
-                      f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}")
-                continue
-            print(f"{engine}: computed {_fmt(comp.get('mean_efficiency'))}, measured "
-                  f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}; difference "
-                  f"{_fmt(cmp.get('difference'), '.4f')}, significant (k=2): "
-                  f"{cmp.get('significant_k2', '-')}")
+        _print_validation(s)
         print(f"wrote {args.out}/report.md", file=sys.stderr)
-    failed = [e for e, c in s["computed"].items() if c["status"] != "ok"]
-    return EXIT_FAILED if failed else EXIT_OK
+    return EXIT_OK if v.success else EXIT_FAILED
 
 
 def cmd_synthetic(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from rigdata import synthetic
-
+    """``cardan rig synthetic``: write a synthetic rig file, labelled as such."""
     out = Path(args.out)
     if out.is_dir():
-        raise _BadOption(f"--out {args.out!r} is a directory; give the name of the file to write")
+        raise BadInput(f"--out {args.out!r} is a directory; give the name of the file to write")
     if not out.parent.is_dir():
-        raise _BadOption(f"--out {args.out!r}: the folder {str(out.parent)!r} does not exist")
+        raise BadInput(f"--out {args.out!r}: the folder {str(out.parent)!r} does not exist")
     exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
-    settings = _settings(synthetic.RigSettings, revolutions=args.revolutions, seed=args.seed,
-                                     speed_channel=args.speed_channel, **exact)
-    used = synthetic.write(args.out, args.format, settings)
+    settings = _settings(rigdata.RigSettings, revolutions=args.revolutions, seed=args.seed,
+                         speed_channel=args.speed_channel, **exact)
+    used = rigdata.synthetic.write(args.out, args.format, settings)
     if args.json:
         print(json.dumps(used, indent=2))
     else:
@@ -235,9 +235,9 @@ def _file_options(p: argparse.ArgumentParser) -> None:
                    help="map a column to torque_in, torque_out, speed_in, speed_out, angle_in, angle_out")
     p.add_argument("--unit", action="append", metavar="CHANNEL=UNIT",
                    help="unit of a channel where the file does not state it, e.g. speed_in=rpm")
-    p.add_argument("--sensitivity", type=_number("V/(N m)", positive=True), default=0.1,
+    p.add_argument("--sensitivity", type=arguments.number("V/(N m)", positive=True), default=0.1,
                    help="torque output of the transducers for columns in volts (default 0.1, paper)")
-    p.add_argument("--pulses-per-rev", type=_count("--pulses-per-rev"), default=60,
+    p.add_argument("--pulses-per-rev", type=arguments.count("--pulses-per-rev"), default=60,
                    help="speed pulses per revolution for count columns (default 60, paper)")
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
 
@@ -245,20 +245,39 @@ def _file_options(p: argparse.ArgumentParser) -> None:
 def _measure_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--angle", type=_shaft_angle, default=15.0,
                    help="shaft angle [deg] (default 15, the paper's rig case)")
-    p.add_argument("--cutoff-harmonics", type=_number("-", positive=True), default=10.0,
+    p.add_argument("--cutoff-harmonics", type=arguments.number("-", positive=True), default=10.0,
                    help="low-pass cut-off in input shaft harmonics (default 10)")
-    p.add_argument("--settle", type=_number("rev", non_negative=True), default=0.25,
+    p.add_argument("--settle", type=arguments.number("rev", non_negative=True), default=0.25,
                    help="input revolutions dropped at each end (default 0.25)")
     p.add_argument("--derivative", choices=("savgol", "spline"), default="savgol")
-    p.add_argument("--full-scale", type=_number("N m", positive=True), default=100.0,
+    p.add_argument("--full-scale", type=arguments.number("N m", positive=True), default=100.0,
                    help="transducer full scale [N m] (default 100, paper)")
-    p.add_argument("--accuracy-class", type=_number("%", non_negative=True), default=0.1,
+    p.add_argument("--accuracy-class", type=arguments.number("%", non_negative=True), default=0.1,
                    help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
-    p.add_argument("--zero-drift", type=_number("N m", non_negative=True), default=0.01,
+    p.add_argument("--zero-drift", type=arguments.number("N m", non_negative=True), default=0.01,
                    help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
     p.add_argument("--mc", type=_seed, default=2000,
                    help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only)")
     p.add_argument("--seed", type=_seed, default=0, help="seed of the Monte Carlo draws")
+
+
+def _validate_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
+    p.add_argument("--scene", default="rig-calibrated",
+                   help="named scene of the joint (default rig-calibrated; drive and load replaced)")
+    p.add_argument("--friction", type=arguments.number("-", non_negative=True),
+                   help="friction coefficient of every pair (default: the scene's, 0.42 for the rig)")
+    p.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")
+
+
+def _synthetic_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", required=True, metavar="FILE")
+    p.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
+    p.add_argument("--revolutions", type=arguments.number("rev", positive=True), default=5.0)
+    p.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
+    p.add_argument("--seed", type=_seed, default=1, help="seed of the drawn transducer errors and noise")
+    p.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
+    p.add_argument("--json", action="store_true", help="print the settings used as JSON")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -267,53 +286,29 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="Measured efficiency from transducer files and its comparison "
                                    "with the model driven by the measurement (the paper's Figure 10).")
     rig = p.add_subparsers(dest="rig_command", required=True)
-    q = rig.add_parser("inspect", help="what a file holds: channels, units, rate, duration, revolutions")
-    _file_options(q)
-    q.set_defaults(func=_guarded(cmd_inspect))
-    q = rig.add_parser("measure", help="measured efficiency over whole revolutions with its uncertainty")
-    _file_options(q)
-    _measure_options(q)
-    q.set_defaults(func=_guarded(cmd_measure))
-    q = rig.add_parser("validate", help="measured against computed efficiency: report like Figure 10")
-    _file_options(q)
-    _measure_options(q)
-    q.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
-    q.add_argument("--scene", default="rig-calibrated",
-                   help="named scene of the joint (default rig-calibrated; drive and load replaced)")
-    q.add_argument("--friction", type=_number("-", non_negative=True),
-                   help="friction coefficient of every pair (default: the scene's, 0.42 for the rig)")
-    q.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")
-    q.set_defaults(func=_guarded(cmd_validate))
-    q = rig.add_parser("synthetic", help="write a synthetic rig file (labelled as such)")
-    q.add_argument("--out", required=True, metavar="FILE")
-    q.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
-    q.add_argument("--revolutions", type=_number("rev", positive=True), default=5.0)
-    q.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
-    q.add_argument("--seed", type=_seed, default=1, help="seed of the drawn transducer errors and noise")
-    q.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
-    q.add_argument("--json", action="store_true", help="print the settings used as JSON")
-    q.set_defaults(func=_guarded(cmd_synthetic))
+    commands = [
+        ("inspect", "what a file holds: channels, units, rate, duration, revolutions", cmd_inspect,
+         (_file_options,)),
+        ("measure", "measured efficiency over whole revolutions with its uncertainty", cmd_measure,
+         (_file_options, _measure_options)),
+        ("validate", "measured against computed efficiency: report like Figure 10", cmd_validate,
+         (_file_options, _measure_options, _validate_options)),
+        ("synthetic", "write a synthetic rig file (labelled as such)", cmd_synthetic, (_synthetic_options,)),
+    ]
+    for name, help_text, handler, options in commands:
+        q = rig.add_parser(name, help=help_text)
+        for add in options:
+            add(q)
+        q.set_defaults(func=_guarded(handler))
 
 
-def _guarded(func):
+def _guarded(func: Callable[[argparse.Namespace], int]) -> Callable[[argparse.Namespace], int]:
     """Bad input of any kind -> one line on stderr, exit 2, no traceback."""
     def run(args: argparse.Namespace) -> int:
-        from cardan_exudyn.io import OutputError
-        from reference.scene import SceneError
-        from rigdata.record import RigDataError
-
         try:
             return func(args)
-        except (RigDataError, SceneError, _BadOption, _SettingsError, OutputError, FileNotFoundError,
-                IsADirectoryError, PermissionError) as exc:
+        except (rigdata.RigDataError, *BAD_INPUT) as exc:
             print(f"cardan rig {args.rig_command}: error: {exc}", file=sys.stderr)
             return EXIT_BAD_INPUT
 
     return run
-
-
-
-def _fmt(x, spec: str = ".6f") -> str:
-    """A finite number formatted, anything else as '-' (never 'nan')."""
-    finite = isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-    return format(x, spec) if finite else "-"

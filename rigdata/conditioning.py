@@ -27,7 +27,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy import signal
-from scipy.interpolate import PchipInterpolator
+from scipy.integrate import cumulative_trapezoid
+from scipy.interpolate import PchipInterpolator, make_smoothing_spline
 from scipy.optimize import minimize_scalar
 
 from reference.kinematics import speed_ratio
@@ -129,6 +130,7 @@ class Conditioned:
 
     @property
     def dt(self) -> float:
+        """Sampling interval [s]."""
         return float(self.t[1] - self.t[0])
 
     def in_window(self) -> np.ndarray:
@@ -172,8 +174,6 @@ def angle_on_grid(record: RigRecord, shaft: str) -> tuple[np.ndarray, np.ndarray
         return PchipInterpolator(times, levels, extrapolate=True)(t), times
     if angle is not None:
         return np.asarray(angle, float), None
-    from scipy.integrate import cumulative_trapezoid
-
     return cumulative_trapezoid(record.channels[f"speed_{shaft}"], t, initial=0.0), None
 
 
@@ -194,8 +194,6 @@ def derivatives(angle: np.ndarray, dt: float, cutoff: float, method: str) -> tup
     its half-power frequency at the cut-off.
     """
     if method == "spline":
-        from scipy.interpolate import make_smoothing_spline
-
         t = np.arange(angle.size) * dt
         # the penalty lam int f''^2 makes the spline a low-pass with gain 1 / (1 + lam (2 pi f)^4
         # / dt) on a uniform grid: half power at the cut-off for this lam (generalised

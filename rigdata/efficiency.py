@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigdata.conditioning import Conditioned, lowpass
+from rigdata.record import RigDataError
 from rigdata.transducer import Transducer
 
 SQRT3 = math.sqrt(3.0)
@@ -120,8 +121,6 @@ def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transduce
     weights = window_weights(c.t, t_a, t_b)
     w_in, w_out = _works(c, t_a, t_b, c.torque_in, c.torque_out)
     if not w_in > 0:
-        from rigdata.record import RigDataError
-
         raise RigDataError(f"the input work over the window is {w_in:.3g} J (not positive): the "
                            "input torque or speed has the wrong sign or the joint is driven backwards",
                            channel="torque_in")

@@ -14,7 +14,7 @@ renames it over the target, so a failure leaves either the old file or none, nev
 from __future__ import annotations
 
 import contextlib
-import datetime as _dt
+import datetime
 import io
 import os
 import secrets
@@ -24,6 +24,7 @@ from typing import IO
 
 import numpy as np
 import pandas as pd
+from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
 from rigdata.units import split_header
 
@@ -203,7 +204,7 @@ def write_lvm(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
     if not 1 <= segments <= n:
         raise ValueError(f"`segments` must be in [1, {n}], got {segments!r}")
     dt = _interval(t)
-    now = _dt.datetime.now()
+    now = datetime.datetime.now()
     date = metadata.get("Date", now.strftime("%Y/%m/%d"))
     clock = metadata.get("Time", now.strftime("%H:%M:%S.%f"))
 
@@ -265,8 +266,6 @@ def write_tdms(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: 
     Path
         ``path``.
     """
-    from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
-
     columns, time = _check(table, units, metadata)
     t = columns[time]
     dt = _interval(t)

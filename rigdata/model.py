@@ -17,7 +17,9 @@ from typing import Any
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from cardan_exudyn import engines
 from reference.scene import AngleDrive, Load, Scene
+from reference.schema import Result
 from rigdata.conditioning import Conditioned
 
 #: The margin of drive history kept after the window (so the engines find the window's end) [rev].
@@ -54,53 +56,71 @@ def measured_scene(c: Conditioned, base: Scene, points_per_revolution: int = 120
                    name=f"{base.name}-measured", description=f"{base.name} driven by a measurement")
 
 
-def computed_efficiency(result: Any) -> dict:
+def computed_efficiency(result: Result) -> dict[str, Any]:
     """Mean and instantaneous computed efficiency from an engine result.
 
     ``mean_efficiency`` is 1 - lost work / input work over the window; the instantaneous one is
     the paper's: 1 - P_loss / P_in (its code "estimates the output power computing the power
     loss at the kinematic pairs", footnote 2), next to P_out / P_in.
+
+    Parameters
+    ----------
+    result : Result
+        From :func:`cardan_exudyn.engines.run`.
+
+    Returns
+    -------
+    dict
+        ``status`` (:class:`~reference.schema.Status`), ``reason``, ``engine``,
+        ``mean_efficiency`` [-], ``work_ratio`` [-], ``mean_torque_in`` [N m] (None unless the
+        status is ok), ``wall_time_s`` [s]; and when the run is ok and recorded its time series,
+        ``series``: ``t`` [s], ``theta_in`` [rad], ``efficiency`` and ``power_ratio`` [-],
+        ``torque_in`` [N m].
     """
     s = result.summary
-    out = {"status": s.get("status"), "reason": s.get("reason", ""), "engine": s.get("engine"),
-           "mean_efficiency": s.get("mean_efficiency"), "work_ratio": s.get("work_ratio"),
-           "mean_torque_in": s.get("mean_torque_in"), "wall_time_s": s.get("wall_time_s")}
-    table = result.table
-    if table is not None and s.get("status") == "ok":
-        with np.errstate(divide="ignore", invalid="ignore"):
-            p_in = table["power_in"].to_numpy()
-            out["series"] = {"t": table["t"].to_numpy(), "theta_in": table["theta_in"].to_numpy(),
-                             "efficiency": 1.0 - table["power_loss"].to_numpy() / p_in,
-                             "power_ratio": table["power_out"].to_numpy() / p_in,
-                             "torque_in": table["torque_in"].to_numpy()}
+    out = {"status": s.status, "reason": s.reason, "engine": s.engine,
+           "mean_efficiency": s.mean_efficiency, "work_ratio": s.work_ratio,
+           "mean_torque_in": s.mean_torque_in, "wall_time_s": s.wall_time_s}
+    if result.table is not None and result.success:
+        out["series"] = _series(result.table)
     return out
 
 
-def run_engine(engine: str, scene: Scene):
-    """Run one engine by name (``reference`` or ``exudyn``) on ``scene``."""
-    if engine == "reference":
-        from reference.engine import run
-    elif engine == "exudyn":
-        from cardan_exudyn.model.solve import run
-    else:
-        raise ValueError(f"`engine` must be 'reference' or 'exudyn', got {engine!r}")
-    return run(scene)
+def _series(table: Any) -> dict[str, np.ndarray]:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p_in = table["power_in"].to_numpy()
+        return {"t": table["t"].to_numpy(), "theta_in": table["theta_in"].to_numpy(),
+                "efficiency": 1.0 - table["power_loss"].to_numpy() / p_in,
+                "power_ratio": table["power_out"].to_numpy() / p_in,
+                "torque_in": table["torque_in"].to_numpy()}
 
 
 def model_sensitivities(c: Conditioned, base: Scene, delta: float, baseline: float,
-                        points_per_revolution: int = 120) -> dict:
+                        points_per_revolution: int = 120) -> dict[str, float]:
     """What the computed efficiency owes to the measurement (reference engine).
 
-    ``load`` [1/(N m)]: the change per N m of load offset (the output transducer's error drives
-    the model too, so it is correlated with the measured efficiency's); ``phase_ambiguity`` [-]:
-    the computed efficiency with the yoke half a turn away minus at the estimate (the fit cannot
-    tell them apart).
-    """
-    from reference.engine import run
+    Parameters
+    ----------
+    c : Conditioned
+    base : Scene
+    delta : float
+        Load offset to difference over [N m].
+    baseline : float
+        The reference engine's mean efficiency on the measured scene [-].
+    points_per_revolution : int
+        See :func:`measured_scene`.
 
-    def eta(**kwargs) -> float:
-        s = run(measured_scene(c, base, points_per_revolution, **kwargs)).summary
-        return float(s["mean_efficiency"]) if s["status"] == "ok" else float("nan")
+    Returns
+    -------
+    dict
+        ``load`` [1/(N m)]: the change per N m of load offset (the output transducer's error
+        drives the model too, so it is correlated with the measured efficiency's);
+        ``load_delta`` [N m]; ``phase_ambiguity`` [-]: the computed efficiency with the yoke half
+        a turn away minus at the estimate (the fit cannot tell them apart).
+    """
+    def eta(**changes: float) -> float:
+        result = engines.run(measured_scene(c, base, points_per_revolution, **changes), "reference")
+        return float(result.mean_efficiency) if result.success else float("nan")
 
     return {"load": (eta(load_offset=delta) - baseline) / delta, "load_delta": delta,
             "phase_ambiguity": eta(phase_shift=math.pi) - baseline}

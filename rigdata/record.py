@@ -156,6 +156,7 @@ class RigRecord:
 
     @property
     def file(self) -> Any:
+        """The file the record was read from (``provenance["file"]``), None if not known."""
         return self.provenance.get("file")
 
     def turned(self, shaft: str = "in") -> float:

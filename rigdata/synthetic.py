@@ -21,7 +21,16 @@ import math
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
+from scipy import signal
+from scipy.integrate import cumulative_trapezoid
+from scipy.interpolate import CubicSpline
 
+from cardan_exudyn import engines
+from reference.engine import ReferenceOptions, columns_at, input_motion
+from reference.paper import named_scene
+from reference.scene import AngleDrive, Load, Scene
+from reference.schema import Result
+from rigdata import files
 from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
 from rigdata.units import parse_unit, to_si
@@ -123,9 +132,6 @@ def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tupl
     e1, e2 = settings.ripple
     total = 2 * math.pi * (settings.revolutions + 0.5)
     theta = np.linspace(0.0, total, int((settings.revolutions + 0.5) * points_per_revolution) + 1)
-    from scipy.integrate import cumulative_trapezoid
-    from scipy.interpolate import CubicSpline
-
     # t(theta) from d t / d theta = 1 / omega, integrated on a fine grid then sampled
     fine = np.linspace(0.0, total, 20 * theta.size)
     th_f = fine + settings.phase
@@ -135,34 +141,38 @@ def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tupl
     return t, theta + settings.phase
 
 
+def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
+    """The constant brake torque [N m] for a mean input torque of ``target`` [N m], and the
+    reference engine's run with it.
+
+    Efficiency barely depends on the load level (friction is proportional to it), so one
+    correction step is enough.
+    """
+    brake = target
+    for _ in range(2):
+        result = engines.run(replace(scene, load=Load(brake)), "reference")
+        if not result.success:
+            raise ValueError(f"the synthetic rig's model does not run: {result.message}")
+        brake *= target / result.summary.mean_torque_in
+    return brake, engines.run(replace(scene, load=Load(brake)), "reference")
+
+
 def true_signals(settings: RigSettings) -> Truth:
     """Run the reference engine on the rig driven by the motor; sample on the rig's grid."""
-    from reference.engine import ReferenceOptions, columns_at, input_motion
-    from reference.engine import run as run_reference
-    from reference.paper import named_scene
-    from reference.scene import AngleDrive, Load
-
     t_knots, angle = motor_angle(settings)
     base = named_scene(settings.scene)
     scene = replace(base, drive=AngleDrive(tuple(t_knots), tuple(angle)),
                     revolutions=1.0, record=replace(base.record, timeseries=False))
-    # the brake torque for the target mean input torque: efficiency barely depends on the load
-    # level (friction is proportional to it), so one correction step is enough
-    brake = settings.input_torque
-    for _ in range(2):
-        summary = run_reference(replace(scene, load=Load(brake))).summary
-        if summary["status"] != "ok":
-            raise ValueError(f"the synthetic rig's model does not run: {summary.get('reason')}")
-        brake *= settings.input_torque / summary["mean_torque_in"]
+    brake, result = _brake_torque(scene, settings.input_torque)
     scene = replace(scene, load=Load(brake))
-    summary = run_reference(scene).summary
     t = np.arange(0.0, t_knots[-1] - 0.25 * 2 * math.pi / settings.speed, 1.0 / settings.rate)
+    # the true signals on the rig's grid, from the engine's own closed-form input motion
     motion = input_motion(scene, ReferenceOptions())
     cols = columns_at(scene, motion, t)
     return Truth(t=t, angle_in=cols["theta_in"], angle_out=cols["theta_out"],
                  speed_in=cols["omega_in"], speed_out=cols["omega_out"],
                  torque_in=cols["torque_in"], torque_out=cols["torque_out"],
-                 efficiency=float(summary["mean_efficiency"]), brake_torque=float(brake))
+                 efficiency=float(result.mean_efficiency), brake_torque=float(brake))
 
 
 def _errors(settings: RigSettings, transducer: Transducer, rng: np.random.Generator) -> tuple:
@@ -177,8 +187,6 @@ def measure(truth: Truth, settings: RigSettings,
             transducer: Transducer | None = None) -> tuple[dict, dict, dict]:
     """Apply the transducer model. Returns ``(table, units, settings_used)``: raw columns
     (time [s], torques [V], pulse counts or speeds [rpm]) as a file holds them."""
-    from scipy import signal
-
     transducer = transducer or Transducer()
     rng = np.random.default_rng(settings.seed)
     offsets, drifts = _errors(settings, transducer, rng)
@@ -247,8 +255,6 @@ def write(path, fmt: str, settings: RigSettings | None = None, transducer: Trans
           truth: Truth | None = None) -> dict:
     """Write a synthetic measurement file (``csv``: comma and point; ``lvm``: LabVIEW with
     decimal comma; ``tdms``). Returns the settings used (with the true efficiency)."""
-    from rigdata import files
-
     if fmt not in FORMATS:
         raise ValueError(f"`fmt` must be one of {FORMATS}, got {fmt!r}")
     settings = settings or RigSettings()

@@ -88,4 +88,5 @@ class Transducer:
         return 2.0 * self.adc_range / 2 ** self.adc_bits / self.sensitivity
 
     def as_dict(self) -> dict:
+        """The settings as a JSON-ready dict."""
         return asdict(self)

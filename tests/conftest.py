@@ -6,18 +6,9 @@ import math
 
 import pytest
 
+from reference.joint import Body, Geometry, Joint, Pair, Pairs
 from reference.paper import named_scene
-from reference.scene import (
-    Body,
-    Geometry,
-    Joint,
-    Load,
-    Pair,
-    Pairs,
-    Record,
-    Scene,
-    SpeedDrive,
-)
+from reference.scene import Load, Numerics, Record, Scene, SpeedDrive
 
 M_IN, M_SPIDER, M_OUT = 0.9, 0.05, 0.8
 B_IN, B_OUT = 0.12, 0.09
@@ -36,8 +27,6 @@ def balanced_joint(shaft_angle: float = 0.0) -> Joint:
 
 def balanced_scene(shaft_angle_deg: float = 0.0, rpm: float = 600.0, load: float = 1.5,
                    gravity=(0.0, 0.0, -9.81), revolutions: float = 1.0, **numerics) -> Scene:
-    from reference.scene import Numerics
-
     return Scene(
         joint=balanced_joint(math.radians(shaft_angle_deg)),
         drive=SpeedDrive(rpm * 2 * math.pi / 60),

@@ -1,17 +1,36 @@
-"""Imports point one way: reference <- cardan_exudyn <- rigdata."""
+"""The shape of the house: import direction and cycles, one engine dispatch, sizes, public faces.
+
+Figures behind these tests: ``python tests/code_metrics.py``.
+"""
 
 from __future__ import annotations
 
 import ast
+import importlib
+import re
 from pathlib import Path
 
 import pytest
+from code_metrics import (
+    PACKAGES,
+    ROOT,
+    cycles,
+    functions,
+    import_graph,
+    module_lines,
+    module_name,
+    product_files,
+)
 
-ROOT = Path(__file__).resolve().parents[1]
 FORBIDDEN = {
     "reference": {"exudyn", "cardan_exudyn", "rigdata"},
     "cardan_exudyn": {"rigdata"},
 }
+MAX_MODULE_LINES = 600
+MAX_FUNCTION_LINES = 60
+# modules that may print: the command line and the study commands' handlers
+MAY_PRINT = re.compile(r"^(cardan_exudyn\.cli|cardan_exudyn\.studies\..*|rigdata\.cli)$")
+ENGINE_RUN_MODULES = {"cardan_exudyn.model.solve", "reference.engine", "cardan_exudyn.mujoco_engine"}
 
 
 def imported_roots(path: Path) -> set[str]:
@@ -25,9 +44,117 @@ def imported_roots(path: Path) -> set[str]:
     return roots
 
 
+@pytest.fixture(scope="module")
+def graph() -> dict[str, set[str]]:
+    return import_graph()
+
+
 @pytest.mark.parametrize("package", sorted(FORBIDDEN))
 def test_import_direction(package):
-    """No module of a package imports a package above it."""
+    """No module of a package imports a package above it: reference <- cardan_exudyn <- rigdata."""
     offenders = {str(p.relative_to(ROOT)): imported_roots(p) & FORBIDDEN[package]
                  for p in (ROOT / package).rglob("*.py")}
     assert not {k: v for k, v in offenders.items() if v}
+
+
+def test_no_import_cycles(graph):
+    """No two product modules import each other, directly or through others, function-level
+    imports included."""
+    assert cycles(graph) == []
+
+
+def test_only_the_cli_imports_studies(graph):
+    """Inside cardan_exudyn nothing imports the studies or the CLI except the CLI (and studies
+    each other); rigdata registers its command through an entry point."""
+    def is_job(m: str) -> bool:
+        return m == "cardan_exudyn.cli" or m.startswith("cardan_exudyn.studies")
+
+    offenders = {m: sorted(filter(is_job, deps)) for m, deps in graph.items()
+                 if not is_job(m) and any(map(is_job, deps))}
+    assert offenders == {}
+
+
+def test_metrics_see_a_cycle(tmp_path):
+    """The cycle finder finds a function-level import cycle (so the test above can fail)."""
+    pkg = tmp_path / "reference"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("def f():\n    from reference import b\n")
+    (pkg / "b.py").write_text("import reference.a\n")
+    for name in ("cardan_exudyn", "rigdata"):
+        (tmp_path / name).mkdir()
+    assert cycles(import_graph(tmp_path)) == [["reference.a", "reference.b"]]
+
+
+def _product_sources() -> list[tuple[str, str]]:
+    return [(module_name(p), p.read_text(encoding="utf-8")) for p in product_files()]
+
+
+def test_engine_runs_go_through_the_dispatch():
+    """No engine-string dispatch and no engine's run function imported outside engines.py."""
+    dispatch = re.compile(r"""(==|!=)\s*["'](exudyn|reference|mujoco)["']|"""
+                          r"""in\s*\(\s*["'](exudyn|reference|mujoco)["']""")
+    offenders = []
+    for module, text in _product_sources():
+        if module == "cardan_exudyn.engines":
+            continue
+        offenders += [f"{module}: {m.group(0)}" for m in dispatch.finditer(text)]
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ImportFrom) and node.module in ENGINE_RUN_MODULES:
+                offenders += [f"{module}: from {node.module} import run"
+                              for a in node.names if a.name == "run"]
+    assert offenders == []
+
+
+def test_module_sizes():
+    """No product module over 600 lines."""
+    assert {m: n for m, n in module_lines().items() if n > MAX_MODULE_LINES} == {}
+
+
+def test_function_lengths():
+    """No function body over 60 lines (docstring excluded)."""
+    long = [f"{f.module}:{f.name} ({f.length} lines)" for p in product_files() for f in functions(p)
+            if f.length > MAX_FUNCTION_LINES]
+    assert long == []
+
+
+def test_library_code_does_not_print():
+    """Only the CLI and the study commands print; library code returns data."""
+    offenders = []
+    for module, text in _product_sources():
+        if MAY_PRINT.match(module):
+            continue
+        for node in ast.walk(ast.parse(text)):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id == "print"):
+                offenders.append(f"{module}:{node.lineno}")
+    assert offenders == []
+
+
+def test_no_private_names_imported_across_modules():
+    """``from x import _name`` never reaches into another product module's private names."""
+    offenders = []
+    for module, text in _product_sources():
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] in PACKAGES:
+                offenders += [f"{module}: {node.module}.{a.name}" for a in node.names
+                              if a.name.startswith("_")]
+    assert offenders == []
+
+
+def test_no_banner_comments():
+    """Comments say why; no decorative banner lines."""
+    banner = re.compile(r"^\s*#\s*[-=#*]{4,}", re.MULTILINE)
+    offenders = [f"{m}: {b.group(0).strip()}" for m, text in _product_sources()
+                 for b in banner.finditer(text)]
+    assert offenders == []
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_public_face(package):
+    """Each package names its public API in ``__all__``; every name resolves and ``dir`` shows it."""
+    module = importlib.import_module(package)
+    assert module.__all__, f"{package}.__all__ is empty"
+    for name in module.__all__:
+        assert getattr(module, name) is not None, name
+    assert set(module.__all__) <= set(dir(module))

@@ -14,11 +14,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn.studies import bench
+from cardan_exudyn import engines
 from cardan_exudyn.cli import main
-from cardan_exudyn.model.solve import run
+from cardan_exudyn.studies.bench_audit import skip_audit, solution_file, solve_only
+from cardan_exudyn.studies.bench_configs import EXUDYN_TUNED, Config, configurations
+from cardan_exudyn.studies.bench_ladders import run_errors, yardstick
+from cardan_exudyn.studies.bench_targets import EFFICIENCY_TARGET, evaluate_targets, paper_scenes_timing
 from reference.paper import named_scene
 from reference.scene import replace
+from reference.schema import Result, Status, Summary
 
 
 def test_run_errors_follow_the_integrators_order():
@@ -26,12 +30,12 @@ def test_run_errors_follow_the_integrators_order():
     revolution) by about four: the errors are measured against the exact reference, not against
     a run of the same engine."""
     scene = named_scene("paper-35deg-frictionless")
-    yard = bench.yardstick(scene)
+    yard = yardstick(scene)
     errs = []
     for n in (100, 200):
-        config = bench.Config("exudyn", "exudyn tuned", n, bench.EXUDYN_TUNED)
+        config = Config("exudyn", "exudyn tuned", n, EXUDYN_TUNED)
         s = config.scene(scene)
-        errs.append(bench.run_errors(s, config.run(s), yard))
+        errs.append(run_errors(s, config.run(s), yard))
     for key in ("speed_ratio_error", "torque_in_error_steady"):
         assert 3.3 < errs[0][key] / errs[1][key] < 4.7, (key, errs)
     assert errs[1]["speed_ratio_error"] < 2e-4
@@ -41,8 +45,8 @@ def test_run_errors_follow_the_integrators_order():
 
 def test_run_errors_of_a_failed_run_are_nan():
     scene = named_scene("paper-10deg-frictionless")
-    failed = type("R", (), {"summary": {"status": "integration_failure"}, "table": None})()
-    errs = bench.run_errors(scene, failed, bench.yardstick(scene))
+    failed = Result(None, Summary(Status.INTEGRATION_FAILURE, "solver failed"))
+    errs = run_errors(scene, failed, yardstick(scene))
     assert all(math.isnan(v) for v in errs.values())
 
 
@@ -68,7 +72,7 @@ def test_targets_take_the_cheapest_run_at_the_level_from_each_engine():
         {"scene": "friction-10deg", "engine": "exudyn", "config": "e", "steps_per_revolution": 200,
          "mean_efficiency_error": 5e-5, "wall_per_simulated_s": 0.9},
     ])
-    targets = {(t["target"], t["variant"]): t for t in bench.evaluate_targets(rows, None)}
+    targets = {(t["target"], t["variant"]): t for t in evaluate_targets(rows, None)}
     plain = targets[("kinematics", "integrator velocities")]
     assert plain["measured"] == pytest.approx(3.0) and not plain["met"]
     assert "100 steps/rev" in plain["exudyn"] and "40 steps/rev" in plain["other"]
@@ -101,7 +105,7 @@ def test_quick_bench_cli_writes_files_with_the_environment_header(tmp_path, caps
 
 
 def test_skip_audit_measures_each_item_side_by_side():
-    audit = bench.skip_audit(repeats=1, steps=100, revolutions=1, fast_module=False)
+    audit = skip_audit(repeats=1, steps=100, revolutions=1, fast_module=False)
     assert len(audit) == 8
     assert (audit["with_s"] > 0).all() and (audit["without_s"] > 0).all()
     np.testing.assert_allclose(audit["with_over_without"], audit["with_s"] / audit["without_s"])
@@ -109,6 +113,25 @@ def test_skip_audit_measures_each_item_side_by_side():
     # effect is far above timing noise
     row = audit[audit["item"] == "Python drive function"].iloc[0]
     assert row["with_over_without"] > 1.1
+
+
+def test_solve_only_is_the_engine_solve_with_the_tweak(tmp_path):
+    """The audit's build-and-solve runs are the engine's one solve sequence (the same step as a
+    full run), with the tweak applied once before the solver starts: the solution-file item
+    really writes Exudyn's coordinates file."""
+    scene = replace(named_scene("paper-10deg-frictionless"),
+                    **{"numerics.dt": 2 * math.pi / 209.44 / 100, "revolutions": 1,
+                       "record.timeseries": False})
+    steps = []
+
+    def tweak(model, settings):
+        ti = settings.timeIntegration
+        steps.append((ti.endTime - ti.startTime) / ti.numberOfSteps)
+        solution_file(str(tmp_path))(model, settings)
+
+    assert solve_only(scene, EXUDYN_TUNED, tweak) > 0
+    assert (tmp_path / "solution.txt").stat().st_size > 0
+    assert steps == [pytest.approx(engines.run(scene, "exudyn", EXUDYN_TUNED).summary.dt, rel=1e-12)]
 
 
 @pytest.mark.parametrize("args, message", [
@@ -131,25 +154,30 @@ def test_bad_input_is_exit_2_with_one_line(args, message, capsys, tmp_path):
 def test_paper_scene_timing_reports_errors_against_the_tight_reference():
     """The eleven-scene timing with a deliberately coarse Exudyn step must report an error above
     the 1e-4 level (the check is real), and the reference at loose settings one far below it."""
-    part = bench.paper_scenes_timing(repeats=1, exudyn_steps=100)
+    part = paper_scenes_timing(repeats=1, exudyn_steps=100)
     assert len(part["exudyn"]["errors"]) == 11
-    assert part["exudyn"]["max_error"] > bench.EFFICIENCY_TARGET
+    assert part["exudyn"]["max_error"] > EFFICIENCY_TARGET
     assert part["reference"]["max_error"] < 1e-6
     assert part["reference"]["failed"] == 0
 
 
 def test_configurations_cover_the_issue_dimensions():
-    full = bench.configurations("friction-35deg", quick=False)
+    full = configurations("friction-35deg", quick=False)
     labels = {c.label for c in full}
     assert {"exudyn default", "exudyn tuned", "exudyn tuned lagged"} <= labels
     assert any(c.engine == "reference" for c in full)
     assert not any(c.engine == "mujoco" for c in full)  # MuJoCo has no reaction friction
-    free = bench.configurations("frictionless-35deg", quick=False)
+    free = configurations("frictionless-35deg", quick=False)
     assert any("projection" in c.label for c in free)
     scene = free[0].scene(named_scene("paper-35deg-frictionless"))
     assert scene.numerics.dt == pytest.approx(2 * math.pi / scene.drive.speed / free[0].steps)
     lagged = next(c for c in full if c.coupling == "lagged")
     assert lagged.scene(named_scene("paper-35deg")).friction.coupling == "lagged"
+    # the reference engine's resolution is its table samples, in its options, not a time step
+    reference = [c for c in full if c.engine == "reference"]
+    base = named_scene("paper-35deg")
+    assert all(c.options.samples_per_revolution == c.steps for c in reference)
+    assert all(c.scene(base).numerics.dt == base.numerics.dt for c in reference)
 
 
 def test_exudyn_tuned_options_do_not_change_the_answer():
@@ -157,7 +185,7 @@ def test_exudyn_tuned_options_do_not_change_the_answer():
     defaults to 1e-7 on a friction scene (the bench's 'tuned' is a cost change only)."""
     scene = replace(named_scene("paper-10deg"), **{"numerics.dt": 2 * math.pi / 209.44 / 200,
                                                     "revolutions": 1})
-    a = run(scene)
-    b = run(scene, bench.EXUDYN_TUNED)
-    assert a.ok and b.ok
-    assert abs(a.summary["mean_efficiency"] - b.summary["mean_efficiency"]) < 1e-7
+    a = engines.run(scene, "exudyn")
+    b = engines.run(scene, "exudyn", EXUDYN_TUNED)
+    assert a.success and b.success
+    assert abs(a.summary.mean_efficiency - b.summary.mean_efficiency) < 1e-7

@@ -95,3 +95,24 @@ def test_self_locking_exits_3():
     assert proc.returncode == 3
     assert "self_locking" in proc.stderr and "loop gain" in proc.stderr
     assert "mean efficiency" not in proc.stdout
+
+
+def test_reader_that_goes_away_ends_quietly():
+    """`cardan run --json | head -1`: no BrokenPipeError traceback, exit 141 (128 + SIGPIPE)."""
+    proc = subprocess.Popen([sys.executable, "-m", "cardan_exudyn.cli", "run", "--name",
+                             "paper-10deg-frictionless", "--revolutions", "1", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader is gone before the command writes
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 141
+    assert err == ""
+
+
+@pytest.mark.parametrize("command", ["run", "scene", "sweep", "compare", "calibrate", "study",
+                                     "tolerance"])
+def test_every_command_has_help(command, capsys):
+    """Core and study commands are all registered: `--help` prints their usage, exit 0."""
+    with pytest.raises(SystemExit) as stop:
+        main([command, "--help"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.startswith(f"usage: cardan {command}")

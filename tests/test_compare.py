@@ -18,10 +18,16 @@ import math
 import numpy as np
 import pytest
 
+from cardan_exudyn import ExudynOptions
 from cardan_exudyn.cli import main
-from cardan_exudyn.compare import compare, join_on_input_angle
+from cardan_exudyn.comparison import Comparison, compare, join_on_input_angle
+from cardan_exudyn.engines import run
+from cardan_exudyn.io import dumps
+from reference.engine import ReferenceOptions
+from reference.joint import PAIR_NAMES
 from reference.paper import named_scene
-from reference.scene import PAIR_NAMES, replace
+from reference.scene import replace
+from reference.schema import OptionsError, Status
 
 SKIP = 0.25  # revolutions left out of the steady statistics
 SCENES = ["paper-30deg-frictionless", "paper-10deg", "paper-calibrated-30deg"]
@@ -55,7 +61,7 @@ CHECKED = (["theta_out", "omega_out", "torque_in"]
            + [f"power_loss_{p}" for p in PAIR_NAMES])
 
 
-def run_pair(name: str, steps_per_revolution: int) -> tuple[dict, float]:
+def run_pair(name: str, steps_per_revolution: int) -> tuple[Comparison, float]:
     base = named_scene(name)
     h = 2 * math.pi / abs(base.drive.speed) / steps_per_revolution
     scene = replace(base, revolutions=1, **{"numerics.dt": h})
@@ -81,8 +87,8 @@ def test_richardson_extrapolated_exudyn_predicts_the_reference(ladder, name):
     RMS ratios E(h) / E(h/2) of 3-7); those scenes are held to the weaker claims below."""
     coarse, _ = ladder[(name, 200)]
     fine, _ = ladder[(name, 400)]
-    e_h, ref = coarse["tables"]["exudyn"], coarse["tables"]["reference"]
-    e_h2 = fine["tables"]["exudyn"].iloc[::2].reset_index(drop=True)  # the rows at t = k h
+    e_h, ref = coarse.results["exudyn"].table, coarse.results["reference"].table
+    e_h2 = fine.results["exudyn"].table.iloc[::2].reset_index(drop=True)  # the rows at t = k h
     assert np.allclose(e_h2["t"], e_h["t"], rtol=0, atol=1e-12)
     theta = e_h["theta_in"].to_numpy()
     steady = np.abs(theta - theta[0]) >= 2 * math.pi * SKIP
@@ -104,9 +110,9 @@ def test_richardson_extrapolated_exudyn_predicts_the_reference(ladder, name):
 @pytest.mark.parametrize("spr", [200, 400])
 def test_mean_efficiency_within_the_second_order_bound(ladder, name, spr):
     comparison, wh2 = ladder[(name, spr)]
-    engines = comparison["engines"]
-    assert engines["exudyn"]["status"] == engines["reference"]["status"] == "ok"
-    assert abs(comparison["differences"]["reference"]["means"]["mean_efficiency"]) <= wh2
+    results = comparison.results
+    assert results["exudyn"].status == results["reference"].status == Status.OK
+    assert abs(comparison.differences["reference"].means["mean_efficiency"]) <= wh2
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -115,14 +121,14 @@ def test_differences_shrink_with_the_step(ladder, name):
     4 (second order) without friction; with friction by at least 2.5 (the sign ramps narrower
     than a step keep some columns away from their asymptotic rate at these steps, on either
     side), and the drive torque and output speed still by about 4."""
-    coarse = ladder[(name, 200)][0]["differences"]["reference"]["steady"]
-    fine = ladder[(name, 400)][0]["differences"]["reference"]["steady"]
-    scales = kind_scales(ladder[(name, 200)][0]["tables"]["exudyn"])
+    coarse = ladder[(name, 200)][0].differences["reference"].steady
+    fine = ladder[(name, 400)][0].differences["reference"].steady
+    scales = kind_scales(ladder[(name, 200)][0].results["exudyn"].table)
     frictionless = name.endswith("frictionless")
     for column in CHECKED:
-        if coarse[column]["rms"] <= 1e-8 * scales[kind_of(column)]:
+        if coarse.loc[column, "rms"] <= 1e-8 * scales[kind_of(column)]:
             continue  # zero in both engines up to solver noise (e.g. friction without friction)
-        ratio = coarse[column]["rms"] / fine[column]["rms"]
+        ratio = coarse.loc[column, "rms"] / fine.loc[column, "rms"]
         if frictionless or column in ("torque_in", "omega_out"):
             assert 3.0 < ratio < 5.0, (column, ratio)
         else:
@@ -132,11 +138,9 @@ def test_differences_shrink_with_the_step(ladder, name):
 def test_join_interpolates_when_rows_differ():
     """Different sampling: the spline join reproduces a smooth column far below the differences
     the comparison measures (reference sampled at two resolutions against itself)."""
-    from reference.engine import ReferenceOptions, run
-
     scene = replace(named_scene("paper-20deg-frictionless"), revolutions=1)
-    a = run(scene, ReferenceOptions(samples_per_revolution=720)).table
-    b = run(scene, ReferenceOptions(samples_per_revolution=360)).table
+    a = run(scene, "reference", ReferenceOptions(samples_per_revolution=720)).table
+    b = run(scene, "reference", ReferenceOptions(samples_per_revolution=360)).table
     joined, how = join_on_input_angle(a, b)
     assert how.startswith("cubic spline")
     # cubic interpolation error ~ h^4 f'''' / 384 with h = 1 deg: ~1e-9 of the scale
@@ -173,3 +177,56 @@ def test_cli_compare_bad_engines(tmp_path, capsys, engines, message):
     assert code == 2
     assert message in capsys.readouterr().err
     assert not out.exists()  # nothing half-written
+
+
+def test_comparison_api(ladder):
+    """The typed comparison: statistics per column as a DataFrame, the JSON shape of the report,
+    and the differing columns as a text table."""
+    comparison, _ = ladder[("paper-30deg-frictionless", 200)]
+    assert comparison.base == "exudyn" and comparison.success
+    d = comparison.differences["reference"]
+    assert d.against == "exudyn" and d.join == "same rows"
+    assert list(d.steady.columns) == ["max_abs", "rms", "scale", "max_rel", "rows"]
+    assert d.steady.index.name == "column" and "torque_in" in d.steady.index
+    row = d.steady.loc["torque_in"]
+    assert row["max_rel"] == pytest.approx(row["max_abs"] / row["scale"])
+    assert 0 < row["rms"] <= row["max_abs"]
+    data = json.loads(dumps(comparison.to_dict()))
+    assert set(data) == {"scene", "skip_revolutions", "engines", "differences"}
+    assert data["engines"]["reference"]["status"] == "ok"
+    assert set(data["differences"]["reference"]["all"]["torque_in"]) == {"max_abs", "rms", "scale", "rows"}
+    assert data["differences"]["reference"]["steady"]["torque_in"]["rms"] == pytest.approx(row["rms"])
+    # nothing differs by its own scale; at 1e-12 of the scale the torque does
+    assert comparison.differing(rtol=1.0).empty
+    differing = comparison.differing(rtol=1e-12)
+    assert "torque_in" in set(differing["column"]) and set(differing["engine"]) == {"reference"}
+    text = comparison.differences_table(rtol=1e-12)
+    assert text.startswith("| engine | column | max_abs | rms | scale | max_rel |")
+    assert "| reference | torque_in |" in text and "nan" not in text
+
+
+def test_compare_passes_each_engine_its_options():
+    scene = replace(named_scene("paper-10deg-frictionless"), revolutions=1)
+    options = {"reference": ReferenceOptions(gauss_nodes=6)}
+    comparison = compare(scene, ("exudyn", "reference"), options=options)
+    assert comparison.results["reference"].summary.options["gauss_nodes"] == 6
+    assert comparison.results["exudyn"].success and comparison.results["reference"].success
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"mujoco": ReferenceOptions()}, "not among"),
+    ({"reference": ExudynOptions()}, "not the options of engine 'reference'"),
+])
+def test_compare_refuses_wrong_options_before_running(options, message):
+    scene = named_scene("paper-10deg-frictionless")
+    with pytest.raises(OptionsError, match=message):
+        compare(scene, ("exudyn", "reference"), options=options)
+
+
+def test_the_package_function_survives_the_module_import():
+    """`cardan_exudyn.compare` is the function, also after its module has been imported (a
+    submodule named `compare` would have replaced it)."""
+    import cardan_exudyn
+    import cardan_exudyn.comparison
+
+    assert cardan_exudyn.compare is compare and cardan_exudyn.Comparison is Comparison

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import balanced_scene
 
-from cardan_exudyn.model.solve import run
+from cardan_exudyn import run
 from reference.paper import named_scene
 from reference.scene import AngleDrive, replace
 

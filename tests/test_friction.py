@@ -12,11 +12,12 @@ import math
 import numpy as np
 import pytest
 
-from cardan_exudyn.model.solve import run
+from cardan_exudyn import run
 from cardan_exudyn.model.build import build_model
 from reference.friction import friction_from_columns, pair_friction, regularised_sign
+from reference.joint import PAIR_KIND, PAIR_NAMES, Pair
 from reference.paper import named_scene
-from reference.scene import PAIR_KIND, PAIR_NAMES, Pair, replace
+from reference.scene import replace
 
 
 def _scene(coupling: str, **changes):

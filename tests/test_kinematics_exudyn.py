@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import balanced_scene
 
-from cardan_exudyn.model.solve import run
+from cardan_exudyn import run
 from reference.kinematics import output_angle, speed_ratio
 
 

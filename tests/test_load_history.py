@@ -7,10 +7,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cardan_exudyn.model.solve import run as run_exudyn
+from cardan_exudyn import run as run_exudyn
 from reference.engine import run as run_reference
 from reference.paper import named_scene
-from reference.scene import AngleDrive, Load, SceneError, load_scene, scene_from_dict, scene_to_dict
+from reference.scene import AngleDrive, Load, scene_from_dict, scene_to_dict
+from reference.scene_files import load_scene
+from reference.validation import SceneError
 
 SPEED = 6.0
 SPAN = 2 * np.pi * 2.2 / SPEED

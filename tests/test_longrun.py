@@ -1,50 +1,152 @@
-"""Long runs (issue 8, ``cardan_exudyn.studies.longrun``): drift over thousands of revolutions with friction,
-and energy conservation of the free-spinning frictionless joint.
+"""Long runs (issue 8, ``cardan_exudyn.studies.longrun``): drift over thousands of revolutions with
+friction, and energy conservation of the free-spinning frictionless joint.
 
-The fast tests run the quick variant once (20 revolutions with friction for Rxyz and EP nodes;
-20 free-spinning revolutions at 35 deg with a step ladder and a spectral-radius ladder; the
-reference engine for 2 revolutions) and check real properties against the module's stated
-tolerances (``longrun.TOLERANCES``, ``DISSIPATION_MODEL``: measured values with a margin and a
-reason, see the module). The slow test runs the full study (2000 / 1000 revolutions).
+The library measures; the verdicts are here: :data:`TOLERANCES` holds each tolerance with its
+reason (measured values with a margin, see ``cardan_exudyn/studies/longrun.py``), and every
+verdict test runs on each variant of the study: a short one in the default suite (5 revolutions
+with friction for Rxyz and EP nodes, 8 free-spinning revolutions at 35 deg, the reference engine
+for 1; about 7 s), the quick one of ``cardan stress --quick`` and the full one (2000 / 1000
+revolutions, about 21 minutes) with ``-m slow``.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+import re
 from itertools import pairwise
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn.studies import longrun
-from cardan_exudyn.studies.longrun import (
-    DEFAULT_RHO,
-    DISSIPATION_MARGIN,
-    TOLERANCES,
-    LongRuns,
+from cardan_exudyn import ExudynOptions
+from cardan_exudyn.studies.longrun import LongRuns, long_runs
+from cardan_exudyn.studies.longrun_measures import (
     algorithmic_damping,
+    at_revolutions,
     damping_coefficient,
-    long_runs,
-    markdown,
-    model_loss,
-    write_long,
+    linear_trend,
+    per_revolution_max,
+    revolution_index,
 )
+from cardan_exudyn.studies.longrun_plan import (
+    DEFAULT_RHO,
+    DISSIPATION_MODEL,
+    FULL,
+    QUICK,
+    RHO_LADDER_STEPS,
+    RHO_MODEL,
+    LongRunPlan,
+    model_loss,
+)
+from cardan_exudyn.studies.longrun_report import markdown, write_long
 
 
-@pytest.fixture(scope="module")
-def quick() -> LongRuns:
+class Tolerance(NamedTuple):
+    value: float
+    reason: str
+
+
+NEWTON_TOLERANCE = ExudynOptions().newton_absolute_tolerance
+TOLERANCES: dict[str, Tolerance] = {
+    "position_violation_m": Tolerance(NEWTON_TOLERANCE, (
+        "Newton's absolute tolerance: index-3 integration solves the position constraints every "
+        "step, so in every revolution they must hold to the tolerance the solver is given "
+        "(measured: rounding, 3e-17 m)")),
+    "angle_violation_rad": Tolerance(NEWTON_TOLERANCE,
+                                     "as for positions, for the misalignment of pair axes"),
+    "velocity_growth_ratio": Tolerance(1.01, (
+        "the velocity-level residual is the O(h^2) error of index-3 generalized-alpha and is "
+        "periodic with the motion: its per-revolution maximum over the last window may exceed the "
+        "first window's by 1 % at most (measured: equal to 7 digits)")),
+    "orthogonality_error": Tolerance(1e-13, (
+        "rounding: A is orthogonal by construction for Rxyz and rotation vectors, and for Euler "
+        "parameters up to 2 (|p|^2 - 1); measured <= 2e-15, the bound is 50 x that")),
+    "ep_norm_error": Tolerance(NEWTON_TOLERANCE, (
+        "the normalisation |p|^2 = 1 is an algebraic constraint solved by Newton like the joints "
+        "(measured: rounding, 3.3e-16)")),
+    "rotvec_norm_excess": Tolerance(1e-12, (
+        "the post-step wrap keeps |nu| <= pi; the stored vectors are those after the wrap, so only "
+        "rounding may exceed pi")),
+    "input_angle_spacing_rad": Tolerance(NEWTON_TOLERANCE, (
+        "the input's Tait-Bryan angle is the unbounded input angle; its floating-point spacing "
+        "grows with it and must stay below Newton's tolerance, or the position constraints cannot "
+        "be resolved (measured 1.8e-12 rad after 2000 revolutions; it passes 1e-10 at 2^19 rad, "
+        "83,400 revolutions)")),
+    "balance_residual_change": Tolerance(0.01, (
+        "W_in - W_out - W_loss - dE per revolution is the O(h^2) error of the work integrals and "
+        "of the integrator; it is periodic, so the last window's may differ from the first's by "
+        "1 % at most (measured: 4e-7 for Rxyz and EP, 3e-4 for RotVecLG)")),
+    "efficiency_drift": Tolerance(1e-5, (
+        "a drift of the per-revolution efficiency over the run below 1/50 of the discretisation "
+        "error of the mean efficiency at this step (5e-4 against the reference engine at 10 deg) "
+        "changes no conclusion drawn from it (measured: trend over 2000 revolutions 3e-11 (Rxyz), "
+        "7e-10 (EP); scatter 1.5e-8, that of the converged friction iteration)")),
+    "dissipation_order": Tolerance(0.1, (
+        "the damping ratio of generalized-alpha is c(rho) (Omega h)^3, so the energy lost per "
+        "revolution should fall as h^3; measured order 2.98 to 3.03 between neighbouring steps "
+        "(100 to 741 steps per revolution, both angles)")),
+    "rho_dependence_factor": Tolerance(1.1, (
+        "loss(rho)/loss(0.6) against the linear theory's c(rho)/c(0.6), rho 0.3 to 0.9 at "
+        "200 steps per revolution: measured within a factor 1.036")),
+    "reference_drift_per_revolution": Tolerance(1e-10, (
+        "the reference engine integrates the one degree of freedom with DOP853 at rtol = atol = "
+        "1e-11: its energy may drift by 10 x rtol per revolution at most (measured 1.5e-11 per "
+        "revolution at 35 deg, 1.7e-12 at 10 deg)")),
+    "dissipation_margin": Tolerance(1.5, (
+        "the default settings' relative energy drift may be this many times the model's loss "
+        "(DISSIPATION_MODEL) times the revolutions: at 10 deg the first revolutions lose more than "
+        "the steady rate (start-up of the integrator), measured 1.34 x the model after 20 "
+        "revolutions, 1.07 x after 100, 1.01 x after 1000 at the default step; at 35 deg less "
+        "(0.76 x after 20, 0.40 x after 8). 1.5 covers the 20-revolution start-up")),
+}
+#: RotVecLG stops at revolution 268 (measured 267.99, with and without friction; see the module).
+ROTVEC_LAST_REVOLUTION = 267
+#: Spectral radii from which Exudyn's index-3 Newton iteration fails (too little damping).
+UNDAMPED_RHO = 0.99
+
+SHORT = LongRunPlan("short", drift_revolutions=5, node_types=("Rxyz", "EP"), energy_revolutions=8,
+                    energy_angles=(35.0,), step_ladder=(100, 200), rho_ladder=(0.3,),
+                    reference_revolutions=1)
+VARIANTS = [pytest.param(SHORT, id="short"),
+            pytest.param(QUICK, id="quick", marks=pytest.mark.slow),
+            pytest.param(FULL, id="full", marks=pytest.mark.slow)]
+
+
+def within(name: str, value: float, subject: str) -> None:
+    """Assert ``value <= TOLERANCES[name]`` (a NaN fails), naming the tolerance's reason."""
+    tol = TOLERANCES[name]
+    assert np.isfinite(value) and value <= tol.value, (
+        f"{subject}: {name} = {value:.3g} > {tol.value:g} ({tol.reason})")
+
+
+@functools.cache
+def run_variant(plan: LongRunPlan) -> LongRuns:
+    """The study's variant, run once per session (the verdict tests share it)."""
     messages: list[str] = []
-    result = long_runs(quick=True, progress=messages.append)
+    result = long_runs(plan=plan, progress=messages.append)
     assert messages, "progress was never called"
     return result
 
 
-def _cases(result: LongRuns, engine: str = "exudyn") -> list[dict]:
-    return [c for c in result.summary["energy"]["cases"] if c["engine"] == engine]
+@pytest.fixture(scope="module", params=VARIANTS)
+def runs(request) -> LongRuns:
+    return run_variant(request.param)
 
 
-# ------------------------------------------------------------------ helpers, no simulation
+def completing(result: LongRuns) -> dict[str, dict[str, Any]]:
+    """The drift runs expected to run through: all but RotVecLG beyond its last revolution."""
+    revolutions = result.summary["settings"]["drift_revolutions"]
+    return {t: info for t, info in result.summary["drift"].items()
+            if t != "RotVecLG" or revolutions <= ROTVEC_LAST_REVOLUTION}
+
+
+def exudyn_cases(result: LongRuns) -> list[dict[str, Any]]:
+    """The free-spinning Exudyn cases expected to run through (damped enough)."""
+    return [c for c in result.summary["energy"]["cases"]
+            if c["engine"] == "exudyn" and c["spectral_radius"] < UNDAMPED_RHO]
 
 
 def test_algorithmic_damping_is_third_order_and_vanishes_at_rho_one():
@@ -60,152 +162,176 @@ def test_algorithmic_damping_is_third_order_and_vanishes_at_rho_one():
 
 def test_revolution_helpers():
     theta = np.linspace(0.0, 3 * 2 * math.pi, 31)  # 10 steps per revolution
-    index = longrun.revolution_index(theta, 3)
+    index = revolution_index(theta, 3)
     assert index[0] == 1 and index[10] == 1 and index[11] == 2 and index[-1] == 3
     values = np.arange(31.0)
-    np.testing.assert_array_equal(longrun.per_revolution_max(values, index, 3), [10, 20, 30])
-    np.testing.assert_allclose(longrun.at_revolutions(values, theta, 3), [0, 10, 20, 30])
-    trend = longrun.linear_trend(np.arange(10), 2.0 + 0.5 * np.arange(10))
+    np.testing.assert_array_equal(per_revolution_max(values, index, 3), [10, 20, 30])
+    np.testing.assert_allclose(at_revolutions(values, theta, 3), [0, 10, 20, 30])
+    trend = linear_trend(np.arange(10), 2.0 + 0.5 * np.arange(10))
     assert abs(trend["slope"] - 0.5) < 1e-12 and trend["scatter"] < 1e-12
 
 
-# ------------------------------------------------------------------ quick variant
+def test_harness_errors_are_reported():
+    """A run that raised is named by ``errors()`` (what `cardan stress` exits 3 for)."""
+    summary = {"drift": {"Rxyz": {"status": "ok"}, "EP": {"status": "error", "reason": "ValueError: x"}},
+               "energy": {"cases": [{"case": "c", "status": "ok"}, {"case": "d", "status": "error",
+                                                                     "reason": "KeyError: y"}]}}
+    result = LongRuns(pd.DataFrame(), pd.DataFrame(), summary)
+    assert result.errors() == [("drift EP", "ValueError: x"), ("d", "KeyError: y")]
+    assert result.status_line() == "drift Rxyz ok, EP error; energy 1 of 2 cases ok"
 
 
-def test_quick_variant_shape_and_settings(quick):
-    s = quick.summary
+def test_shape_and_settings(runs):
+    s = runs.summary
     st = s["settings"]
-    assert st["quick"] and st["drift_scene"] == "paper-10deg-2000rpm"
+    assert st["drift_scene"] == "paper-10deg-2000rpm"
     assert st["drift_steps_per_revolution"] == 156  # the scene's automatic step at 10 deg
     assert st["spectral_radius"] == DEFAULT_RHO
-    assert set(quick.drift["node_type"]) == set(longrun.QUICK_NODE_TYPES)
-    assert len(quick.drift) == len(longrun.QUICK_NODE_TYPES) * longrun.QUICK_DRIFT_REVOLUTIONS
-    for node_type, info in s["drift"].items():
+    assert set(runs.drift["node_type"]) == set(st["drift_node_types"])
+    rows = runs.drift.groupby("node_type").size()
+    for node_type in completing(runs):
+        assert rows[node_type] == st["drift_revolutions"]
+    assert {"case", "engine", "revolution", "relative_energy_deviation"} <= set(runs.energy.columns)
+    if st["variant"] == "quick":
+        assert s["wall_time_s"]["total"] < 120  # about 15-30 s on 2 shared cores
+
+
+def test_runs_complete(runs):
+    """Every drift run and free-spinning case runs all its revolutions (but the known failures,
+    pinned by :func:`test_full_variant_pins_the_known_failures`)."""
+    for node_type, info in completing(runs).items():
         assert info["status"] == "ok", (node_type, info["reason"])
-    assert {"case", "engine", "revolution", "relative_energy_deviation"} <= set(quick.energy.columns)
-    assert all(c["status"] == "ok" for c in s["energy"]["cases"]), s["energy"]["cases"]
-    failed = [c for c in s["checks"] if not c["pass"]]
-    assert not failed, failed
-    assert s["wall_time_s"]["total"] < 120  # about 15-30 s on 2 shared cores
+        assert info["completed_revolutions"] == info["requested_revolutions"], info
+    cases = exudyn_cases(runs) + [c for c in runs.summary["energy"]["cases"] if c["engine"] == "reference"]
+    for c in cases:
+        assert c["status"] == "ok", c
 
 
-def test_constraints_hold_and_do_not_drift(quick):
+def test_constraints_hold_and_do_not_drift(runs):
     """Positions stay on the constraint manifold to rounding; the O(h^2) velocity residuals of
     index-3 integration are periodic, the same in the last revolutions as in the first."""
-    for node_type, info in quick.summary["drift"].items():
+    for node_type, info in completing(runs).items():
         m = info["measures"]
-        assert m["position_violation_m"]["max_abs"] <= TOLERANCES["position_violation_m"][0]
-        assert m["angle_violation_rad"]["max_abs"] <= TOLERANCES["angle_violation_rad"][0]
+        within("position_violation_m", m["position_violation_m"]["max_abs"], node_type)
+        within("angle_violation_rad", m["angle_violation_rad"]["max_abs"], node_type)
         for key in ("velocity_violation_m_s", "angular_velocity_violation_rad_s"):
-            assert m[key]["growth_ratio"] <= TOLERANCES["velocity_growth_ratio"][0], (node_type, key)
+            within("velocity_growth_ratio", m[key]["growth_ratio"], f"{node_type} {key}")
             assert 0 < m[key]["last_window_max_abs"] < 0.1  # real, small residuals
 
 
-def test_euler_parameter_norm_bounded(quick):
-    rows = quick.drift[quick.drift["node_type"] == "EP"]
-    assert rows["ep_norm_error"].notna().all()
-    assert rows["ep_norm_error"].max() <= TOLERANCES["ep_norm_error"][0]
-    assert rows["orthogonality_error"].max() <= TOLERANCES["orthogonality_error"][0]
-    assert quick.drift.loc[quick.drift["node_type"] == "Rxyz", "ep_norm_error"].isna().all()
+def test_rotation_coordinates_stay_healthy(runs):
+    for node_type, info in completing(runs).items():
+        m = info["measures"]
+        within("orthogonality_error", m["orthogonality_error"]["max_abs"], node_type)
+        if node_type == "EP":
+            within("ep_norm_error", m["ep_norm_error"]["max_abs"], node_type)
+        if node_type == "RotVecLG":
+            within("rotvec_norm_excess", m["rotvec_norm_max"]["max_abs"] - math.pi, node_type)
+        within("input_angle_spacing_rad", info["input_angle_spacing_rad"], node_type)
+    if "EP" in runs.summary["drift"]:
+        assert runs.drift.loc[runs.drift["node_type"] == "EP", "ep_norm_error"].notna().all()
+    assert runs.drift.loc[runs.drift["node_type"] == "Rxyz", "ep_norm_error"].isna().all()
 
 
-def test_efficiency_per_revolution_is_stationary(quick):
+def test_energy_balance_residual_is_stationary(runs):
+    for node_type, info in completing(runs).items():
+        balance = info["measures"]["balance_residual_j"]
+        change = abs(balance["last_window_max_abs"] / balance["first_window_max_abs"] - 1.0)
+        within("balance_residual_change", change, node_type)
+
+
+def test_efficiency_per_revolution_is_stationary(runs):
     """After the start-up revolution the per-revolution efficiency has no trend beyond its
     scatter, and its level is the paper scene's (about 0.4758 under the plain reading)."""
-    for node_type, info in quick.summary["drift"].items():
+    for node_type, info in completing(runs).items():
         e = info["efficiency"]
         assert 0.47 < e["mean"] < 0.48
         assert e["scatter"] < 1e-6
         assert abs(e["last_minus_first"]) <= max(4 * e["difference_stderr"], 1e-9), (node_type, e)
-        assert abs(e["trend_over_run"]) <= TOLERANCES["efficiency_drift"][0]
-        assert abs(e["last_minus_first"]) <= TOLERANCES["efficiency_drift"][0]
+        within("efficiency_drift", abs(e["trend_over_run"]), f"{node_type} trend over the run")
+        within("efficiency_drift", abs(e["last_minus_first"]), f"{node_type} last - first window")
 
 
-def test_energy_drift_of_default_settings_below_tolerance(quick):
-    (default,) = [c for c in _cases(quick) if c["dt_choice"] != "given"]
-    assert default["spectral_radius"] == DEFAULT_RHO
-    angle = default["shaft_angle_deg"]
-    allowed = (DISSIPATION_MARGIN * model_loss(angle, DEFAULT_RHO, default["steps_per_revolution"])
-               * default["completed_revolutions"])
-    assert default["relative_drift"] < 0  # numerical damping loses energy, never gains
-    assert abs(default["relative_drift"]) <= allowed, (default["relative_drift"], allowed)
-    (reference,) = _cases(quick, "reference")
-    per_rev = abs(reference["relative_drift"]) / reference["completed_revolutions"]
-    assert per_rev <= TOLERANCES["reference_drift_per_revolution"][0]
+def test_energy_drift_of_default_settings_follows_the_model(runs):
+    """The automatic step at the default spectral radius loses energy (never gains), within a
+    margin of K c(rho) h^3 per revolution."""
+    defaults = [c for c in exudyn_cases(runs) if c.get("dt_choice") != "given"]
+    assert len(defaults) == len(runs.summary["settings"]["energy_shaft_angles_deg"])
+    for c in defaults:
+        assert c["spectral_radius"] == DEFAULT_RHO and c["shaft_angle_deg"] in DISSIPATION_MODEL
+        assert c["relative_drift"] < 0
+        model = (model_loss(c["shaft_angle_deg"], DEFAULT_RHO, c["steps_per_revolution"])
+                 * c["completed_revolutions"])
+        within("dissipation_margin", abs(c["relative_drift"]) / model, c["case"])
 
 
-def test_dissipation_scales_with_step_cubed(quick):
+def test_reference_engine_conserves_energy(runs):
+    for c in runs.summary["energy"]["cases"]:
+        if c["engine"] == "reference":
+            per_revolution = abs(c["relative_drift"]) / c["completed_revolutions"]
+            within("reference_drift_per_revolution", per_revolution, c["case"])
+
+
+def test_dissipation_scales_with_step_cubed(runs):
     """Energy lost per revolution at rho 0.6 against steps per revolution: order 3 (the
-    damping ratio of generalized-alpha is c(rho) (Omega h)^3)."""
-    ladder = sorted((c for c in _cases(quick) if c["spectral_radius"] == DEFAULT_RHO),
-                    key=lambda c: c["steps_per_revolution"])
-    assert len(ladder) >= 3
-    for a, b in pairwise(ladder):
-        order = (math.log(a["loss_per_revolution"] / b["loss_per_revolution"])
-                 / math.log(b["steps_per_revolution"] / a["steps_per_revolution"]))
-        assert abs(order - 3.0) <= TOLERANCES["dissipation_order"][0], (a["case"], b["case"], order)
+    damping ratio of generalized-alpha is c(rho) (Omega h)^3), fitted and between neighbours."""
+    for angle, fit in runs.summary["energy"]["fits"].items():
+        within("dissipation_order", abs(fit["order"] - 3.0), f"{angle} deg, fitted order")
+        ladder = sorted((c for c in exudyn_cases(runs) if c["spectral_radius"] == DEFAULT_RHO
+                         and f"{c['shaft_angle_deg']:g}" == angle), key=lambda c: c["steps_per_revolution"])
+        assert len(ladder) >= 3
+        for a, b in pairwise(ladder):
+            order = (math.log(a["loss_per_revolution"] / b["loss_per_revolution"])
+                     / math.log(b["steps_per_revolution"] / a["steps_per_revolution"]))
+            within("dissipation_order", abs(order - 3.0), f"{a['case']} to {b['case']}")
 
 
-def test_dissipation_follows_spectral_radius_theory(quick):
-    at_200 = {c["spectral_radius"]: c["loss_per_revolution"] for c in _cases(quick)
-              if c["nominal_steps_per_revolution"] == longrun.RHO_LADDER_STEPS}
-    assert len(at_200) >= 3
-    for rho, loss in at_200.items():
-        measured = loss / at_200[DEFAULT_RHO]
-        theory = damping_coefficient(rho) / damping_coefficient(DEFAULT_RHO)
-        factor = max(measured / theory, theory / measured)
-        assert factor <= TOLERANCES["rho_dependence_factor"][0], (rho, measured, theory)
+def test_dissipation_follows_spectral_radius_theory(runs):
+    """loss(rho)/loss(0.6) at 200 steps per revolution against c(rho)/c(0.6), rho 0.3 to 0.9."""
+    for angle, fit in runs.summary["energy"]["fits"].items():
+        rows = [r for r in fit["rho_dependence"] if RHO_MODEL[0] <= r["spectral_radius"] <= RHO_MODEL[1]
+                and r["spectral_radius"] != DEFAULT_RHO]
+        assert rows, fit
+        for r in rows:
+            factor = max(r["measured_ratio"] / r["theory_ratio"], r["theory_ratio"] / r["measured_ratio"])
+            within("rho_dependence_factor", factor, f"{angle} deg, rho {r['spectral_radius']:g} "
+                   f"at {RHO_LADDER_STEPS} steps/rev")
 
 
-def test_write_long_and_markdown(quick, tmp_path):
-    names = write_long(quick, tmp_path)
+def test_write_long_and_markdown(runs, tmp_path):
+    names = write_long(runs, tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
     for name in names:
         assert (tmp_path / name).stat().st_size > 0
     back = pd.read_csv(tmp_path / "longrun_drift.csv")
-    assert len(back) == len(quick.drift)
-    text = markdown(quick)
+    assert len(back) == len(runs.drift)
+    text = markdown(runs)
     assert text.startswith("## Long runs")
-    for needle in ("Drift", "Energy", "Tolerances and checks", "All checks passed: yes",
-                   f"{quick.summary['drift']['EP']['efficiency']['mean']:.7f}"):
+    for needle in ("Drift", "Energy", "What the tests check", "tests/test_longrun.py",
+                   f"{runs.summary['drift']['EP']['efficiency']['mean']:.7f}"):
         assert needle in text, needle
-
-
-# ------------------------------------------------------------------ full variant
+    assert not re.search(r"\bnan\b", text, re.IGNORECASE)
 
 
 @pytest.mark.slow
-def test_full_long_runs():
-    """2000 revolutions with friction for every node type, 1000 free-spinning revolutions at
-    10 and 35 deg with the step and spectral-radius ladders, the reference for 20: every check
-    within its tolerance, except the measured RotVecLG failure (pinned here: if a later Exudyn
-    resolves rotations near the identity, this test says so and the module's account must change)."""
-    result = long_runs(quick=False)
+def test_full_variant_pins_the_known_failures():
+    """RotVecLG stops near revolution 268 and rho 0.99 within 50 revolutions (if a later Exudyn
+    resolves rotations near the identity, this test says so and the module's account must
+    change)."""
+    result = run_variant(FULL)
     s = result.summary
-    assert s["settings"]["drift_revolutions"] == 2000
     assert set(s["drift"]) == {"Rxyz", "EP", "RotVecLG"}
-    for node_type in ("Rxyz", "EP"):
-        info = s["drift"][node_type]
-        assert info["status"] == "ok" and info["completed_revolutions"] == 2000, info
-    failed = [c for c in s["checks"] if not c["pass"] and c["subject"] != "RotVecLG"]
-    assert not failed, failed
-
-    # RotVecLG: stops near revolution 268 (measured 267.99, with and without friction)
     rv = s["drift"]["RotVecLG"]
     assert rv["status"] == "integration_failure" and 200 <= rv["completed_revolutions"] <= 400, rv
     rows = result.drift[result.drift["node_type"] == "RotVecLG"]
-    assert rows["position_violation_m"].max() <= TOLERANCES["position_violation_m"][0]
+    within("position_violation_m", rows["position_violation_m"].max(), "RotVecLG before it fails")
     # the axis misalignment before the failure is the input angle's rounding drift, which the
     # identity step cannot follow (module docstring)
     late = rows.tail(50)
     worst = late["angle_violation_rad"].max()
     assert abs(worst / late["input_angle_error_rad"].abs().max() - 1.0) < 0.1  # measured 1.0000
-    assert worst > TOLERANCES["angle_violation_rad"][0]  # measured 1.3e-9 rad
+    assert worst > TOLERANCES["angle_violation_rad"].value  # measured 1.3e-9 rad
     assert any(f.startswith("RotVecLG") for f in s["findings"])
-
-    # energy: every case up to rho 0.95 runs 1000 revolutions; rho 0.99 fails early
     for c in s["energy"]["cases"]:
-        if c["engine"] == "exudyn" and c["spectral_radius"] >= 0.99:
+        if c["engine"] == "exudyn" and c["spectral_radius"] >= UNDAMPED_RHO:
             assert c["status"] != "ok" and c["completed_revolutions"] < 50, c
-        else:
-            assert c["status"] == "ok", c

@@ -20,24 +20,28 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from cardan_exudyn.mujoco_engine import (  # noqa: E402 (after the optional-import skip)
+from cardan_exudyn import engines, mujoco_engine  # noqa: E402 (after the optional-import skip)
+from cardan_exudyn.mujoco_engine import MujocoOptions, speed_ratio_error_model  # noqa: E402
+from cardan_exudyn.studies.mujoco_settings import (  # noqa: E402
     MUJOCO_DEFAULTS,
-    MujocoOptions,
     accuracy,
-    run,
     settings_study,
-    speed_ratio_error_model,
     study_cases,
 )
 from reference.dynamics import inverse_dynamics  # noqa: E402
 from reference.paper import named_scene  # noqa: E402
 from reference.scene import Numerics, Scene, TorqueDrive, replace  # noqa: E402
-from reference.schema import table_columns  # noqa: E402
+from reference.schema import OptionsError, Result, Status, table_columns  # noqa: E402
 
 DT = 1e-4
 STEPS_PER_REVOLUTION = 300  # 2000 rpm at DT
 IMPEDANCE_LEAK = 1.0 - 0.9999
 ANGLES = (10, 30)
+
+
+def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
+    """The MuJoCo engine through the one dispatch, as every caller runs it."""
+    return engines.run(scene, "mujoco", options)
 
 
 def paper_scene(deg: int, **changes) -> Scene:
@@ -63,7 +67,7 @@ def reference_columns(scene: Scene, t: np.ndarray) -> dict[str, np.ndarray]:
 def test_speed_ratio_matches_hooke(runs, deg):
     """omega_out / omega_in follows Hooke's formula within the documented error model."""
     scene, result = runs[deg]
-    assert result.ok, result.summary["reason"]
+    assert result.success, result.message
     bound = speed_ratio_error_model(scene, MujocoOptions(), STEPS_PER_REVOLUTION)
     assert accuracy(scene, result)["speed_ratio_error"] <= bound
 
@@ -72,8 +76,8 @@ def test_speed_ratio_matches_hooke(runs, deg):
 def test_loop_closure_holds(runs, deg):
     """The output axis stays in its bearing: 1e-7 rad and 1e-8 m (measured 2.9e-8, 2.7e-9)."""
     summary = runs[deg][1].summary
-    assert summary["max_constraint_violation_rad"] < 1e-7
-    assert summary["max_constraint_violation_m"] < 1e-8
+    assert summary.max_constraint_violation_rad < 1e-7
+    assert summary.max_constraint_violation_m < 1e-8
 
 
 @pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
@@ -93,9 +97,9 @@ def test_mean_torque_is_the_load(runs, deg):
     Measured 6e-8 (10 deg) and 4e-7 N m (30 deg) at this step; 5x that is the tolerance.
     """
     scene, result = runs[deg]
-    np.testing.assert_allclose(result.summary["mean_torque_in"], scene.load.torque,
+    np.testing.assert_allclose(result.summary.mean_torque_in, scene.load.torque,
                                rtol=0.0, atol=2e-6)
-    np.testing.assert_allclose(result.summary["work_ratio"], 1.0, rtol=0.0, atol=1e-6)
+    np.testing.assert_allclose(result.summary.work_ratio, 1.0, rtol=0.0, atol=1e-6)
 
 
 @pytest.mark.parametrize("deg", ANGLES, ids=lambda d: f"{d}deg")
@@ -121,31 +125,38 @@ def test_columns_and_summary_follow_the_schema(runs):
     assert result.table[unfilled].isna().all().all()
     filled = [c for c in table_columns() if c not in unfilled]
     assert result.table[filled].notna().all().all()
-    for key in ("status", "reason", "engine_version", "scene", "dt", "steps", "wall_time_s",
-                "mean_efficiency", "mean_torque_in", "work_ratio"):
-        assert key in result.summary
-    assert result.summary["engine"] == "mujoco"
-    assert result.summary["dt"] == DT
+    summary = result.summary
+    assert summary.status == Status.OK and summary.reason == ""
+    for value in (summary.engine_version, summary.scene, summary.dt, summary.steps,
+                  summary.wall_time_s, summary.mean_efficiency, summary.mean_torque_in,
+                  summary.work_ratio):
+        assert value is not None and value == value  # set and not NaN
+    assert summary.engine == "mujoco"
+    assert summary.dt == DT
+    assert set(summary.to_dict()) >= {"status", "reason", "max_drive_error_rad", "mean_efficiency"}
 
 
 def test_friction_scene_is_refused():
-    """MuJoCo cannot model friction proportional to reactions: friction scenes raise."""
+    """MuJoCo cannot model friction proportional to reactions: the engine raises
+    NotImplementedError, which the dispatch reports as the engine being unavailable."""
     with pytest.raises(NotImplementedError, match="friction"):
+        mujoco_engine.run(named_scene("paper-10deg"))
+    with pytest.raises(engines.EngineUnavailable, match="friction"):
         run(named_scene("paper-10deg"))
 
 
 def test_mujoco_defaults_are_flagged():
     """MuJoCo's own defaults (Euler, 2 ms, solref 0.02) open the loop: the run is flagged."""
     result = run(named_scene("paper-30deg-frictionless"), MUJOCO_DEFAULTS)
-    assert result.summary["status"] == "constraint_violated"
-    assert result.summary["max_constraint_violation_rad"] > 0.1
+    assert result.status == Status.CONSTRAINT_VIOLATED
+    assert result.summary.max_constraint_violation_rad > 0.1
 
 
 def test_automatic_step_meets_the_accuracy():
     """Without a step, the engine picks one that meets ``numerics.accuracy`` on the speed ratio."""
     scene = replace(named_scene("paper-30deg-frictionless"), **{"numerics.accuracy": 1e-7})
     result = run(scene)
-    assert result.summary["dt_choice"].startswith("auto")
+    assert result.summary.dt_choice.startswith("auto")
     assert accuracy(scene, result)["speed_ratio_error"] <= 1e-7
 
 
@@ -155,7 +166,7 @@ def test_torque_drive_balances_energy():
     scene = Scene(joint=base.joint, drive=TorqueDrive(torque=3.0, initial_speed=100.0),
                   load=base.load, gravity=base.gravity, revolutions=2.0, numerics=Numerics(dt=DT))
     result = run(scene)
-    assert result.ok, result.summary["reason"]
+    assert result.success, result.message
     table = result.table
     assert table["theta_in"].iloc[-1] >= 2.0 * 2.0 * math.pi
     t = table["t"].to_numpy()
@@ -178,8 +189,8 @@ def test_torque_drive_balances_energy():
     ({"iterations": 0}, "iterations"),
 ], ids=["integrator", "solimp", "solref", "o_solref", "timeconst", "iterations"])
 def test_invalid_settings_are_rejected(kwargs, match):
-    """Bad settings raise ValueError naming the argument."""
-    with pytest.raises(ValueError, match=match):
+    """Bad settings raise OptionsError (a ValueError) naming the argument."""
+    with pytest.raises(OptionsError, match=match):
         MujocoOptions(**kwargs)
 
 

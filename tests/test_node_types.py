@@ -20,9 +20,10 @@ import exudyn.rigidBodyUtilities as rbu
 import numpy as np
 import pytest
 
-import cardan_exudyn.model.solve as engine
-from cardan_exudyn.model.solve import ExudynOptions, body_states, run
+import cardan_exudyn.model.solve as engine  # its build_model is patched to look inside the runs
+from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.model.build import build_model
+from cardan_exudyn.model.postprocess import body_states
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES
 from reference.engine import run as reference_run
 from reference.kinematics import speed_ratio
@@ -57,7 +58,7 @@ def built(monkeypatch):
 
 
 def _run(scene, node_type, built):
-    result = run(scene, ExudynOptions(node_type=node_type))
+    result = run(scene, options=ExudynOptions(node_type=node_type))
     model = built[-1]
     # the option reached the model: spider and output carry the node type, the input stays Rxyz
     assert model.node_type == node_type

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from cardan_exudyn.model.solve import ExudynOptions, run
+from cardan_exudyn import ExudynOptions, run
 from reference.engine import run as reference_run
 from reference.kinematics import speed_ratio
 from reference.paper import named_scene
@@ -37,7 +37,7 @@ def test_projection_gives_hookes_speed_ratio_at_a_coarse_step(angle):
     rounding only. The drive torque (a Lagrange multiplier) is not touched."""
     scene = _steps(named_scene(f"paper-{angle}deg-frictionless"), 50)
     plain = run(scene)
-    projected = run(scene, ExudynOptions(velocity_projection=True))
+    projected = run(scene, options=ExudynOptions(velocity_projection=True))
     assert plain.ok and projected.ok
     assert _ratio_error(scene, plain.table) > 5e-5
     assert _ratio_error(scene, projected.table) < 1e-12
@@ -53,7 +53,7 @@ def test_projection_with_mounting_errors_matches_the_reference_engine():
     instants."""
     scene = replace(named_scene("rig-calibrated-errors-frictionless"),
                     **{"revolutions": 1, "numerics.dt": 2 * math.pi / 6.0 / 60})
-    ex = run(scene, ExudynOptions(velocity_projection=True))
+    ex = run(scene, options=ExudynOptions(velocity_projection=True))
     plain = run(scene)
     ref = reference_run(scene)
     assert ex.ok and ref.ok
@@ -72,26 +72,21 @@ def test_projection_with_mounting_errors_matches_the_reference_engine():
 def test_torque_drive_projection_satisfies_the_constraints_and_is_idempotent():
     """With a torque drive one degree of freedom is left: the projection is the closest
     consistent velocity in the kinetic-energy metric; projecting it again changes nothing."""
-    from cardan_exudyn.model import solve as eng
+    from cardan_exudyn.model.postprocess import body_states, pair_kinematics
     from cardan_exudyn.model.projection import constraint_jacobian, project_velocities
+    from cardan_exudyn.model.solve import solve
 
     scene = replace(named_scene("paper-20deg-frictionless"),
                     drive={"kind": "torque", "torque": 2.0, "initial_speed": 100.0},
                     load={"torque": 0.0}, revolutions=1, **{"numerics.dt": 2e-4})
-    result = run(scene, ExudynOptions(velocity_projection=True))
-    assert result.ok
-    model = eng.build_model(scene)
-    # recompute from a fresh solve to reach the states
-    options = ExudynOptions()
-    settings = eng.simulation_settings(2e-4, 0.0, 0.01, options)
-    import exudyn as exu
-
-    solver = exu.MainSolverImplicitSecondOrder()
-    assert solver.SolveSystem(model.mbs, settings)
-    states = eng.body_states(model)
+    result = run(scene, options=ExudynOptions(velocity_projection=True))
+    assert result.success
+    # a fresh solve (the one solve sequence) to reach the unprojected states
+    model = solve(scene, ExudynOptions(), reactions=False).model
+    states = body_states(model)
     n = min(len(s["t"]) for s in states.values())
     states = {k: {c: v[:n] for c, v in s.items()} for k, s in states.items()}
-    pairs = eng._pair_kinematics(model, states, n)
+    pairs = pair_kinematics(model, states, n)
     u_of = lambda st: np.concatenate([np.concatenate([st[b]["v"], st[b]["omega"]], axis=1)  # noqa: E731
                                       for b in ("input", "spider", "output")], axis=1)
     jac = constraint_jacobian(states, pairs)

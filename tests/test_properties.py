@@ -100,13 +100,15 @@ from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from test_energy import balance_residual
 
-from cardan_exudyn.model.solve import NODE_TYPES, ExudynOptions
-from cardan_exudyn.model.solve import run as exudyn_run
+from cardan_exudyn import run as exudyn_run
+from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import error_coefficient
 from reference.engine import ReferenceOptions
 from reference.engine import run as reference_run
+from reference.joint import PAIR_KIND, PAIR_NAMES
 from reference.paper import named_scene
-from reference.scene import COUPLINGS, DEG, PAIR_KIND, PAIR_NAMES, RPM, Numerics, replace
+from reference.scene import COUPLINGS, Numerics, replace
+from reference.validation import DEG, RPM
 
 # --------------------------------------------------------------------------- contract
 
@@ -192,7 +194,7 @@ def run_cell(cell: dict, engine: str, node_type: str = "Rxyz"):
     scene = scene_of(cell)
     if engine == "reference":
         return scene, reference_run(scene)
-    return scene, exudyn_run(scene, ExudynOptions(node_type=node_type))
+    return scene, exudyn_run(scene, options=ExudynOptions(node_type=node_type))
 
 
 # --------------------------------------------------------------------------- measures

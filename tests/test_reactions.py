@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import B_IN, B_OUT, M_IN, M_OUT, M_SPIDER, balanced_scene
 
-from cardan_exudyn.model.solve import run
+from cardan_exudyn import run
 
 G = 9.81
 LOAD = 1.5

@@ -10,19 +10,12 @@ from test_reference_kinematics import derivative
 
 from reference import engine
 from reference.dynamics import inverse_dynamics, reaction_system
+from reference.joint import Body, Geometry, Joint
 from reference.joint_motion import joint_motion
 from reference.kinematics import body_motions, speed_ratio
 from reference.paper import named_scene
-from reference.scene import (
-    Body,
-    Geometry,
-    Joint,
-    Load,
-    Scene,
-    SpeedDrive,
-    replace,
-)
-from reference.schema import table_columns
+from reference.scene import Load, Scene, SpeedDrive, replace
+from reference.schema import Status, table_columns
 
 EPS = np.finfo(float).eps
 M_IN, M_SPIDER, M_OUT = 0.9, 0.05, 0.8  # [kg]
@@ -107,13 +100,12 @@ def test_input_work_equals_output_work_over_whole_revolutions(beta_deg):
     """Without friction the mechanical energy is periodic, so input work = output work."""
     result = run(named_scene(f"paper-{beta_deg:g}deg-frictionless"))
     s, table = result.summary, result.table
-    assert s["status"] == "ok" and s["revolutions"] == 2
+    assert s.status is Status.OK and s.revolutions == 2
     scale = np.trapezoid(np.abs(table["power_in"]) + np.abs(table["power_out"]), table["t"])
     # worst-case rounding of the trapezoidal sums: n eps times the integral of |terms|
     tol = len(table) * EPS * scale
-    assert abs(s["input_work"] - s["output_work"]) <= tol
-    assert s["input_work"] == pytest.approx(2 * 2 * np.pi * s["scene"]["load"]["torque"],
-                                            rel=0, abs=tol)
+    assert abs(s.input_work - s.output_work) <= tol
+    assert s.input_work == pytest.approx(2 * 2 * np.pi * s.scene["load"]["torque"], rel=0, abs=tol)
 
 
 def energy_rate(scene: Scene, theta: np.ndarray, theta_t: np.ndarray):
@@ -169,14 +161,14 @@ def test_result_follows_the_schema():
     assert len(table) == (2 * 36) // 2 + 1  # 2 revolutions, endpoint included, every 2nd row
     assert table["t"].iloc[0] == 0.0
     assert table["theta_in"].iloc[-1] == pytest.approx(4 * np.pi, rel=1e-15)
-    assert s["status"] == "ok" and s["engine"] == "reference" and s["scene"]["name"] == scene.name
+    assert s.status is Status.OK and s.engine == "reference" and s.scene["name"] == scene.name
     assert {"engine_version", "wall_time_s", "input_work", "mean_efficiency"} <= s.to_dict().keys()
     # no friction, no sliding, and no axial force / torque in the cylindrical pairs
     zero_suffixes = ("_mz", "friction_torque", "friction_force", "slide_rel")
     zero_cols = [c for c in table_columns() if c.startswith("power_loss") or c.endswith(zero_suffixes)
                  or (c.endswith("_fz") and c != "frame_input_fz")]
     assert not table[zero_cols].to_numpy().any()
-    assert np.all(table["efficiency"] == 1.0) and s["mean_efficiency"] == 1.0
+    assert np.all(table["efficiency"] == 1.0) and s.mean_efficiency == 1.0
     assert run(replace(scene, **{"record.timeseries": False})).table is None
 
 

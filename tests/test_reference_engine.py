@@ -17,7 +17,7 @@ from reference.friction import friction_from_columns
 from reference.joint_motion import joint_motion
 from reference.paper import named_scene, paper_scene
 from reference.scene import AngleDrive, Scene, TorqueDrive, replace
-from reference.schema import table_columns
+from reference.schema import Status, table_columns
 
 FRICTION_SCENES = ["paper-10deg", "paper-35deg", "paper-calibrated-20deg"]
 
@@ -77,13 +77,13 @@ def test_momentum_balance_with_friction(name):
 def test_work_quadrature_closes_the_energy_balance(name):
     """W_in - W_out - W_loss - change of energy, from the quadrature, is at rounding level."""
     s = run(named_scene(name)).summary
-    assert s["status"] == "ok" and s["revolutions"] == 2
+    assert s.status is Status.OK and s.revolutions == 2
     # the quadrature is accepted at 1e-9 of W_in per panel; the balance holds node by node,
     # so only rounding of the sums (~1e3 nodes, terms <= 1e3 W) remains: 1e-12 W_in
-    assert abs(s["energy_balance_residual"]) <= 1e-12 * s["input_work"]
-    assert s["loss_work"] == pytest.approx(sum(s[f"loss_work_{p}"] for p in
-                                               ("frame_input", "input_spider", "spider_output",
-                                                "output_frame")), rel=1e-13)
+    assert abs(s.extras["energy_balance_residual"]) <= 1e-12 * s.input_work
+    assert s.loss_work == pytest.approx(sum(s.pair_loss_work[p] for p in
+                                            ("frame_input", "input_spider", "spider_output",
+                                             "output_frame")), rel=1e-13)
 
 
 @pytest.mark.parametrize("name", ["paper-10deg", "paper-35deg", "paper-calibrated-20deg"])
@@ -91,7 +91,7 @@ def test_mean_efficiency_self_converges_to_1e_8(name):
     """Refining the quadrature and the table sampling moves the mean efficiency by < 1e-8."""
     scene = one_revolution(name)
     values = [run(scene, ReferenceOptions(samples_per_revolution=spr, quadrature_rtol=rtol,
-                                          panels_per_revolution=panels)).summary["mean_efficiency"]
+                                          panels_per_revolution=panels)).summary.mean_efficiency
               for spr, rtol, panels in [(90, 1e-7, 4), (360, 1e-9, 8), (1000, 1e-11, 16)]]
     assert max(values) - min(values) < 1e-8, values
 
@@ -104,8 +104,8 @@ def test_table_trapezoid_agrees_with_the_quadrature():
     t, f = r.table["t"].to_numpy(), r.table["power_loss"].to_numpy()
     h = t[1] - t[0]
     bound = (t[-1] - t[0]) * np.max(np.abs(np.diff(f, 2))) / 12.0
-    assert abs(np.trapezoid(f, t) - r.summary["loss_work"]) <= bound
-    assert bound < 3e-3 * r.summary["loss_work"]  # the check has teeth: 0.3 % of the loss
+    assert abs(np.trapezoid(f, t) - r.summary.loss_work) <= bound
+    assert bound < 3e-3 * r.summary.loss_work  # the check has teeth: 0.3 % of the loss
     assert h > 0
 
 
@@ -116,9 +116,9 @@ def test_self_locking_is_reported_per_sample():
     r = run(scene, ReferenceOptions(samples_per_revolution=180))
     table = r.table
     locked = table["self_locking"].to_numpy()
-    assert r.summary["status"] == "self_locking" and "self-locks" in r.summary["reason"]
+    assert r.summary.status is Status.SELF_LOCKING and "self-locks" in r.summary.reason
     assert 0 < locked.sum() < locked.size
-    assert "mean_efficiency" not in r.summary
+    assert r.summary.mean_efficiency is None
     gain = table["friction_loop_gain"].to_numpy()  # infinite where no solution exists
     assert np.all(gain[locked] >= 1.0) and np.all(gain[~locked] < 1.0)
     assert table.loc[locked, "torque_in"].isna().all()
@@ -128,8 +128,8 @@ def test_self_locking_is_reported_per_sample():
 def test_no_self_locking_below_the_threshold():
     """At 40 deg (plain reading) every sample has a loop gain below 1: no locking."""
     r = run(replace(paper_scene(40.0), revolutions=1), ReferenceOptions(samples_per_revolution=180))
-    assert r.summary["status"] == "ok"
-    assert 0.5 < r.summary["max_friction_loop_gain"] < 1.0
+    assert r.summary.status is Status.OK
+    assert 0.5 < r.summary.max_friction_loop_gain < 1.0
 
 
 def test_angle_history_of_a_constant_speed_equals_the_speed_drive():
@@ -139,9 +139,9 @@ def test_angle_history_of_a_constant_speed_equals_the_speed_drive():
     t = np.linspace(0.0, 1.2 * 2 * math.pi / w, 13)
     angle_scene = dataclasses.replace(scene, drive=AngleDrive(tuple(t), tuple(w * t)))
     a, b = run(scene).summary, run(angle_scene).summary
-    assert b["status"] == "ok" and b["quadrature"]["knots"] > 0
-    assert b["mean_efficiency"] == pytest.approx(a["mean_efficiency"], abs=1e-12)
-    assert b["input_work"] == pytest.approx(a["input_work"], rel=1e-11)
+    assert b.status is Status.OK and b.extras["quadrature"]["knots"] > 0
+    assert b.mean_efficiency == pytest.approx(a.mean_efficiency, abs=1e-12)
+    assert b.input_work == pytest.approx(a.input_work, rel=1e-11)
 
 
 def torque_scene(torque: float, speed: float, name="paper-10deg") -> Scene:
@@ -154,13 +154,13 @@ def test_torque_drive_without_friction_conserves_energy():
     r = run(torque_scene(8.0, 60.0, name="paper-10deg-frictionless"),
             ReferenceOptions(ode_rtol=1e-10, ode_atol=1e-10))
     s, table = r.summary, r.table
-    assert s["status"] == "ok"
+    assert s.status is Status.OK
     assert table["theta_in"].iloc[-1] == pytest.approx(2 * math.pi, rel=1e-12)
     assert table["omega_in"].iloc[-1] > 60.0  # 8 N m against 2 N m accelerates the joint
     # the quadrature integrates the forward solution's own powers: the balance measures the
     # integration error of theta and omega (rtol 1e-10) against the input work
-    assert abs(s["energy_balance_residual"]) < 1e-8 * s["input_work"]
-    assert s["mean_efficiency"] == 1.0
+    assert abs(s.extras["energy_balance_residual"]) < 1e-8 * s.input_work
+    assert s.mean_efficiency == 1.0
 
 
 def test_torque_drive_reverses_and_stops_after_the_turn():
@@ -170,7 +170,7 @@ def test_torque_drive_reverses_and_stops_after_the_turn():
             ReferenceOptions(ode_rtol=1e-8, ode_atol=1e-8))
     table = r.table
     assert table["omega_in"].iloc[-1] < 0 and table["theta_in"].iloc[-1] == pytest.approx(-2 * math.pi)
-    assert r.summary["status"] == "no_whole_revolution"  # the angle is not monotonic
+    assert r.summary.status is Status.NO_WHOLE_REVOLUTION  # the angle is not monotonic
 
 
 @pytest.mark.slow
@@ -180,9 +180,9 @@ def test_torque_drive_with_friction_converges_with_the_tolerance():
     solved at every right-hand-side evaluation, ~2000 of them)."""
     scene = torque_scene(8.0, 60.0)
     s = [run(scene, ReferenceOptions(ode_rtol=rt, ode_atol=rt)).summary for rt in (1e-8, 1e-10)]
-    assert all(e["status"] == "ok" for e in s)
-    assert abs(s[0]["mean_efficiency"] - s[1]["mean_efficiency"]) < 1e-6
-    assert abs(s[1]["energy_balance_residual"]) < 1e-8 * s[1]["input_work"]
+    assert all(e.status is Status.OK for e in s)
+    assert abs(s[0].mean_efficiency - s[1].mean_efficiency) < 1e-6
+    assert abs(s[1].extras["energy_balance_residual"]) < 1e-8 * s[1].input_work
 
 
 def test_extra_columns_and_schema():

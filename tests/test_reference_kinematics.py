@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from reference.joint import PAIR_BODIES, PAIR_NAMES
 from reference.kinematics import (
     body_motions,
     output_angle,
@@ -14,7 +15,6 @@ from reference.kinematics import (
     pair_frames_in_body_a,
     relative_speeds,
 )
-from reference.scene import PAIR_BODIES, PAIR_NAMES
 
 EPS = np.finfo(float).eps
 ANGLES_DEG = [0.0, 5.0, 37.0, 60.0, 85.0]

@@ -4,17 +4,16 @@ interruption, failing cases, worker processes, bad input."""
 from __future__ import annotations
 
 import json
-import os
 import shutil
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn.studies import reproduce as rep
 from cardan_exudyn.cli import main
-from cardan_exudyn.engines import run_scene
-from cardan_exudyn.sweep.runner import CASES_FILE, make_plan, read_records
+from cardan_exudyn.engines import run as engine_run
+from cardan_exudyn.studies import reproduce as rep
+from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
 from reference.paper import paper_scene
 from reference.scene import replace
 from reference.schema import Result, Status, Summary
@@ -44,7 +43,7 @@ class Counting:
             raise RuntimeError("boom in the engine")
         if action == "self_locking":
             return Result(None, Summary(Status.SELF_LOCKING, "friction loop gain 1.3 >= 1"))
-        return run_scene(scene, engine)
+        return engine_run(scene, engine)
 
 
 @pytest.fixture
@@ -65,7 +64,7 @@ def no_drawing(monkeypatch):
 @pytest.fixture(scope="module")
 def quick_report(tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce") / "quick"
-    assert rep.reproduce(out, quick=True, workers=1, progress=False) == 0
+    assert rep.reproduce(out, quick=True, workers=1, progress=False).success
     return out
 
 
@@ -87,7 +86,9 @@ def test_runner_builds_the_paper_scenes(quick):
         built = replace(plan.base, **case.overrides)
         assert built == expected, run.id
         assert built.name == expected.name
-    assert plan.spec.function == rep.CASE_FUNCTION
+    assert plan.spec.function == rep.CASE_FUNCTION and plan.spec.function_args == {}
+    assert rep.sweep_spec(runs, quick, files="/report/runs/files").function_args == {
+        "files": "/report/runs/files"}
 
 
 def test_quick_report_numbers_and_files(quick_report):
@@ -96,7 +97,7 @@ def test_quick_report_numbers_and_files(quick_report):
     rows = pd.read_csv(quick_report / "results.csv")
     assert len(rows) == 6 and (rows.status == "ok").all()
     assert set(rows.parameters) == {"plain", "calibrated"}
-    direct = run_scene(replace(paper_scene(10.0, 2000.0), **rep.QUICK_OVERRIDES), "exudyn")
+    direct = engine_run(replace(paper_scene(10.0, 2000.0), **rep.QUICK_OVERRIDES), "exudyn")
     numbers = rep.run_numbers(direct)
     row = rows[(rows.parameters == "plain") & (rows.study == "table2")
                & (rows.shaft_angle_deg == 10.0)].iloc[0]
@@ -118,11 +119,12 @@ def test_quick_report_numbers_and_files(quick_report):
         "paper-0deg-2000rpm", "paper-10deg-2000rpm", "paper-10deg-500rpm",
         "paper-calibrated-0deg-2000rpm", "paper-calibrated-10deg-2000rpm",
         "paper-calibrated-10deg-500rpm"]
-    assert summaries[1]["mean_efficiency"] == direct.summary["mean_efficiency"]
+    assert summaries[1]["mean_efficiency"] == direct.summary.mean_efficiency
     for name in ("fig4_efficiency_10deg_plain.png", "fig6_angles_calibrated.png",
                  "fig7_speeds_plain.png", "table2_calibrated.png"):
         assert (quick_report / name).is_file(), name
-    assert os.environ.get(rep.FILES_ENV) is None
+    plan = json.loads((quick_report / rep.RUNS_DIR / "plan.json").read_text())
+    assert plan["function_args"] == {"files": str(files.resolve())}
 
 
 def test_interrupted_reproduce_resumes(tmp_path, monkeypatch, no_drawing):
@@ -131,18 +133,18 @@ def test_interrupted_reproduce_resumes(tmp_path, monkeypatch, no_drawing):
     --restart runs all again."""
     out = tmp_path / "rep"
     first = Counting(interrupt_at=4)
-    monkeypatch.setattr(rep, "run_scene", first)
+    monkeypatch.setattr(rep.engines, "run", first)
     with pytest.raises(KeyboardInterrupt):
         rep.reproduce(out, quick=True, workers=1, progress=False)
     assert sorted(_records(out)) == sorted(QUICK_IDS[:3])
     assert not (out / "report.md").exists()
-    assert os.environ.get(rep.FILES_ENV) is None
     stray = out / rep.RUNS_DIR / rep.FILES_DIR / "paper-calibrated-0deg-2000rpm-interrupted"
     stray.mkdir()
 
     second = Counting()
-    monkeypatch.setattr(rep, "run_scene", second)
-    assert rep.reproduce(out, quick=True, workers=1, progress=False) == 0
+    monkeypatch.setattr(rep.engines, "run", second)
+    result = rep.reproduce(out, quick=True, workers=1, progress=False)
+    assert result.success and result.reused == 3 and result.sweep["run_now"] == 3
     assert second.names == ["paper-calibrated-0deg-2000rpm", "paper-calibrated-10deg-2000rpm",
                             "paper-calibrated-10deg-500rpm"]
     assert not stray.exists()
@@ -152,14 +154,14 @@ def test_interrupted_reproduce_resumes(tmp_path, monkeypatch, no_drawing):
     assert len(json.loads((out / "summaries.json").read_text())) == 6
 
     third = Counting()
-    monkeypatch.setattr(rep, "run_scene", third)
-    assert rep.reproduce(out, quick=True, workers=1, progress=False) == 0
+    monkeypatch.setattr(rep.engines, "run", third)
+    assert rep.reproduce(out, quick=True, workers=1, progress=False).success
     assert third.names == []
     assert pd.read_csv(out / "results.csv").equals(rows)
 
     fourth = Counting()
-    monkeypatch.setattr(rep, "run_scene", fourth)
-    assert rep.reproduce(out, quick=True, workers=1, progress=False, restart=True) == 0
+    monkeypatch.setattr(rep.engines, "run", fourth)
+    assert rep.reproduce(out, quick=True, workers=1, progress=False, restart=True).success
     assert len(fourth.names) == 6
     assert "earlier invocation" not in (out / "report.md").read_text()
     assert len(list((out / rep.RUNS_DIR / rep.FILES_DIR).iterdir())) == 6
@@ -172,7 +174,7 @@ def test_failing_cases_are_recorded_and_the_report_is_written(tmp_path, monkeypa
     out = tmp_path / "rep"
     engine = Counting(fail={"paper-calibrated-10deg-500rpm": "raise",
                             "paper-0deg-2000rpm": "self_locking"})
-    monkeypatch.setattr(rep, "run_scene", engine)
+    monkeypatch.setattr(rep.engines, "run", engine)
     assert main(["reproduce", "--quick", "--workers", "1", "--out", str(out)]) == 3
     records = _records(out)
     assert records["calibrated-speed-10deg-500rpm"]["status"] == "error"
@@ -195,18 +197,18 @@ def test_failing_cases_are_recorded_and_the_report_is_written(tmp_path, monkeypa
     assert "calibrated-speed-10deg-500rpm: error: RuntimeError: boom in the engine" in err
 
     again = Counting()
-    monkeypatch.setattr(rep, "run_scene", again)
+    monkeypatch.setattr(rep.engines, "run", again)
     assert main(["reproduce", "--quick", "--workers", "1", "--retry-failed", "--out", str(out)]) == 0
     assert sorted(again.names) == ["paper-0deg-2000rpm", "paper-calibrated-10deg-500rpm"]
     assert (pd.read_csv(out / "results.csv").status == "ok").all()
 
 
 def test_two_workers_give_the_same_report(quick_report, tmp_path, no_drawing):
-    """Cases in two spawned worker processes (which find the files folder through the
-    environment): the same numbers, summaries and histories (what the figures are drawn from)
-    as in one process, and the same figure files."""
+    """Cases in two spawned worker processes (which receive the files folder as an argument of
+    the case function): the same numbers, summaries and histories (what the figures are drawn
+    from) as in one process, and the same figure files."""
     out = tmp_path / "rep"
-    assert rep.reproduce(out, quick=True, workers=2, progress=False) == 0
+    assert rep.reproduce(out, quick=True, workers=2, progress=False).success
     sweep = json.loads((out / rep.RUNS_DIR / "sweep.json").read_text())
     assert sweep["executor"] == {"kind": "processes", "workers": 2}
     a = pd.read_csv(quick_report / "results.csv").drop(columns="wall_time_s")
@@ -232,7 +234,7 @@ def test_bad_input_exits_2_with_one_line(quick_report, tmp_path, monkeypatch, ca
     """--out naming a file, and an OUT/runs holding another plan (--quick runs, then the full
     set): exit 2, one line naming the problem, nothing run, nothing changed."""
     engine = Counting()
-    monkeypatch.setattr(rep, "run_scene", engine)
+    monkeypatch.setattr(rep.engines, "run", engine)
     target = tmp_path / "file.txt"
     target.write_text("keep")
     assert main(["reproduce", "--out", str(target)]) == 2

@@ -9,19 +9,25 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
+import rigdata
+from cardan_exudyn.engines import run
 from reference.paper import named_scene
+from reference.schema import Status
 from rigdata import synthetic
 from rigdata.conditioning import Conditioning, condition, estimate_phase, pulse_edges
 from rigdata.efficiency import measured_efficiency, window_weights
-from rigdata.model import computed_efficiency, measured_scene, run_engine
+from rigdata.model import computed_efficiency, measured_scene
 from rigdata.record import ChannelSource, RigDataError, RigRecord
-from rigdata.report import validate, write_report
+from rigdata.report import write_report
 from rigdata.transducer import Transducer
+from rigdata.validation import Validation, validate
 
 BETA = math.radians(15.0)
 #: a 24-bit card and no class or drift errors: what is left is the pipeline itself
@@ -127,8 +133,8 @@ def test_model_driven_by_measurement_recovers_true_efficiency(truth, engine, tol
     efficiency: reference within 2e-5 (measured 4e-7), Exudyn within 3e-5 (measured 3e-6)."""
     rec, _ = perfect(truth)
     c = condition(rec, BETA)
-    comp = computed_efficiency(run_engine(engine, measured_scene(c, named_scene("rig-calibrated"))))
-    assert comp["status"] == "ok"
+    comp = computed_efficiency(run(measured_scene(c, named_scene("rig-calibrated")), engine))
+    assert comp["status"] == Status.OK
     assert comp["mean_efficiency"] == pytest.approx(truth.efficiency, abs=tol)
 
 
@@ -139,6 +145,8 @@ def test_validate_report_and_atomic_replacement(truth, tmp_path, monkeypatch):
 
     rec, _ = synthetic.record(synthetic.RigSettings(), truth=truth)
     v = validate(rec, named_scene("rig-calibrated"), engines=("reference",), monte_carlo=200)
+    assert isinstance(v, Validation) and v.success
+    assert not list(tmp_path.iterdir())  # validate writes nothing
     out = tmp_path / "rep"
     s = write_report(v, out)
     assert sorted(p.name for p in out.iterdir()) == ["figure10.png", "report.md", "signals.csv",
@@ -186,3 +194,31 @@ def test_still_shaft_is_refused():
     t = np.linspace(0, 3.0, 3001)
     with pytest.raises(RigDataError, match="does not turn"):
         condition(_record(t, np.zeros_like(t)), BETA)
+
+
+def test_public_api_measure_a_file(truth, tmp_path):
+    """``rigdata.read`` and ``rigdata.measure`` on a written synthetic file: the record's
+    provenance says synthetic, and the measured efficiency is the one of the record measured
+    directly (same conditioning, same draws)."""
+    path = tmp_path / "rig.csv"
+    used = rigdata.synthetic.write(path, "csv", rigdata.RigSettings(), truth=truth)
+    rec = rigdata.read(path)
+    assert rec.provenance["synthetic"]["synthetic"] == "true"
+    m = rigdata.measure(path, 15.0, monte_carlo=100)
+    direct = measured_efficiency(condition(rec, BETA), monte_carlo=100)
+    assert m.efficiency == direct.efficiency and m.u == direct.u
+    assert m.as_dict()["synthetic"] is True
+    lo, hi = m.measured.monte_carlo["interval_95"]
+    assert lo <= used["true_efficiency"] <= hi
+    with pytest.raises(ValueError, match="apply to a file"):
+        rigdata.measure(rec, format="csv")
+
+
+def test_import_rigdata_is_light():
+    """``import rigdata`` loads none of its modules (scipy, pandas, the engines) until a name
+    is used; then the name is the module's own."""
+    code = ("import sys, rigdata; heavy = [m for m in ('scipy', 'pandas', 'rigdata.readers') "
+            "if m in sys.modules]; print(heavy); print(rigdata.read.__module__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split("\n")[:2] == ["[]", "rigdata.readers"]
+    assert set(rigdata.__all__) <= set(dir(rigdata))

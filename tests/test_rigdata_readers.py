@@ -46,10 +46,6 @@ def check_record(rec, table, spaces: bool = True) -> None:
     assert len(rec.provenance["sha256"]) == 64
 
 
-# ---------------------------------------------------------------------------------------------
-# round trips
-
-
 @pytest.mark.parametrize("kwargs", [
     {}, {"sep": ";", "decimal": ","}, {"sep": "\t"}, {"sep": "\t", "decimal": ",", "units_row": True},
     {"sep": ",", "units_row": True}, {"sep": " ", "units_row": True},
@@ -137,10 +133,6 @@ def test_writers_are_atomic(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         files.write_csv(target, table, unit, META)
     assert target.read_text() == "old" and list(tmp_path.iterdir()) == [target]
-
-
-# ---------------------------------------------------------------------------------------------
-# headers, preambles, recognition, mapping
 
 
 def test_units_in_headers_and_preamble(tmp_path):
@@ -245,10 +237,6 @@ def test_unused_text_column_and_quotes(tmp_path):
     assert read_table(path).text_cells["Note"].count == 5
 
 
-# ---------------------------------------------------------------------------------------------
-# units
-
-
 def test_unit_table_is_consistent():
     """Every spelling leads back to its own entry (no two entries share a spelling); Nm is torque."""
     for symbol, (quantity, factor, others) in units._TABLE.items():
@@ -294,9 +282,6 @@ def test_split_header(header, name, unit):
     """Unit annotations in brackets, parentheses, braces or after a slash."""
     assert units.split_header(header) == (name, unit)
 
-
-# ---------------------------------------------------------------------------------------------
-# bad input: one RigDataError naming the file and the channel or problem
 
 GOOD = ("# rig: test bench\n"
         "time [s],Torque In [N m],Torque Out [N m],Speed In [rpm],Speed Out [rpm]\n"
@@ -397,6 +382,14 @@ BAD = [
      LVM + lvm_segment(0.0, 0.001, [r.replace("\t600\t600", "\t600\tx12") if i == 2 else r
                                     for i, r in enumerate(lvm_rows(0.0, 0.001, 5))]), {},
      r"channel 'speed_out': non-numeric cell 'x12' at row 2 \(line 23\) in column 'Speed Out'"),
+    ("lvm-quoted-cell", "quote.lvm",
+     LVM + lvm_segment(0.0, 0.001, [r + '"' if i == 2 else r for i, r in enumerate(lvm_rows(0.0, 0.001, 5))]),
+     {}, r"channel 'speed_out': non-numeric cell '600\"' at row 2 \(line 23\) in column 'Speed Out'"),
+    ("lvm-no-channels", "blank.lvm", LVM + lvm_segment(0.0, 0.001).replace(  # a blank line in the header
+        "\t\nChannels", "X_Dimension\tTime\tTime\tTime\tTime\t\nChannels", 1).replace(
+        "Y_Unit_Label\tN m\tN m\trpm\trpm\t\nX_Dimension\tTime\tTime\tTime\tTime\t\n",
+        "Y_Unit_Label\tN m\tN m\trpm\trpm\t\n\t\n"), {},
+     "segment 1 has no channels besides X_Value: its header is incomplete"),
     ("lvm-truncated", "cut.lvm", LVM + lvm_segment(0.0, 0.001)[:-9], {},
      r"truncated: the last line \(25\) has 3 of 5 fields and no line end"),
     ("lvm-samples", "short.lvm", LVM + lvm_segment(0.0, 0.001, samples=1000), {},

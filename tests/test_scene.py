@@ -3,20 +3,18 @@
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import pytest
+import tomli_w
 
-from reference.paper import assumption_register, named_scene, paper_cases, stated_values
-from reference.scene import (
-    Body,
-    Geometry,
-    SceneError,
-    SpeedDrive,
-    load_scene,
-    replace,
-    scene_from_dict,
-    scene_to_dict,
-)
+import reference
+from reference.joint import Body, Geometry
+from reference.paper import assumption_register, named_scene, paper_cases, stated_values, table1_body
+from reference.scene import SpeedDrive, replace, scene_from_dict, scene_to_dict
+from reference.scene_files import load_scene
+from reference.validation import SceneError
 
 DIAG = [[1e-3, 0, 0], [0, 1e-3, 0], [0, 0, 1e-3]]
 
@@ -88,8 +86,6 @@ def test_missing_scene_file(tmp_path):
 
 def test_toml_round_trip(tmp_path):
     """A resolved scene dumped to TOML loads back to an equal scene."""
-    import tomli_w
-
     scene = named_scene("paper-25deg-1000rpm-frictionless")
     path = tmp_path / "s.toml"
     path.write_text(tomli_w.dumps(scene_to_dict(scene)))
@@ -127,8 +123,6 @@ def test_paper_data_has_provenance():
 
 def test_table1_reading_is_consistent():
     """Under the 'origin' reading both shafts have the same centroidal inertia (Table 1 check)."""
-    from reference.paper import table1_body
-
     j_in = sorted(table1_body("input").canonical()[2].diagonal())
     j_out = sorted(table1_body("output").canonical()[2].diagonal())
     # Table 1 gives 3-4 significant digits; measured agreement 0.39 % (axial), 0.1 % (others)
@@ -139,3 +133,16 @@ def test_dict_rejects_non_table():
     """A section that is not a table is named."""
     with pytest.raises(SceneError, match=r"\[joint\] must be a table"):
         scene_from_dict({"joint": 3, "drive": {"kind": "speed", "speed": 1.0}})
+
+
+def test_public_face_is_lazy():
+    """``import reference`` imports none of its modules (every ``import reference.x`` runs it);
+    each public name resolves to its home module's object on first use."""
+    code = "import sys, reference; print(sorted(m for m in sys.modules if m.startswith('reference')))"
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert loaded.stdout.strip() == "['reference']"
+    assert reference.Scene is reference.scene.Scene and reference.load_scene is load_scene
+    assert reference.run is reference.engine.run and reference.SceneError is SceneError
+    assert set(reference.__all__) <= set(dir(reference))
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        reference.nope  # noqa: B018

@@ -10,8 +10,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn.studies import stress
-from cardan_exudyn.studies.stress import Panel, base_scene, classify, efficiency_promise, measure_cell
+from cardan_exudyn import ExudynOptions
+from cardan_exudyn.cli import main
+from cardan_exudyn.engines import run
+from cardan_exudyn.model.stepsize import error_coefficient
+from cardan_exudyn.studies import stress_map
+from cardan_exudyn.studies.stress_map import Panel, base_scene, classify, efficiency_promise, measure_cell
+from reference.kinematics import speed_ratio
 from reference.scene import replace
 
 
@@ -27,11 +32,11 @@ def record(**changes):
 
 def test_promise_is_the_step_halving_estimate_with_a_floor():
     r = record(exu_efficiency=0.61, exu_efficiency_half=0.60)
-    assert efficiency_promise(r) == pytest.approx(3.0 * 4.0 / 3.0 * 0.01 + stress.EFFICIENCY_FLOOR)
+    assert efficiency_promise(r) == pytest.approx(3.0 * 4.0 / 3.0 * 0.01 + stress_map.EFFICIENCY_FLOOR)
     assert math.isnan(efficiency_promise(record(half_status="self_locking")))
     # the lagged coupling is first order: error(h) = 2 |eta_h - eta_h/2|
     lagged = record(exu_efficiency=0.61, exu_efficiency_half=0.60, coupling="lagged")
-    assert efficiency_promise(lagged) == pytest.approx(3.0 * 2.0 * 0.01 + stress.EFFICIENCY_FLOOR)
+    assert efficiency_promise(lagged) == pytest.approx(3.0 * 2.0 * 0.01 + stress_map.EFFICIENCY_FLOOR)
 
 
 @pytest.mark.parametrize("changes, cls, agrees, category", [
@@ -95,20 +100,16 @@ def test_cells_either_side_of_the_self_locking_boundary():
 def test_auto_step_meets_the_accuracy_with_every_node_type(node_type, angle):
     """The map found Euler parameters 18x over the requested speed-ratio accuracy at 0 deg with
     the Rxyz step model (K = 0 there); the node-type model now picks the step for each."""
-    from cardan_exudyn.model.solve import ExudynOptions, run
-    from cardan_exudyn.model.stepsize import error_coefficient
-    from reference.kinematics import speed_ratio
-
     accuracy = 2e-5
     scene = replace(base_scene(), **{"joint.geometry.shaft_angle": math.radians(angle),
                                      "numerics.accuracy": accuracy})
     scene = replace(scene, **{f"joint.pairs.{p}.friction_coefficient": 0.0
                               for p in ("frame_input", "input_spider", "spider_output", "output_frame")})
-    result = run(scene, ExudynOptions(node_type=node_type))
+    result = run(scene, options=ExudynOptions(node_type=node_type))
     t = result.table
     err = np.max(np.abs(t["omega_out"] / t["omega_in"]
                         - speed_ratio(t["theta_in"].to_numpy(), scene.joint.geometry.shaft_angle)))
-    assert err <= accuracy, (err, result.summary["dt_choice"])
+    assert err <= accuracy, (err, result.summary.dt_choice)
     if error_coefficient(scene.joint.geometry.shaft_angle, node_type) > 0:
         assert err > accuracy / 10  # the step is not wastefully small either
 
@@ -116,14 +117,12 @@ def test_auto_step_meets_the_accuracy_with_every_node_type(node_type, angle):
 def test_quick_command_writes_the_report_atomically(tmp_path, capsys):
     """`cardan stress --quick --only map`: report, cells, plot; the sweep records are kept in
     OUT/runs, and a second invocation reuses every cell."""
-    from cardan_exudyn.cli import main
-
     out = tmp_path / "stress"
     code = main(["stress", "--quick", "--only", "map", "--out", str(out), "--workers", "2"])
     assert code == 0, capsys.readouterr().err
     cells = pd.read_csv(out / "map_cells.csv")
-    assert len(cells) == sum(len(p.angles) * len(p.x_values) for p in stress.panels(quick=True))
-    assert set(cells["cell_class"]) <= set(stress.CLASSES)
+    assert len(cells) == sum(len(p.angles) * len(p.x_values) for p in stress_map.panels(quick=True))
+    assert set(cells["cell_class"]) <= set(stress_map.CLASSES)
     assert "error" not in set(cells["cell_class"])
     # the quick map holds both boundary verdicts and the lagged scheme's run-on cell
     assert {"agree: ok", "agree: self-locking", "runs on through a physical self-lock"} <= set(
@@ -134,6 +133,7 @@ def test_quick_command_writes_the_report_atomically(tmp_path, capsys):
     summary = json.loads((out / "stress.json").read_text())
     assert summary["map"]["cells"] == len(cells)
     assert not list(tmp_path.glob(".*"))  # no temporary folder left next to OUT
+    assert f"report: {out}/report.md" in capsys.readouterr().out
     code = main(["stress", "--quick", "--only", "map", "--out", str(out), "--json"])
     assert code == 0
     again = json.loads(capsys.readouterr().out)
@@ -143,11 +143,10 @@ def test_quick_command_writes_the_report_atomically(tmp_path, capsys):
 @pytest.mark.parametrize("argv, word", [
     (["--only", "map,nothing"], "--only"),
     (["--only", ""], "--only"),
+    (["--only", "map,inputs"], "pytest tests/test_hardening.py"),
     (["--workers", "0"], "--workers"),
 ])
 def test_bad_stress_options_exit_2(tmp_path, capsys, argv, word):
-    from cardan_exudyn.cli import main
-
     code = main(["stress", "--out", str(tmp_path / "o"), *argv]) if argv[0] != "--workers" else None
     if code is None:
         with pytest.raises(SystemExit) as exc:
@@ -156,3 +155,14 @@ def test_bad_stress_options_exit_2(tmp_path, capsys, argv, word):
     err = capsys.readouterr().err
     assert code == 2 and word in err and "Traceback" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_help_names_where_the_verdicts_are(capsys):
+    """`cardan stress --help` says what it runs and where the bad-input table and the long-run
+    verdicts went (the tests)."""
+    with pytest.raises(SystemExit) as exc:
+        main(["stress", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert exc.value.code == 0
+    assert "pytest tests/test_hardening.py" in out and "pytest tests/test_longrun.py" in out
+    assert "subset of map, long" in out

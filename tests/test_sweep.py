@@ -16,11 +16,12 @@ import pandas as pd
 import pytest
 
 from cardan_exudyn.cli import main
-from cardan_exudyn.sweep.runner import (
+from cardan_exudyn.sweep import (
     Distribution,
     RandomSpec,
     SweepError,
     SweepSpec,
+    expand_cases,
     load_spec,
     make_plan,
     read_records,
@@ -28,7 +29,7 @@ from cardan_exudyn.sweep.runner import (
     spec_from_mapping,
     summary_outputs,
 )
-from reference.scene import SceneError
+from reference.validation import SceneError
 
 TESTS = Path(__file__).parent
 # the reference engine at one revolution without a time table: ~0.05 s per case
@@ -47,6 +48,11 @@ def cheap_case(scene, engine):
     if torque == 7:
         return {"status": "self_locking", "reason": "test", "torque": torque}
     return {"torque": torque, "square": torque**2, "engine": engine}
+
+
+def scaled_case(scene, engine, factor=1.0, label="none"):
+    """A case function with keyword arguments (the spec's `function_args`)."""
+    return {"scaled": scene.load.torque * factor, "label": label, "pid": os.getpid()}
 
 
 def dying_case(scene, engine):
@@ -93,7 +99,7 @@ def test_grid_is_the_cartesian_product_last_path_fastest():
     spec = spec_from_mapping({**BASE, "grid": {"joint.geometry.shaft_angle_deg": [0, 10],
                                                "drive.speed_rpm": {"linspace": [500, 2000, 3]},
                                                "engine": ["reference", "exudyn"]}})
-    cases = spec.expand()
+    cases = expand_cases(spec)
     assert len(cases) == 12
     assert [c.id for c in cases[:2]] == ["0000", "0001"]
     assert [c.engine for c in cases[:4]] == ["reference", "exudyn", "reference", "exudyn"]
@@ -104,10 +110,10 @@ def test_grid_is_the_cartesian_product_last_path_fastest():
 def test_unquoted_dotted_keys_and_explicit_cases():
     """TOML's unquoted dotted keys mean the dotted path; explicit cases keep their ids and engines."""
     nested = spec_from_mapping({**BASE, "grid": {"joint": {"geometry": {"shaft_angle_deg": [1, 2]}}}})
-    assert nested.expand()[1].overrides == {"joint.geometry.shaft_angle_deg": 2}
+    assert expand_cases(nested)[1].overrides == {"joint.geometry.shaft_angle_deg": 2}
     spec = spec_from_mapping({**BASE, "cases": [{"id": "a", "load.torque": 1.0},
                                                 {"engine": "exudyn", "load.torque": 2.0}]})
-    assert [(c.id, c.engine, c.overrides) for c in spec.expand()] == [
+    assert [(c.id, c.engine, c.overrides) for c in expand_cases(spec)] == [
         ("a", "reference", {"load.torque": 1.0}), ("0001", "exudyn", {"load.torque": 2.0})]
 
 
@@ -149,7 +155,7 @@ def test_grid_times_random_gives_every_sample_at_every_grid_point():
     spec = spec_from_mapping({**BASE, "grid": {"joint.geometry.shaft_angle_deg": [5, 15]},
                               "random": {"samples": 3, "seed": 1, "parameters": {
                                   "load.torque": {"dist": "uniform", "low": 1, "high": 3}}}})
-    cases = spec.expand()
+    cases = expand_cases(spec)
     assert len(cases) == 6
     first = [c.overrides["load.torque"] for c in cases[:3]]
     assert first == [c.overrides["load.torque"] for c in cases[3:]]
@@ -191,6 +197,12 @@ BAD_SPECS = [
     ({**BASE, "random": {"samples": 4, "seed": 0, "parameters": {
         "joint.pairs.input_spider.friction_coefficient": {"dist": "normal", "mean": 0.05, "std": 0.02}}}},
      SceneError, "1e-09 quantile .*truncate"),
+    ({**BASE, "grid": {"load.torque": [1]}, "function_args": [1]}, SweepError,
+     "`function_args` must be a table"),
+    ({**BASE, "grid": {"load.torque": [1]}, "function_args": {"engine": "reference"}}, SweepError,
+     "cannot set `engine`"),
+    ({**BASE, "grid": {"load.torque": [1]}, "function_args": {"x": object()}}, SweepError,
+     "must hold JSON values"),
 ]
 
 
@@ -206,7 +218,7 @@ def test_bad_specs_are_refused_up_front(data, error, match):
 def test_reference_sweep_records_the_summary_and_writes_the_table(tmp_path):
     """Each record carries the engine's scalar summary (equal to a direct run); the table has the
     parameters as columns and sweep.json the statistics over the cases."""
-    from cardan_exudyn.engines import run_scene
+    from cardan_exudyn import engines
     from reference.paper import named_scene
     from reference.scene import replace
 
@@ -217,10 +229,10 @@ def test_reference_sweep_records_the_summary_and_writes_the_table(tmp_path):
     assert list(t.columns[:4]) == ["id", "engine", "joint.geometry.shaft_angle_deg", "status"]
     assert t["joint.geometry.shaft_angle_deg"].tolist() == angles
     assert "scene" not in t and "quadrature.evaluations" in t
-    direct = run_scene(replace(named_scene("paper-10deg"), revolutions=1,
-                               **{"record.timeseries": False, "joint.geometry.shaft_angle_deg": 20}),
-                       "reference").summary
-    assert t["mean_efficiency"].iloc[2] == direct["mean_efficiency"]
+    direct = engines.run(replace(named_scene("paper-10deg"), revolutions=1,
+                                 **{"record.timeseries": False, "joint.geometry.shaft_angle_deg": 20}),
+                         "reference").summary
+    assert t["mean_efficiency"].iloc[2] == direct.mean_efficiency
     stats = json.loads((tmp_path / "sweep.json").read_text())["statistics"]["mean_efficiency"]
     eta = t["mean_efficiency"].to_numpy()
     assert stats["n"] == 3 and stats["mean"] == pytest.approx(eta.mean(), rel=1e-15)
@@ -358,6 +370,33 @@ def test_a_different_spec_is_refused_on_resume(tmp_path):
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     summary = run_sweep(torque_spec([1, 2, 4]), tmp_path, workers=1, restart=True)
     assert summary["run_now"] == 3 and table(tmp_path)["square"].tolist() == [1, 4, 16]
+
+
+def test_function_args_reach_the_case_function_in_worker_processes(tmp_path):
+    """`function_args` are keyword arguments of the case function, in spawned worker processes
+    too; they are part of the plan (another value is refused on resume, the same resumes) and of
+    sweep.json's spec."""
+    spec = torque_spec([1, 2, 3], function="test_sweep:scaled_case",
+                       function_args={"factor": 10, "label": "ten"})
+    summary = run_sweep(spec, tmp_path, workers=2)
+    t = table(tmp_path)
+    assert t["scaled"].tolist() == [10, 20, 30] and set(t["label"]) == {"ten"}
+    assert os.getpid() not in set(t["pid"])
+    assert summary["spec"]["function_args"] == {"factor": 10, "label": "ten"}
+    assert json.loads((tmp_path / "plan.json").read_text())["function_args"] == {"factor": 10, "label": "ten"}
+    with pytest.raises(SweepError, match="holds a different sweep \\(case function arguments"):
+        run_sweep({**spec, "function_args": {"factor": 2}}, tmp_path, workers=1)
+    assert run_sweep(spec, tmp_path, workers=1)["run_now"] == 0
+
+
+def test_the_default_function_by_either_name_is_one_plan(tmp_path):
+    """The default case function named by the public face (the default) or passed as the
+    function object (named by its module) is the same plan: the sweep resumes."""
+    spec = {**BASE, "grid": {"joint.geometry.shaft_angle_deg": [0, 10]}}
+    first = run_sweep(spec, tmp_path, workers=1)
+    assert first["spec"]["function"] == "cardan_exudyn.sweep:summary_outputs"
+    again = run_sweep({**spec, "function": summary_outputs}, tmp_path, workers=1)
+    assert again["run_now"] == 0 and again["ok"] == 2
 
 
 def test_progress_shows_cases_failures_and_eta(tmp_path, capsys):

@@ -37,9 +37,11 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
+from cardan_exudyn.model.coupling import FrictionCoupling
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES, RotationCoordinates
 from reference import rccc
-from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES, AngleDrive, Scene, SpeedDrive
+from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.scene import AngleDrive, Scene, SpeedDrive
 
 CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
 
@@ -182,7 +184,24 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
     mbs = sc.AddSystem()
     model = ExudynModel(scene=scene, system_container=sc, mbs=mbs, node_type=node_type)
     ground = mbs.AddObject(eii.ObjectGround())
+    _add_bodies(model)
+    _add_pairs(model, ground)
+    _add_drive(model, ground)
+    _add_loads(model)
+    if scene.has_friction and scene.friction.coupling != "uncoupled":
+        model.friction = FrictionCoupling(model)
+    if sensors:
+        add_sensors(model, reactions=reactions)
+    mbs.Assemble()
+    if model.friction is not None:
+        model.friction.prepare()
+    _wrap_rotation_vectors(model)
+    return model
 
+
+def _add_bodies(model: ExudynModel) -> None:
+    """A node and a rigid body per moving body, in the assembled initial state."""
+    scene, mbs = model.scene, model.mbs
     theta0, omega0, t0 = _initial_drive_state(scene)
     model.start_time = t0
     state = assembled_state(scene, theta0, omega0)
@@ -196,7 +215,7 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
         model.com_reference[name] = reference_state[name]["origin"] + com
         model.mass[name] = mass
         model.inertia[name] = inertia
-        rot = ROTATION_COORDINATES["Rxyz" if name == "input" else node_type]
+        rot = ROTATION_COORDINATES["Rxyz" if name == "input" else model.node_type]
         model.rotations[name] = rot
         a0 = state[name]["A"]
         p0 = rot.from_matrix(a0)
@@ -217,6 +236,11 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
             nodeNumber=node,
         ))
 
+
+def _add_pairs(model: ExudynModel, ground: int) -> None:
+    """A marker on each body of each pair and the pair's generic joint (R or C)."""
+    mbs = model.mbs
+
     def marker(owner: str, position: np.ndarray, frame: np.ndarray):
         # node axes equal the global axes at reference, so the pair frame is the marker rotation
         body = ground if owner == "ground" else model.bodies[owner]
@@ -224,7 +248,7 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
         ht = exu.HT(rotation=frame, translation=local)
         return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localHT=ht)), local
 
-    for name, (origin, frame) in pair_geometry(scene).items():
+    for name, (origin, frame) in pair_geometry(model.scene).items():
         body_a, body_b = PAIR_BODIES[name]
         m_a, l_a = marker(body_a, origin, frame)
         m_b, l_b = marker(body_b, origin, frame)
@@ -235,20 +259,6 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
             markerNumbers=[m_a, m_b],
             constrainedAxes=CONSTRAINED_AXES[PAIR_KIND[name]],
         ))
-
-    _add_drive(model, ground)
-    _add_loads(model)
-    if scene.has_friction and scene.friction.coupling != "uncoupled":
-        from cardan_exudyn.model.coupling import FrictionCoupling
-
-        model.friction = FrictionCoupling(model)
-    if sensors:
-        add_sensors(model, reactions=reactions)
-    mbs.Assemble()
-    if model.friction is not None:
-        model.friction.prepare()
-    _wrap_rotation_vectors(model)
-    return model
 
 
 def _wrap_rotation_vectors(model: ExudynModel) -> None:

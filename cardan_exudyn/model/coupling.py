@@ -53,7 +53,8 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
+from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.schema import Status
 
 # geometric growth of the friction (lagged scheme) taken as self-locking
@@ -75,20 +76,11 @@ REST_FLOOR = 1e-6
 _GROUND = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
 
 
-def _sign(speed: float, band: float) -> float:
-    """Regularised sign: linear ramp of width ``band``, exact sign for band 0."""
-    if band <= 0.0:
-        return float(speed > 0.0) - float(speed < 0.0)
-    return max(-1.0, min(1.0, speed / band))
-
-
 @dataclass
 class _PairData:
     name: str
     kind: str
-    f: float
-    d: float
-    lever: float
+    law: PairLaw
     joint: int                          # the pair's ObjectJointGeneric
     bodies: tuple[str, str]
     local: tuple[np.ndarray, np.ndarray]  # pair point in each body's node frame
@@ -121,10 +113,11 @@ class FrictionCoupling:
             if pair.friction_coefficient <= 0.0:
                 continue
             frame = model.pair_frames[name]
-            p = _PairData(name=name, kind=PAIR_KIND[name], f=pair.friction_coefficient,
-                          d=pair.journal_diameter, lever=pair.moment_lever,
-                          joint=model.joints[name], bodies=PAIR_BODIES[name],
-                          local=model.marker_local[name], axis_local=frame[:, 2].copy())
+            law = PairLaw(PAIR_KIND[name] == "cylindrical", pair.friction_coefficient,
+                          pair.journal_diameter, pair.moment_lever)
+            p = _PairData(name=name, kind=PAIR_KIND[name], law=law, joint=model.joints[name],
+                          bodies=PAIR_BODIES[name], local=model.marker_local[name],
+                          axis_local=frame[:, 2].copy())
             for role, body, local in zip((-1, 1), p.bodies, p.local, strict=True):
                 if body == "ground":
                     continue
@@ -155,15 +148,15 @@ class FrictionCoupling:
         for k, p in enumerate(self.pairs):
             mask[k, 0] = True
             mask[k, 1] = p.kind == "cylindrical"
-            self._weight[k, 1] = 0.5 * p.d
+            self._weight[k, 1] = 0.5 * p.law.d
         self._mask = mask.ravel()
         self.unconverged_steps = 0
         self.status, self.reason = Status.OK, ""
+        self.error: Exception | None = None  # raised inside the user function (see post_newton)
         self.scale_floor = 0.0  # set by evaluate (REST_FLOOR)
         self._growth_steps, self._growth_start = 0, 0.0
         self._ode2 = {}
 
-    # ------------------------------------------------------------------ set-up after Assemble
     def prepare(self) -> None:
         """Look up coordinate indices (after ``mbs.Assemble``) and register the user functions."""
         for name, node in self.model.nodes.items():
@@ -185,7 +178,6 @@ class FrictionCoupling:
         d.ignoreMaxIterations = True
         d.useRecommendedStepSize = False
 
-    # ------------------------------------------------------------------ the law
     def _body_states(self) -> dict[str, tuple]:
         sd = self.mbs.systemData
         q = sd.GetODE2Coordinates(exu.ConfigurationType.Current)
@@ -230,10 +222,8 @@ class FrictionCoupling:
         c2 = hist[-2][1]
         delta2 = c1 - c2
         delta2[:, 0] = (delta2[:, 0] + math.pi) % (2.0 * math.pi) - math.pi
-        h2 = hist[-1][0] - hist[-2][0]
-        # second-order backward difference on a possibly non-uniform grid
-        w = h1 / h2
-        return ((1.0 + 2.0 * w) / (1.0 + w) * delta - w * w / (1.0 + w) * delta2) / h1
+        w1, w2 = bdf2_weights(h1, hist[-1][0] - hist[-2][0])
+        return (w1 * delta - w2 * delta2) / h1
 
     def _velocity_level_speeds(self, states: dict[str, tuple]) -> np.ndarray:
         """Relative speeds from the body velocities (used at the initial, consistent state)."""
@@ -300,15 +290,11 @@ class FrictionCoupling:
         for k, p in enumerate(self.pairs):
             lx, ly, _ = get(p.joint, force_local)
             tx, ty, _ = get(p.joint, torque_local)
-            force_n, moment_n = math.hypot(lx, ly), math.hypot(tx, ty)
             omega_rel, slide = speeds[k]
-            torque = p.f * p.d * moment_n / p.lever + 0.5 * p.f * p.d * force_n
-            friction[k, 0] = -_sign(0.5 * p.d * omega_rel, self.band) * torque
-            sliding = max(sliding, torque)
-            if p.kind == "cylindrical":
-                axial = p.f * (force_n + 2.0 * moment_n / p.lever)
-                friction[k, 1] = -_sign(slide, self.band) * axial
-                sliding = max(sliding, 0.5 * p.d * axial)
+            # TorqueLocal's in-plane components are rotated by 90 deg; only the magnitude enters
+            loads = pair_loads(p.law, lx, ly, tx, ty, float(omega_rel), float(slide), self.band)
+            friction[k] = loads.torque, loads.force
+            sliding = max(sliding, loads.sliding_scale)
         self.scale_floor = REST_FLOOR * sliding
         return friction, coords
 
@@ -326,8 +312,22 @@ class FrictionCoupling:
             set_load(load, "loadVector", [value * x, value * y, value * z])
         self.applied = friction.copy()
 
-    # ------------------------------------------------------------------ user functions
     def post_newton(self, mbs: Any, t: float) -> list[float]:
+        """Exudyn's post-Newton user function: update the friction, return the change as the
+        discontinuous iteration's error (see the module doc).
+
+        Exudyn reports any Python exception raised here as a solver failure; the exception is
+        kept in :attr:`error` instead (the pre-step function then stops the run) so that
+        :func:`cardan_exudyn.model.solve.solve` re-raises it: a bug is not a physical outcome.
+        """
+        try:
+            return self._update(t)
+        except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it
+            self.error = exc
+            self.status, self.reason = Status.INTEGRATION_FAILURE, f"friction update raised {exc!r}"
+            return [0.0, -1.0]
+
+    def _update(self, t: float) -> list[float]:
         if t != self._step_t and self._step_t is not None:  # the previous step was accepted
             self._history = [self._history[-1], (self._step_t, self._coords)]
         friction, self._coords = self.evaluate(t)
@@ -459,7 +459,6 @@ class FrictionCoupling:
         else:
             self._growth_steps = 0
 
-    # ------------------------------------------------------------------ results
     def summary(self) -> dict[str, Any]:
         iterations = np.asarray(self.log.iterations, dtype=float)
         return {

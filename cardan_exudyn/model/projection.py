@@ -38,7 +38,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from reference.scene import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 
 BODIES = ("input", "spider", "output")
 

@@ -87,7 +87,6 @@ def rxyz_frame_one(psi, psi_t) -> tuple[np.ndarray, np.ndarray]:
     return a, omega
 
 
-# ---------------------------------------------------------------------- Euler parameters (EP)
 # Exudyn's NodeRigidBodyEP: p = (e0, e1, e2, e3), e0 the scalar part, |p| = 1 kept by an algebraic
 # constraint; A(p) and omega = G(p) p_t (global) in the unnormalised form Exudyn evaluates
 # (RigidBodyMath::EP2RotationMatrix, EP2G), so that the post-processing sees what the solver saw.
@@ -159,7 +158,6 @@ def ep_rates(p: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return 0.25 * g.T @ np.asarray(omega, dtype=float)
 
 
-# ---------------------------------------------------------------------- rotation vector (RotVecLG)
 # Exudyn's NodeRigidBodyRotVecLG: p = nu, A = exp(skew(nu)) (Rodrigues, as in
 # RigidBodyMath::RotationVector2RotationMatrix; Exudyn's Lie-group update keeps |nu| <= 2 pi), and
 # the velocity coordinates are the *local* angular velocity: omega = A p_t.
@@ -225,7 +223,6 @@ def rotvec_rates(p: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return a.T @ np.asarray(omega, dtype=float)
 
 
-# ---------------------------------------------------------------------- per node type
 
 
 @dataclass(frozen=True)

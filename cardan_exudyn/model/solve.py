@@ -1,15 +1,5 @@
-"""Run a scene with Exudyn and return the common result schema.
-
-Reaction conventions (pinned by ``tests/test_reactions.py``)
-------------------------------------------------------------
-Exudyn 1.13.6 reports for ``ObjectJointGeneric`` in dynamic runs ``ForceLocal`` = minus the force
-that body ``a`` (marker 0) exerts on body ``b``, in the joint frame fixed to body ``a``; and
-``TorqueLocal`` with its in-plane components rotated by 90 degrees, the same sign flip, and
-its components in the joint frame attached to body ``b`` (marker 1): the moment of body ``a`` on
-body ``b`` in the pair frame of body ``b`` is ``(-TL_y, TL_x, -TL_z)``; it is rotated into the
-pair frame of body ``a`` with the pair's relative rotation (they differ by the free rotation about
-the pair axis, e.g. the whole shaft angle for ``frame_input``).
-The drive torque on the input shaft is minus the ``Force`` of the coordinate connector.
+"""Run a scene with Exudyn: the one solve sequence (step choice, solver settings, friction set-up,
+stop function) and the run that turns it into the common result (:class:`reference.schema.Result`).
 """
 
 from __future__ import annotations
@@ -24,97 +14,23 @@ import exudyn as exu
 import numpy as np
 
 from cardan_exudyn.model.build import ExudynModel, build_model
-from cardan_exudyn.model.projection import project_velocities
+from cardan_exudyn.model.options import ExudynOptions
+from cardan_exudyn.model.postprocess import constraint_violation, first_non_finite, postprocess
 from cardan_exudyn.model.stepsize import choose_step
-from reference.friction import friction_from_columns
-from reference.rccc import LoopClosureError
-from reference.scene import (
-    PAIR_BODIES,
-    PAIR_KIND,
-    PAIR_NAMES,
-    AngleDrive,
-    Scene,
-    check_steps,
-    scene_to_dict,
-)
+from reference.joint import PAIR_NAMES
+from reference.loop_closure import LoopClosureError
+from reference.scene import AngleDrive, Scene, scene_to_dict
 from reference.schema import (
     REACTION_SUFFIXES,
-    OptionsError,
     Result,
     Status,
     Summary,
-    instantaneous_efficiency,
     mean_values,
     table_columns,
 )
+from reference.validation import check_steps
 
 ENGINE_NAME = "exudyn"
-
-
-NODE_TYPES = ("Rxyz", "EP", "RotVecLG")
-SENSOR_SCOPES = ("auto", "all")
-
-
-@dataclass(frozen=True)
-class ExudynOptions:
-    """Solver settings of the Exudyn engine.
-
-    Attributes
-    ----------
-    spectral_radius : float
-        Generalized-alpha spectral radius at infinity, in [0, 1); lower damps more.
-    modified_newton : bool
-        Use modified Newton (Jacobian reused) instead of full Newton.
-    jacobian_every_step : bool
-        With modified Newton: compute the Jacobian once at the start of every step (Exudyn's
-        ``modifiedNewtonJacUpdatePerStep``) instead of only when the iteration stalls.
-    newton_relative_tolerance, newton_absolute_tolerance : float
-        Tolerances of the Newton iteration (relative to the initial residual, and absolute).
-    node_type : str
-        Rigid-body node of the bodies: ``"Rxyz"`` (Tait-Bryan angles), ``"EP"`` (Euler
-        parameters) or ``"RotVecLG"`` (rotation vector, Lie-group integration); see
-        :func:`cardan_exudyn.model.build.build_model` for which body gets which.
-    sensors : str
-        ``"auto"``: record the pair reactions only when the scene asks for the time table (a
-        summary-only run does not need them); ``"all"``: always.
-    velocity_projection : bool
-        Report velocities projected onto the velocity constraints at the computed positions
-        (post-processing, :mod:`cardan_exudyn.model.projection`): exact speed ratio for a prescribed
-        input; the drive torque, reactions and friction keep the integrator's error.
-    """
-
-    spectral_radius: float = 0.6
-    modified_newton: bool = False
-    jacobian_every_step: bool = False
-    newton_relative_tolerance: float = 1e-10
-    newton_absolute_tolerance: float = 1e-10
-    node_type: str = "Rxyz"
-    sensors: str = "auto"
-    velocity_projection: bool = False
-
-    def __post_init__(self) -> None:
-        if not 0.0 <= self.spectral_radius < 1.0:
-            raise OptionsError(f"`spectral_radius` must be in [0, 1), got {self.spectral_radius!r}")
-        for name in ("newton_relative_tolerance", "newton_absolute_tolerance"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and 0.0 < value < 1.0):
-                raise OptionsError(f"`{name}` must be in (0, 1), got {value!r}")
-        if self.node_type not in NODE_TYPES:
-            raise OptionsError(f"`node_type` must be one of {list(NODE_TYPES)}, got {self.node_type!r}")
-        if self.node_type == "RotVecLG" and self.spectral_radius > 0.8:
-            # measured: at 0.9 friction runs end "ok" with the efficiency 0.2 off, at 0.95 the
-            # frictionless run fails
-            raise OptionsError(f"`spectral_radius` must be <= 0.8 with node_type 'RotVecLG', got "
-                             f"{self.spectral_radius!r}")
-        if self.sensors not in SENSOR_SCOPES:
-            raise OptionsError(f"`sensors` must be one of {list(SENSOR_SCOPES)}, got {self.sensors!r}")
-
-    def to_dict(self) -> dict[str, Any]:
-        return {name: getattr(self, name) for name in self.__dataclass_fields__}
-
-    def records_reactions(self, scene: Scene) -> bool:
-        """Whether the run records the pair-reaction sensors (see ``sensors``)."""
-        return self.sensors == "all" or scene.record.timeseries
 
 
 def engine_version() -> str:
@@ -215,8 +131,10 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
             solver.FinalizeSolver(model.mbs, settings)
         if not ok:
             status, reason = Status.INTEGRATION_FAILURE, solver.GetErrorString() or "solver failed"
-    except Exception as exc:  # Exudyn raises plain RuntimeError/ValueError on divergence
+    except (RuntimeError, ValueError) as exc:  # how Exudyn reports a failed solve
         status, reason = Status.INTEGRATION_FAILURE, str(exc).strip().splitlines()[0][:300]
+    if friction is not None and friction.error is not None:
+        raise friction.error
     if friction is not None and friction.status != Status.OK:
         status, reason = friction.status, friction.reason
     return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
@@ -272,7 +190,7 @@ def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarr
         summary.extras["max_velocity_correction"] = model.velocity_correction
     unrecorded = set() if f"{PAIR_NAMES[0]}_force" in model.sensors else {
         f"{p}_{c}" for p in PAIR_NAMES for c in REACTION_SUFFIXES}
-    bad = _first_non_finite({k: v for k, v in columns.items() if k not in unrecorded})
+    bad = first_non_finite({k: v for k, v in columns.items() if k not in unrecorded})
     if bad and summary.success:
         summary.fail(Status.DIVERGED, f"non-finite values in `{bad}`")
     target = 2.0 * math.pi * scene.revolutions
@@ -310,236 +228,3 @@ def _set_pre_step(model: ExudynModel, target: float | None) -> None:
     model.mbs.SetPreStepUserFunction(pre_step)
 
 
-def _first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
-    for key, values in columns.items():
-        if key != "efficiency" and not np.all(np.isfinite(values)):
-            return key
-    return None
-
-
-def _stored(model: ExudynModel, key: str) -> np.ndarray:
-    data = np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
-    if data.ndim != 2:  # nothing recorded, e.g. a failure in the first step
-        raise ValueError(f"sensor `{key}` recorded no data")
-    return data
-
-
-def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
-    """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity.
-
-    ``psi`` holds the node's total rotation coordinates (reference included): the Rxyz angles
-    for the input (every node type; the first is the shaft angle), else those of
-    ``model.rotations[name]``.
-    """
-    states = {}
-    for name in model.nodes:
-        q = _stored(model, f"{name}_q")
-        q_t = _stored(model, f"{name}_q_t")
-        n = min(len(q), len(q_t))
-        q, q_t = q[:n], q_t[:n]
-        rot = model.rotations[name]
-        end = 4 + rot.size
-        p = q[:, 4:end] if rot.zero_reference else q[:, 4:end] + np.asarray(rot.reference)
-        a, omega = rot.frame(p, q_t[:, 4:end])
-        states[name] = {
-            "t": q[:, 0],
-            "r": model.com_reference[name] + q[:, 1:4],
-            "v": q_t[:, 1:4],
-            "A": a,
-            "omega": omega,
-            "psi": p,
-        }
-    return states
-
-
-def _ground_state(n: int) -> dict[str, np.ndarray]:
-    return {"r": np.zeros((n, 3)), "v": np.zeros((n, 3)),
-            "A": np.broadcast_to(np.eye(3), (n, 3, 3)), "omega": np.zeros((n, 3))}
-
-
-def _pair_kinematics(model: ExudynModel, states: dict, n: int) -> dict[str, dict[str, np.ndarray]]:
-    """Pair axes, marker points and their velocities (global) for both bodies of each pair."""
-    out = {}
-    for name in PAIR_NAMES:
-        body_a, body_b = PAIR_BODIES[name]
-        l_a, l_b = model.marker_local[name]
-        frame = model.pair_frames[name]
-        sa = _ground_state(n) if body_a == "ground" else states[body_a]
-        sb = _ground_state(n) if body_b == "ground" else states[body_b]
-        pa = sa["r"][:n] + sa["A"][:n] @ l_a
-        pb = sb["r"][:n] + sb["A"][:n] @ l_b
-        va = sa["v"][:n] + np.cross(sa["omega"][:n], pa - sa["r"][:n])
-        vb = sb["v"][:n] + np.cross(sb["omega"][:n], pb - sb["r"][:n])
-        out[name] = {
-            "frame_a": sa["A"][:n] @ frame,
-            "frame_b": sb["A"][:n] @ frame,
-            "pa": pa, "pb": pb, "va": va, "vb": vb,
-            "omega_a": sa["omega"][:n], "omega_b": sb["omega"][:n],
-        }
-    return out
-
-
-def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarray]:
-    """Columns of the result schema from the recorded sensors.
-
-    ``project``: replace the recorded velocities by their projection onto the velocity
-    constraints (:mod:`cardan_exudyn.model.projection`); the largest correction is left in
-    ``model.velocity_correction``.
-    """
-    scene = model.scene
-    states = body_states(model)
-    n = min(len(s["t"]) for s in states.values())
-    t = states["input"]["t"][:n]
-    if n < 2:
-        raise ValueError("fewer than two recorded steps")
-    if project:
-        states = _projected_states(model, states, n)
-    cols: dict[str, np.ndarray] = {"t": t}
-    cols["theta_in"] = states["input"]["psi"][:n, 0]
-    cols["omega_in"] = states["input"]["omega"][:n, 0]
-    kin = _pair_kinematics(model, states, n)
-    # the output turns about the output_frame axis (fixed in the ground); its angle is minus the
-    # pair's relative rotation (ground relative to output), zero in the reference configuration
-    out = kin["output_frame"]
-    cols["theta_out"] = -_relative_angle(out)
-    cols["omega_out"] = states["output"]["omega"][:n] @ model.pair_frames["output_frame"][:, 2]
-    if scene.drive.kind == "torque":
-        cols["torque_in"] = np.full(n, scene.drive.torque)
-    else:
-        cols["torque_in"] = -_stored(model, "drive_force")[:n, 1]
-    cols["torque_out"] = scene.load.at(t)
-    cols["power_in"] = cols["torque_in"] * cols["omega_in"]
-    cols["power_out"] = cols["torque_out"] * cols["omega_out"]
-
-    for name in PAIR_NAMES:
-        if f"{name}_force" in model.sensors:
-            force = _stored(model, f"{name}_force")[:n, 1:4]
-            torque = _stored(model, f"{name}_torque")[:n, 1:4]
-        else:  # reactions not recorded (summary-only run)
-            force = torque = np.full((n, 3), np.nan)
-        k = kin[name]
-        fx, fy, fz = (-force).T
-        # TorqueLocal: 90-degree in-plane swap, sign flip, and components in the frame of body b
-        m_b = np.stack([-torque[:, 1], torque[:, 0], -torque[:, 2]], axis=1)
-        relative = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])  # frame_a^T frame_b
-        mx, my, mz = np.einsum("nij,nj->ni", relative, m_b).T
-        omega_rel, slide_rel = relative_speeds(t, k, cylindrical=PAIR_KIND[name] == "cylindrical")
-        for suffix, values in zip(("fx", "fy", "fz", "mx", "my", "mz", "omega_rel", "slide_rel"),
-                                  (fx, fy, fz, mx, my, mz, omega_rel, slide_rel), strict=True):
-            cols[f"{name}_{suffix}"] = values
-    if model.friction is not None:
-        applied = model.friction.columns(t)
-    elif scene.has_friction:  # uncoupled: the law evaluated on the frictionless reactions
-        law = friction_from_columns(scene, cols)
-        applied = {f"{p}_{kind}": law[p][j] for p in PAIR_NAMES
-                   for j, kind in enumerate(("friction_torque", "friction_force"))}
-    else:
-        applied = {f"{p}_{k}": np.zeros(n) for p in PAIR_NAMES
-                   for k in ("friction_torque", "friction_force")}
-    loss_total = np.zeros(n)
-    for name in PAIR_NAMES:
-        friction_torque = applied[f"{name}_friction_torque"]
-        friction_force = applied[f"{name}_friction_force"]
-        loss = -(friction_torque * cols[f"{name}_omega_rel"] + friction_force * cols[f"{name}_slide_rel"])
-        loss_total += loss
-        cols[f"{name}_friction_torque"] = friction_torque
-        cols[f"{name}_friction_force"] = friction_force
-        cols[f"power_loss_{name}"] = loss
-    cols["power_loss"] = loss_total
-    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(model, states, n)
-    cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
-    model.pair_kinematics = kin
-    return cols
-
-
-def _projected_states(model: ExudynModel, states: dict, n: int) -> dict:
-    """``states`` with velocities projected onto the joint's velocity constraints."""
-    drive = model.scene.drive
-    if isinstance(drive, AngleDrive):
-        spline = drive.spline()
-
-        def input_speed(t):
-            return spline(t, 1)
-    elif drive.kind == "speed":
-        def input_speed(t):
-            return np.full(np.shape(t), drive.speed)
-    else:
-        input_speed = None
-    trimmed = {name: {k: v[:n] for k, v in s.items()} for name, s in states.items()}
-    projected = project_velocities(trimmed, _pair_kinematics(model, trimmed, n), model.mass,
-                                   model.inertia, model.pair_frames["frame_input"][:, 2], input_speed)
-    model.velocity_correction = projected.pop("max_velocity_correction")
-    return projected
-
-
-def _relative_angle(k: dict[str, np.ndarray]) -> np.ndarray:
-    """Rotation of body b's pair frame relative to body a's about the pair axis [rad], unwrapped."""
-    rel = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])
-    return np.unwrap(np.arctan2(rel[:, 1, 0], rel[:, 0, 0]))
-
-
-def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
-                    cylindrical: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Relative angular and sliding speed of body b w.r.t. body a of a pair.
-
-    Index-3 integration keeps positions on the constraint manifold to the Newton tolerance but
-    leaves O(h^2) residuals in the velocity constraints (sliding speeds of ~1e-3 m/s in pairs
-    that cannot slide). The relative speeds are therefore the second-order backward difference
-    (BDF2, BDF1 for the first step) of the pair's relative coordinates: the rotation angle of
-    b's pair frame about the axis and the axial offset of b's pair point. The initial row uses the
-    (consistent) initial velocities. The friction law uses the same definition in the step loop.
-    """
-    axis = k["frame_a"][:, :, 2]
-    angle = _relative_angle(k)
-    velocity_level = [np.einsum("ij,ij->i", k["omega_b"] - k["omega_a"], axis)]
-    coords = [angle]
-    if cylindrical:
-        coords.append(np.einsum("ij,ij->i", k["pb"] - k["pa"], axis))
-        velocity_level.append(np.einsum("ij,ij->i", k["vb"] - k["va"], axis))
-    speeds = []
-    for c, v in zip(coords, velocity_level, strict=True):
-        out = np.empty_like(c)
-        out[0] = v[0]
-        if len(c) > 1:
-            out[1] = (c[1] - c[0]) / (t[1] - t[0])
-        if len(c) > 2:
-            h1, h2 = np.diff(t)[1:], np.diff(t)[:-1]
-            w = h1 / h2
-            d1, d2 = c[2:] - c[1:-1], c[1:-1] - c[:-2]
-            out[2:] = ((1.0 + 2.0 * w) / (1.0 + w) * d1 - w * w / (1.0 + w) * d2) / h1
-        speeds.append(out)
-    if not cylindrical:
-        speeds.append(np.zeros_like(angle))
-    return speeds[0], speeds[1]
-
-
-def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and gravitational potential energy of the three bodies [J]."""
-    kinetic = np.zeros(n)
-    potential = np.zeros(n)
-    g = np.asarray(model.scene.gravity)
-    for name, s in states.items():
-        m, j_body = model.mass[name], model.inertia[name]
-        w_body = np.einsum("nji,nj->ni", s["A"][:n], s["omega"][:n])  # A^T omega
-        kinetic += 0.5 * m * np.einsum("ni,ni->n", s["v"][:n], s["v"][:n])
-        kinetic += 0.5 * np.einsum("ni,ij,nj->n", w_body, j_body, w_body)
-        potential -= m * (s["r"][:n] @ g)
-    return kinetic, potential
-
-
-def constraint_violation(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> dict[str, float]:
-    """Largest violation of the pair constraints over the run.
-
-    Position [m]: distance of the two marker points (revolute) or of marker b from the axis of
-    marker a (cylindrical). Angle [rad]: misalignment of the two pair axes, and for the revolute
-    the twist is free so only the axis counts.
-    """
-    pos, ang = 0.0, 0.0
-    for name, k in pair_kinematics.items():
-        d = k["pb"] - k["pa"]
-        za, zb = k["frame_a"][:, :, 2], k["frame_b"][:, :, 2]
-        if PAIR_KIND[name] == "cylindrical":
-            d = d - np.einsum("ij,ij->i", d, za)[:, None] * za
-        pos = max(pos, float(np.max(np.linalg.norm(d, axis=1))))
-        ang = max(ang, float(np.max(np.linalg.norm(np.cross(za, zb), axis=1))))
-    return {"max_constraint_violation_m": pos, "max_constraint_violation_rad": ang}

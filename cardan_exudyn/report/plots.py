@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from reference.scene import PAIR_NAMES  # noqa: E402
+from reference.joint import PAIR_NAMES  # noqa: E402
 
 
 def _axes(ax):

@@ -8,6 +8,7 @@ imports this package; library code never does.
 
 from __future__ import annotations
 
-COMMANDS: tuple[str, ...] = ()
+COMMANDS: tuple[str, ...] = ("reproduce", "bench", "stress", "coupling", "calibrate", "compare",
+                             "tolerance")
 """Modules of this package that register a subcommand, in the order ``cardan --help`` lists them.
 A module is added here when its ``register`` exists."""

@@ -13,10 +13,12 @@ calibrate`` from a subset of the paper's numbers) the report has
   6 (efficiency at several angles) and 7 (efficiency at several speeds);
 - the energy balance residual of every run, and the assumption register.
 
+This module runs the cases and registers the command; :mod:`.reproduce_report` writes the report.
+
 How the runs are made
 ---------------------
 The runs (the eleven cases under each parameter set: 22; 6 with ``--quick``) are one sweep of
-:mod:`cardan_exudyn.sweep.runner` with an explicit case list, in ``OUT/runs/``. The base scene is
+:mod:`cardan_exudyn.sweep` with an explicit case list, in ``OUT/runs/``. The base scene is
 ``paper_scene(10 deg, 2000 rpm)``; each case's overrides are the leaf-by-leaf difference between
 its own scene (:func:`reference.paper.paper_scene`, either parameter set) and the base, and
 :func:`paper_runs` checks that the runner rebuilds exactly that scene. Case ids read like
@@ -42,20 +44,20 @@ folder's name in its record (``files``). Why this way:
   files of every recorded case; a random token keeps two runs of one scene (Table 2's 10 deg case
   is the speed study's 2000 rpm case) and a rerun of a failed case apart; folders no record names
   (a case interrupted after writing them) are deleted once every case has a record;
-- the folder reaches the case function through the environment variable
-  :data:`FILES_ENV`, set by :func:`reproduce` for the duration of the sweep: the runner calls a
-  case function with the scene and the engine only, the folder is no part of a scene (in it, it
-  would change the scene and its hash, and so the plan, whenever the report folder moves), and
-  the runner's workers are this process or processes spawned from it, which inherit its
-  environment (``reproduce`` offers no Dask cluster, whose workers would not). Without the
-  variable the function writes nothing and returns the numbers, so it also serves
-  ``cardan sweep --function cardan_exudyn.studies.reproduce:paper_case_outputs``;
+- the folder reaches the case function as its argument ``files`` (the sweep's
+  ``function_args``), which the runner sends with the function's name to every worker, in this
+  process or a spawned one: the folder is no part of a scene (in it, it would change the scene
+  and its hash whenever the report folder moves), and it is part of the sweep's plan, so a
+  report folder moved elsewhere takes ``--restart``. Without it the function writes nothing and
+  returns the numbers, so it also serves ``cardan sweep --function
+  cardan_exudyn.studies.reproduce:paper_case_outputs``;
 - ``.npz`` keeps float64 exactly (whether a CSV reads back bit for bit depends on the pandas
-  version's parser), so the figures are drawn from exactly the engine's numbers, as before.
+  version's parser), so the figures are drawn from exactly the engine's numbers.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import shutil
@@ -66,277 +68,89 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
-from cardan_exudyn.studies.calibrate import in_fit
-from cardan_exudyn.engines import run_scene
+from cardan_exudyn import engines
+from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, count, out_folder
 from cardan_exudyn.io import atomic_directory, atomic_write, dumps
-from cardan_exudyn.sweep.runner import (
-    CASES_FILE,
-    SweepError,
-    SweepSpec,
-    _flatten,
-    _never_leaf,
-    read_records,
-    run_sweep,
-)
-from reference.paper import (
-    PARAMETER_SETS,
-    assumption_register,
-    calibrated_choices,
-    calibrated_parameters,
-    paper_cases,
-    paper_data,
-    paper_scene,
-    stated_values,
-)
-from reference.scene import PAIR_NAMES, Scene, replace, scene_to_dict
+from cardan_exudyn.report.format import number
+from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
+from reference.joint import PAIR_NAMES
+from reference.paper import PARAMETER_SETS, calibrated_parameters, paper_cases, paper_scene
+from reference.scene import Scene, replace, scene_to_dict
+from reference.schema import Result, Status
 
-
-def fit_case_keys() -> list[str]:
-    """The cases the calibrated set was fitted to, as ``study:angle:rpm`` keys."""
-    return list(paper_data().get("calibrated", {}).get("fit_cases", []))
-
+__all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_OVERRIDES",
+           "PaperRun", "Reproduction", "run_numbers", "paper_case_outputs", "selected_cases",
+           "base_scene", "paper_runs", "sweep_spec", "reproduce", "register", "handler",
+           "outcome_lines"]
 
 RUNS_DIR, FILES_DIR = "runs", "files"
-FILES_ENV = "CARDAN_REPRODUCE_FILES"
 CASE_FUNCTION = "cardan_exudyn.studies.reproduce:paper_case_outputs"
 HISTORY_COLUMNS = ("t", "efficiency", *(f"power_loss_{pair}" for pair in PAIR_NAMES))
 QUICK_OVERRIDES = {"numerics.accuracy": 1e-4, "revolutions": 1.0}
-# the numbers of a run, in the order of the report's results.csv (after difference_to_paper)
-RUN_NUMBERS = ("mean_torque_in", "input_work_J", "loss_work_J", "energy_balance_residual_J",
-               "loop_gain_estimate", "friction_evaluations_per_step", "steps", "wall_time_s",
-               *(f"loss_share_{pair}" for pair in PAIR_NAMES))
+HISTORY_ANGLES = (0.0, 10.0, 20.0, 35.0)
+BASE_ANGLE_DEG, BASE_SPEED_RPM = 10.0, 2000.0
 
 
-def run_numbers(result) -> dict[str, Any]:
-    """Status, reason and, for a run that is ``ok``, the numbers the report tabulates."""
+def run_numbers(result: Result) -> dict[str, Any]:
+    """Status, reason and, for a run that is ``ok``, the numbers the report tabulates.
+
+    Works in J (``input_work_J``, ``loss_work_J``, ``energy_balance_residual_J``: input minus
+    output minus friction loss work minus the change of mechanical energy, trapezoidal over the
+    run), ``mean_torque_in`` in N m, ``wall_time_s`` in s; efficiencies, loop gain and loss shares
+    are dimensionless.
+    """
     s = result.summary
-    out: dict[str, Any] = {"status": s["status"], "reason": s.get("reason", "")}
-    if not result.ok:
+    out: dict[str, Any] = {"status": s.status, "reason": s.reason}
+    if not result.success:
         return out
     t = result.table
     energy = t["energy_kinetic"] + t["energy_potential"]
     work = {c: float(np.trapezoid(t[c], t["t"])) for c in ("power_in", "power_out", "power_loss")}
+    friction = s.extras["friction"]
     out.update({
-        "mean_efficiency": s["mean_efficiency"],
-        "mean_instantaneous_efficiency": s["mean_instantaneous_efficiency"],
-        "mean_torque_in": s["mean_torque_in"],
-        "input_work_J": s["input_work"],
-        "loss_work_J": s["loss_work"],
+        "mean_efficiency": s.mean_efficiency,
+        "mean_instantaneous_efficiency": s.mean_instantaneous_efficiency,
+        "mean_torque_in": s.mean_torque_in,
+        "input_work_J": s.input_work,
+        "loss_work_J": s.loss_work,
         "energy_balance_residual_J": work["power_in"] - work["power_out"] - work["power_loss"]
         - float(energy.iloc[-1] - energy.iloc[0]),
-        "loop_gain_estimate": s["friction"]["loop_gain_estimate"],
-        "friction_evaluations_per_step": s["friction"]["mean_iterations_per_step"],
-        "steps": s["steps"],
-        "wall_time_s": s["wall_time_s"],
+        "loop_gain_estimate": friction["loop_gain_estimate"],
+        "friction_evaluations_per_step": friction["mean_iterations_per_step"],
+        "steps": s.steps,
+        "wall_time_s": s.wall_time_s,
     })
     for pair in PAIR_NAMES:
-        out[f"loss_share_{pair}"] = s[f"loss_work_{pair}"] / s["input_work"]
+        out[f"loss_share_{pair}"] = s.pair_loss_work[pair] / s.input_work
     return out
 
 
-def paper_case_outputs(scene: Scene, engine: str) -> dict[str, Any]:
-    """Sweep case function: run ``scene``, return :func:`run_numbers` and the name of the folder
-    (under ``$CARDAN_REPRODUCE_FILES``) holding its ``summary.json`` and ``history.npz``."""
-    result = run_scene(scene, engine)
+def paper_case_outputs(scene: Scene, engine: str, files: str | None = None) -> dict[str, Any]:
+    """Sweep case function: run ``scene`` and return :func:`run_numbers`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The case's scene.
+    engine : str
+        Engine name.
+    files : str, optional
+        Folder under which the run's ``summary.json`` and ``history.npz`` go, into a folder of
+        their own whose name the outputs give as ``files``; nothing is written without it.
+    """
+    result = engines.run(scene, engine)
     out = run_numbers(result)
-    root = os.environ.get(FILES_ENV)
-    if root:
-        folder = Path(root) / f"{scene.name}-{uuid.uuid4().hex[:12]}"
+    if files:
+        folder = Path(files) / f"{scene.name}-{uuid.uuid4().hex[:12]}"
         folder.mkdir(parents=True, exist_ok=True)
         atomic_write(folder / "summary.json",
-                      lambda f: f.write((dumps(result.summary) + "\n").encode("utf-8")))
-        if result.ok and result.table is not None:
+                     lambda f: f.write((dumps(result.summary) + "\n").encode("utf-8")))
+        if result.success and result.table is not None:
             columns = {c: result.table[c].to_numpy(dtype=float) for c in HISTORY_COLUMNS}
             atomic_write(folder / "history.npz", lambda f: np.savez(f, **columns))
         out["files"] = folder.name
     return out
-
-
-def case_row(case: dict, parameters: str, record: dict[str, Any]) -> dict[str, Any]:
-    """One row of the report's ``results.csv``: the case, the paper's value and the run's numbers
-    (from its sweep record)."""
-    row: dict[str, Any] = {
-        "parameters": parameters,
-        "study": case["study"],
-        "shaft_angle_deg": case["shaft_angle_deg"],
-        "speed_rpm": case["speed_rpm"],
-        "paper_mean_efficiency": case["paper_mean_efficiency"],
-        "status": record["status"],
-        "reason": record.get("reason") or "",
-        "used_in_fit": parameters == "calibrated" and in_fit(case, fit_case_keys()),
-    }
-    if record["status"] != "ok":
-        return row
-
-    def number(key: str) -> Any:
-        value = record.get(key)
-        return float("nan") if value is None else value
-
-    row["mean_efficiency"] = number("mean_efficiency")
-    row["mean_instantaneous_efficiency"] = number("mean_instantaneous_efficiency")
-    row["difference_to_paper"] = row["mean_efficiency"] - case["paper_mean_efficiency"]
-    row.update({key: number(key) for key in RUN_NUMBERS})
-    return row
-
-
-def _md(df: pd.DataFrame, columns: list[str], floatfmt: str = ".4f") -> str:
-    head = "| " + " | ".join(columns) + " |\n|" + "---|" * len(columns) + "\n"
-    lines = []
-    for _, r in df[columns].iterrows():
-        cells = []
-        for c, v in zip(columns, r, strict=True):
-            if isinstance(v, (float, np.floating)):
-                fmt = "g" if c.endswith(("_deg", "_rpm")) else floatfmt
-                cells.append("" if np.isnan(v) else format(v, fmt))
-            else:
-                cells.append(str(v))
-        lines.append("| " + " | ".join(cells) + " |")
-    return head + "\n".join(lines) + "\n"
-
-
-def _held_out_summary(rows: pd.DataFrame) -> str:
-    cal = rows[(rows.parameters == "calibrated") & (rows.status == "ok")]
-    if cal.empty:
-        return ""
-    out = []
-    for label, sel in (("fitted", cal[cal.used_in_fit]), ("held out", cal[~cal.used_in_fit])):
-        if sel.empty:
-            continue
-        err = sel["difference_to_paper"].abs()
-        out.append(f"- {label} ({len(sel)} cases): max |difference| {err.max():.4f}, "
-                   f"RMS {np.sqrt((err ** 2).mean()):.4f}")
-    plain = rows[(rows.parameters == "plain") & (rows.status == "ok")]
-    if not plain.empty:
-        err = plain["difference_to_paper"].abs()
-        out.append(f"- plain reading ({len(plain)} cases): max |difference| {err.max():.4f}, "
-                   f"RMS {np.sqrt((err ** 2).mean()):.4f}")
-    return "\n".join(out) + "\n"
-
-
-def write_report(folder: Path, rows: pd.DataFrame, histories: dict, quick: bool,
-                 wall: float, reused: int = 0) -> None:
-    """``report.md``, ``results.csv``, ``assumptions.csv`` and the figures into ``folder``;
-    ``reused``: runs taken from an earlier invocation's records (said in the report's head)."""
-    from cardan_exudyn.report import plots
-
-    rows.to_csv(folder / "results.csv", index=False)
-    register = pd.DataFrame(assumption_register())
-    register.to_csv(folder / "assumptions.csv", index=False)
-    calibrated = pd.DataFrame(calibrated_parameters())
-    stated = pd.DataFrame(stated_values())
-    stated["value"] = stated["value"].astype(str)
-    figures = []
-    for parameters in PARAMETER_SETS:
-        sel = rows[(rows.parameters == parameters) & (rows.status == "ok")]
-        if sel.empty:
-            continue
-        t2 = sel[sel.study == "table2"].sort_values("shaft_angle_deg")
-        sp = sel[sel.study == "speed"].sort_values("speed_rpm")
-        hist = histories.get(parameters, {})
-        if not t2.empty:
-            plots.save(plots.efficiency_against_paper({parameters: t2}, "shaft_angle_deg",
-                                                      "shaft angle [deg]"),
-                       folder / f"table2_{parameters}.png")
-            figures.append(f"table2_{parameters}.png")
-        if not sp.empty:
-            plots.save(plots.efficiency_against_paper({parameters: sp}, "speed_rpm",
-                                                      "input speed [rpm]"),
-                       folder / f"speed_{parameters}.png")
-            figures.append(f"speed_{parameters}.png")
-        if "10deg" in hist:
-            plots.save(plots.efficiency_history({"10 deg, 2000 rpm": hist["10deg"]},
-                                                f"Figure 4 ({parameters})"),
-                       folder / f"fig4_efficiency_10deg_{parameters}.png")
-            plots.save(plots.pair_losses(hist["10deg"], f"Figure 5 ({parameters}): power loss, "
-                                                        "10 deg, 2000 rpm"),
-                       folder / f"fig5_pair_losses_{parameters}.png")
-            figures += [f"fig4_efficiency_10deg_{parameters}.png",
-                        f"fig5_pair_losses_{parameters}.png"]
-        angles = {k: v for k, v in hist.items() if k.startswith("angle ")}
-        if angles:
-            plots.save(plots.efficiency_history(angles, f"Figure 6 ({parameters})", ylim=(-0.5, 1.05)),
-                       folder / f"fig6_angles_{parameters}.png")
-            figures.append(f"fig6_angles_{parameters}.png")
-        speeds = {k: v for k, v in hist.items() if k.startswith("speed ")}
-        if speeds:
-            plots.save(plots.efficiency_history(speeds, f"Figure 7 ({parameters})"),
-                       folder / f"fig7_speeds_{parameters}.png")
-            figures.append(f"fig7_speeds_{parameters}.png")
-
-    main_cols = ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
-                 "paper_mean_efficiency", "mean_efficiency", "difference_to_paper",
-                 "mean_instantaneous_efficiency", "used_in_fit", "loop_gain_estimate"]
-    loss_cols = ["parameters", "shaft_angle_deg", "speed_rpm"] + [f"loss_share_{p}" for p in PAIR_NAMES]
-    check_cols = ["parameters", "shaft_angle_deg", "speed_rpm", "input_work_J", "loss_work_J",
-                  "energy_balance_residual_J", "friction_evaluations_per_step", "steps",
-                  "wall_time_s"]
-    ok = rows[rows.status == "ok"]
-    failed = rows[rows.status != "ok"]
-    md = [
-        "# The paper's results with friction: plain reading and calibrated set\n",
-        f"Generated by `cardan reproduce{' --quick' if quick else ''}` in {wall:.1f} s"
-        + (f" ({reused} of the {len(rows)} runs from the records of an earlier invocation in "
-           f"`{RUNS_DIR}/`)" if reused else "") + ". Every "
-        "number and plot here was computed by the code in this repository from "
-        "`reference/data/paper.toml`; nothing is copied from the paper except the column "
-        "`paper_mean_efficiency`.\n",
-        "**Parameter sets.** `plain`: every value the paper states, read literally (moment "
-        "lever of eq. (1) = bearing length L), and the assumption register below for what it "
-        "does not state. `calibrated`: the plain reading with the parameters listed under "
-        "*Calibrated parameters* identified by `cardan calibrate` from the cases marked "
-        "`used_in_fit`; the other cases are held out.\n",
-        "**Definitions.** `mean_efficiency` = 1 - (loss work)/(input work) over whole input "
-        "revolutions; `mean_instantaneous_efficiency` = time average of eq. (18), which is "
-        "unbounded where the input power changes sign (it does at large angles).\n",
-        "## Mean efficiency against the paper\n",
-        _md(ok, main_cols),
-        "\n### Summary of differences to the paper\n",
-        _held_out_summary(rows),
-    ]
-    if not failed.empty:
-        md += ["\n### Cases without a result\n",
-               _md(failed, ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
-                            "reason"])]
-    if not calibrated.empty:
-        cal = calibrated.assign(plain_value=calibrated["plain_value"].astype(str))
-        choices = pd.DataFrame([{"name": k, **v} for k, v in calibrated_choices().items()])
-        md += ["\n## Calibrated parameters\n",
-               f"Fitted by `cardan calibrate` to {', '.join(fit_case_keys())} "
-               "(study:angle:rpm):\n\n",
-               _md(cal, ["name", "value", "unit", "plain_value", "meaning"], ".5g"),
-               "\nDiscrete choices of the calibrated set (not fitted):\n\n",
-               _md(choices.assign(value=choices["value"].astype(str)), ["name", "value", "reason"]),
-               "\n**Reading.** The fitted levers are not plausible dimensions for a joint this "
-               "size (a 60 mm spider lever is a 30 mm arm radius on a 45.6 g spider; a 0.59 m "
-               "frame lever is a bearing spacing far beyond shafts whose centres of mass sit "
-               "0.13 m and 0.09 m from the joint). They act as correction factors: the paper's "
-               "numbers need the moment term of eqs. (1)-(2) about 10 times weaker in the "
-               "spider pairs and about 60 times weaker in the frame pairs than the stated "
-               "bearing lengths give.\n"]
-    md += [
-        "\n## Where the power goes: share of the input work lost in each pair\n",
-        _md(ok, loss_cols),
-        "\n## Checks: energy balance and cost\n",
-        "`energy_balance_residual_J` = input work - output work - friction loss work - change "
-        "of mechanical energy over the run (trapezoidal, zero up to the integration error).\n\n",
-        _md(ok, check_cols, ".4g"),
-        "\n## Plots\n",
-        "\n".join(f"![{f}]({f})\n" for f in figures),
-        "\n## Assumption register\n",
-        "Every value the paper does not state, the value used, and why (also "
-        "`assumptions.csv`).\n\n",
-        _md(register.assign(value=register["value"].astype(str)),
-            ["name", "value", "unit", "assumption", "reason"]),
-        "\n## Values taken from the paper\n",
-        _md(stated, ["name", "value", "unit", "source"]),
-    ]
-    (folder / "report.md").write_text("\n".join(md), encoding="utf-8")
-
-
-HISTORY_ANGLES = (0.0, 10.0, 20.0, 35.0)
-BASE_ANGLE_DEG, BASE_SPEED_RPM = 10.0, 2000.0
 
 
 @dataclass(frozen=True)
@@ -373,17 +187,13 @@ def paper_runs(quick: bool = False) -> list[PaperRun]:
     base = base_scene()
     fixed = QUICK_OVERRIDES if quick else {}
     built_base = replace(base, **fixed) if fixed else base
-    base_leaves = _flatten(scene_to_dict(base), _never_leaf)
+    base_leaves = flatten_paths(scene_to_dict(base))
     sets = [p for p in PARAMETER_SETS if p == "plain" or calibrated_parameters()]
     runs = []
     for parameters in sets:
         for case in selected_cases(quick):
             scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=parameters)
-            leaves = _flatten(scene_to_dict(scene), _never_leaf)
-            if set(leaves) != set(base_leaves):
-                raise RuntimeError(f"{scene.name}: scene fields {sorted(set(leaves) ^ set(base_leaves))} "
-                                   "differ in kind from the base scene's")
-            overrides = {k: v for k, v in leaves.items() if v != base_leaves[k]}
+            overrides = _overrides(scene, base_leaves)
             expected = replace(scene, **fixed) if fixed else scene
             if replace(built_base, **overrides) != expected:
                 raise RuntimeError(f"{scene.name}: the overrides do not rebuild the scene")
@@ -393,24 +203,35 @@ def paper_runs(quick: bool = False) -> list[PaperRun]:
     return runs
 
 
-def sweep_spec(runs: list[PaperRun], quick: bool = False) -> SweepSpec:
+def _overrides(scene: Scene, base_leaves: dict[str, Any]) -> dict[str, Any]:
+    """The leaves (dotted paths) in which ``scene`` differs from the base scene's."""
+    leaves = flatten_paths(scene_to_dict(scene))
+    if set(leaves) != set(base_leaves):
+        raise RuntimeError(f"{scene.name}: scene fields {sorted(set(leaves) ^ set(base_leaves))} "
+                           "differ in kind from the base scene's")
+    return {k: v for k, v in leaves.items() if v != base_leaves[k]}
+
+
+def sweep_spec(runs: list[PaperRun], quick: bool = False,
+               files: str | os.PathLike | None = None) -> SweepSpec:
     """The explicit-case sweep of the runs (engine ``exudyn``, case function
-    :func:`paper_case_outputs`)."""
+    :func:`paper_case_outputs`, writing into ``files`` when given)."""
     return SweepSpec(scene=base_scene(), engine="exudyn",
                      fixed=dict(QUICK_OVERRIDES) if quick else {},
-                     cases=tuple({"id": r.id, **r.overrides} for r in runs), function=CASE_FUNCTION)
+                     cases=tuple({"id": r.id, **r.overrides} for r in runs), function=CASE_FUNCTION,
+                     function_args={"files": str(files)} if files is not None else {})
 
 
 def _case_files(files: Path, run: PaperRun, record: dict[str, Any]) -> Path | None:
     """The folder of a recorded run's summary and history; ``None`` for a run that raised."""
     name = record.get("files")
     if not name:
-        if record["status"] == "ok":
+        if record["status"] == Status.OK:
             raise SweepError(f"the record of case {run.id} names no files (was it made by another "
                              "case function?); rerun with --restart")
         return None
     folder = files / name
-    needed = ["summary.json"] + (["history.npz"] if record["status"] == "ok" else [])
+    needed = ["summary.json"] + (["history.npz"] if record["status"] == Status.OK else [])
     missing = [n for n in needed if not (folder / n).is_file()]
     if missing:
         raise SweepError(f"{folder}: {', '.join(missing)} missing (case {run.id}); rerun with --restart")
@@ -427,11 +248,87 @@ def _remove_unreferenced(files: Path, records: dict[str, dict[str, Any]]) -> Non
             shutil.rmtree(entry) if entry.is_dir() else entry.unlink()
 
 
+def _history_labels(case: dict[str, Any]) -> list[str]:
+    """Where a run's history appears: Figure 6's angles, Figures 4-5 (10 deg), Figure 7's speeds."""
+    labels = []
+    if case["study"] == "table2" and case["shaft_angle_deg"] in HISTORY_ANGLES:
+        labels.append(f"angle {case['shaft_angle_deg']:g} deg")
+    if case["study"] == "table2" and case["shaft_angle_deg"] == 10.0:
+        labels.append("10deg")
+    if case["study"] == "speed":
+        labels.append(f"speed {case['speed_rpm']:g} rpm")
+    return labels
+
+
+def _load_history(path: Path) -> dict[str, np.ndarray]:
+    with np.load(path) as data:
+        return {c: data[c] for c in HISTORY_COLUMNS}
+
+
+def _collect(runs: list[PaperRun], records: dict[str, dict[str, Any]],
+             files: Path) -> tuple[list[dict[str, Any]], dict[str, dict[str, Any]]]:
+    """The engine summary of every run (a stand-in naming the status for a run that raised) and
+    the time histories by parameter set and label, from the runs' files."""
+    summaries: list[dict[str, Any]] = []
+    histories: dict[str, dict[str, Any]] = {r.parameters: {} for r in runs}
+    for run in runs:
+        record = records[run.id]
+        case_files = _case_files(files, run, record)
+        if case_files is None:
+            summaries.append({"status": record["status"], "reason": record.get("reason"),
+                              "case": run.id})
+            continue
+        summaries.append(json.loads((case_files / "summary.json").read_text(encoding="utf-8")))
+        if record["status"] == Status.OK:
+            history = _load_history(case_files / "history.npz")
+            for label in _history_labels(run.case):
+                histories[run.parameters][label] = history
+    return summaries, histories
+
+
+@dataclass(frozen=True)
+class Reproduction:
+    """What :func:`reproduce` did.
+
+    Attributes
+    ----------
+    out : Path
+        The report folder.
+    runs : list of PaperRun
+        Every run, in report order.
+    records : dict
+        Case id -> sweep record (status, reason, the numbers of :func:`run_numbers`).
+    sweep : dict
+        The sweep's summary (``OUT/runs/sweep.json``): ``run_now``, ``wall_time_s`` [s],
+        ``executor``, ...
+    """
+
+    out: Path
+    runs: list[PaperRun]
+    records: dict[str, dict[str, Any]]
+    sweep: dict[str, Any]
+
+    @property
+    def failed(self) -> list[PaperRun]:
+        """The runs whose status is not ``ok``."""
+        return [r for r in self.runs if self.records[r.id]["status"] != Status.OK]
+
+    @property
+    def success(self) -> bool:
+        """True when every run ended ``ok``."""
+        return not self.failed
+
+    @property
+    def reused(self) -> int:
+        """Runs taken from the records of an earlier invocation."""
+        return len(self.runs) - self.sweep["run_now"]
+
+
 def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
               restart: bool = False, retry_failed: bool = False,
-              progress: bool | None = None) -> int:
+              progress: bool | None = None) -> Reproduction:
     """Run the paper's cases under both parameter sets through the sweep runner and write the
-    report into ``out``; returns 0, or 3 when a run failed (the report covers the others).
+    report into ``out``.
 
     Parameters
     ----------
@@ -449,6 +346,12 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
     progress : bool, optional
         The sweep runner's progress bar on stderr; default when stderr is a terminal.
 
+    Returns
+    -------
+    Reproduction
+        The runs, their records and the sweep's summary; ``success`` is False when a run failed
+        (the report covers the others).
+
     Raises
     ------
     SweepError
@@ -456,63 +359,69 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
         or another invocation is running there (raised before anything runs); or, after the
         runs, a recorded case's files are missing (the records are kept; ``restart`` helps).
     """
+    # pandas and matplotlib (about 1 s) load only to write a report: `cardan` imports this module
+    # to register the command
+    from cardan_exudyn.studies import reproduce_report
+
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {str(out)!r} exists and is not a folder")
     runs = paper_runs(quick)
     folder_runs = out / RUNS_DIR
     files = folder_runs / FILES_DIR
-    previous = os.environ.get(FILES_ENV)
-    os.environ[FILES_ENV] = str(files.resolve())
-    try:
-        sweep = run_sweep(sweep_spec(runs, quick), folder_runs, workers=workers, restart=restart,
-                          retry_failed=retry_failed, progress=progress)
-    finally:
-        if previous is None:
-            os.environ.pop(FILES_ENV, None)
-        else:
-            os.environ[FILES_ENV] = previous
+    sweep = run_sweep(sweep_spec(runs, quick, files.resolve()), folder_runs, workers=workers,
+                      restart=restart, retry_failed=retry_failed, progress=progress)
     records = read_records(folder_runs / CASES_FILE)
-    rows, summaries = [], []
-    histories: dict[str, dict[str, Any]] = {r.parameters: {} for r in runs}
-    for run in runs:
-        record = records[run.id]
-        rows.append(case_row(run.case, run.parameters, record))
-        case_files = _case_files(files, run, record)
-        if case_files is None:
-            summaries.append({"status": record["status"], "reason": record.get("reason"),
-                              "case": run.id})
-            continue
-        summaries.append(json.loads((case_files / "summary.json").read_text(encoding="utf-8")))
-        if record["status"] != "ok":
-            continue
-        with np.load(case_files / "history.npz") as data:
-            table = pd.DataFrame({c: data[c] for c in HISTORY_COLUMNS})
-        hist, case = histories[run.parameters], run.case
-        if case["study"] == "table2" and case["shaft_angle_deg"] in HISTORY_ANGLES:
-            hist[f"angle {case['shaft_angle_deg']:g} deg"] = table
-        if case["study"] == "table2" and case["shaft_angle_deg"] == 10.0:
-            hist["10deg"] = table
-        if case["study"] == "speed":
-            hist[f"speed {case['speed_rpm']:g} rpm"] = table
+    rows = [reproduce_report.case_row(r.case, r.parameters, records[r.id]) for r in runs]
+    summaries, histories = _collect(runs, records, files)
     _remove_unreferenced(files, records)
-    frame = pd.DataFrame(rows)
-    wall = sweep["wall_time_s"]
-    reused = len(runs) - sweep["run_now"]
+    result = Reproduction(out, runs, records, sweep)
     with atomic_directory(out) as folder:
-        write_report(folder, frame, histories, quick, wall, reused)
+        reproduce_report.write_report(folder, rows, histories, quick, sweep["wall_time_s"],
+                                      result.reused, RUNS_DIR)
         (folder / "summaries.json").write_text(dumps(summaries) + "\n", encoding="utf-8")
         os.replace(folder_runs, folder / RUNS_DIR)
-    failed = [r for r in runs if records[r.id]["status"] != "ok"]
-    for run in failed:
-        record = records[run.id]
-        print(f"  {run.id}: {record['status']}: {record.get('reason')}", file=sys.stderr)
+    return result
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``cardan reproduce`` to the ``cardan`` subcommands."""
+    p = subparsers.add_parser("reproduce", help="reproduce the paper's studies into a report folder")
+    p.add_argument("--out", metavar="DIR", default="reports/reproduce", help="report folder")
+    p.add_argument("--quick", action="store_true", help="fewer scenes and a coarser accuracy")
+    p.add_argument("--workers", type=count("--workers"), metavar="N",
+                   help="local processes (default: all cores; 1 runs in this process)")
+    p.add_argument("--restart", action="store_true",
+                   help="discard the runs recorded in OUT/runs and run every case again")
+    p.add_argument("--retry-failed", action="store_true", help="rerun the cases recorded as failed")
+    p.set_defaults(func=handler)
+
+
+def handler(args: argparse.Namespace) -> int:
+    """Run ``cardan reproduce``; exit 3 when a run failed (the report covers the others)."""
+    out_folder(args.out)
+    try:
+        result = reproduce(args.out, quick=args.quick, workers=args.workers, restart=args.restart,
+                           retry_failed=args.retry_failed)
+    except SweepError as exc:
+        raise BadInput(str(exc)) from None
+    for line in outcome_lines(result):
+        print(line, file=sys.stderr)
+    return EXIT_OK if result.success else EXIT_FAILED
+
+
+def outcome_lines(result: Reproduction) -> list[str]:
+    """What ``cardan reproduce`` says at the end: each failed run, then where the report is."""
+    lines = [f"  {run.id}: {result.records[run.id]['status']}: {result.records[run.id].get('reason')}"
+             for run in result.failed]
+    sweep, out = result.sweep, result.out
     executor = sweep["executor"]
-    how = (f" in {wall:.1f} s, {executor['kind']}"
+    how = (f" in {number(sweep['wall_time_s'], '.1f')} s, {executor['kind']}"
            + (f", {executor['workers']} workers" if executor.get("workers", 1) > 1 else "")
            if sweep["run_now"] else "")
-    print(f"wrote {out}/report.md ({len(runs)} runs, {len(runs) - len(failed)} ok; "
-          f"{sweep['run_now']} run now{how}"
-          + (f"; {reused} from earlier records in {out}/{RUNS_DIR}, --restart runs them again"
-             if reused else "") + ")", file=sys.stderr)
-    return 0 if not failed else 3
+    earlier = (f"; {result.reused} from earlier records in {out}/{RUNS_DIR}, --restart runs them again"
+               if result.reused else "")
+    lines.append(f"wrote {out}/report.md ({len(result.runs)} runs, "
+                 f"{len(result.runs) - len(result.failed)} ok; {sweep['run_now']} run now{how}"
+                 f"{earlier})")
+    return lines

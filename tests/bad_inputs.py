@@ -1,56 +1,54 @@
-"""Bad input at every entry point: a data-driven list of cases and a runner (issue 8).
+"""Bad input at every entry point: the cases that ``tests/test_hardening.py`` runs (issue 8).
 
 Every entry point must reject bad input with one clear line naming what is wrong: the ``cardan``
 command line (every subcommand, ``cardan rig ...`` included) exits with status 2, one line on
 stderr, nothing on stdout, no traceback, and leaves an output folder it was given as it was; the
 Python API raises a documented exception (:class:`~reference.scene.SceneError`,
-:class:`~cardan_exudyn.sweep.runner.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
+:class:`~cardan_exudyn.sweep.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
 :class:`~cardan_exudyn.io.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
 one-line message. A run that fails is not bad input: it exits with status 3 and a status line
 with its reason, and prints no NaN or infinite efficiency (nor does a run with no input work,
 whose efficiency is 0/0: it says "undefined").
 
-:data:`CASES` lists the cases (scene files, command-line options, Python API calls, rig files,
-sweep specifications, run failures); :func:`run_cases` runs each in a fresh folder, the command
-line in this process through :func:`cardan_exudyn.cli.main`, and returns one row per case;
-:func:`markdown` turns the rows into a report table. Every case is fast (no long simulation).
-
-``cardan rig`` is a plugin: this module reaches it only through ``cli.main(["rig", ...])``, never
-by importing ``rigdata`` (imports point one way); cases of ``rigdata``'s own Python API can be
-added by the caller (``run_cases(folder, CASES + more)``, as ``tests/test_hardening.py`` does).
+:data:`CASES` lists the cases: scene files, command-line options, Python API calls, rig files,
+sweep specifications, run failures. Every case is fast (no long simulation). Add a case here and
+``pytest tests/test_hardening.py`` runs it under its id.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
-import json
 import math
-import os
-import re
-import shutil
-import time
-import traceback
-import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from cardan_exudyn.engines import EngineUnavailable
-from cardan_exudyn.io import OutputError
-from cardan_exudyn.sweep.runner import SweepError
-from reference.scene import SceneError
-from reference.schema import OptionsError
+import numpy as np
 
-#: Entry points, in the order of the report.
+from cardan_exudyn import ExudynOptions
+from cardan_exudyn.comparison import compare
+from cardan_exudyn.engines import EngineUnavailable, get_engine, run
+from cardan_exudyn.io import OutputError, write_result
+from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
+from reference.engine import ReferenceOptions
+from reference.joint import Body
+from reference.paper import named_scene
+from reference.scene import Load, replace, scene_from_dict
+from reference.scene_files import load_scene
+from reference.schema import OptionsError, Result, Status, Summary
+from reference.validation import SceneError
+from rigdata.readers import read
+from rigdata.record import ChannelSource, RigDataError, RigRecord
+from rigdata.synthetic import RigSettings
+
+__all__ = ["CASES", "Case", "DIRECTORY", "ENTRY_POINTS", "MARKER"]
+
+#: Entry points, in the order of :data:`CASES`.
 ENTRY_POINTS = ("scene file", "cli", "python api", "rig file", "sweep spec", "run failure")
 #: Content of ``Case.files`` that makes a folder instead of a file.
 DIRECTORY = object()
 #: What an output folder (or file) given to a command holds before the command runs.
 MARKER = "previous output\n"
-#: Non-finite numbers as a command would print them (``nan``, ``inf``, ``-inf``, ``infinity``).
-_NON_FINITE = re.compile(r"(?<![\w.])[-+]?(nan|inf|infinity)(?![\w])", re.IGNORECASE)
 
 
 @dataclass(frozen=True)
@@ -60,7 +58,7 @@ class Case:
     Attributes
     ----------
     id : str
-        Short unique name, also the case's folder.
+        Short unique name: the test id and the case's folder.
     entry : str
         One of :data:`ENTRY_POINTS`.
     description : str
@@ -102,13 +100,13 @@ class Case:
 
     @property
     def input(self) -> str:
-        """The input as the report shows it."""
+        """The input as a failure message shows it."""
         if self.argv:
             return "cardan " + " ".join(a.replace("{d}/", "").replace("{out}", "OUT") for a in self.argv)
         return self.call.__doc__.strip().splitlines()[0] if self.call.__doc__ else self.call.__name__
 
 
-# ------------------------------------------------------------------------------------ inputs
+# Inputs
 
 _PAPER = 'base = "paper"\n'
 _PAPER_FRICTIONLESS = 'base = "paper-frictionless"\n'
@@ -139,132 +137,116 @@ _SWEEP = ("sweep", "{d}/spec.toml", "--out", "{out}", "--workers", "1", "--quiet
 _RIG_FILE = {"rig.csv": _rig_csv()}
 
 
-# ----------------------------------------------------------------------------- API callables
+# Python API calls (the first line of each docstring is the case's input)
 
 
 def _api_load_missing(d: Path) -> Any:
     """reference.scene.load_scene("missing.toml")"""
-    from reference.scene import load_scene
-
     return load_scene(d / "missing.toml")
 
 
 def _api_empty_dict(d: Path) -> Any:
     """reference.scene.scene_from_dict({})"""
-    from reference.scene import scene_from_dict
-
     return scene_from_dict({})
 
 
 def _api_replace_nan(d: Path) -> Any:
     """replace(scene, **{"joint.geometry.shaft_angle": nan})"""
-    from reference.paper import named_scene
-    from reference.scene import replace
-
     return replace(named_scene("paper"), **{"joint.geometry.shaft_angle": math.nan})
 
 
 def _api_replace_unknown(d: Path) -> Any:
     """replace(scene, **{"joint.nope.x": 1})"""
-    from reference.paper import named_scene
-    from reference.scene import replace
-
     return replace(named_scene("paper"), **{"joint.nope.x": 1})
 
 
 def _api_body_unphysical(d: Path) -> Any:
     """Body(1.0, diag(1, 1, 5)): violates the triangle inequality of inertia"""
-    from reference.scene import Body
-
     return Body(1.0, [[1, 0, 0], [0, 1, 0], [0, 0, 5]])
 
 
 def _api_load_text(d: Path) -> Any:
     """Load(torque=[1, "a"], time=[0, 1])"""
-    from reference.scene import Load
-
     return Load(torque=[1.0, "a"], time=[0.0, 1.0])
 
 
 def _api_named_unknown(d: Path) -> Any:
     """reference.paper.named_scene("nope")"""
-    from reference.paper import named_scene
-
     return named_scene("nope")
 
 
 def _api_engine_unknown(d: Path) -> Any:
     """cardan_exudyn.engines.get_engine("warp")"""
-    from cardan_exudyn.engines import get_engine
-
     return get_engine("warp")
 
 
 def _api_tiny_step(d: Path) -> Any:
-    """run_scene(paper-frictionless with numerics.dt = 1e-12, "reference")"""
-    from cardan_exudyn.engines import run_scene
-    from reference.paper import named_scene
-    from reference.scene import replace
-
-    return run_scene(replace(named_scene("paper-frictionless"), **{"numerics.dt": 1e-12}), "reference")
+    """cardan_exudyn.engines.run(paper-frictionless with numerics.dt = 1e-12, "reference")"""
+    return run(replace(named_scene("paper-frictionless"), **{"numerics.dt": 1e-12}), "reference")
 
 
 def _api_compare_unknown(d: Path) -> Any:
     """compare(scene, ["exudyn", "warp"]): refused before any engine runs"""
-    from cardan_exudyn.compare import compare
-    from reference.paper import named_scene
-
     return compare(named_scene("paper-frictionless"), ["exudyn", "warp"])
 
 
 def _api_spec_empty_grid(d: Path) -> Any:
     """spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})"""
-    from cardan_exudyn.sweep.runner import spec_from_mapping
-
     return spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})
 
 
 def _api_sweep_out_of_range(d: Path) -> Any:
     """run_sweep({"scene": "paper", "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, OUT)"""
-    from cardan_exudyn.sweep.runner import run_sweep
-
     return run_sweep({"scene": "paper", "engine": "reference",
                       "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, d / "out", workers=1)
 
 
 def _api_distribution(d: Path) -> Any:
     """Distribution("normal", mean=0, std=0)"""
-    from cardan_exudyn.sweep.runner import Distribution
-
     return Distribution("normal", mean=0.0, std=0.0)
 
 
 def _api_write_result_file(d: Path) -> Any:
     """cardan_exudyn.io.write_result(result, "a-file"): the target exists and is not a folder"""
-    from cardan_exudyn.io import write_result
-    from reference.schema import Result
-
-    return write_result(Result(None, {"status": "ok"}), d / "out")
+    return write_result(Result(None, Summary(Status.OK)), d / "out")
 
 
 def _api_reference_options(d: Path) -> Any:
     """ReferenceOptions(quadrature_rtol=-1)"""
-    from reference.engine import ReferenceOptions
-
     return ReferenceOptions(quadrature_rtol=-1.0)
 
 
 def _api_exudyn_options(d: Path) -> Any:
     """ExudynOptions(node_type="warp")"""
-    from cardan_exudyn.model.solve import ExudynOptions
-
     return ExudynOptions(node_type="warp")
 
 
-# ------------------------------------------------------------------------------------- cases
+def _rig_read_empty(d: Path) -> Any:
+    """rigdata.readers.read("empty.csv")"""
+    return read(d / "empty.csv")
+
+
+def _rig_read_mapping(d: Path) -> Any:
+    """rigdata.readers.read("rig.csv", mapping={"foo": "bar"})"""
+    return read(d / "rig.csv", mapping={"foo": "bar"})
+
+
+def _rig_record_repeated_time(d: Path) -> Any:
+    """RigRecord with time 0, 1, 1, 2"""
+    channels = {c: np.ones(4) for c in ("torque_in", "torque_out", "speed_in", "speed_out")}
+    return RigRecord(np.array([0.0, 1.0, 1.0, 2.0]), channels,
+                     {c: ChannelSource(c, "SI") for c in channels})
+
+
+def _rig_settings_huge(d: Path) -> Any:
+    """rigdata.synthetic.RigSettings(revolutions=1e9)"""
+    return RigSettings(revolutions=1e9)
+
+
+# The cases, by entry point
 
 CASES: tuple[Case, ...] = (
-    # ---------------------------------------------------------------- scene files
+    # scene files
     Case("scene-toml-syntax", "scene file", "a table header without its closing bracket",
          ("scene", "--scene", "{d}/scene.toml"),
          files=_scene_toml('revolutions = 2\n[joint.geometry\nshaft_angle_deg = 3\n'),
@@ -326,7 +308,7 @@ CASES: tuple[Case, ...] = (
     Case("scene-tiny-step", "scene file", "`numerics.dt` = 1e-12 s: 6e10 steps",
          ("run", "--scene", "{d}/scene.toml", "--out", "{out}"),
          files=_scene_toml(_PAPER_FRICTIONLESS + "[numerics]\ndt = 1e-12\n"), out="folder", match="steps"),
-    # ---------------------------------------------------------------- command-line options
+    # command-line options
     Case("run-angle-text", "cli", "non-numeric shaft angle", ("run", "--angle", "abc"),
          match="argument --angle: expected a number"),
     Case("run-rpm-inf", "cli", "infinite speed", ("run", "--rpm=-inf"), match="expected a finite number"),
@@ -430,7 +412,7 @@ CASES: tuple[Case, ...] = (
     Case("rig-validate-out-file", "cli", "validate --out names an existing file",
          ("rig", "validate", "{d}/rig.csv", "--out", "{out}"), files=_RIG_FILE, out="file",
          match="not a folder"),
-    # ---------------------------------------------------------------- Python API
+    # Python API
     Case("api-load-missing", "python api", "load a scene file that does not exist", call=_api_load_missing,
          expect=SceneError, match="cannot read scene file"),
     Case("api-empty-scene", "python api", "a scene from an empty table", call=_api_empty_dict,
@@ -464,7 +446,16 @@ CASES: tuple[Case, ...] = (
          expect=ValueError, match="quadrature_rtol"),
     Case("api-exudyn-options", "python api", "unknown node type", call=_api_exudyn_options,
          expect=OptionsError, match="node_type"),
-    # ---------------------------------------------------------------- rig files
+    Case("api-rig-empty", "python api", "read an empty rig file", call=_rig_read_empty,
+         files={"empty.csv": ""}, expect=RigDataError, match="empty file"),
+    Case("api-rig-mapping", "python api", "read with a mapping to an unknown channel",
+         call=_rig_read_mapping, files=_RIG_FILE, expect=ValueError, match="`mapping` keys"),
+    Case("api-rig-record", "python api", "a record whose time repeats a value",
+         call=_rig_record_repeated_time, expect=RigDataError,
+         match="does not increase at sample 2 (1.0 "),
+    Case("api-rig-settings", "python api", "a synthetic record of 1e12 samples",
+         call=_rig_settings_huge, expect=ValueError, match="samples"),
+    # rig files
     Case("rig-empty", "rig file", "empty file", ("rig", "inspect", "{d}/rig.csv"), files={"rig.csv": ""},
          match="empty file"),
     Case("rig-truncated", "rig file", "the last line cut short, no line end",
@@ -513,7 +504,7 @@ CASES: tuple[Case, ...] = (
     Case("rig-one-revolution", "rig file", "less than one whole revolution after settling",
          ("rig", "measure", "{d}/rig.csv", "--mc", "0"), files={"rig.csv": _rig_csv(rows=110)},
          match="less than one whole input revolution"),
-    # ---------------------------------------------------------------- sweep specifications
+    # sweep specifications
     Case("spec-unknown-parameter", "sweep spec", "grid over a scene field that does not exist", _SWEEP,
          files=_spec('scene = "paper"\nengine = "reference"\n[grid]\n"joint.geometry.nope" = [1, 2]\n'),
          out="folder", match="unknown key(s) ['nope']"),
@@ -559,7 +550,7 @@ CASES: tuple[Case, ...] = (
     Case("spec-scene-missing", "sweep spec", "the spec's scene file does not exist", _SWEEP,
          files=_spec('scene = "nope.toml"\n[grid]\nrevolutions = [1]\n'), out="folder",
          match="cannot read scene file"),
-    # ---------------------------------------------------------------- failures inside a run
+    # failures inside a run
     Case("fail-run-reference", "run failure", "self-locking at 50 deg, reference engine",
          ("run", "--name", "paper-50deg", "--engine", "reference", "--revolutions", "1"), expect=3,
          match="status: self_locking"),
@@ -582,210 +573,3 @@ CASES: tuple[Case, ...] = (
          ("tolerance", "montecarlo", "--name", "paper-50deg", "--revolutions", "1", "--samples", "2",
           "--workers", "1", "--out", "{d}/mc"), expect=3, match="self_locking"),
 )
-
-
-# ------------------------------------------------------------------------------------ runner
-
-
-def _materialise(case: Case, folder: Path) -> Path:
-    """Create the case's files and, when the case has one, its pre-populated output; returns the
-    output's path (``{out}``)."""
-    for name, content in case.files.items():
-        path = folder / name
-        if content is DIRECTORY:
-            path.mkdir(parents=True)
-        elif isinstance(content, bytes):
-            path.write_bytes(content)
-        else:
-            path.write_text(content, encoding="utf-8")
-    out = folder / "out"
-    if case.out is None:
-        return out
-    if case.out == "folder":
-        out.mkdir()
-        (out / "marker.txt").write_text(MARKER, encoding="utf-8")
-    else:
-        out.write_text(MARKER, encoding="utf-8")
-    return out
-
-
-def _untouched(out: Path, kind: str) -> tuple[bool, str]:
-    """Whether the output is exactly as :func:`_materialise` left it, with no temporary sibling."""
-    siblings = [p.name for p in out.parent.iterdir() if p.name.startswith(f".{out.name}")]
-    if siblings:
-        return False, f"temporary files left next to the output: {siblings}"
-    if kind == "file":
-        if not out.is_file() or out.read_text(encoding="utf-8") != MARKER:
-            return False, "the output file was replaced or changed"
-        return True, ""
-    if not out.is_dir():
-        return False, "the output folder is gone or replaced"
-    entries = sorted(p.name for p in out.iterdir())
-    if entries != ["marker.txt"] or (out / "marker.txt").read_text(encoding="utf-8") != MARKER:
-        return False, f"the output folder changed: it holds {entries}"
-    return True, ""
-
-
-def run_cli(argv: list[str]) -> tuple[int, str, str]:
-    """``cardan argv`` in this process: exit status, stdout and stderr. An exception the command
-    lets through is printed as the interpreter would (a traceback) with exit status 1."""
-    from cardan_exudyn.cli import main
-
-    stdout, stderr = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), warnings.catch_warnings():
-        try:
-            status = main(argv)
-        except SystemExit as exc:  # argparse
-            status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-        except BaseException:  # noqa: BLE001 - the point is to see what escapes
-            traceback.print_exc(file=stderr)
-            status = 1
-    return int(status if status is not None else 0), stdout.getvalue(), stderr.getvalue()
-
-
-def _non_finite(text: str) -> list[str]:
-    """Non-finite numbers in printed output, leaving out a friction loop gain (a reason's
-    ``loop gain inf`` says why a run locked; it is not a result)."""
-    text = re.sub(r"loop gain\)?:? ?[-+]?inf", "", text, flags=re.IGNORECASE)
-    return [m.group(0) for m in _NON_FINITE.finditer(text)]
-
-
-def _refuse_constant(name: str) -> None:
-    raise ValueError(f"{name} in the JSON")
-
-
-def _check_cli(case: Case, status: int, stdout: str, stderr: str) -> list[str]:
-    problems = []
-    lines = [line for line in stderr.splitlines() if line.strip()]
-    if status != case.expect:
-        problems.append(f"exit status {status}, expected {case.expect}")
-    if "Traceback (most recent call last)" in stderr:
-        problems.append("traceback")
-    if case.expect == 2:
-        if len(lines) != 1:
-            problems.append(f"{len(lines)} lines on stderr, expected one")
-        if stdout.strip():
-            problems.append("output on stdout")
-        text = stderr
-    else:
-        text = stdout + stderr
-        bad = _non_finite(text)
-        if bad:
-            problems.append(f"non-finite numbers printed: {bad[:3]}")
-        if "--json" in case.argv:
-            try:
-                json.loads(stdout, parse_constant=_refuse_constant)
-            except ValueError as exc:
-                problems.append(f"stdout is not strict JSON: {exc}")
-    if case.match.lower() not in text.lower():
-        problems.append(f"message lacks {case.match!r}")
-    return problems
-
-
-def _run_one(case: Case, folder: Path) -> dict[str, Any]:
-    folder.mkdir(parents=True)
-    out = _materialise(case, folder)
-    row: dict[str, Any] = {"id": case.id, "entry": case.entry, "description": case.description,
-                           "input": case.input, "files": ", ".join(sorted(case.files)) or "-"}
-    start = time.perf_counter()
-    if case.argv:
-        argv = [a.replace("{d}", str(folder)).replace("{out}", str(out)) for a in case.argv]
-        status, stdout, stderr = run_cli(argv)
-        lines = [line for line in stderr.splitlines() if line.strip()]
-        printed = lines + [line for line in stdout.splitlines() if line.strip()]
-        # the line with the key word (a failed run's status may be on stdout), else the first
-        message = next((line for line in printed if case.match.lower() in line.lower()),
-                       printed[0] if printed else "")
-        row.update(expected=f"exit {case.expect}", exit_status=status, exception="", message=message,
-                   stderr_lines=len(lines), traceback="Traceback (most recent call last)" in stderr)
-        problems = _check_cli(case, status, stdout, stderr)
-    else:
-        expect = case.expect
-        problems = []
-        try:
-            case.call(folder)
-        except Exception as exc:  # noqa: BLE001 - every exception is a result here
-            text = str(exc)
-            row.update(exception=type(exc).__name__,
-                       message=text.strip().splitlines()[0] if text.strip() else "",
-                       traceback=False)
-            if not isinstance(exc, expect):
-                problems.append(f"{type(exc).__name__} raised, expected {expect.__name__}")
-                row["traceback"] = True  # a deep error: the caller would see its traceback
-            if len(text.strip().splitlines()) != 1:
-                problems.append("message is not one line")
-            if case.match.lower() not in text.lower():
-                problems.append(f"message lacks {case.match!r}")
-        else:
-            row.update(exception="(none)", message="", traceback=False)
-            problems.append("no exception")
-        row.update(expected=expect.__name__, exit_status=None, stderr_lines=None)
-    row["seconds"] = time.perf_counter() - start
-    row["message"] = row["message"].replace(f"{folder}{os.sep}", "")  # paths as the report shows them
-    if case.out is not None:
-        intact, why = _untouched(out, case.out)
-        row["output_intact"] = intact
-        if not intact:
-            problems.append(why)
-    else:
-        row["output_intact"] = None
-    row["passed"] = not problems
-    row["problems"] = "; ".join(problems)
-    return row
-
-
-def run_cases(workdir: str | os.PathLike, cases: tuple[Case, ...] | list[Case] = CASES):
-    """Run every case in a fresh subfolder of ``workdir`` and return one row per case.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns ``id``, ``entry``, ``description``, ``input``, ``files``, ``expected`` (exit
-        status or exception type), ``exit_status`` (command line), ``exception`` (API),
-        ``message`` (first line), ``stderr_lines``, ``traceback``, ``output_intact`` (None when
-        the case has no output), ``seconds``, ``passed``, ``problems`` (why not).
-    """
-    import pandas as pd
-
-    workdir = Path(workdir)
-    workdir.mkdir(parents=True, exist_ok=True)
-    ids = [c.id for c in cases]
-    if len(set(ids)) != len(ids):
-        raise ValueError(f"case ids must be unique, repeated: {sorted({i for i in ids if ids.count(i) > 1})}")
-    rows = []
-    for case in cases:
-        folder = workdir / case.id
-        if folder.exists():
-            shutil.rmtree(folder)
-        rows.append(_run_one(case, folder))
-    table = pd.DataFrame(rows)
-    for column in ("exit_status", "stderr_lines"):  # integers, missing for the Python API cases
-        table[column] = table[column].astype("Int64")
-    return table
-
-
-def markdown(table) -> str:
-    """The rows of :func:`run_cases` as a markdown table, grouped by entry point, with a count."""
-    import pandas as pd
-
-    def cell(value: Any) -> str:
-        if value is None or (not isinstance(value, str) and pd.isna(value)):
-            return "-"
-        text = str(value).replace("|", "\\|").replace("\n", " ")
-        return text if len(text) <= 140 else text[:137] + "..."
-
-    passed = int(table["passed"].sum())
-    lines = [f"{passed} of {len(table)} bad-input cases behave as required.", "",
-             "| case | entry point | input | expected | got | message | stderr lines | traceback | "
-             "output intact | result |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
-    order = {e: k for k, e in enumerate(ENTRY_POINTS)}
-    for row in sorted(table.to_dict(orient="records"), key=lambda r: order.get(r["entry"], len(order))):
-        got = row["exception"] if row.get("exception") else f"exit {row['exit_status']}"
-        intact = row.get("output_intact")
-        result = "pass" if row["passed"] else f"FAIL: {row['problems']}"
-        lines.append(f"| {cell(row['id'])} | {cell(row['entry'])} | `{cell(row['input'])}` | "
-                     f"{cell(row['expected'])} | {cell(got)} | {cell(row['message'])} | "
-                     f"{cell(row['stderr_lines'])} | {'yes' if row['traceback'] else 'no'} | "
-                     f"{'-' if intact is None else ('yes' if intact else 'NO')} | {cell(result)} |")
-    return "\n".join(lines) + "\n"

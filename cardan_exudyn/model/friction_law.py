@@ -1,0 +1,125 @@
+"""The friction law of the Exudyn model as pure functions: floats in, floats out, no Exudyn.
+
+Written separately from :mod:`reference.friction` on purpose (the reference exists to catch
+mistakes here; neither calls the other). Plain ``float`` arithmetic, because the coupling calls
+it once per pair after every Newton solve and numpy on scalars costs more than the law itself.
+
+A pair with friction coefficient ``f``, journal diameter ``d`` and moment lever ``L`` carries a
+reaction with the magnitudes ``|F|`` (force normal to its axis) and ``|M|`` (bending moment).
+The bending moment acts as a couple of normal forces ``|M| / L`` (eq. (1)); each rubs at the
+journal radius, so the friction torque magnitude is (eqs. (2)-(4))
+
+    T = f d |M| / L + f (d / 2) |F|
+
+and a cylindrical pair also resists sliding with the axial force magnitude (eq. (5))
+
+    A = f (|F| + 2 |M| / L).
+
+Body ``b`` of the pair receives ``-s(v_rot) T`` about the axis and ``-s(v_slide) A`` along it,
+body ``a`` the opposite, where ``s`` is the sign of the relative surface speed of ``b`` with
+respect to ``a``, regularised by a linear ramp of width ``band`` [m/s]; for the rotation the
+surface speed is ``omega_rel d / 2``.
+
+References
+----------
+Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
+experimental validation": eqs. (1)-(5).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "bdf2_weights"]
+
+
+@dataclass(frozen=True)
+class PairLaw:
+    """The constants of one pair's law.
+
+    Attributes
+    ----------
+    cylindrical : bool
+        True for a cylindrical pair (axial friction too), False for a revolute.
+    f : float
+        Friction coefficient [-].
+    d : float
+        Journal diameter [m].
+    lever : float
+        Moment lever ``L`` of eqs. (1)-(2) [m].
+    """
+
+    cylindrical: bool
+    f: float
+    d: float
+    lever: float
+
+
+@dataclass(frozen=True)
+class FrictionLoads:
+    """Friction on body ``b`` of a pair.
+
+    Attributes
+    ----------
+    torque : float
+        About the pair axis [N m].
+    force : float
+        Along the pair axis [N] (0 for a revolute pair).
+    sliding_scale : float
+        The largest load the pair would carry sliding, axial force counted as the torque it makes
+        at the journal radius [N m]: the scale of the coupling's convergence tests.
+    """
+
+    torque: float
+    force: float
+    sliding_scale: float
+
+
+def ramp_sign(speed: float, band: float) -> float:
+    """Sign of ``speed`` [m/s], a linear ramp of width ``band`` [m/s]; the exact sign for 0."""
+    if band <= 0.0:
+        return float(speed > 0.0) - float(speed < 0.0)
+    return max(-1.0, min(1.0, speed / band))
+
+
+def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, moment_y: float,
+               omega_rel: float, slide_rel: float, band: float) -> FrictionLoads:
+    """Friction of one pair from its reaction and relative motion (eqs. (1)-(5)).
+
+    Parameters
+    ----------
+    law : PairLaw
+    force_x, force_y : float
+        Reaction force components normal to the pair axis, in any frame whose z is the axis [N].
+    moment_x, moment_y : float
+        Bending moment components in such a frame [N m].
+    omega_rel : float
+        Angular speed of body ``b`` relative to ``a`` about the axis [rad/s].
+    slide_rel : float
+        Sliding speed of ``b`` relative to ``a`` along the axis [m/s] (ignored for a revolute).
+    band : float
+        Width of the sign ramp [m/s].
+    """
+    force_n = math.hypot(force_x, force_y)
+    moment_n = math.hypot(moment_x, moment_y)
+    radius = 0.5 * law.d
+    torque = law.f * law.d * moment_n / law.lever + law.f * radius * force_n
+    scale = torque
+    axial = 0.0
+    if law.cylindrical:
+        magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
+        axial = -ramp_sign(slide_rel, band) * magnitude
+        scale = max(scale, radius * magnitude)
+    return FrictionLoads(-ramp_sign(radius * omega_rel, band) * torque, axial, scale)
+
+
+def bdf2_weights(h1: float, h2: float) -> tuple[float, float]:
+    """Weights of the second-order backward difference on a non-uniform grid.
+
+    With ``d1 = c_n - c_{n-1}`` over the last step ``h1`` and ``d2 = c_{n-1} - c_{n-2}`` over the
+    one before, ``h2``, the derivative at ``t_n`` is ``(w1 d1 - w2 d2) / h1`` (exact for
+    quadratics). Returns ``(w1, w2)``.
+    """
+    w = h1 / h2
+    return (1.0 + 2.0 * w) / (1.0 + w), w * w / (1.0 + w)

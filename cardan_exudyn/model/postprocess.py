@@ -1,0 +1,287 @@
+"""The result schema's columns from an Exudyn run's recorded sensors.
+
+Reaction conventions (pinned by ``tests/test_reactions.py``)
+------------------------------------------------------------
+Exudyn 1.13.6 reports for ``ObjectJointGeneric`` in dynamic runs ``ForceLocal`` = minus the force
+that body ``a`` (marker 0) exerts on body ``b``, in the joint frame fixed to body ``a``; and
+``TorqueLocal`` with its in-plane components rotated by 90 degrees, the same sign flip, and
+its components in the joint frame attached to body ``b`` (marker 1): the moment of body ``a`` on
+body ``b`` in the pair frame of body ``b`` is ``(-TL_y, TL_x, -TL_z)``; it is rotated into the
+pair frame of body ``a`` with the pair's relative rotation (they differ by the free rotation about
+the pair axis, e.g. the whole shaft angle for ``frame_input``).
+The drive torque on the input shaft is minus the ``Force`` of the coordinate connector.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cardan_exudyn.model.build import ExudynModel
+from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
+from cardan_exudyn.model.projection import project_velocities
+from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.scene import AngleDrive
+from reference.schema import instantaneous_efficiency
+
+__all__ = ["postprocess", "body_states", "pair_kinematics", "relative_speeds", "relative_angle",
+           "mechanical_energy", "constraint_violation", "first_non_finite", "stored"]
+
+
+def first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
+    for key, values in columns.items():
+        if key != "efficiency" and not np.all(np.isfinite(values)):
+            return key
+    return None
+
+
+def stored(model: ExudynModel, key: str) -> np.ndarray:
+    data = np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
+    if data.ndim != 2:  # nothing recorded, e.g. a failure in the first step
+        raise ValueError(f"sensor `{key}` recorded no data")
+    return data
+
+
+def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
+    """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity.
+
+    ``psi`` holds the node's total rotation coordinates (reference included): the Rxyz angles
+    for the input (every node type; the first is the shaft angle), else those of
+    ``model.rotations[name]``.
+    """
+    states = {}
+    for name in model.nodes:
+        q = stored(model, f"{name}_q")
+        q_t = stored(model, f"{name}_q_t")
+        n = min(len(q), len(q_t))
+        q, q_t = q[:n], q_t[:n]
+        rot = model.rotations[name]
+        end = 4 + rot.size
+        p = q[:, 4:end] if rot.zero_reference else q[:, 4:end] + np.asarray(rot.reference)
+        a, omega = rot.frame(p, q_t[:, 4:end])
+        states[name] = {
+            "t": q[:, 0],
+            "r": model.com_reference[name] + q[:, 1:4],
+            "v": q_t[:, 1:4],
+            "A": a,
+            "omega": omega,
+            "psi": p,
+        }
+    return states
+
+
+def ground_state(n: int) -> dict[str, np.ndarray]:
+    return {"r": np.zeros((n, 3)), "v": np.zeros((n, 3)),
+            "A": np.broadcast_to(np.eye(3), (n, 3, 3)), "omega": np.zeros((n, 3))}
+
+
+def pair_kinematics(model: ExudynModel, states: dict, n: int) -> dict[str, dict[str, np.ndarray]]:
+    """Pair axes, marker points and their velocities (global) for both bodies of each pair."""
+    out = {}
+    for name in PAIR_NAMES:
+        body_a, body_b = PAIR_BODIES[name]
+        l_a, l_b = model.marker_local[name]
+        frame = model.pair_frames[name]
+        sa = ground_state(n) if body_a == "ground" else states[body_a]
+        sb = ground_state(n) if body_b == "ground" else states[body_b]
+        pa = sa["r"][:n] + sa["A"][:n] @ l_a
+        pb = sb["r"][:n] + sb["A"][:n] @ l_b
+        va = sa["v"][:n] + np.cross(sa["omega"][:n], pa - sa["r"][:n])
+        vb = sb["v"][:n] + np.cross(sb["omega"][:n], pb - sb["r"][:n])
+        out[name] = {
+            "frame_a": sa["A"][:n] @ frame,
+            "frame_b": sb["A"][:n] @ frame,
+            "pa": pa, "pb": pb, "va": va, "vb": vb,
+            "omega_a": sa["omega"][:n], "omega_b": sb["omega"][:n],
+        }
+    return out
+
+
+def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarray]:
+    """Columns of the result schema from the recorded sensors.
+
+    ``project``: replace the recorded velocities by their projection onto the velocity
+    constraints (:mod:`cardan_exudyn.model.projection`); the largest correction is left in
+    ``model.velocity_correction``. Raises ``ValueError`` when fewer than two steps were recorded.
+    """
+    states = body_states(model)
+    n = min(len(s["t"]) for s in states.values())
+    if n < 2:
+        raise ValueError("fewer than two recorded steps")
+    if project:
+        states = projected_states(model, states, n)
+    kin = pair_kinematics(model, states, n)
+    cols = _shaft_columns(model, states, kin, n)
+    for name in PAIR_NAMES:
+        cols.update(_pair_columns(model, name, kin[name], cols["t"], n))
+    applied = _friction_columns(model, cols, n)
+    loss_total = np.zeros(n)
+    for name in PAIR_NAMES:
+        torque, force = applied[name]
+        loss = -(torque * cols[f"{name}_omega_rel"] + force * cols[f"{name}_slide_rel"])
+        loss_total += loss
+        cols[f"{name}_friction_torque"], cols[f"{name}_friction_force"] = torque, force
+        cols[f"power_loss_{name}"] = loss
+    cols["power_loss"] = loss_total
+    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(model, states, n)
+    cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
+    model.pair_kinematics = kin
+    return cols
+
+
+def _shaft_columns(model: ExudynModel, states: dict, kin: dict, n: int) -> dict[str, np.ndarray]:
+    """Time, shaft angles and speeds, torques and powers."""
+    scene = model.scene
+    t = states["input"]["t"][:n]
+    cols: dict[str, np.ndarray] = {"t": t}
+    cols["theta_in"] = states["input"]["psi"][:n, 0]
+    cols["omega_in"] = states["input"]["omega"][:n, 0]
+    # the output turns about the output_frame axis (fixed in the ground); its angle is minus the
+    # pair's relative rotation (ground relative to output), zero in the reference configuration
+    cols["theta_out"] = -relative_angle(kin["output_frame"])
+    cols["omega_out"] = states["output"]["omega"][:n] @ model.pair_frames["output_frame"][:, 2]
+    if scene.drive.kind == "torque":
+        cols["torque_in"] = np.full(n, scene.drive.torque)
+    else:
+        cols["torque_in"] = -stored(model, "drive_force")[:n, 1]
+    cols["torque_out"] = scene.load.at(t)
+    cols["power_in"] = cols["torque_in"] * cols["omega_in"]
+    cols["power_out"] = cols["torque_out"] * cols["omega_out"]
+    return cols
+
+
+def _pair_columns(model: ExudynModel, name: str, k: dict[str, np.ndarray], t: np.ndarray,
+                  n: int) -> dict[str, np.ndarray]:
+    """Reaction components in the pair frame of body a, and the relative speeds, of one pair."""
+    if f"{name}_force" in model.sensors:
+        force = stored(model, f"{name}_force")[:n, 1:4]
+        torque = stored(model, f"{name}_torque")[:n, 1:4]
+    else:  # reactions not recorded (summary-only run)
+        force = torque = np.full((n, 3), np.nan)
+    fx, fy, fz = (-force).T
+    # TorqueLocal: 90-degree in-plane swap, sign flip, and components in the frame of body b
+    m_b = np.stack([-torque[:, 1], torque[:, 0], -torque[:, 2]], axis=1)
+    relative = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])  # frame_a^T frame_b
+    mx, my, mz = np.einsum("nij,nj->ni", relative, m_b).T
+    omega_rel, slide_rel = relative_speeds(t, k, cylindrical=PAIR_KIND[name] == "cylindrical")
+    values = (fx, fy, fz, mx, my, mz, omega_rel, slide_rel)
+    suffixes = ("fx", "fy", "fz", "mx", "my", "mz", "omega_rel", "slide_rel")
+    return {f"{name}_{s}": v for s, v in zip(suffixes, values, strict=True)}
+
+
+def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
+                      n: int) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Friction torque and force on body b of each pair at the recorded times.
+
+    Coupled runs: what the coupling applied. ``uncoupled``: the law evaluated on the frictionless
+    reactions, row by row (the scalar law of :mod:`cardan_exudyn.model.friction_law`).
+    """
+    scene = model.scene
+    if model.friction is not None:
+        applied = model.friction.columns(cols["t"])
+        return {p: (applied[f"{p}_friction_torque"], applied[f"{p}_friction_force"])
+                for p in PAIR_NAMES}
+    out = {p: (np.zeros(n), np.zeros(n)) for p in PAIR_NAMES}
+    if not scene.has_friction:
+        return out
+    for name, pair in scene.joint.pairs.items():
+        if pair.friction_coefficient <= 0.0:
+            continue
+        law = PairLaw(PAIR_KIND[name] == "cylindrical", pair.friction_coefficient,
+                      pair.journal_diameter, pair.moment_lever)
+        rows = zip(*(cols[f"{name}_{s}"].tolist()
+                     for s in ("fx", "fy", "mx", "my", "omega_rel", "slide_rel")), strict=True)
+        loads = [pair_loads(law, *row, scene.friction.sign_band) for row in rows]
+        out[name] = (np.array([x.torque for x in loads]), np.array([x.force for x in loads]))
+    return out
+
+
+def projected_states(model: ExudynModel, states: dict, n: int) -> dict:
+    """``states`` with velocities projected onto the joint's velocity constraints."""
+    drive = model.scene.drive
+    if isinstance(drive, AngleDrive):
+        spline = drive.spline()
+
+        def input_speed(t):
+            return spline(t, 1)
+    elif drive.kind == "speed":
+        def input_speed(t):
+            return np.full(np.shape(t), drive.speed)
+    else:
+        input_speed = None
+    trimmed = {name: {k: v[:n] for k, v in s.items()} for name, s in states.items()}
+    projected = project_velocities(trimmed, pair_kinematics(model, trimmed, n), model.mass,
+                                   model.inertia, model.pair_frames["frame_input"][:, 2], input_speed)
+    model.velocity_correction = projected.pop("max_velocity_correction")
+    return projected
+
+
+def relative_angle(k: dict[str, np.ndarray]) -> np.ndarray:
+    """Rotation of body b's pair frame relative to body a's about the pair axis [rad], unwrapped."""
+    rel = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])
+    return np.unwrap(np.arctan2(rel[:, 1, 0], rel[:, 0, 0]))
+
+
+def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
+                    cylindrical: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Relative angular and sliding speed of body b w.r.t. body a of a pair.
+
+    Index-3 integration keeps positions on the constraint manifold to the Newton tolerance but
+    leaves O(h^2) residuals in the velocity constraints (sliding speeds of ~1e-3 m/s in pairs
+    that cannot slide). The relative speeds are therefore the second-order backward difference
+    (BDF2, BDF1 for the first step) of the pair's relative coordinates: the rotation angle of
+    b's pair frame about the axis and the axial offset of b's pair point. The initial row uses the
+    (consistent) initial velocities. The friction law uses the same definition in the step loop.
+    """
+    axis = k["frame_a"][:, :, 2]
+    angle = relative_angle(k)
+    velocity_level = [np.einsum("ij,ij->i", k["omega_b"] - k["omega_a"], axis)]
+    coords = [angle]
+    if cylindrical:
+        coords.append(np.einsum("ij,ij->i", k["pb"] - k["pa"], axis))
+        velocity_level.append(np.einsum("ij,ij->i", k["vb"] - k["va"], axis))
+    speeds = []
+    for c, v in zip(coords, velocity_level, strict=True):
+        out = np.empty_like(c)
+        out[0] = v[0]
+        if len(c) > 1:
+            out[1] = (c[1] - c[0]) / (t[1] - t[0])
+        if len(c) > 2:
+            h1, h2 = np.diff(t)[1:], np.diff(t)[:-1]
+            w1, w2 = bdf2_weights(h1, h2)
+            out[2:] = (w1 * (c[2:] - c[1:-1]) - w2 * (c[1:-1] - c[:-2])) / h1
+        speeds.append(out)
+    if not cylindrical:
+        speeds.append(np.zeros_like(angle))
+    return speeds[0], speeds[1]
+
+
+def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and gravitational potential energy of the three bodies [J]."""
+    kinetic = np.zeros(n)
+    potential = np.zeros(n)
+    g = np.asarray(model.scene.gravity)
+    for name, s in states.items():
+        m, j_body = model.mass[name], model.inertia[name]
+        w_body = np.einsum("nji,nj->ni", s["A"][:n], s["omega"][:n])  # A^T omega
+        kinetic += 0.5 * m * np.einsum("ni,ni->n", s["v"][:n], s["v"][:n])
+        kinetic += 0.5 * np.einsum("ni,ij,nj->n", w_body, j_body, w_body)
+        potential -= m * (s["r"][:n] @ g)
+    return kinetic, potential
+
+
+def constraint_violation(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> dict[str, float]:
+    """Largest violation of the pair constraints over the run.
+
+    Position [m]: distance of the two marker points (revolute) or of marker b from the axis of
+    marker a (cylindrical). Angle [rad]: misalignment of the two pair axes, and for the revolute
+    the twist is free so only the axis counts.
+    """
+    pos, ang = 0.0, 0.0
+    for name, k in pair_kinematics.items():
+        d = k["pb"] - k["pa"]
+        za, zb = k["frame_a"][:, :, 2], k["frame_b"][:, :, 2]
+        if PAIR_KIND[name] == "cylindrical":
+            d = d - np.einsum("ij,ij->i", d, za)[:, None] * za
+        pos = max(pos, float(np.max(np.linalg.norm(d, axis=1))))
+        ang = max(ang, float(np.max(np.linalg.norm(np.cross(za, zb), axis=1))))
+    return {"max_constraint_violation_m": pos, "max_constraint_violation_rad": ang}

@@ -1,0 +1,127 @@
+"""The whole of ``cardan bench`` in one call (:func:`run_bench`) and what it returns
+(:class:`BenchResult`)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import pandas as pd
+
+from cardan_exudyn.studies.bench_audit import skip_audit
+from cardan_exudyn.studies.bench_configs import ENGINE_NAMES, SCENES, BenchError, Progress
+from cardan_exudyn.studies.bench_ladders import work_precision
+from cardan_exudyn.studies.bench_targets import evaluate_targets, paper_scenes_timing
+from cardan_exudyn.sweep import environment
+
+__all__ = ["BenchResult", "check_inputs", "run_bench"]
+
+
+@dataclass
+class BenchResult:
+    """Everything one bench run measured.
+
+    Attributes
+    ----------
+    rows : pandas.DataFrame
+        The work-precision rows, one per configuration.
+    targets : list of dict
+        :func:`cardan_exudyn.studies.bench_targets.evaluate_targets`.
+    paper : dict or None
+        The paper scenes' timing, None when not run.
+    audit : pandas.DataFrame or None
+        The skip audit, None when not run.
+    environment : dict
+        Versions, CPU, date and commit.
+    settings : dict
+        ``quick``, ``repeats``, ``scenes``, ``engines``.
+    wall_s : float
+        Wall time of the whole bench [s].
+    """
+
+    rows: pd.DataFrame
+    targets: list[dict[str, Any]]
+    paper: dict[str, Any] | None
+    audit: pd.DataFrame | None
+    environment: dict[str, Any]
+    settings: dict[str, Any] = field(default_factory=dict)
+    wall_s: float = 0.0
+
+    def summary(self) -> dict[str, Any]:
+        """What ``--json`` prints: environment, targets, paper timing, audit, best per scene."""
+        best = []
+        for (scene, config), sel in self.rows.groupby(["scene", "config"], sort=False):
+            ok = sel[sel["status"] == "ok"]
+            best.append({"scene": scene, "config": config, "runs": len(sel), "ok": len(ok),
+                         "fastest_wall_per_simulated_s": float(ok["wall_per_simulated_s"].min())
+                         if not ok.empty else None})
+        return {"environment": self.environment, "settings": self.settings, "wall_s": self.wall_s,
+                "targets": self.targets, "paper_scenes": self.paper,
+                "audit": None if self.audit is None else self.audit.to_dict(orient="records"),
+                "configurations": best}
+
+
+def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
+                 repeats: int | None, quick: bool) -> tuple[list[str], list[str], int]:
+    """The scene keys, engines and repeats of a bench run (defaults filled in).
+
+    Raises
+    ------
+    BenchError
+        For an unknown scene key or engine, or repeats that are not a positive integer.
+    """
+    keys = list(scenes) if scenes is not None else list(SCENES)
+    unknown = [k for k in keys if k not in SCENES]
+    if unknown:
+        raise BenchError(f"`--scenes` must be among {list(SCENES)}, got {unknown}")
+    engines = list(engines)
+    bad = [e for e in engines if e not in ENGINE_NAMES]
+    if bad:
+        raise BenchError(f"`--engines` must be among {', '.join(ENGINE_NAMES)}, got {bad}")
+    repeats = repeats if repeats is not None else (1 if quick else 3)
+    if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+        raise BenchError(f"`--repeats` must be a positive integer, got {repeats!r}")
+    return keys, engines, repeats
+
+
+def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[str] | None = None,
+              engines: Iterable[str] = ENGINE_NAMES, audit: bool = True, paper: bool = True,
+              progress: Progress | None = None) -> BenchResult:
+    """The whole bench: work-precision runs, the paper scenes' timing, the skip audit, targets.
+
+    Parameters
+    ----------
+    quick : bool
+        Short ladders, one repeat by default, a shorter audit without the fast module.
+    repeats : int, optional
+        Timed runs per configuration (default 3, quick 1).
+    scenes : iterable of str, optional
+        Keys of :data:`~cardan_exudyn.studies.bench_configs.SCENES` (default all).
+    engines : iterable of str
+        Engines to run; the paper timing needs Exudyn and the reference, the audit Exudyn.
+    audit, paper : bool
+        Run the skip audit, the paper scenes' timing.
+    progress : callable, optional
+        Called with one line of text per finished piece of work.
+
+    Raises
+    ------
+    BenchError
+        Bad scenes, engines or repeats.
+    """
+    keys, engines, repeats = check_inputs(scenes, engines, repeats, quick)
+    start = time.perf_counter()
+    env = environment()
+    rows = work_precision(keys, quick, repeats, engines, progress)
+    paper_result = None
+    if paper and "exudyn" in engines and "reference" in engines:
+        paper_result = paper_scenes_timing(repeats=repeats, progress=progress)
+    audit_table = None
+    if audit and "exudyn" in engines:
+        audit_table = skip_audit(repeats=3 if quick else 7, progress=progress, fast_module=not quick)
+    targets = evaluate_targets(rows, paper_result)
+    return BenchResult(rows, targets, paper_result, audit_table, env,
+                       {"quick": quick, "repeats": repeats, "scenes": keys, "engines": engines},
+                       time.perf_counter() - start)

@@ -1,0 +1,207 @@
+"""A sweep's plan: the spec expanded into cases with stable ids, validated before any case runs.
+
+A :class:`Plan` is what ``plan.json`` holds: the spec, the base scene's hash, the case function
+and every case. A rerun into the same folder resumes only when its plan equals the stored one
+(:func:`plan_difference`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cardan_exudyn.engines import get_engine
+from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.sweep.spec import (
+    SweepError,
+    SweepSpec,
+    looks_like_path,
+    resolve_function,
+    spec_from_mapping,
+)
+from reference.paper import named_scene
+from reference.scene import Scene, replace, scene_to_dict
+from reference.scene_files import load_scene, scene_from_mapping
+from reference.validation import SceneError
+
+__all__ = ["PLAN_FORMAT", "Case", "Plan", "expand_cases", "base_scene", "make_plan", "plan_difference"]
+
+PLAN_FORMAT = "cardan-sweep/1"
+# quantiles of a random parameter checked against the scene's validation before any case runs
+CHECKED_QUANTILES = (1e-9, 0.5, 1.0 - 1e-9)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run of a sweep: ``function(replace(base, **overrides), engine)``."""
+
+    id: str
+    engine: str
+    overrides: dict[str, Any]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The case as stored in ``plan.json`` and at the head of its record."""
+        return {"id": self.id, "engine": self.engine, "overrides": to_jsonable(self.overrides)}
+
+
+def expand_cases(spec: SweepSpec) -> list[Case]:
+    """Every case of the sweep, in order.
+
+    Ids are ``0000``, ``0001``, ... (wider when there are more than 10,000 cases) unless the
+    explicit cases give their own: the same spec always gives the same ids, which is what lets
+    a sweep resume.
+    """
+    if spec.cases:
+        return _explicit_cases(spec.cases, spec.engine)
+    grid = [dict(zip(spec.grid, combo, strict=True))
+            for combo in itertools.product(*spec.grid.values())] or [{}]
+    samples = spec.random.points() if spec.random else [{}]
+    points = [{**g, **s} for g in grid for s in samples]
+    width = max(4, len(str(len(points) - 1)))
+    cases = []
+    for i, point in enumerate(points):
+        engine = point.pop("engine", spec.engine)
+        cases.append(Case(f"{i:0{width}d}", engine, point))
+    return cases
+
+
+def _explicit_cases(cases: Sequence, engine: str) -> list[Case]:
+    width = max(4, len(str(len(cases) - 1)))
+    out, seen = [], set()
+    for i, item in enumerate(cases):
+        if not isinstance(item, Mapping):
+            raise SweepError(f"`cases[{i}]` must be a table of overrides, got {item!r}")
+        overrides = dict(item)
+        case_id = overrides.pop("id", f"{i:0{width}d}")
+        if not isinstance(case_id, str) or not case_id or "\n" in case_id:
+            raise SweepError(f"`cases[{i}].id` must be a non-empty string, got {case_id!r}")
+        if case_id in seen:
+            raise SweepError(f"`cases[{i}].id` {case_id!r} is used twice")
+        seen.add(case_id)
+        out.append(Case(case_id, overrides.pop("engine", engine), overrides))
+    return out
+
+
+def base_scene(spec: SweepSpec) -> Scene:
+    """The spec's scene (named, a file or a table) with its ``fixed`` overrides applied."""
+    scene = spec.scene
+    if isinstance(scene, Mapping):
+        scene = scene_from_mapping(scene)
+    elif isinstance(scene, str):
+        scene = load_scene(scene) if looks_like_path(scene) or Path(scene).is_file() else named_scene(scene)
+    elif not isinstance(scene, Scene):
+        raise SweepError(f"`scene` must be a scene name, path, table or Scene, got {scene!r}")
+    if not spec.fixed:
+        return scene
+    try:
+        return replace(scene, **spec.fixed)
+    except SceneError as exc:
+        raise SceneError(f"`fixed` overrides: {exc}") from None
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A validated sweep: the spec, the base scene and every case."""
+
+    spec: SweepSpec
+    base: Scene
+    cases: list[Case]
+
+    @property
+    def base_hash(self) -> str:
+        """SHA-256 of the base scene's canonical JSON."""
+        text = json.dumps(to_jsonable(scene_to_dict(self.base)), sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    @property
+    def parameters(self) -> list[str]:
+        """Every overridden path, in first-seen order."""
+        return list(dict.fromkeys(p for c in self.cases for p in c.overrides))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The content of ``plan.json`` (``function_args`` only when the spec has any)."""
+        data = {"format": PLAN_FORMAT, "spec": self.spec.to_dict(), "function": self.spec.function,
+                "base_scene_sha256": self.base_hash, "cases": [c.to_dict() for c in self.cases]}
+        if self.spec.function_args:
+            data["function_args"] = to_jsonable(dict(self.spec.function_args))
+        return data
+
+
+def make_plan(spec: SweepSpec | Mapping[str, Any]) -> Plan:
+    """Validate a spec and expand it.
+
+    The scene, the engines, the first case's scene, every grid value and the 1e-9, 0.5 and
+    1 - 1e-9 quantiles of every random parameter must be valid before any case runs.
+
+    Parameters
+    ----------
+    spec : SweepSpec or dict
+        A dictionary is read by :func:`cardan_exudyn.sweep.spec_from_mapping`.
+
+    Raises
+    ------
+    SweepError, SceneError, EngineUnavailable
+        Naming the key, value or case at fault.
+    """
+    spec = spec if isinstance(spec, SweepSpec) else spec_from_mapping(spec)
+    base = base_scene(spec)
+    cases = expand_cases(spec)
+    for engine in dict.fromkeys(c.engine for c in cases):
+        get_engine(engine)
+    first = cases[0]
+    _check_scene(base, first.overrides, f"case {first.id}")
+    for path, values in spec.grid.items():
+        if path != "engine":
+            for v in values:
+                _check_scene(base, {**first.overrides, path: v}, f"`grid.\"{path}\"` value {v!r}")
+    for path, dist in (spec.random.parameters.items() if spec.random else ()):
+        for q, v in zip(CHECKED_QUANTILES, dist.ppf(np.array(CHECKED_QUANTILES)), strict=True):
+            _check_scene(base, {**first.overrides, path: float(v)},
+                         f"`random.parameters.\"{path}\"` at its {q:g} quantile ({float(v):.6g}); "
+                         "narrow or truncate the distribution (low/high)")
+    return Plan(spec, base, cases)
+
+
+def _check_scene(base: Scene, overrides: dict[str, Any], what: str) -> None:
+    try:
+        replace(base, **overrides)
+    except SceneError as exc:
+        raise SceneError(f"{what}: {exc}") from None
+
+
+def plan_difference(stored: Mapping[str, Any], new: Mapping[str, Any]) -> str:
+    """What makes a stored ``plan.json`` another sweep than ``new`` (a plan's ``to_dict``); ""
+    when a rerun may resume it: same format, case function, base scene, cases and arguments."""
+    if stored.get("format") != PLAN_FORMAT:
+        return f"plan format {stored.get('format')!r}, expected {PLAN_FORMAT!r}"
+    if not _same_function(stored.get("function"), new["function"]):
+        return f"case function {stored.get('function')!r} then, {new['function']!r} now"
+    if stored.get("base_scene_sha256") != new["base_scene_sha256"]:
+        return "the base scene differs (scene, its file, `fixed` or the code that builds it changed)"
+    old_cases, new_cases = stored.get("cases", []), new["cases"]
+    if len(old_cases) != len(new_cases):
+        return f"{len(old_cases)} cases then, {len(new_cases)} now"
+    for old, case in zip(old_cases, new_cases, strict=True):
+        if old != case:
+            return f"case {case['id']}: {old} then, {case} now"
+    old_args, new_args = stored.get("function_args", {}), new.get("function_args", {})
+    if old_args != new_args:
+        return f"case function arguments {old_args} then, {new_args} now"
+    return ""
+
+
+def _same_function(old: Any, new: str) -> bool:
+    """Same name, or two names of one function (its module's and the public face's)."""
+    if old == new:
+        return True
+    try:
+        return resolve_function(old) is resolve_function(new)
+    except SweepError:
+        return False

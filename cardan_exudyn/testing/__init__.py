@@ -1,0 +1,43 @@
+"""The harness inside a user's own pytest suite.
+
+Installing cardan-exudyn registers the pytest plugin :mod:`cardan_exudyn.testing.plugin`
+(entry point ``pytest11``): the fixtures ``cardan_scene`` and ``cardan_run``, the marker
+``cardan_slow`` and the ``--cardan-*`` options. The assertions work with or without pytest::
+
+    from cardan_exudyn.testing import assert_efficiency, assert_engines_agree
+
+See ``docs/pytest.md``.
+
+Names are imported on first use (PEP 562): pytest imports the plugin at every start, and the
+comparison behind :func:`assert_engines_agree` pulls in pandas and scipy.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+__all__ = ["assert_efficiency", "assert_engines_agree", "CardanToleranceWarning", "DEFAULT_COLUMNS",
+           "CachingRunner", "RunRecord", "make_scene"]
+
+_LAZY = {
+    "assert_efficiency": "cardan_exudyn.testing.assertions",
+    "assert_engines_agree": "cardan_exudyn.testing.assertions",
+    "CardanToleranceWarning": "cardan_exudyn.testing.assertions",
+    "DEFAULT_COLUMNS": "cardan_exudyn.testing.assertions",
+    "CachingRunner": "cardan_exudyn.testing.runner",
+    "RunRecord": "cardan_exudyn.testing.runner",
+    "make_scene": "cardan_exudyn.testing.scenes",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'cardan_exudyn.testing' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

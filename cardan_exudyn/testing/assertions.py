@@ -1,0 +1,376 @@
+"""Assertions for a test suite: a run's mean efficiency, and engines agreeing on a scene.
+
+Tolerances come from the runs' own accuracy (:mod:`cardan_exudyn.accuracy`): a value may differ
+by :data:`~cardan_exudyn.accuracy.SAFETY_FACTOR` times its estimated error (the sum of both
+runs' errors when two runs are compared). A tolerance the test gives (``rtol``, ``atol``) is used
+when it is larger; when the estimate is larger it wins, with a :class:`CardanToleranceWarning`
+(the run cannot resolve what was asked). A check never passes by default without an estimate,
+nor with an estimate over :data:`MAX_RELATIVE_ERROR` of the value's scale: it fails and says so.
+A run that did not end ``ok`` fails the check with its status and reason.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from cardan_exudyn.accuracy import (
+    ESTIMATED_MEANS,
+    SAFETY_FACTOR,
+    AccuracyError,
+    ErrorEstimate,
+    error_estimate,
+    mean_values,
+)
+from cardan_exudyn.comparison import COMPARED, SAMPLED_ENGINES, check_request, join_on_input_angle
+from cardan_exudyn.engines import run as run_engine
+from cardan_exudyn.report.format import is_number, markdown_table, number
+from reference.scene import Scene, replace
+from reference.schema import Result
+
+__all__ = ["MAX_RELATIVE_ERROR", "ROUNDING", "DEFAULT_COLUMNS", "CardanToleranceWarning", "Limit",
+           "Check", "assert_efficiency", "assert_engines_agree", "tolerance"]
+
+MAX_RELATIVE_ERROR = 1e-2
+"""Largest tolerance an error estimate may set, relative to the value's scale: beyond it a check
+would hardly fail, and it fails instead, asking for a finer run or an explicit tolerance."""
+ROUNDING = 1e-12
+"""Tolerance floor relative to the value's scale (an exact run still carries rounding)."""
+DEFAULT_COLUMNS = ("mean_efficiency", "work_ratio", "input_work", "output_work", "loss_work")
+"""What :func:`assert_engines_agree` compares unless told otherwise: the mean values."""
+
+
+class CardanToleranceWarning(UserWarning):
+    """A run's estimated error is larger than the tolerance a test asked for, and replaced it."""
+
+
+@dataclass(frozen=True)
+class Limit:
+    """A tolerance and where it comes from.
+
+    Attributes
+    ----------
+    value : float
+        The largest difference that passes (units of the value checked).
+    asked : float or None
+        ``max(atol, rtol * scale)`` when the test gave a tolerance.
+    estimated : float or None
+        ``SAFETY_FACTOR`` times the estimated error, when there is an estimate.
+    """
+
+    value: float
+    asked: float | None
+    estimated: float | None
+
+    @property
+    def widened(self) -> bool:
+        """True when the estimate replaced a smaller tolerance the test asked for."""
+        return self.asked is not None and self.estimated is not None and self.estimated > self.asked
+
+    def describe(self) -> str:
+        """Which term set the tolerance: the one asked, the estimate, or the rounding floor."""
+        if self.asked is not None and self.value == self.asked:
+            return "asked"
+        if self.estimated is not None and self.value == self.estimated:
+            return f"{SAFETY_FACTOR:g} x estimated error"
+        return "rounding"
+
+
+@dataclass(frozen=True)
+class Check:
+    """One value compared: the two values, their difference, the tolerance, or why it cannot be
+    compared (``problem``)."""
+
+    name: str
+    values: tuple[float | None, float | None]
+    difference: float | None = None
+    limit: Limit | None = None
+    problem: str = ""
+
+    @property
+    def failed(self) -> bool:
+        return bool(self.problem) or abs(self.difference) > self.limit.value
+
+    def row(self, labels: Sequence[str]) -> dict[str, Any]:
+        """The check as a row of the failure table."""
+        limit = self.limit
+        note = self.problem or (limit.describe() if limit else "")
+        return {"quantity": self.name, labels[0]: self.values[0], labels[1]: self.values[1],
+                "difference": self.difference, "tolerance": limit.value if limit else None,
+                "from": note}
+
+
+def tolerance(scale: float, errors: Sequence[float | None], rtol: float | None = None,
+              atol: float | None = None) -> Limit | str:
+    """The tolerance of a difference between two values, or why there is none.
+
+    Parameters
+    ----------
+    scale : float
+        Magnitude of the value (units of the value): ``rtol`` and the limits are relative to it.
+    errors : sequence of float or None
+        Estimated errors of the values compared (None: no estimate; an exact value has 0).
+    rtol, atol : float, optional
+        The test's tolerance, ``max(atol, rtol * scale)``.
+
+    Returns
+    -------
+    Limit or str
+        The tolerance, or the reason the value cannot be checked.
+    """
+    asked = None if rtol is None and atol is None else max(atol or 0.0, (rtol or 0.0) * scale)
+    estimated = None
+    if all(e is not None for e in errors):
+        estimated = SAFETY_FACTOR * float(sum(errors))
+    elif asked is None:
+        return "no error estimate: give rtol or atol"
+    if estimated is not None and (asked is None or estimated > asked):
+        if not estimated <= MAX_RELATIVE_ERROR * scale:
+            return (f"{SAFETY_FACTOR:g} x estimated error = {number(estimated, '.3g')} is over "
+                    f"{MAX_RELATIVE_ERROR:g} of the value: refine the run (numerics.accuracy, dt)")
+    value = max(asked or 0.0, estimated or 0.0, ROUNDING * scale)
+    return Limit(value, asked, estimated)
+
+
+def check_values(name: str, values: tuple[Any, Any], scale: float | None,
+                 errors: Sequence[float | None], rtol: float | None, atol: float | None) -> Check:
+    """Compare ``values[1]`` with ``values[0]`` (``scale``: default ``|values[0]|``)."""
+    if not (is_number(values[0]) and is_number(values[1])):
+        return Check(name, values, problem="no finite value to compare")
+    first, second = float(values[0]), float(values[1])
+    limit = tolerance(abs(first) if scale is None else scale, errors, rtol, atol)
+    if isinstance(limit, str):
+        return Check(name, (first, second), second - first, problem=limit)
+    return Check(name, (first, second), second - first, limit)
+
+
+def warn_widened(checks: Sequence[Check]) -> None:
+    """A :class:`CardanToleranceWarning` for each check whose estimate replaced the tolerance
+    asked, attributed to the caller of the assertion."""
+    for check in checks:
+        if check.limit is not None and check.limit.widened:
+            warnings.warn(CardanToleranceWarning(
+                f"{check.name}: the tolerance asked ({check.limit.asked:.3g}) is below "
+                f"{SAFETY_FACTOR:g} x the estimated error ({check.limit.estimated:.3g}), which is "
+                "used instead: the run cannot resolve the tolerance asked"), stacklevel=3)
+
+
+def check_tolerances(rtol: float | None, atol: float | None) -> None:
+    """Refuse a tolerance that is not a finite number >= 0 (a usage error, not a failure)."""
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if value is not None and not (is_number(value) and value >= 0):
+            raise ValueError(f"`{name}` must be a finite number >= 0 or None, got {value!r}")
+
+
+def estimate_of(result: Result, run: Callable[..., Result] | None,
+                skip_revolutions: float = 0.0) -> ErrorEstimate | str | None:
+    """The run's error estimate, or why it could not be made."""
+    try:
+        return error_estimate(result, run, skip_revolutions)
+    except AccuracyError as exc:
+        return f"cannot estimate the error of the {result.summary.engine} run: {exc}"
+
+
+def failed_runs(results: Mapping[str, Result]) -> str:
+    """One line per run that did not end ``ok`` (empty when all did)."""
+    return "\n".join(f"the {engine} run of scene {result.summary.scene.get('name', '?')!r} ended "
+                     f"{result.status}: {result.message}"
+                     for engine, result in results.items() if not result.success)
+
+
+def failure_message(title: str, checks: Sequence[Check], labels: Sequence[str],
+                    estimates: Mapping[str, ErrorEstimate | None]) -> str:
+    """The title, the failed checks as a table, and how the errors were estimated."""
+    columns = ["quantity", *labels, "difference", "tolerance", "from"]
+    formats = {labels[0]: ".8g", labels[1]: ".8g", "difference": "+.3e", "tolerance": ".3e"}
+    table = markdown_table([c.row(labels) for c in checks if c.failed], columns, formats)
+    notes = [f"{engine}: {e.detail}" if e is not None else f"{engine}: no error estimate"
+             for engine, e in estimates.items()]
+    return f"{title}\n\n{table}\nerror estimates: {'; '.join(notes)}"
+
+
+def assert_efficiency(result: Result, expected: float, *, rtol: float | None = None,
+                      atol: float | None = None, run: Callable[..., Result] | None = None) -> None:
+    """Assert that a run's mean efficiency is ``expected``, within the run's accuracy.
+
+    Parameters
+    ----------
+    result : Result
+        The run (any engine).
+    expected : float
+        The expected mean efficiency [-].
+    rtol, atol : float, optional
+        A tolerance relative to ``|expected|`` [-] and an absolute one [-]. Default: from the
+        run's own accuracy alone, ``SAFETY_FACTOR`` times its estimated error.
+    run : callable, optional
+        ``run(scene, engine, options) -> Result`` for the rerun at half the step that estimates
+        a fixed-step engine's error; pass the plugin's ``cardan_run`` to reuse its cache.
+
+    Raises
+    ------
+    AssertionError
+        The run did not end ``ok``; its error cannot be estimated and no tolerance was given;
+        or the mean efficiency differs from ``expected`` by more than the tolerance. The
+        message is a table: value, expected, difference, tolerance and its origin.
+    """
+    __tracebackhide__ = True
+    check_tolerances(rtol, atol)
+    if not is_number(expected):
+        raise ValueError(f"`expected` must be a finite number, got {expected!r}")
+    engine, scene = result.summary.engine, result.summary.scene.get("name", "?")
+    if not result.success:
+        raise AssertionError(f"{failed_runs({engine: result})}: no mean efficiency to compare "
+                             f"with {expected!r}")
+    estimate = estimate_of(result, run)
+    if isinstance(estimate, str):
+        raise AssertionError(estimate)
+    error = estimate.of("mean_efficiency") if estimate is not None else None
+    check = check_values("mean_efficiency", (expected, result.mean_efficiency), abs(expected),
+                         [error, 0.0], rtol, atol)
+    warn_widened([check])
+    if check.failed:
+        raise AssertionError(failure_message(
+            f"mean efficiency of scene {scene!r} ({engine}) is not {expected!r}:", [check],
+            ["expected", engine], {engine: estimate}))
+
+
+def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],
+                run: Callable[..., Result]) -> dict[str, Result]:
+    """Each engine's run of ``scene`` (every step a row), as :func:`cardan_exudyn.compare`
+    makes them: engines that only sample an exact solution are sampled at the first step."""
+    scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
+    results: dict[str, Result] = {}
+    base_dt = None
+    for engine in engines:
+        run_scene = scene
+        if engine in SAMPLED_ENGINES and base_dt is not None and scene.numerics.dt is None:
+            run_scene = replace(scene, **{"numerics.dt": base_dt})
+        results[engine] = run(run_scene, engine, options.get(engine))
+        base_dt = base_dt if base_dt is not None else results[engine].summary.dt
+    return results
+
+
+def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
+    """The scale of a mean value: a work's is the input work (a zero loss has a scale too), any
+    other's its magnitude (None)."""
+    if name.endswith("_work") or name.startswith("loss_work_"):
+        return max(abs(values.get(name, 0.0)), abs(values.get("input_work", 0.0)))
+    return None
+
+
+def check_means(names: Sequence[str], base: Result, other: Result,
+                errors: tuple[ErrorEstimate | None, ErrorEstimate | None],
+                rtol: float | None, atol: float | None) -> list[Check]:
+    """The mean values ``names`` of two runs compared."""
+    a, b = mean_values(base.summary), mean_values(other.summary)
+    return [check_values(name, (a.get(name), b.get(name)), mean_scale(name, a),
+                         [e.of(name) if e is not None else None for e in errors], rtol, atol)
+            for name in names]
+
+
+def check_columns(names: Sequence[str], base: Result, other: Result,
+                  errors: tuple[ErrorEstimate | None, ErrorEstimate | None],
+                  rtol: float | None, atol: float | None, skip_revolutions: float) -> list[Check]:
+    """The time-table columns ``names`` of two runs compared where they differ most (rows
+    joined on the input angle; the first ``skip_revolutions`` left out)."""
+    if not names:
+        return []
+    joined, _ = join_on_input_angle(base.table, other.table)
+    theta = base.table["theta_in"].to_numpy(float)
+    keep = np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
+    checks = []
+    for name in names:
+        first = base.table[name].to_numpy(float)[keep]
+        second = joined.get(name, np.full(theta.shape, np.nan))[keep]
+        finite = np.isfinite(first) & np.isfinite(second)
+        if not np.any(finite):
+            checks.append(Check(name, (None, None), problem="no row where both are finite"))
+            continue
+        worst = int(np.argmax(np.where(finite, np.abs(second - first), -1.0)))
+        scale = float(np.max(np.abs(first[np.isfinite(first)])))
+        estimated = [e.columns.get(name) if e is not None else None for e in errors]
+        checks.append(check_values(f"{name} (largest difference)", (first[worst], second[worst]),
+                                   scale, estimated, rtol, atol))
+    return checks
+
+
+def check_names(columns: Sequence[str]) -> tuple[list[str], list[str]]:
+    """Split ``columns`` into mean values and time-table columns; unknown names are refused."""
+    means = [c for c in columns if c not in COMPARED]
+    unknown = [c for c in means if c not in ESTIMATED_MEANS and not c.startswith("loss_work_")]
+    if unknown:
+        raise ValueError(f"unknown column(s) {unknown}: give mean values {list(ESTIMATED_MEANS)} "
+                         "or loss_work_<pair>, or time-table columns")
+    return means, [c for c in columns if c in COMPARED]
+
+
+def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "reference"),
+                         columns: Sequence[str] | None = None, *, rtol: float | None = None,
+                         atol: float | None = None, options: Mapping[str, Any] | None = None,
+                         skip_revolutions: float = 0.0,
+                         run: Callable[..., Result] | None = None) -> None:
+    """Assert that engines agree on a scene, within their own accuracy.
+
+    Every engine after the first is compared with the first (the base), as
+    :func:`cardan_exudyn.compare` does: same scene, every step recorded, the reference
+    engine sampled at the base engine's step, rows joined on the input angle.
+
+    Parameters
+    ----------
+    scene : Scene
+    engines : sequence of str
+        At least two engines; the first is the base.
+    columns : sequence of str, optional
+        Mean values (:data:`DEFAULT_COLUMNS` by default, ``mean_torque_in``,
+        ``loss_work_<pair>``) and time-table columns (``omega_out``, ``torque_in``, ...; each
+        compared where the two differ most, over the rows after ``skip_revolutions``).
+    rtol, atol : float, optional
+        A tolerance relative to the base's value (a work: the base's input work; a column: its
+        largest magnitude) and an absolute one, in the units of each value. Default: from the
+        runs' own accuracy alone, ``SAFETY_FACTOR`` times the sum of their estimated errors.
+    options : mapping, optional
+        Engine name -> options of that engine.
+    skip_revolutions : float
+        Input revolutions left out of the time-table comparisons [-].
+    run : callable, optional
+        ``run(scene, engine, options) -> Result`` (:func:`cardan_exudyn.engines.run` by
+        default); pass the plugin's ``cardan_run`` to reuse its cache.
+
+    Raises
+    ------
+    AssertionError
+        A run did not end ``ok``; or some value differs by more than its tolerance, or cannot
+        be checked. The message is a table of those values: each engine's value, difference,
+        tolerance and its origin.
+    ValueError
+        Fewer than two engines, an engine twice, an unknown column or a bad tolerance.
+    """
+    __tracebackhide__ = True
+    check_tolerances(rtol, atol)
+    engines, options = list(engines), dict(options or {})
+    check_request(engines, options, skip_revolutions)
+    means, table_columns = check_names(list(columns or DEFAULT_COLUMNS))
+    run = run or run_engine
+    results = run_engines(scene, engines, options, run)
+    if failed_runs(results):
+        raise AssertionError(failed_runs(results))
+    estimates = {engine: estimate_of(result, run, skip_revolutions) for engine, result in results.items()}
+    problems = [e for e in estimates.values() if isinstance(e, str)]
+    if problems:
+        raise AssertionError("\n".join(problems))
+    base, *others = engines
+    for other in others:
+        errors = (estimates[base], estimates[other])
+        checks = (check_means(means, results[base], results[other], errors, rtol, atol)
+                  + check_columns(table_columns, results[base], results[other], errors, rtol, atol,
+                                  skip_revolutions))
+        warn_widened(checks)
+        if any(c.failed for c in checks):
+            raise AssertionError(failure_message(
+                f"engine {other} disagrees with engine {base} on scene {scene.name!r}:", checks,
+                [base, other], {base: estimates[base], other: estimates[other]}))

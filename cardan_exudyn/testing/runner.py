@@ -1,0 +1,132 @@
+"""A runner that runs each (scene, engine, options) once and hands out copies of the result.
+
+Scenes and engine options are frozen dataclasses, compared and hashed by value: two scenes built
+separately with the same values are the same key, and any changed value (the step, a friction
+coefficient, the name) is another. Options are resolved before the key is made, so no options,
+the engine's default options and the same values given as keywords are one key.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from cardan_exudyn.accuracy import ErrorEstimate, error_estimate
+from cardan_exudyn.engines import engine_of, make_options
+from cardan_exudyn.engines import run as run_engine
+from reference.scene import Scene
+from reference.schema import OptionsError, Result, Status
+
+__all__ = ["DEFAULT_ENGINE", "RunRecord", "CachingRunner"]
+
+DEFAULT_ENGINE = "exudyn"
+
+
+@dataclass
+class RunRecord:
+    """One engine run of a session: what ran (scene name, revolutions, engine, step [s]), how it
+    ended, its wall time [s], and how often its result was handed out again from the cache
+    (``reused``)."""
+
+    scene: str
+    revolutions: float
+    engine: str
+    dt: float | None
+    status: Status
+    mean_efficiency: float | None
+    wall_time_s: float
+    reused: int = 0
+
+
+class CachingRunner:
+    """``runner(scene, engine=None, options=None, **option_values) -> Result``, each distinct run
+    computed once.
+
+    Parameters
+    ----------
+    run : callable, optional
+        ``run(scene, engine, options) -> Result``; :func:`cardan_exudyn.engines.run` by default.
+    cache : bool
+        False runs the engine on every call (the records still list each run).
+
+    Notes
+    -----
+    Every call returns its own deep copy of the result: a test may change it (add a column,
+    drop rows) without another test seeing the change. Failed runs (status not ``ok``) are
+    results too and are cached; exceptions (bad scene, options or engine) are not.
+    """
+
+    def __init__(self, run: Callable[..., Result] | None = None, cache: bool = True) -> None:
+        self._run = run or run_engine
+        self.cache = cache
+        self._results: dict[tuple[Scene, str, Any], Result] = {}
+        self._records: dict[tuple[Scene, str, Any], RunRecord] = {}
+        self._uncached: list[RunRecord] = []
+
+    def __call__(self, scene: Scene, engine: str | None = None, options: Any = None,
+                 **option_values: Any) -> Result:
+        """Run ``scene`` with ``engine`` (default ``"exudyn"``, or the engine of ``options``),
+        or return a copy of the result of an earlier identical run.
+
+        Raises the errors of :func:`cardan_exudyn.engines.run` (``EngineUnavailable``,
+        ``OptionsError``, ``SceneError``).
+        """
+        key = self.key(scene, engine, options, **option_values)
+        if self.cache and key in self._results:
+            self._records[key].reused += 1
+            return copy.deepcopy(self._results[key])
+        result = self._run(*key)
+        record = RunRecord(scene.name, scene.revolutions, key[1], result.summary.dt, result.status,
+                           result.mean_efficiency, result.summary.wall_time_s)
+        if self.cache:
+            self._results[key], self._records[key] = result, record
+            return copy.deepcopy(result)
+        self._uncached.append(record)
+        return result
+
+    @staticmethod
+    def key(scene: Scene, engine: str | None = None, options: Any = None,
+            **option_values: Any) -> tuple[Scene, str, Any]:
+        """``(scene, engine, options)`` with the engine and its options resolved.
+
+        Raises
+        ------
+        TypeError
+            ``scene`` is not a :class:`reference.scene.Scene`.
+        OptionsError
+            Both ``options`` and option keywords, or options of another engine's class.
+        """
+        if not isinstance(scene, Scene):
+            raise TypeError(f"`scene` must be a reference.scene.Scene, got {type(scene).__name__}")
+        if options is not None and option_values:
+            raise OptionsError("give `options` or option keywords, not both")
+        if engine is None:
+            engine = engine_of(options) if options is not None else DEFAULT_ENGINE
+        if options is None:
+            options = make_options(engine, **option_values)
+        elif engine_of(options) != engine:
+            raise OptionsError(f"`options` are {type(options).__name__}, not the options of "
+                               f"engine {engine!r}")
+        return scene, engine, options
+
+    def error_estimate(self, result: Result) -> ErrorEstimate | None:
+        """:func:`cardan_exudyn.accuracy.error_estimate` with this runner for the rerun at half
+        the step, so an estimate is computed once per run."""
+        return error_estimate(result, run=self)
+
+    @property
+    def records(self) -> list[RunRecord]:
+        """Every engine run so far, in order."""
+        return [*self._records.values(), *self._uncached]
+
+    @property
+    def runs(self) -> int:
+        """Engine runs computed so far."""
+        return len(self._records) + len(self._uncached)
+
+    @property
+    def reused(self) -> int:
+        """Calls answered from the cache so far."""
+        return sum(record.reused for record in self._records.values())

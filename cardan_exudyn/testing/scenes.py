@@ -1,0 +1,61 @@
+"""A scene for a test: a named scene, a TOML file or a scene, with overrides."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from reference.paper import named_scene
+from reference.scene import Scene, replace
+from reference.scene_files import load_scene
+from reference.validation import SceneError
+
+__all__ = ["make_scene"]
+
+
+def make_scene(source: str | Path | Scene, root: str | Path | None = None, **changes: Any) -> Scene:
+    """The scene ``source`` names, with ``changes`` applied.
+
+    Parameters
+    ----------
+    source : str, pathlib.Path or Scene
+        A named scene (``"paper-10deg"``, ``"rig-frictionless"``, see
+        :func:`reference.paper.named_scene`), a TOML scene file (a ``Path``, or a string ending
+        in ``.toml`` or holding a ``/``), or a scene to change.
+    root : str or pathlib.Path, optional
+        The folder a relative file path is taken from (the current folder by default).
+    **changes
+        Scene fields by dotted path, as :func:`reference.scene.replace` takes them; a double
+        underscore stands for the dot, so ``numerics__accuracy=1e-4`` is
+        ``**{"numerics.accuracy": 1e-4}``. Unit-suffixed names work (``shaft_angle_deg``).
+
+    Raises
+    ------
+    SceneError
+        Unknown name, unreadable or invalid file, unknown field or invalid value; the message
+        names the source.
+    """
+    try:
+        scene = _source(source, root)
+        if changes:
+            scene = replace(scene, **{k.replace("__", "."): v for k, v in changes.items()})
+    except SceneError as exc:
+        raise SceneError(f"scene {_label(source)}: {exc}") from None
+    return scene
+
+
+def _source(source: str | Path | Scene, root: str | Path | None) -> Scene:
+    if isinstance(source, Scene):
+        return source
+    if isinstance(source, Path) or (isinstance(source, str) and
+                                    (source.lower().endswith(".toml") or "/" in source)):
+        path = Path(source)
+        return load_scene(path if root is None or path.is_absolute() else Path(root) / path)
+    if isinstance(source, str):
+        return named_scene(source)
+    raise SceneError(f"the source must be a scene name, a TOML file or a Scene, "
+                     f"got {type(source).__name__}")
+
+
+def _label(source: Any) -> str:
+    return repr(source.name) if isinstance(source, Scene) else repr(str(source))

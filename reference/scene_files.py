@@ -1,0 +1,100 @@
+"""Scenes as users write them: TOML files and tables that may start from a named scene.
+
+A file (or a table in a sweep spec) may begin with ``base = "paper-10deg"`` (any name of
+:func:`reference.paper.named_scene`) and override only what differs; the rest of the table is
+the dictionary form of :func:`reference.scene.scene_from_dict`. Resolving the base needs the
+paper's data, which itself is built from scenes, so this module sits above both
+:mod:`reference.scene` and :mod:`reference.paper` and neither imports it.
+"""
+
+from __future__ import annotations
+
+import pathlib
+from collections.abc import Mapping
+from typing import Any
+
+from reference.paper import named_scene
+from reference.scene import UNIT_ALIASES, Scene, scene_from_dict, scene_to_dict
+from reference.validation import SceneError
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+
+
+def _merge(base: dict, over: Mapping) -> dict:
+    """``base`` (a scene's dictionary form) with the tables and values of ``over`` laid on top."""
+    out = dict(base)
+    for alias_base, (suffix, _) in UNIT_ALIASES.items():
+        if alias_base + suffix in over:
+            out.pop(alias_base, None)  # the override's unit-suffixed value replaces the base's
+    for key, value in over.items():
+        if (key == "drive" and isinstance(value, Mapping) and isinstance(out.get(key), Mapping)
+                and "kind" in value and value["kind"] != out[key].get("kind")):
+            out[key] = dict(value)  # another kind of drive replaces the base's, keys and all
+        elif isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = _merge(out[key], value)
+        elif key == "drive" and isinstance(value, Mapping) and "kind" not in value:
+            out[key] = _merge(out.get(key, {}), value)
+        else:
+            out[key] = value
+    return out
+
+
+def load_scene(path: str | pathlib.Path) -> Scene:
+    """Load a scene from a TOML file.
+
+    A file may start from a named scene with ``base = "paper-10deg"`` and override any part.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The scene file (UTF-8 TOML, SI units or unit-suffixed aliases).
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        The file cannot be read, is not TOML, or does not describe a valid scene; the message
+        starts with the path.
+    """
+    path = pathlib.Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SceneError(f"cannot read scene file {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"scene file {str(path)!r} is not UTF-8 text (byte {exc.start}); a scene is a "
+                         "TOML file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
+    try:
+        return scene_from_mapping(data)
+    except SceneError as exc:
+        raise SceneError(f"{path}: {exc}") from None
+
+
+def scene_from_mapping(data: Mapping[str, Any]) -> Scene:
+    """Like :func:`reference.scene.scene_from_dict`, resolving an optional ``base`` named scene
+    first.
+
+    Parameters
+    ----------
+    data : Mapping
+        A scene table; ``base`` (optional) names the scene the other keys override.
+
+    Returns
+    -------
+    Scene
+    """
+    data = dict(data)
+    base = data.pop("base", None)
+    if base is not None:
+        data = _merge(scene_to_dict(named_scene(base)), data)
+    return scene_from_dict(data)

@@ -1,0 +1,132 @@
+"""Readers of measured rig files: delimited text, LabVIEW Measurement (.lvm), NI TDMS.
+
+:func:`read_table` returns what a file holds (:class:`RawTable`: columns as floats, units and
+header as written); :func:`read` goes on to the record: it picks the time axis and the four
+transducer channels (explicit ``mapping`` or recognition by name, :func:`match_channels`),
+converts them to SI with :mod:`rigdata.units` and returns a validated
+:class:`~rigdata.record.RigRecord` whose ``provenance`` says where every number came from.
+
+Every problem with a file is one :class:`~rigdata.record.RigDataError` naming the file, the
+channel or column, and the problem; errors of pandas, lvm_read and npTDMS are wrapped the same
+way. The record's own validation (time increasing and uniform, no NaN) is not repeated here.
+
+Modules: ``detect`` (bytes, format, text), ``delimited``, ``lvm``, ``tdms`` (one per format),
+``table`` (the :class:`RawTable` they return), ``channels`` (recognition, mapping, units of
+columns), ``assemble`` (time axis, SI conversion, provenance).
+
+Assumptions
+-----------
+* A time column without a unit (header ``time`` or ``t``) is in seconds; the record's
+  provenance lists this under ``assumptions``. LVM X values and TDMS waveform timing are seconds
+  by the formats' definitions.
+* Pulse counts are a cumulative counter (:func:`rigdata.units.unwrap_counter`); a speed given as
+  a pulse frequency must say ``pulses/s``, ``Hz`` is refused as ambiguous.
+* Raw conversions default to the paper's Magtrol TMB 210: 0.1 V/(N m), 60 pulses per revolution.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from rigdata.readers.assemble import to_record
+from rigdata.readers.channels import KIND_WORDS, SIDE_WORDS, TIME_WORDS, match_channels, recognise
+from rigdata.readers.delimited import read_delimited
+from rigdata.readers.detect import FORMAT_ALIASES, choose_format, decode, file_bytes
+from rigdata.readers.lvm import read_lvm
+from rigdata.readers.table import FORMATS, RawTable, TextCells
+from rigdata.readers.tdms import read_tdms
+from rigdata.record import RigRecord
+from rigdata.units import PULSES_PER_REV, SENSITIVITY
+
+__all__ = ["FORMATS", "KIND_WORDS", "SIDE_WORDS", "TIME_WORDS", "RawTable", "TextCells",
+           "match_channels", "read", "read_table", "recognise"]
+
+
+def read_table(path: str | Path, format: str = "auto") -> RawTable:
+    """Read a rig file's columns, units and header as they are, without choosing channels.
+
+    Parameters
+    ----------
+    path : str or Path
+        File to read.
+    format : {"auto", "csv", "lvm", "tdms"}
+        ``"auto"`` goes by the extension (``.lvm``, ``.tdms``, anything else delimited text);
+        content that contradicts the extension or the given format is an error.
+
+    Returns
+    -------
+    RawTable
+
+    Raises
+    ------
+    RigDataError
+        File missing, empty, binary where text is expected, of another format than stated,
+        truncated, without a header line, with rows of the wrong number of fields, or that the
+        format's library cannot parse.
+    """
+    if format not in FORMAT_ALIASES:
+        raise ValueError(f"`format` must be 'auto' or one of {FORMATS}, got {format!r}")
+    path = Path(path)
+    data = file_bytes(path)
+    fmt = choose_format(path, format, data[:64])
+    sha = hashlib.sha256(data).hexdigest()
+    if fmt == "tdms":
+        return read_tdms(path, data, sha)
+    text = decode(data, path)
+    return read_lvm(path, text, sha) if fmt == "lvm" else read_delimited(path, text, sha)
+
+
+def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | None] | None = None,
+         units: Mapping[str, str] | None = None, sensitivity: float = SENSITIVITY,
+         pulses_per_rev: int = PULSES_PER_REV) -> RigRecord:
+    """Read a rig file into a validated record in SI units.
+
+    Parameters
+    ----------
+    path : str or Path
+        Delimited text (``.csv``, ``.tsv``, ``.txt``, ``.dat``), LabVIEW Measurement (``.lvm``)
+        or NI TDMS (``.tdms``) file.
+    format : {"auto", "csv", "lvm", "tdms"}
+        See :func:`read_table`.
+    mapping : mapping of str to str or None, optional
+        Record channel (or ``"time"``) -> column; channels not named are recognised by their
+        headers (:func:`recognise`). None drops a channel.
+    units : mapping of str to str, optional
+        Unit by channel or column name; overrides or supplies the file's units (``{"speed_in":
+        "rpm"}``, ``{"time": "ms"}``).
+    sensitivity : float
+        Torque transducer output [V/(N m)] for channels in volts; default 0.1 (paper, section 4:
+        Magtrol TMB 210, 100 mV/(N m)).
+    pulses_per_rev : int
+        Pulses per revolution for channels in pulse counts or pulses/s; default 60 (paper,
+        section 4: Magtrol TMB 210).
+
+    Returns
+    -------
+    RigRecord
+        Time [s], torques [N m], speeds [rad/s], angles [rad]; ``provenance`` holds ``file``,
+        ``format``, ``reader`` (name, version), ``sha256``, ``header`` (the file's key/value
+        pairs), ``time`` (column or how the time axis was built), ``conversion``
+        (sensitivity, pulses per revolution), ``notes``, ``assumptions`` and, when the header
+        has a ``synthetic`` key, ``synthetic`` (``synthetic``, ``generator``, ``settings`` as
+        written).
+
+    Raises
+    ------
+    RigDataError
+        Any problem with the file or its data, naming the file, the channel and the problem.
+    ValueError
+        Bad arguments (``format``, ``mapping`` keys, ``sensitivity``, ``pulses_per_rev``).
+    """
+    if not (isinstance(sensitivity, (int, float)) and math.isfinite(sensitivity) and sensitivity > 0):
+        raise ValueError(f"`sensitivity` must be a positive number of V/(N m), got {sensitivity!r}")
+    if not (isinstance(pulses_per_rev, (int, np.integer)) and pulses_per_rev > 0):
+        raise ValueError(f"`pulses_per_rev` must be a positive integer, got {pulses_per_rev!r}")
+    raw = read_table(path, format)
+    chosen = match_channels(raw, mapping)
+    return to_record(raw, chosen, dict(units or {}), sensitivity, pulses_per_rev)

@@ -1,0 +1,247 @@
+"""Which column is which channel: recognition by name, the explicit mapping (``--map``) and the
+unit of each column and channel.
+
+Recognition reads a header's words (case, separators and camelCase do not matter): a time word,
+or one side word and one kind word; when the name has a side and no kind word, or two kinds,
+the unit decides. A mapping names columns explicitly and wins over recognition.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from rigdata.readers.table import RawTable
+from rigdata.record import CHANNELS, SHAFTS, RigDataError
+from rigdata.units import ACCEPTS, Unit, lookup, parse_unit, split_header
+
+__all__ = ["TIME_WORDS", "KIND_WORDS", "SIDE_WORDS", "MAP_HINT", "recognise", "time_column",
+           "column_unit", "channel_unit", "match_channels"]
+
+# Vocabulary of channel recognition (tokens of a header's bare name, lower case).
+TIME_WORDS = {"time", "t", "zeit", "elapsed", "timestamp", "seconds"}
+KIND_WORDS = {
+    "torque": {"torque", "trq", "tq", "moment", "drehmoment", "t", "m", "md"},
+    "speed": {"speed", "omega", "w", "n", "rpm", "velocity", "angvel", "drehzahl"},
+    "angle": {"angle", "phi", "theta", "pulses", "pulse", "counts", "count", "cnt", "encoder", "enc",
+              "position", "pos", "winkel", "imp", "ticks"},
+}
+SIDE_WORDS = {
+    "in": {"in", "input", "1", "drive", "driving", "driver", "motor", "antrieb", "primary"},
+    "out": {"out", "output", "2", "brake", "load", "driven", "abtrieb", "secondary"},
+}
+#: Words that may stand next to a side word when the kind comes from the unit ("Drive [N m]").
+FILLER = {"shaft", "side", "sensor", "transducer", "signal", "tmb", "magtrol", "measured", "meas"}
+ALL_SIDES = set().union(*SIDE_WORDS.values())
+#: Kind words that may be glued to a side word ("torquein", "speedout"), longest first.
+COMPOUND_KINDS = sorted({k for ks in KIND_WORDS.values() for k in ks if len(k) >= 3}, key=len, reverse=True)
+#: How to name a channel's column, for error messages (format with ``ch``).
+MAP_HINT = "--map {ch}=COLUMN (read(..., mapping={{{ch!r}: COLUMN}}))"
+#: Units to suggest when a channel's column states none.
+UNIT_EXAMPLES = {"torque": ["N m", "V"], "speed": ["rad/s", "rpm", "pulses/s"],
+                 "angle": ["rad", "deg", "counts"], "time": ["s", "ms"]}
+
+
+def tokens(name: str) -> list[str]:
+    """Words of a bare column name: camelCase, letters/digits and punctuation split, lower case."""
+    s = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name)
+    s = re.sub(r"(?<=[A-Za-z])(?=\d)|(?<=\d)(?=[A-Za-z])", " ", s)
+    words = [t for t in re.split(r"[^0-9a-z]+", s.lower()) if t]
+    out = []
+    for w in words:
+        for kind in COMPOUND_KINDS:
+            if w.startswith(kind) and w[len(kind):] in ALL_SIDES:
+                out += [kind, w[len(kind):]]
+                break
+        else:
+            out.append(w)
+    return out
+
+
+def is_time(words: list[str]) -> bool:
+    """True for the words of a time column's name (``time``, ``time ms``, ``x value``)."""
+    if words in (["x", "value"], ["xvalue"]):
+        return True
+    if not words or words[0] not in TIME_WORDS:
+        return False
+    rest = words[1:]
+    return not rest or rest in (["rel"], ["relative"]) or (
+        len(rest) == 1 and lookup(rest[0]) is not None and lookup(rest[0]).quantity == "time")
+
+
+def recognise(header: str, unit: str | None = None) -> str | None:
+    """The record channel a column header names, ``"time"``, or None.
+
+    Recognised (case, separators and camelCase do not matter; a unit annotation is ignored):
+
+    * time: ``time``, ``t``, ``Time [s]``, ``time_ms``, ``X_Value``, ``Zeit``, ``elapsed``;
+    * kind: torque (``torque``, ``trq``, ``tq``, ``T``, ``M``, ``moment``), speed (``speed``,
+      ``omega``, ``w``, ``n``, ``rpm``, ``velocity``), angle (``angle``, ``phi``, ``theta``,
+      ``pulses``, ``counts``, ``cnt``, ``encoder``, ``position``);
+    * side: input (``in``, ``input``, ``1``, ``drive``, ``motor``), output (``out``,
+      ``output``, ``2``, ``brake``, ``load``, ``driven``).
+
+    A header needs exactly one side and one kind (``torque_in``, ``Torque In``, ``T_in``,
+    ``Trq1``, ``Brake torque``, ``omega_out``, ``n2``, ``Encoder 1``). When the name has a side
+    and no kind word, or two kinds, the unit decides (``Drive [N m]``, ``Encoder speed [rpm]``).
+
+    Parameters
+    ----------
+    header : str
+        Column header as in the file.
+    unit : str, optional
+        Unit of the column when it is not in the header.
+
+    Returns
+    -------
+    str or None
+        A key of :data:`rigdata.record.CHANNELS`, ``"time"``, or None.
+    """
+    bare, annotated = split_header(header)
+    words_list = tokens(bare)
+    if is_time(words_list):
+        return "time"
+    words = set(words_list)
+    sides = [s for s, w in SIDE_WORDS.items() if w & words]
+    if len(sides) != 1:
+        return None
+    kinds = {k for k, w in KIND_WORDS.items() if w & words}
+    found = lookup(annotated or unit or "")
+    by_unit = {k for k, q in ACCEPTS.items() if found is not None and found.quantity in q} - {"time"}
+    if len(kinds) > 1:
+        kinds &= by_unit
+    elif not kinds and not (words - SIDE_WORDS[sides[0]] - FILLER):
+        kinds = by_unit
+    return f"{kinds.pop()}_{sides[0]}" if len(kinds) == 1 else None
+
+
+def time_column(columns: Mapping[str, np.ndarray]) -> str | None:
+    """The one column recognised as time, None when there is none or more than one."""
+    found = [c for c in columns if recognise(c) == "time"]
+    return found[0] if len(found) == 1 else None
+
+
+def column_unit(header: str, stated: str | None) -> str | None:
+    """Unit of a column: the header annotation, else a unit stated elsewhere (units row, LVM
+    label, TDMS property), else a unit suffix of a time column name (``time_s``)."""
+    bare, unit = split_header(header)
+    if unit is None:
+        unit = stated
+    if unit is None:
+        words = tokens(bare)
+        suffix = lookup(words[1]) if len(words) == 2 and words[0] in TIME_WORDS else None
+        if suffix is not None and suffix.quantity == "time":
+            unit = words[1]
+    return unit
+
+
+def channel_unit(raw: RawTable, column: str, channel: str, units: Mapping[str, str]) -> Unit:
+    """Unit of ``channel`` read from ``column``: given by channel or column name in ``units``,
+    else as the file states it; a column without one is an error."""
+    kind = "time" if channel == "time" else channel.split("_")[0]
+    given = units.get(channel, units.get(column))
+    if given is not None:
+        return parse_unit(given, kind=kind, column=column, file=raw.file, channel=channel)
+    stated = raw.units.get(column)
+    if stated is None:
+        raise RigDataError(f"no unit: column {column!r} states none; give it with --unit {channel}=UNIT "
+                           f"(read(..., units={{{channel!r}: UNIT}})), e.g. "
+                           f"{', '.join(UNIT_EXAMPLES[kind])}", file=raw.file, channel=channel)
+    return parse_unit(stated, kind=kind, column=column, file=raw.file, channel=channel)
+
+
+def _key(text: str) -> str:
+    return re.sub(r"\s+", " ", text.strip().casefold())
+
+
+def _find_column(wanted: str, columns: list[str], channel: str, path: Path) -> str:
+    """The column a mapping names: exact, else ignoring case and blanks, else by bare name."""
+    if wanted in columns:
+        return wanted
+    for pick in (_key, lambda c: _key(split_header(c)[0])):
+        hits = [c for c in columns if pick(c) == _key(wanted)]
+        if len(hits) == 1:
+            return hits[0]
+        if len(hits) > 1:
+            raise RigDataError(f"mapping {wanted!r} is ambiguous: columns {hits} match", file=path,
+                               channel=channel)
+    raise RigDataError(f"mapped to column {wanted!r}, which the file does not have; columns found: "
+                       f"{columns}", file=path, channel=channel)
+
+
+def _recognised_time(names: list[str], chosen: Mapping[str, str], path: Path) -> str | None:
+    candidates = [c for c in names if recognise(c) == "time" and c not in chosen.values()]
+    if len(candidates) > 1:
+        raise RigDataError(f"ambiguous: columns {candidates} all look like time; choose one with "
+                           f"{MAP_HINT.format(ch='time')}", file=path, channel="time")
+    return candidates[0] if candidates else None
+
+
+def _recognised_channels(raw: RawTable, chosen: Mapping[str, str], mapping: Mapping[str, str | None],
+                         path: Path) -> dict[str, str]:
+    found: dict[str, list[str]] = {}
+    for col in raw.columns:
+        if col in chosen.values():
+            continue
+        ch = recognise(col, raw.units.get(col))
+        if ch in CHANNELS and ch not in mapping:
+            found.setdefault(ch, []).append(col)
+    for ch, cols in found.items():
+        if len(cols) > 1:
+            raise RigDataError(f"ambiguous: columns {cols} both match; choose one with "
+                               f"{MAP_HINT.format(ch=ch)}", file=path, channel=ch)
+    return {ch: cols[0] for ch, cols in found.items()}
+
+
+def match_channels(raw: RawTable, mapping: Mapping[str, str | None] | None = None) -> dict[str, str]:
+    """Columns of the record channels and of time: ``mapping`` first, recognition for the rest.
+
+    Parameters
+    ----------
+    raw : RawTable
+        From :func:`rigdata.readers.read_table`.
+    mapping : mapping of str to str or None, optional
+        Record channel (key of :data:`rigdata.record.CHANNELS`, or ``"time"``) -> column name
+        (exact, or ignoring case and blanks, or without its unit annotation). None leaves a
+        channel out that recognition would otherwise add.
+
+    Returns
+    -------
+    dict of str to str
+        Channel -> column; ``"time"`` only when the file has a time column.
+
+    Raises
+    ------
+    RigDataError
+        Unknown channel in ``mapping``, a mapped column missing, two columns recognised as one
+        channel, a required channel with no column.
+    """
+    path = Path(raw.file)
+    mapping = dict(mapping or {})
+    unknown = set(mapping) - set(CHANNELS) - {"time"}
+    if unknown:
+        raise ValueError(f"`mapping` keys must be 'time' or one of {sorted(CHANNELS)}, got {sorted(unknown)}")
+    names = list(raw.columns)
+    chosen = {ch: _find_column(col, names, ch, path) for ch, col in mapping.items() if col is not None}
+    if "time" not in mapping:
+        time = _recognised_time(names, chosen, path)
+        if time is not None:
+            chosen["time"] = time
+    chosen.update(_recognised_channels(raw, chosen, mapping, path))
+    _require(chosen, names, path)
+    return chosen
+
+
+def _require(chosen: Mapping[str, str], names: list[str], path: Path) -> None:
+    for ch in ("torque_in", "torque_out"):
+        if ch not in chosen:
+            raise RigDataError(f"missing: no column recognised as {ch}; columns found: {names}; name it "
+                               f"with {MAP_HINT.format(ch=ch)}", file=path, channel=ch)
+    for shaft in SHAFTS:
+        if f"speed_{shaft}" not in chosen and f"angle_{shaft}" not in chosen:
+            raise RigDataError(f"missing: no column recognised as speed_{shaft} or angle_{shaft}; columns "
+                               f"found: {names}; name one with {MAP_HINT.format(ch=f'speed_{shaft}')}",
+                               file=path, channel=f"speed_{shaft}")

@@ -1,0 +1,90 @@
+"""A rig file's bytes, its format (the extension or the caller's word, checked against the first
+bytes) and, for text formats, its text."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rigdata.record import RigDataError
+
+__all__ = ["FORMAT_ALIASES", "file_bytes", "content_format", "choose_format", "decode"]
+
+#: Format names a caller may give -> the reader they select.
+FORMAT_ALIASES = {"auto": "auto", "csv": "csv", "text": "csv", "txt": "csv", "tsv": "csv", "dat": "csv",
+                  "lvm": "lvm", "tdms": "tdms"}
+
+
+def file_bytes(path: Path) -> bytes:
+    """The file's bytes; a missing, unreadable or empty file is an error."""
+    if not path.exists():
+        raise RigDataError("file not found", file=path)
+    if path.is_dir():
+        raise RigDataError("is a directory, not a file", file=path)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise RigDataError(f"cannot read the file: {exc.strerror or exc}", file=path) from exc
+    if not data.strip():
+        raise RigDataError("empty file" if not data else "empty file (only blank space)", file=path)
+    return data
+
+
+def content_format(head: bytes) -> str | None:
+    """Format the first bytes show: "tdms", "lvm", or None (text of some other kind)."""
+    if head.startswith(b"TDSm"):
+        return "tdms"
+    text = head.lstrip(b"\xef\xbb\xbf")
+    if text.startswith(b"\xff\xfe") or text.startswith(b"\xfe\xff"):
+        text = text.decode("utf-16", errors="ignore").encode()
+    return "lvm" if text.lstrip().startswith(b"LabVIEW Measurement") else None
+
+
+def choose_format(path: Path, format: str, head: bytes) -> str:
+    """The format to read, checked against the file's first bytes.
+
+    Parameters
+    ----------
+    path : Path
+        The file (its extension decides when ``format`` is ``"auto"``).
+    format : str
+        A key of :data:`FORMAT_ALIASES`.
+    head : bytes
+        The file's first bytes.
+    """
+    suffix = path.suffix.lower()
+    if suffix == ".tdms_index":
+        raise RigDataError("is a TDMS index file; read the .tdms file next to it", file=path)
+    wanted = FORMAT_ALIASES[format]
+    said = "format" if wanted != "auto" else f"extension {path.suffix or '(none)'!r}"
+    if wanted == "auto":
+        wanted = {".lvm": "lvm", ".tdms": "tdms"}.get(suffix, "csv")
+    found = content_format(head)
+    if found is not None and found != wanted:
+        name = {"tdms": "a TDMS file", "lvm": "a LabVIEW Measurement (LVM) file"}[found]
+        raise RigDataError(f"content is {name} but the {said} says {wanted}; rename the file or pass "
+                           f"format={found!r}", file=path)
+    if wanted == "tdms" and found != "tdms":
+        raise RigDataError(f"not a TDMS file: it does not start with 'TDSm' (the {said} says TDMS; "
+                           f"{len(head)} bytes read: {head[:16]!r})", file=path)
+    if wanted == "lvm" and found != "lvm":
+        raise RigDataError(f"not a LabVIEW Measurement file: the first line is not 'LabVIEW Measurement' "
+                           f"(the {said} says LVM; for delimited text pass format='csv')", file=path)
+    return wanted
+
+
+def decode(data: bytes, path: Path) -> str:
+    """Text of a file: UTF-8 (BOM or not), UTF-16 with BOM, else Latin-1; binary refused."""
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")):
+        try:
+            return data.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise RigDataError(f"unreadable UTF-16 text: {exc}", file=path) from exc
+    head = data[:8192]
+    controls = sum(head.count(bytes([b])) for b in range(32) if b not in (9, 10, 12, 13, 26))
+    if b"\x00" in head or controls > 0.02 * len(head):
+        raise RigDataError(f"not a text file (binary content: {head[:16]!r}...); expected delimited "
+                           f"text, LVM or TDMS", file=path)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")

@@ -1,0 +1,254 @@
+"""LabVIEW Measurement files (``.lvm``), parsed by ``lvm_read.read_str``.
+
+Segments are joined when they continue one another (same channels, same ``Delta_X``, no gap);
+the X column, when there is one, is the time axis. lvm_read leaves NaN, silently, in cells it
+cannot read and accepts rows cut short: both are checked here against the text itself.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import lvm_read
+import numpy as np
+
+from rigdata.readers.channels import column_unit
+from rigdata.readers.table import RawTable, TextCells, cell_value, find_text_cells
+from rigdata.record import RATE_TOLERANCE, RigDataError
+
+__all__ = ["read_lvm"]
+
+SEPARATORS = {"tab": "\t", "comma": ",", "semicolon": ";", "space": " "}
+#: What lvm_read raises on a file it cannot parse (it wraps nothing).
+PARSE_ERRORS = (ValueError, LookupError, TypeError, AttributeError, ArithmeticError, SyntaxError)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One LVM data segment: Y channel names, X and Y values, and per Y channel its header."""
+
+    names: list[str]          # Y channel names
+    x: np.ndarray | None      # X values (X_Columns One or Multi)
+    y: np.ndarray             # shape (rows, len(names))
+    x0: list[float]
+    dx: list[float]
+    units: list[str | None]
+    samples: list[float]
+
+
+def _data_lines(lines: list[str], sep: str) -> list[int]:
+    """Line indices of the data rows, segment after segment, as lvm_read walks them."""
+    rows, reading = [], False
+    for i, line in enumerate(lines):
+        first = line.split(sep, 1)[0]
+        if first in ("***End_of_Header***", "LabVIEW Measurement"):
+            continue
+        if line in ("", sep):
+            reading = False
+        elif reading:
+            rows.append(i)
+        elif first == "X_Value":
+            reading = True
+    return rows
+
+
+def _floats(values: list) -> list[float]:
+    return [float(v) if isinstance(v, (int, float)) else math.nan for v in values]
+
+
+def _per_column(seg: dict, key: str, count: int, first: int) -> list:
+    """A segment header tag's value for each of ``count`` columns: the header row has the tag
+    under the first column, values under the Y columns."""
+    values = list(seg.get(key, []))
+    at = [j + first - 1 for j in range(count)]
+    return [values[i] if 0 <= i < len(values) else None for i in at]
+
+
+def _segment_data(seg: dict, k: int, path: Path) -> tuple[list[str], np.ndarray]:
+    """Column names (without a trailing ``Comment``) and the values, padded to one per name."""
+    if "Channel names" not in seg or "data" not in seg:
+        raise RigDataError(f"truncated: segment {k + 1} has no data rows (the file ends in its header?)",
+                           file=path)
+    names = list(seg["Channel names"])
+    if names[-1:] == ["Comment"]:
+        names = names[:-1]
+    data = np.asarray(seg["data"], dtype=float)
+    if data.ndim != 2 or data.shape[0] == 0:
+        raise RigDataError(f"truncated: segment {k + 1} has no data rows", file=path)
+    if data.shape[1] < len(names):
+        data = np.hstack([data, np.full((data.shape[0], len(names) - data.shape[1]), np.nan)])
+    return names, data
+
+
+def _x_values(names: list[str], data: np.ndarray, k: int, path: Path) -> np.ndarray | None:
+    """The X column's values (all X columns must agree), None without one."""
+    x_index = [j for j, name in enumerate(names) if name == "X_Value"]
+    if not x_index:
+        return None
+    xs = [data[:, j] for j in x_index]
+    for j, other in zip(x_index[1:], xs[1:], strict=True):
+        if not np.array_equal(xs[0], other, equal_nan=True):
+            raise RigDataError(f"mixed sampling rates: segment {k + 1} has X columns with different "
+                               f"values (column {j + 1})", file=path)
+    return xs[0]
+
+
+def segment(seg: dict, k: int, x_columns: str, path: Path) -> Segment:
+    """Segment ``k`` (0-based) of what lvm_read returns, checked."""
+    names, data = _segment_data(seg, k, path)
+    first = 1 if x_columns == "No" else 0
+    y_index = [j for j, name in enumerate(names) if name != "X_Value"]
+    x = _x_values(names, data, k, path)
+    x0, dx, samples = (_floats(_per_column(seg, key, len(names), first))
+                       for key in ("X0", "Delta_X", "Samples"))
+    labels = _per_column(seg, "Y_Unit_Label", len(names), first)
+    return Segment([names[j] for j in y_index], x, data[:, y_index], [x0[j] for j in y_index],
+                   [dx[j] for j in y_index], [(labels[j] or "").strip() or None for j in y_index],
+                   [samples[j] for j in y_index])
+
+
+def _check_segment(seg: Segment, k: int, ref: Segment, path: Path) -> None:
+    """Same channels and sampling interval as segment 1, and as many rows as the header says."""
+    if not seg.names:
+        raise RigDataError(f"segment {k + 1} has no channels besides X_Value: its header is incomplete "
+                           f"(a blank line inside it?)", file=path)
+    dt = ref.dx[0]
+    if seg.names != ref.names:
+        raise RigDataError(f"segment {k + 1} has channels {seg.names}, segment 1 {ref.names}: segments "
+                           f"with different channels cannot be joined", file=path)
+    for name, d in zip(seg.names, seg.dx, strict=True):
+        if math.isfinite(dt) and not (math.isfinite(d) and abs(d / dt - 1.0) <= RATE_TOLERANCE):
+            raise RigDataError(f"mixed sampling rates: Delta_X {d:.6g} s in segment {k + 1}, {dt:.6g} s "
+                               f"for {ref.names[0]!r} in segment 1", file=path, channel=name)
+    samples = {s for s in seg.samples if math.isfinite(s)}
+    if len(samples) == 1 and seg.y.shape[0] < samples.pop():
+        raise RigDataError(f"truncated: segment {k + 1} has {seg.y.shape[0]} rows, its header says "
+                           f"Samples {max(seg.samples):g}", file=path)
+
+
+def _check_contiguous(prev: Segment, seg: Segment, k: int, dt: float, path: Path) -> None:
+    end = prev.x[-1] + dt if prev.x is not None else prev.x0[0] + dt * prev.y.shape[0]
+    start = seg.x[0] if seg.x is not None else seg.x0[0]
+    if math.isfinite(dt) and abs(start - end) > 0.5 * dt:
+        raise RigDataError(f"segment {k + 1} starts at t = {start:.6g} s, segment {k} ends at "
+                           f"{end - dt:.6g} s with Delta_X {dt:.6g} s: the segments are not "
+                           f"contiguous (a gap or overlap); split the file", file=path)
+
+
+def join(segments: list[Segment], path: Path) -> list[str]:
+    """Check that the segments continue one another; notes on what was joined."""
+    ref = segments[0]
+    for k, seg in enumerate(segments):
+        _check_segment(seg, k, ref, path)
+        if k:
+            _check_contiguous(segments[k - 1], seg, k, ref.dx[0], path)
+    return [f"{len(segments)} LVM segments joined"] if len(segments) > 1 else []
+
+
+def data_rows(lines: list[str], sep: str, width: int, path: Path, ends_clean: bool) -> list[int]:
+    """Line indices of the data rows; a row with fewer than ``width`` fields is an error (the
+    last one, or one without a line end: the file was cut short)."""
+    rows = _data_lines(lines, sep)
+    for k, i in enumerate(rows):
+        n = len(lines[i].split(sep))
+        if n >= width and (ends_clean or k < len(rows) - 1):
+            continue
+        if k == len(rows) - 1:
+            cut = "" if ends_clean else " and no line end"
+            raise RigDataError(f"truncated: the last line ({i + 1}) has {n} of {width} fields{cut}; the file "
+                               f"seems cut short", file=path)
+        raise RigDataError(f"line {i + 1} has {n} fields, the header has {width}", file=path)
+    return rows
+
+
+def text_cells(lines: list[str], rows: list[int], sep: str, decimal: str,
+               positions: Mapping[str, int], columns: Mapping[str, np.ndarray]) -> dict[str, TextCells]:
+    """The text behind the NaN that lvm_read leaves, silently, for cells it cannot read."""
+    cells = {}
+    for name, j in positions.items():
+        if not np.isnan(columns[name]).any():
+            continue
+        texts = np.array([lines[i].split(sep)[j].strip() for i in rows], dtype=object)
+        numbers = np.array([cell_value(t, decimal) for t in texts])
+        found = find_text_cells(texts, numbers, [i + 1 for i in rows])
+        if found:
+            cells[name] = found
+    return cells
+
+
+def _parse(text: str, path: Path) -> tuple[Any, dict]:
+    """lvm_read's result and the file header's tags as text."""
+    try:
+        lvm = lvm_read.read_str(text)
+    except PARSE_ERRORS as exc:  # lvm_read raises bare ValueError/KeyError/SyntaxError on bad files
+        if "no data segment" in str(exc):
+            raise RigDataError("truncated: no data segment after the LVM header", file=path) from exc
+        raise RigDataError(f"cannot parse as LVM: {type(exc).__name__}: {exc}", file=path) from exc
+    return lvm, {k: str(v) for k, v in lvm.items() if isinstance(k, str) and k != "Segments"}
+
+
+def _segments(lvm: Any, x_columns: str, path: Path) -> list[Segment]:
+    try:
+        return [segment(lvm[k], k, x_columns, path) for k in range(lvm["Segments"])]
+    except RigDataError:
+        raise
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise RigDataError(f"cannot parse as LVM: segment header incomplete ({type(exc).__name__}: {exc})",
+                           file=path) from exc
+
+
+def _time(lvm: Any, segments: list[Segment], path: Path) -> np.ndarray | None:
+    """The X values of every segment, joined; None when the file has no X column."""
+    if segments[0].x is None:
+        return None
+    dimension = (lvm[0].get("X_Dimension") or ["Time"])[0].strip() or "Time"
+    if dimension.lower() != "time":
+        raise RigDataError(f"X_Dimension is {dimension!r}, not Time: not a time record", file=path)
+    return np.concatenate([s.x for s in segments])
+
+
+def read_lvm(path: Path, text: str, sha: str) -> RawTable:
+    """The table of a LabVIEW Measurement file.
+
+    Parameters
+    ----------
+    path : Path
+        The file (for messages and the table's ``file``).
+    text : str
+        Its decoded text.
+    sha : str
+        SHA-256 of its bytes.
+    """
+    lvm, header = _parse(text, path)
+    x_columns = header.get("X_Columns", "One").strip()
+    sep = SEPARATORS.get(header.get("Separator", "Tab").strip().lower(), "\t")
+    segments = _segments(lvm, x_columns, path)
+    notes = join(segments, path)
+    ref = segments[0]
+    dup = sorted({n for n in ref.names if ref.names.count(n) > 1})
+    if dup:
+        raise RigDataError(f"duplicate channel names {dup}", file=path)
+    columns = {name: np.concatenate([s.y[:, j] for s in segments]) for j, name in enumerate(ref.names)}
+    units = {name: column_unit(name, ref.units[j]) for j, name in enumerate(ref.names)}
+    sampling = {name: (ref.x0[j], ref.dx[j]) for j, name in enumerate(ref.names)
+                if math.isfinite(ref.x0[j]) and math.isfinite(ref.dx[j])}
+    x = _time(lvm, segments, path)
+    time = None if x is None else "X_Value"
+    if time is not None:
+        columns, units[time] = {time: x, **columns}, "s"
+    lines = text.splitlines()
+    first = 1 if x_columns == "No" else 0
+    all_names = [n for n in lvm[0]["Channel names"] if n != "Comment"]
+    rows = data_rows(lines, sep, first + len(all_names), path, text.endswith(("\n", "\r")))
+    positions = {n: first + all_names.index(n) for n in ref.names}
+    if time is not None:
+        positions[time] = all_names.index("X_Value")
+    decimal = header.get("Decimal_Separator", ".").strip() or "."
+    cells = text_cells(lines, rows, sep, decimal, positions, columns)
+    return RawTable(str(path), "lvm", time, columns, units, header, cells, sampling,
+                    {"name": "lvm_read", "version": getattr(lvm_read, "__version__", "unknown")}, sha,
+                    tuple(notes))

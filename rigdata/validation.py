@@ -1,0 +1,317 @@
+"""The two computations of ``cardan rig``, as functions that return data.
+
+:func:`measure` (``cardan rig measure``): a record or file, conditioned over whole input
+revolutions, its measured efficiency with the GUM budget and Monte Carlo.
+
+:func:`validate` (``cardan rig validate`` without the report): the same measurement, then each
+engine driven by it (:func:`rigdata.model.measured_scene`) and the comparison: the difference,
+its standard uncertainty (the output transducer's error enters both sides, so that part is
+propagated as correlated) and whether it is significant at k = 2 (and by the Monte Carlo
+interval, which at 0.2 N m is far from symmetric). :func:`rigdata.report.write_report` puts a
+:class:`Validation` in a folder.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from cardan_exudyn.engines import get_engine, run
+from cardan_exudyn.io import to_jsonable
+from reference.paper import named_scene
+from reference.scene import Scene
+from reference.schema import Status
+from rigdata.conditioning import Conditioned, Conditioning, condition
+from rigdata.efficiency import SQRT3, Measured, measured_efficiency
+from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
+from rigdata.readers import read
+from rigdata.record import RigRecord
+from rigdata.transducer import PROVENANCE, Transducer
+
+__all__ = ["K", "MODEL_ENGINES", "Measurement", "Validation", "accuracy_needed", "as_record", "compare",
+           "measure", "validate"]
+
+#: A record, or a rig file to read.
+Source = RigRecord | str | os.PathLike
+#: Engines that take the measured angle drive and load history (MuJoCo takes constant loads only).
+MODEL_ENGINES = ("reference", "exudyn")
+K = 2.0  # coverage factor of the significance test
+#: Budget rows that are a constant error of the output torque, which the model's load shares.
+CONSTANT_OUTPUT_ERRORS = ("accuracy class, output torque", "resolution (acquisition step), output torque")
+
+
+def as_record(source: Source, **read_options: Any) -> RigRecord:
+    """``source`` itself when it is a record, else the record :func:`rigdata.readers.read` reads
+    from it with ``read_options`` (``format``, ``mapping``, ``units``, ``sensitivity``,
+    ``pulses_per_rev``)."""
+    if isinstance(source, RigRecord):
+        if read_options:
+            raise ValueError(f"read options {sorted(read_options)} apply to a file, not to a RigRecord")
+        return source
+    return read(source, **read_options)
+
+
+def _pair(transducers: Transducer | tuple[Transducer, Transducer] | None) -> tuple[Transducer, Transducer]:
+    if transducers is None:
+        return Transducer(), Transducer()
+    return transducers if isinstance(transducers, tuple) else (transducers, transducers)
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """The measured efficiency of one record (what ``cardan rig measure`` prints).
+
+    Attributes
+    ----------
+    record : RigRecord
+    conditioned : Conditioned
+        The signals over the whole-revolution window and the input yoke phase.
+    measured : Measured
+        Efficiency, its standard uncertainty, budget and Monte Carlo.
+    """
+
+    record: RigRecord
+    conditioned: Conditioned
+    measured: Measured
+
+    @property
+    def efficiency(self) -> float:
+        """Measured ``W_out / W_in`` over the window [-]."""
+        return self.measured.efficiency
+
+    @property
+    def u(self) -> float:
+        """Its combined standard uncertainty [-]."""
+        return self.measured.u
+
+    def as_dict(self) -> dict[str, Any]:
+        """``cardan rig measure --json``: file, the measured efficiency and its uncertainty
+        (:meth:`Measured.as_dict`), input yoke phase [deg], whether the data are synthetic."""
+        return {"file": str(self.record.file), **self.measured.as_dict(),
+                "phase_deg": math.degrees(self.conditioned.phase),
+                "synthetic": bool(self.record.provenance.get("synthetic"))}
+
+
+def measure(source: Source, shaft_angle_deg: float = 15.0, *, conditioning: Conditioning | None = None,
+            transducers: Transducer | tuple[Transducer, Transducer] | None = None,
+            monte_carlo: int = 2000, seed: int = 0, **read_options: Any) -> Measurement:
+    """Measured efficiency over whole input revolutions, with its uncertainty.
+
+    Parameters
+    ----------
+    source : RigRecord, str or path-like
+        A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
+    shaft_angle_deg : float
+        The joint's shaft angle [deg] (for the yoke phase estimate); 15 is the paper's rig.
+    conditioning : Conditioning, optional
+        Filter, window and derivative settings (default: :class:`Conditioning`).
+    transducers : Transducer or (input, output) pair, optional
+        Accuracy, drift and acquisition of the transducers (default: the paper's, with the
+        assumptions of :data:`rigdata.transducer.PROVENANCE`).
+    monte_carlo : int
+        Monte Carlo draws (0: GUM only).
+    seed : int
+        Seed of the draws.
+
+    Returns
+    -------
+    Measurement
+
+    Raises
+    ------
+    RigDataError
+        A file or record that cannot be measured (fewer than one whole revolution, ...).
+    """
+    record = as_record(source, **read_options)
+    cond = condition(record, math.radians(shaft_angle_deg), conditioning)
+    measured = measured_efficiency(cond, _pair(transducers), monte_carlo=monte_carlo, seed=seed)
+    return Measurement(record, cond, measured)
+
+
+def compare(measured: Measured, computed: Mapping[str, Any], sensitivities: Mapping[str, float]) -> dict:
+    """Difference measured - computed, its standard uncertainty and significance (k = 2).
+
+    The output transducer's constant errors (class, resolution) move the measured efficiency by
+    ``c_meas`` per N m and the computed one (through the load) by ``sensitivities["load"]``: the
+    difference sees ``c_meas - c_model`` (the drift, a ramp, is left uncorrelated: its share is
+    below 1e-3 of the variance). The yoke phase's half-turn ambiguity is a rectangular term of half
+    width |difference| / 2.
+
+    Returns
+    -------
+    dict
+        ``engine``, ``computed_efficiency`` [-], ``difference`` [-], ``difference_u`` [-],
+        ``expanded_u`` [-] (k = 2), ``significant_k2``; with Monte Carlo draws also
+        ``difference_interval_95_mc`` [-] and ``significant_mc``.
+    """
+    eta_model = computed["mean_efficiency"]
+    d = measured.efficiency - eta_model
+    terms = []
+    for row in measured.budget:
+        c = row["sensitivity"]
+        if row["quantity"] in CONSTANT_OUTPUT_ERRORS:  # the model's load carries them too
+            c = c - sensitivities["load"]
+        terms.append(c * row["standard_uncertainty"])
+    terms.append(0.5 * abs(sensitivities["phase_ambiguity"]) / SQRT3)
+    u = math.sqrt(sum(x * x for x in terms))
+    out = {"engine": computed["engine"], "computed_efficiency": eta_model, "difference": d,
+           "difference_u": u, "expanded_u": K * u, "significant_k2": bool(abs(d) > K * u)}
+    draws = measured.draws
+    if draws:
+        diffs = draws["efficiency"] - (eta_model + sensitivities["load"] * draws["offset_out"])
+        lo, hi = np.percentile(diffs, [2.5, 97.5])
+        # the draws spread the measurement around its value; the difference is significant when
+        # zero is outside the 95 % interval of the difference they give
+        out["difference_interval_95_mc"] = [float(lo), float(hi)]
+        out["significant_mc"] = bool(not (lo <= 0.0 <= hi))
+    return out
+
+
+def accuracy_needed(measured: Measured, target_u: float = 0.01) -> float:
+    """Accuracy class [-] the torque transducers would need for a standard uncertainty of
+    ``target_u`` [-] from the class alone (it scales linearly)."""
+    acc = [b["contribution"] for b in measured.budget if b["quantity"].startswith("accuracy class")]
+    total = math.sqrt(sum(a * a for a in acc))
+    cls = measured.summary["transducer_in"]["accuracy_class"]
+    return cls * target_u / total if total > 0 else float("nan")
+
+
+@dataclass(frozen=True)
+class Validation:
+    """Measured against computed efficiency for one record (what ``cardan rig validate`` reports).
+
+    Attributes
+    ----------
+    record : RigRecord
+    conditioned : Conditioned
+    measured : Measured
+    scene : Scene
+        The scene the engines ran: the joint driven and loaded by the measurement.
+    computed : dict of str to dict
+        Per engine, :func:`rigdata.model.computed_efficiency` of its run.
+    comparisons : dict of str to dict
+        Per engine that ran ``ok``, :func:`compare`.
+    sensitivities : dict
+        :func:`rigdata.model.model_sensitivities` (empty when no engine ran ``ok``).
+    transducers : tuple of Transducer
+        Input and output transducers.
+    """
+
+    record: RigRecord
+    conditioned: Conditioned
+    measured: Measured
+    scene: Scene
+    computed: dict[str, dict[str, Any]]
+    comparisons: dict[str, dict[str, Any]]
+    sensitivities: dict[str, float]
+    transducers: tuple[Transducer, Transducer]
+
+    @property
+    def measured_efficiency(self) -> float:
+        """Measured ``W_out / W_in`` over the window [-]."""
+        return self.measured.efficiency
+
+    @property
+    def computed_efficiency(self) -> dict[str, float | None]:
+        """Each engine's mean efficiency over the same revolutions [-] (None unless ``ok``)."""
+        return {engine: comp["mean_efficiency"] for engine, comp in self.computed.items()}
+
+    @property
+    def success(self) -> bool:
+        """True when every engine ran ``ok``."""
+        return all(comp["status"] == Status.OK for comp in self.computed.values())
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON summary (``validation.json``): file, provenance, conditioning, the measured
+        efficiency with its budget, the computed ones, comparisons, sensitivities, assumptions."""
+        rec, cond, meas = self.record, self.conditioned, self.measured
+        out = {
+            "file": str(rec.file), "provenance": {k: val for k, val in rec.provenance.items()
+                                                  if k not in ("header", "synthetic")},
+            "synthetic": rec.provenance.get("synthetic"), "sample_rate": rec.sample_rate,
+            "duration_s": rec.duration,
+            "conditioning": {**cond.settings, "cutoff_hz": cond.cutoff, "window_s": list(cond.window),
+                             "revolutions": cond.revolutions, "phase": cond.phase,
+                             "phase_deg": math.degrees(cond.phase), "phase_fit": cond.phase_fit},
+            **meas.as_dict(),
+            "computed": {engine: {k: val for k, val in comp.items() if k != "series"}
+                         for engine, comp in self.computed.items()},
+            "comparisons": self.comparisons,
+            "model_sensitivities": self.sensitivities,
+            "accuracy_class_for_u_0.01": accuracy_needed(meas),
+            "assumptions": PROVENANCE,
+        }
+        return to_jsonable(out)
+
+
+def _reference_efficiency(computed: Mapping[str, dict], cond: Conditioned, base: Scene) -> float:
+    """The reference engine's mean efficiency on the measured scene: its run's when it ran
+    ``ok``, else a run of its own (NaN when that fails)."""
+    ref = computed.get("reference")
+    if ref is not None and ref["status"] == Status.OK:
+        return float(ref["mean_efficiency"])
+    result = run(measured_scene(cond, base), "reference")
+    return float(result.mean_efficiency) if result.success else float("nan")
+
+
+def validate(source: Source, scene: Scene | str = "rig-calibrated",
+             engines: tuple[str, ...] = MODEL_ENGINES, *, conditioning: Conditioning | None = None,
+             transducers: Transducer | tuple[Transducer, Transducer] | None = None,
+             monte_carlo: int = 2000, seed: int = 0, progress: Callable[[str], None] | None = None,
+             **read_options: Any) -> Validation:
+    """Measured against computed efficiency for one record (see the module docstring).
+
+    Parameters
+    ----------
+    source : RigRecord, str or path-like
+        A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
+    scene : Scene or str
+        Joint, shaft angle, friction and numerics of the model (its drive and load are replaced);
+        a name for :func:`reference.paper.named_scene`.
+    engines : tuple of str
+        Engines to drive (keys of :data:`cardan_exudyn.engines.ENGINES` that take angle drives
+        and load histories: :data:`MODEL_ENGINES`).
+    conditioning, transducers, monte_carlo, seed
+        As for :func:`measure`.
+    progress : callable(str), optional
+        Called with a line before each long step.
+
+    Returns
+    -------
+    Validation
+        Nothing is written; :func:`rigdata.report.write_report` writes the report folder.
+
+    Raises
+    ------
+    RigDataError
+        A file or record that cannot be measured.
+    EngineUnavailable
+        An engine that is unknown or not installed.
+    """
+    say = progress or (lambda line: None)
+    base = named_scene(scene) if isinstance(scene, str) else scene
+    for engine in engines:
+        get_engine(engine)  # an unknown engine fails now, not after the measurement
+    record, pair = as_record(source, **read_options), _pair(transducers)
+    say("conditioning")
+    cond = condition(record, base.joint.geometry.shaft_angle, conditioning)
+    say("measured efficiency and its uncertainty")
+    measured = measured_efficiency(cond, pair, monte_carlo=monte_carlo, seed=seed)
+    model = measured_scene(cond, base)
+    computed, comparisons, sens = {}, {}, None
+    for engine in engines:
+        say(f"model driven by the measurement: {engine}")
+        computed[engine] = computed_efficiency(run(model, engine))
+        if computed[engine]["status"] != Status.OK:
+            continue
+        if sens is None:
+            say("model sensitivities (load offset, yoke half turn)")
+            sens = model_sensitivities(cond, base, pair[1].accuracy_limit / SQRT3,
+                                       _reference_efficiency(computed, cond, base))
+        comparisons[engine] = compare(measured, computed[engine], sens)
+    return Validation(record, cond, measured, model, computed, comparisons, sens or {}, pair)

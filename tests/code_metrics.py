@@ -1,0 +1,155 @@
+"""Static facts about the product code (``reference``, ``cardan_exudyn``, ``rigdata``): module
+sizes, function lengths, the import graph. ``tests/test_architecture.py`` asserts on them; run
+this file to print the figures::
+
+    python tests/code_metrics.py [ROOT]
+
+A function's length is its body without the docstring, in lines (``end_lineno`` of the last
+statement minus the line of the first, plus one), nested functions counted in their parent too.
+"""
+
+from __future__ import annotations
+
+import ast
+import statistics
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("reference", "cardan_exudyn", "rigdata")
+
+
+@dataclass(frozen=True)
+class Function:
+    module: str
+    name: str
+    line: int
+    length: int
+
+
+def module_name(path: Path, root: Path = ROOT) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def product_files(root: Path = ROOT) -> list[Path]:
+    return sorted(p for pkg in PACKAGES for p in (root / pkg).rglob("*.py"))
+
+
+def body_length(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    body = node.body
+    if (len(body) > 1 and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)
+            and isinstance(body[0].value.value, str)):
+        body = body[1:]
+    return body[-1].end_lineno - body[0].lineno + 1
+
+
+def functions(path: Path, root: Path = ROOT) -> Iterator[Function]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            yield Function(module_name(path, root), node.name, node.lineno, body_length(node))
+
+
+def module_lines(root: Path = ROOT) -> dict[str, int]:
+    return {module_name(p, root): len(p.read_text(encoding="utf-8").splitlines())
+            for p in product_files(root)}
+
+
+def _resolve(module: str, name: str | None, known: set[str]) -> str | None:
+    """The product module an import refers to (a submodule when ``name`` is one)."""
+    if name is not None and f"{module}.{name}" in known:
+        return f"{module}.{name}"
+    return module if module in known else None
+
+
+def imports(path: Path, root: Path = ROOT, known: set[str] | None = None) -> set[str]:
+    """Product modules ``path`` imports anywhere (module level or inside functions).
+
+    The parent packages an import also executes are not counted: a package face that imports
+    its submodules is no cycle; a submodule importing names from its own package face is.
+    """
+    known = known if known is not None else {module_name(p, root) for p in product_files(root)}
+    me = module_name(path, root)
+    package = me if path.name == "__init__.py" else me.rpartition(".")[0]
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        targets: list[str | None] = []
+        if isinstance(node, ast.Import):
+            targets = [_resolve(a.name, None, known) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
+                base = f"{anchor}.{base}" if base else anchor
+            targets = [_resolve(base, a.name, known) for a in node.names]
+        out |= set(filter(None, targets))
+    out.discard(me)
+    return out
+
+
+def import_graph(root: Path = ROOT) -> dict[str, set[str]]:
+    known = {module_name(p, root) for p in product_files(root)}
+    return {module_name(p, root): imports(p, root, known) for p in product_files(root)}
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def report(root: Path = ROOT) -> str:
+    sizes = module_lines(root)
+    lengths = [f.length for p in product_files(root) for f in functions(p, root)]
+    deciles = statistics.quantiles(lengths, n=10)
+    over_60 = sorted((f for p in product_files(root) for f in functions(p, root) if f.length > 60),
+                     key=lambda f: -f.length)
+    lines = [
+        f"modules: {len(sizes)}, lines: {sum(sizes.values())}, largest: "
+        + ", ".join(f"{m} {n}" for m, n in sorted(sizes.items(), key=lambda kv: -kv[1])[:5]),
+        f"modules over 600 lines: {sum(n > 600 for n in sizes.values())}",
+        f"functions: {len(lengths)}, median length {statistics.median(lengths):g}, "
+        f"90th percentile {deciles[-1]:g}, over 30 lines {sum(n > 30 for n in lengths)}, "
+        f"over 60 lines {len(over_60)}",
+        *(f"  {f.module}:{f.name} {f.length}" for f in over_60),
+        f"import cycles: {cycles(import_graph(root)) or 'none'}",
+    ]
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(report(Path(sys.argv[1]).resolve() if len(sys.argv) > 1 else ROOT))
