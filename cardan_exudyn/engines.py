@@ -123,8 +123,3 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
         return run_function(scene, options)
     except NotImplementedError as exc:
         raise EngineUnavailable(f"engine {engine!r} cannot run scene {scene.name!r}: {exc}") from None
-
-
-def run_scene(scene: Scene, engine: str = "exudyn", options: Any = None) -> Result:
-    """Run ``scene`` with the named engine (same as :func:`run`)."""
-    return run(scene, engine, options)

@@ -237,19 +237,6 @@ class Summary:
         summary.status = Status(summary.status)
         return summary
 
-    # Read access by key, as for the version-1 dictionaries: absent keys are those without a value.
-    def _flat(self) -> dict[str, Any]:
-        return {k: v for k, v in self.to_dict().items() if v is not None and k != "schema_version"}
-
-    def __getitem__(self, key: str) -> Any:
-        return self._flat()[key]
-
-    def get(self, key: str, default: Any = None) -> Any:
-        return self._flat().get(key, default)
-
-    def __contains__(self, key: str) -> bool:
-        return key in self._flat()
-
 
 @dataclass
 class Result:
@@ -285,7 +272,6 @@ class Result:
         """One minus lost over input work over whole revolutions (None unless ``ok``)."""
         return self.summary.mean_efficiency
 
-    ok = success  # version-1 name
 
 
 def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tuple[float, float, int]:

@@ -19,8 +19,8 @@ def balance_residual(result) -> tuple[float, float]:
     energy = (t["energy_kinetic"] + t["energy_potential"]).to_numpy()
     theta = t["theta_in"].to_numpy()
     e0 = np.interp(theta[0] + 0.0, theta, energy)
-    e1 = np.interp(theta[0] + 2 * math.pi * s["revolutions"], theta, energy)
-    return s["input_work"] - s["output_work"] - s["loss_work"] - (e1 - e0), s["input_work"]
+    e1 = np.interp(theta[0] + 2 * math.pi * s.revolutions, theta, energy)
+    return s.input_work - s.output_work - s.loss_work - (e1 - e0), s.input_work
 
 
 @pytest.mark.parametrize("name", ["paper-10deg-frictionless", "paper-35deg-frictionless"])
@@ -45,8 +45,8 @@ def test_torque_drive_energy_balance():
     residuals = []
     for dt in (5e-4, 2.5e-4):
         result = run(replace(base, drive=drive, **{"numerics.dt": dt}))
-        assert result.ok, result.summary["reason"]
-        assert isinstance(result.summary["scene"]["drive"], dict)
+        assert result.success, result.summary.reason
+        assert isinstance(result.summary.scene["drive"], dict)
         t = result.table
         # net torque 1.5 N m on ~0.01 kg m^2 accelerates it tenfold within two revolutions
         assert t["omega_in"].iloc[-1] > 5 * t["omega_in"].iloc[0]
@@ -65,7 +65,7 @@ def test_angle_drive_reproduces_speed_drive():
                                               "angle": (omega * t).tolist()})
     assert isinstance(angle_scene.drive, AngleDrive)
     a, b = run(speed_scene), run(angle_scene)
-    assert a.ok and b.ok
+    assert a.success and b.success
     n = min(len(a.table), len(b.table))
     np.testing.assert_allclose(b.table["omega_out"][:n], a.table["omega_out"][:n], rtol=1e-6)
     # the drive torque includes the spline's tiny acceleration error: 1e-4 of 1.5 N m

@@ -14,7 +14,7 @@ from reference.kinematics import output_angle, speed_ratio
 
 def ratio_error(result) -> float:
     t = result.table
-    beta = result.summary["scene"]["joint"]["geometry"]["shaft_angle"]
+    beta = result.summary.scene["joint"]["geometry"]["shaft_angle"]
     return float(np.max(np.abs(t["omega_out"] / t["omega_in"] - speed_ratio(t["theta_in"].to_numpy(), beta))))
 
 
@@ -23,7 +23,7 @@ def test_auto_step_meets_accuracy(beta_deg):
     """With the automatic step the speed-ratio error stays within the requested accuracy."""
     accuracy = 1e-5
     result = run(balanced_scene(beta_deg, rpm=2000, gravity=(0, 0, 0), accuracy=accuracy))
-    assert result.ok
+    assert result.success
     # the step model K(beta) h^2 is fitted within 10 % (cardan_exudyn/stepsize.py)
     assert ratio_error(result) <= 1.1 * accuracy
 

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
 
-from cardan_exudyn.engines import run_scene
+import cardan_exudyn
 from reference import kinematics, rccc
 from reference.dynamics import dynamics_columns
 from reference.engine import run
@@ -134,10 +134,10 @@ def test_energy_balance_closes_with_sliding_pairs(key):
     term breaks the balance by the sliding work, which is 1e-4..1e-2 of the input work here.
     """
     summary = run(_error_scene(key)).summary
-    assert summary["status"] == "ok"
-    sliding = sum(summary[f"loss_work_{p}_sliding"] for p in CYLINDRICAL)
-    assert sliding > 1e-5 * summary["input_work"]
-    assert abs(summary["energy_balance_residual"]) <= 1e-9 * abs(summary["input_work"])
+    assert summary.status == "ok"
+    sliding = sum(summary.pair_sliding_loss_work[p] for p in CYLINDRICAL)
+    assert sliding > 1e-5 * summary.input_work
+    assert abs(summary.extras["energy_balance_residual"]) <= 1e-9 * abs(summary.input_work)
 
 
 @pytest.mark.parametrize("key", list(ERROR_SCENES))
@@ -156,7 +156,7 @@ def test_friction_is_the_law_of_the_reported_reactions_and_slides(key):
 
 def test_ideal_joint_has_no_sliding_work():
     summary = run(one_revolution("rig-calibrated")).summary
-    assert all(summary[f"loss_work_{p}_sliding"] == 0.0 for p in CYLINDRICAL)
+    assert all(summary.pair_sliding_loss_work[p] == 0.0 for p in CYLINDRICAL)
 
 
 @pytest.mark.parametrize("engine", ["reference", "exudyn"])
@@ -167,9 +167,9 @@ def test_ideal_joint_has_no_sliding_work():
 def test_loop_that_cannot_close_is_a_status_not_a_crash(engine, twists, message):
     scene = replace(named_scene("paper-30deg-frictionless"),
                     **{f"joint.errors.{k}": v for k, v in twists.items()})
-    result = run_scene(scene, engine)
-    assert result.summary["status"] == "loop_does_not_close" and result.table is None
-    assert message in result.summary["reason"]
+    result = cardan_exudyn.run(scene, engine)
+    assert result.summary.status == "loop_does_not_close" and result.table is None
+    assert message in result.summary.reason
 
 
 # ----------------------------------------------------------------------------- Exudyn vs reference
@@ -182,7 +182,7 @@ def _on_rows(reference_table, exudyn_table, column):
 @pytest.fixture(scope="module")
 def frictionless_ideal():
     scene = one_revolution("paper-30deg-frictionless")
-    return run_scene(scene, "reference").table, run_scene(scene, "exudyn").table
+    return cardan_exudyn.run(scene, "reference").table, cardan_exudyn.run(scene, "exudyn").table
 
 
 @pytest.mark.parametrize("error", list(SINGLE))
@@ -198,7 +198,7 @@ def test_exudyn_kinematics_and_sliding_agree_with_reference(error, frictionless_
     Exudyn's step error in Exudyn. The pairs that must not slide stay below 1e-9 m/s.
     """
     scene = one_revolution("paper-30deg-frictionless", **{f"joint.errors.{error}": SINGLE[error]})
-    ref, exu = run_scene(scene, "reference").table, run_scene(scene, "exudyn").table
+    ref, exu = cardan_exudyn.run(scene, "reference").table, cardan_exudyn.run(scene, "exudyn").table
     ref0, exu0 = frictionless_ideal
     rows = exu["theta_in"].to_numpy() > 0.5 * math.pi
     assert np.max(np.abs(exu["theta_out"] - _on_rows(ref, exu, "theta_out"))) <= 1e-8
@@ -223,7 +223,7 @@ def test_exudyn_kinematics_and_sliding_agree_with_reference(error, frictionless_
 @pytest.fixture(scope="module")
 def rig_ideal():
     scene = one_revolution("rig-calibrated")
-    return run_scene(scene, "reference").summary, run_scene(scene, "exudyn").summary
+    return cardan_exudyn.run(scene, "reference").summary, cardan_exudyn.run(scene, "exudyn").summary
 
 
 @pytest.mark.parametrize("error", list(SINGLE))
@@ -235,15 +235,15 @@ def test_exudyn_and_reference_agree_on_each_errors_effect_on_efficiency(error, r
     at its automatic step for this case. Sliding work within 1 % of the reference's.
     """
     scene = one_revolution("rig-calibrated", **{f"joint.errors.{error}": SINGLE[error]})
-    ref, exu = run_scene(scene, "reference").summary, run_scene(scene, "exudyn").summary
+    ref, exu = cardan_exudyn.run(scene, "reference").summary, cardan_exudyn.run(scene, "exudyn").summary
     ref0, exu0 = rig_ideal
-    assert ref["status"] == exu["status"] == "ok"
-    effect_ref = ref["mean_efficiency"] - ref0["mean_efficiency"]
-    effect_exu = exu["mean_efficiency"] - exu0["mean_efficiency"]
+    assert ref.status == exu.status == "ok"
+    effect_ref = ref.mean_efficiency - ref0.mean_efficiency
+    effect_exu = exu.mean_efficiency - exu0.mean_efficiency
     assert abs(effect_exu - effect_ref) <= 3e-4
     if error in SLIDING:
         assert abs(effect_ref) > 3e-3  # far above the bound: the agreement is meaningful
         for pair in SLIDING[error]:
-            key = f"loss_work_{pair}_sliding"
-            assert ref[key] > 0
-            assert exu[key] == pytest.approx(ref[key], rel=1e-2), pair
+            assert ref.pair_sliding_loss_work[pair] > 0
+            assert exu.pair_sliding_loss_work[pair] == pytest.approx(
+                ref.pair_sliding_loss_work[pair], rel=1e-2), pair

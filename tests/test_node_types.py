@@ -64,7 +64,7 @@ def _run(scene, node_type, built):
     assert model.node_type == node_type
     for body, expected in (("input", "Rxyz"), ("spider", node_type), ("output", node_type)):
         assert model.mbs.GetNode(model.nodes[body])["nodeType"] == NODE_CLASS[expected]
-    assert result.summary["status"] == "ok", result.summary["reason"]
+    assert result.summary.status == "ok", result.summary.reason
     return result, model
 
 
@@ -153,7 +153,7 @@ def test_speed_ratio_is_second_order(node_type, built):
 
 @pytest.fixture(scope="module")
 def reference_efficiency():
-    return reference_run(_scene("paper-10deg", 200)).summary["mean_efficiency"]
+    return reference_run(_scene("paper-10deg", 200)).summary.mean_efficiency
 
 
 @pytest.mark.parametrize("node_type", NODE_TYPES)
@@ -161,6 +161,6 @@ def test_mean_efficiency_with_friction(node_type, built, reference_efficiency):
     """10 deg, converged friction, 200 steps per revolution: the mean efficiency is within 1e-3 of
     the reference engine's (measured 5.3e-4 to 5.9e-4), and friction really costs power."""
     result, _ = _run(_scene("paper-10deg", 200), node_type, built)
-    eta = result.summary["mean_efficiency"]
+    eta = result.summary.mean_efficiency
     assert eta < 0.6
     assert abs(eta - reference_efficiency) <= EFFICIENCY_BOUND, (eta, reference_efficiency)

@@ -38,13 +38,13 @@ def test_projection_gives_hookes_speed_ratio_at_a_coarse_step(angle):
     scene = _steps(named_scene(f"paper-{angle}deg-frictionless"), 50)
     plain = run(scene)
     projected = run(scene, options=ExudynOptions(velocity_projection=True))
-    assert plain.ok and projected.ok
+    assert plain.success and projected.success
     assert _ratio_error(scene, plain.table) > 5e-5
     assert _ratio_error(scene, projected.table) < 1e-12
     np.testing.assert_array_equal(plain.table["torque_in"], projected.table["torque_in"])
     np.testing.assert_array_equal(plain.table["theta_out"], projected.table["theta_out"])
-    assert projected.summary["max_velocity_correction"] > 0.0
-    assert projected.summary["options"]["velocity_projection"] is True
+    assert projected.summary.extras["max_velocity_correction"] > 0.0
+    assert projected.summary.options["velocity_projection"] is True
 
 
 def test_projection_with_mounting_errors_matches_the_reference_engine():
@@ -56,7 +56,7 @@ def test_projection_with_mounting_errors_matches_the_reference_engine():
     ex = run(scene, options=ExudynOptions(velocity_projection=True))
     plain = run(scene)
     ref = reference_run(scene)
-    assert ex.ok and ref.ok
+    assert ex.success and ref.success
     w_ref = ref.table["omega_out"].to_numpy()
     n = min(len(w_ref), len(ex.table))
     err_projected = np.max(np.abs(ex.table["omega_out"].to_numpy()[:n] - w_ref[:n]))

@@ -220,7 +220,7 @@ def energy_change(result) -> float:
     energy = (t["energy_kinetic"] + t["energy_potential"]).to_numpy()
     theta = t["theta_in"].to_numpy()
     sign = 1.0 if theta[-1] >= theta[0] else -1.0
-    end = theta[0] + sign * 2 * math.pi * s["revolutions"]
+    end = theta[0] + sign * 2 * math.pi * s.revolutions
     if sign < 0:
         theta, end, start = -theta, -end, -theta[0]
     else:
@@ -235,13 +235,13 @@ def signed_balance_residual(result) -> tuple[float, float]:
     if t["theta_in"].iloc[-1] >= t["theta_in"].iloc[0]:
         return balance_residual(result)
     s = result.summary
-    return (s["input_work"] - s["output_work"] - s["loss_work"] - energy_change(result),
-            s["input_work"])
+    return (s.input_work - s.output_work - s.loss_work - energy_change(result),
+            s.input_work)
 
 
 def angle_step(scene, result) -> float:
     """``h = omega dt``, the input-angle step [rad]."""
-    return abs(scene.drive.speed) * result.summary["dt"]
+    return abs(scene.drive.speed) * result.summary.dt
 
 
 def balance_tolerance(scene, result, engine: str) -> float:
@@ -258,7 +258,7 @@ def efficiency_tolerance(scene, exudyn) -> float:
     s = exudyn.summary
     h = angle_step(scene, exudyn)
     k = error_coefficient(scene.joint.geometry.shaft_angle)
-    w_in, w_loss = abs(s["input_work"]), abs(s["loss_work"])
+    w_in, w_loss = abs(s.input_work), abs(s.loss_work)
     bound = h * h * (1.0 + k) * (C_1 * energy_scale(exudyn.table) + C_2 * w_loss)
     if scene.friction.coupling == "lagged":
         bound += C_LAG * h * w_loss
@@ -269,14 +269,14 @@ def efficiency_tolerance(scene, exudyn) -> float:
 
 def check_status_contract(result, engine: str) -> None:
     s = result.summary
-    status, reason = s.get("status"), s.get("reason")
+    status, reason = s.status, s.reason
     assert status in STATUSES[engine], (status, reason)
     assert isinstance(reason, str), reason
     if status == "ok":
         assert reason == "", reason
         return
     assert reason.strip(), f"status {status!r} without a reason"
-    shown = {k: s[k] for k in EFFICIENCY_KEYS if s.get(k) is not None}
+    shown = {k: getattr(s, k) for k in EFFICIENCY_KEYS if getattr(s, k) is not None}
     assert not shown, f"status {status!r} presents efficiencies {shown}"
 
 
@@ -300,21 +300,21 @@ def check_finite(result, engine: str) -> None:
         assert key in numbers, key
     # 0/0 is not a number: NaN marks an undefined quotient (the CLI prints "undefined", JSON null)
     allowed_nan = set()
-    if s["input_work"] == 0.0:
+    if s.input_work == 0.0:
         allowed_nan |= {"mean_efficiency", "work_ratio"}
     if undefined.any() or overflow_allowed:
         allowed_nan.add("mean_instantaneous_efficiency")
     bad = [k for k, v in numbers.items() if not math.isfinite(v) and k not in allowed_nan]
     assert not bad, {k: s[k] for k in bad}
-    assert s["revolutions"] >= 1
+    assert s.revolutions >= 1
 
 
 def uncoupled_without_work(result) -> bool:
     """An uncoupled run whose input work is rounding noise of its energy scale (no load, or a
     load as good as none: hypothesis tries 2e-313 N m)."""
-    coupling = result.summary["scene"]["friction"]["coupling"]
+    coupling = result.summary.scene["friction"]["coupling"]
     return (coupling == "uncoupled"
-            and abs(result.summary["input_work"]) <= 1e-9 * energy_scale(result.table))
+            and abs(result.summary.input_work) <= 1e-9 * energy_scale(result.table))
 
 
 def check_efficiency_column(scene, result, engine: str) -> None:
@@ -355,7 +355,7 @@ def fixed_point_slack(scene, table) -> float:
 def check_energy_and_means(scene, result, engine: str, cell: dict) -> None:
     s = result.summary
     residual, w_in = signed_balance_residual(result)
-    w_loss, w_out = s["loss_work"], s["output_work"]
+    w_loss, w_out = s.loss_work, s.output_work
     tol = balance_tolerance(scene, result, engine)
     uncoupled = scene.friction.coupling == "uncoupled"
     if uncoupled:  # friction is not in the dynamics: the input work pays no loss
@@ -364,14 +364,14 @@ def check_energy_and_means(scene, result, engine: str, cell: dict) -> None:
             cell)
     assert abs(residual) <= tol, (residual, tol, w_in)
     if w_in == 0.0:  # 0/0: no efficiency (check_finite: NaN, not a number presented)
-        assert math.isnan(s["mean_efficiency"])
+        assert math.isnan(s.mean_efficiency)
         return
-    eta = s["mean_efficiency"]
+    eta = s.mean_efficiency
     assert eta == pytest.approx(1.0 - w_loss / w_in, rel=1e-12, abs=1e-12)
     if not scene.has_friction:
         assert eta == 1.0
         if not np.any(result.table["power_in"].to_numpy() == 0.0):
-            assert s["mean_instantaneous_efficiency"] == pytest.approx(1.0, abs=1e-12)
+            assert s.mean_instantaneous_efficiency == pytest.approx(1.0, abs=1e-12)
         return
     assert w_out >= -tol, (w_out, tol)        # the load resists: it only takes power
     assert w_loss >= -tol, (w_loss, tol)      # friction only dissipates
@@ -387,7 +387,7 @@ def check_energy_and_means(scene, result, engine: str, cell: dict) -> None:
 def check_invariants(cell: dict, engine: str, node_type: str = "Rxyz"):
     scene, result = run_cell(cell, engine, node_type)
     check_status_contract(result, engine)
-    if result.ok:
+    if result.success:
         check_finite(result, engine)
         check_efficiency_column(scene, result, engine)
         check_energy_and_means(scene, result, engine, cell)
@@ -466,7 +466,7 @@ QUASI_STATIC = cells(max_angle=45.0, max_rpm=60.0, min_load=0.2, gravity=(False,
 def check_quasi_static(cell: dict, engine: str) -> None:
     """Where the power flows one way, eq. (18) and its time average are in [0, 1]."""
     scene, result = check_invariants(cell, engine)
-    if not result.ok:
+    if not result.success:
         return
     t = result.table
     energy = (t["energy_kinetic"] + t["energy_potential"]).to_numpy()
@@ -477,7 +477,7 @@ def check_quasi_static(cell: dict, engine: str) -> None:
     if engine == "exudyn":  # the friction's fixed-point residual over the smallest input power
         slack = fixed_point_slack(scene, t) / t["power_in"].abs().min()
     assert eta.min() >= -slack and eta.max() <= 1.0 + slack, (eta.min(), eta.max())
-    mean = result.summary["mean_instantaneous_efficiency"]
+    mean = result.summary.mean_instantaneous_efficiency
     assert -slack - 1e-12 <= mean <= 1.0 + slack + 1e-12, mean
 
 
@@ -510,13 +510,13 @@ INSIDE = cells(max_angle=50.0, min_load=0.2, max_friction=0.5, couplings=("conve
 
 def check_engines_agree(cell: dict) -> None:
     scene, ref = check_invariants(cell, "reference")
-    assume(ref.ok and ref.summary["max_friction_loop_gain"] <= CLEARLY_OK_GAIN)
+    assume(ref.success and ref.summary.max_friction_loop_gain <= CLEARLY_OK_GAIN)
     _, exu = check_invariants(cell, "exudyn")
-    assert exu.ok, (exu.summary["status"], exu.summary["reason"])
+    assert exu.success, (exu.summary.status, exu.summary.reason)
     if not scene.has_friction:
-        assert exu.summary["mean_efficiency"] == ref.summary["mean_efficiency"] == 1.0
+        assert exu.summary.mean_efficiency == ref.summary.mean_efficiency == 1.0
         return
-    difference = exu.summary["mean_efficiency"] - ref.summary["mean_efficiency"]
+    difference = exu.summary.mean_efficiency - ref.summary.mean_efficiency
     bound = efficiency_tolerance(scene, exu)
     _record(f"efficiency/{scene.friction.coupling}", abs(difference) / bound, cell)
     assert abs(difference) <= bound, (difference, bound)
@@ -548,7 +548,7 @@ def check_locking_between_samples(angle_deg: float, samples: int) -> None:
     scene = scene_of(cell)
     result = reference_run(scene, ReferenceOptions(samples_per_revolution=samples))
     check_status_contract(result, "reference")
-    if result.ok:
+    if result.success:
         check_finite(result, "reference")
 
 
@@ -566,9 +566,8 @@ def test_statuses_seen_include_locking_and_ok():
     (README)."""
     base = {"base": "paper", "speed_rpm": 2000.0, "direction": 1, "load": 2.0, "f_spider": 0.42,
             "f_frame": 0.2, "coupling": "converged", "gravity": True, "errors": None}
-    assert check_invariants({**base, "shaft_angle_deg": 50.0}, "reference")[1].summary[
-        "status"] == "self_locking"
-    assert check_invariants({**base, "shaft_angle_deg": 10.0}, "reference")[1].ok
+    assert check_invariants({**base, "shaft_angle_deg": 50.0}, "reference")[1].summary.status == "self_locking"
+    assert check_invariants({**base, "shaft_angle_deg": 10.0}, "reference")[1].success
 
 
 def test_instantaneous_efficiency_is_not_bounded():
@@ -580,8 +579,8 @@ def test_instantaneous_efficiency_is_not_bounded():
             "gravity": True, "errors": None}
     _, result = check_invariants(cell, "reference")
     s, t = result.summary, result.table
-    assert result.ok and 0.0 < s["mean_efficiency"] < 0.1  # README: 0.071
-    assert s["mean_instantaneous_efficiency"] < 0.0        # measured -0.41
+    assert result.success and 0.0 < s.mean_efficiency < 0.1  # README: 0.071
+    assert s.mean_instantaneous_efficiency < 0.0        # measured -0.41
     assert (t["power_in"] < 0).any()
 
 
@@ -596,5 +595,5 @@ def test_uncoupled_without_load_has_no_efficiency():
             "load": 0.0, "f_spider": 0.5, "f_frame": 0.2, "coupling": "uncoupled",
             "gravity": False, "errors": None}
     s = reference_run(scene_of(cell)).summary
-    eta = s.get("mean_efficiency")
-    assert s["status"] != "ok" or eta is None or math.isnan(eta) or 0.0 <= eta <= 1.0, eta
+    eta = s.mean_efficiency
+    assert s.status != "ok" or eta is None or math.isnan(eta) or 0.0 <= eta <= 1.0, eta
