@@ -42,6 +42,34 @@ def _merge(base: dict, over: Mapping) -> dict:
     return out
 
 
+def read_toml(path: str | pathlib.Path, what: str, noun: str,
+              error: type[Exception]) -> dict[str, Any]:
+    """The table of a UTF-8 TOML file, or ``error`` with one line naming ``what`` and the path.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    what : str
+        What the file is, for messages ("scene file", "sweep spec").
+    noun : str
+        What such a file holds, for the not-text message ("a scene").
+    error : type
+        The exception to raise (the caller's own input-error type).
+    """
+    path = pathlib.Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise error(f"cannot read {what} {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise error(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}); {noun} is a "
+                    "TOML file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{what} {str(path)!r} is not valid TOML: {exc}") from None
+
+
 def load_scene(path: str | pathlib.Path) -> Scene:
     """Load a scene from a TOML file.
 
@@ -62,18 +90,7 @@ def load_scene(path: str | pathlib.Path) -> Scene:
         The file cannot be read, is not TOML, or does not describe a valid scene; the message
         starts with the path.
     """
-    path = pathlib.Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SceneError(f"cannot read scene file {str(path)!r}: {exc.strerror}") from None
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"scene file {str(path)!r} is not UTF-8 text (byte {exc.start}); a scene is a "
-                         "TOML file") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"scene file {str(path)!r} is not valid TOML: {exc}") from None
+    data = read_toml(path, "scene file", "a scene", SceneError)
     try:
         return scene_from_mapping(data)
     except SceneError as exc:

@@ -566,7 +566,8 @@ def test_statuses_seen_include_locking_and_ok():
     (README)."""
     base = {"base": "paper", "speed_rpm": 2000.0, "direction": 1, "load": 2.0, "f_spider": 0.42,
             "f_frame": 0.2, "coupling": "converged", "gravity": True, "errors": None}
-    assert check_invariants({**base, "shaft_angle_deg": 50.0}, "reference")[1].summary.status == "self_locking"
+    locked = check_invariants({**base, "shaft_angle_deg": 50.0}, "reference")[1]
+    assert locked.summary.status == "self_locking"
     assert check_invariants({**base, "shaft_angle_deg": 10.0}, "reference")[1].success
 
 

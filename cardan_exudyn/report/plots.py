@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from reference.joint import PAIR_NAMES  # noqa: E402
+from reference.schema import Status  # noqa: E402
 
 
 def _axes(ax):
@@ -136,7 +137,7 @@ def work_precision(rows, speed_ratio_level: float, efficiency_level: float):
                              constrained_layout=True)
     markers = {"exudyn": "o", "mujoco": "s", "reference": "^"}
     for j, scene in enumerate(scenes):
-        sel = rows[(rows["scene"] == scene) & (rows["status"] == "ok")]
+        sel = rows[(rows["scene"] == scene) & (rows["status"] == Status.OK)]
         friction = scene.startswith("friction-")
         top = "mean_efficiency_error" if friction else "speed_ratio_error"
         level = efficiency_level if friction else speed_ratio_level
@@ -191,7 +192,7 @@ def stability_map(cells, panels: list[dict], classes):
         for _, r in sel.iterrows():
             i, j = angles.index(r["angle_deg"]), xs.index(r["x"])
             grid[i, j] = index[r["cell_class"]]
-            locks[i, j] = r["reference"] == "self_locking"
+            locks[i, j] = r["reference"] == Status.SELF_LOCKING
             if locks[i, j]:
                 ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///",
                                        lw=0, color="k", alpha=0.45))

@@ -15,6 +15,7 @@ from cardan_exudyn.studies.bench_configs import ENGINE_NAMES, SCENES, BenchError
 from cardan_exudyn.studies.bench_ladders import work_precision
 from cardan_exudyn.studies.bench_targets import evaluate_targets, paper_scenes_timing
 from cardan_exudyn.sweep import environment
+from reference.schema import Status
 
 __all__ = ["BenchResult", "check_inputs", "run_bench"]
 
@@ -53,7 +54,7 @@ class BenchResult:
         """What ``--json`` prints: environment, targets, paper timing, audit, best per scene."""
         best = []
         for (scene, config), sel in self.rows.groupby(["scene", "config"], sort=False):
-            ok = sel[sel["status"] == "ok"]
+            ok = sel[sel["status"] == Status.OK]
             best.append({"scene": scene, "config": config, "runs": len(sel), "ok": len(ok),
                          "fastest_wall_per_simulated_s": float(ok["wall_per_simulated_s"].min())
                          if not ok.empty else None})

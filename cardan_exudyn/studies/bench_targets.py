@@ -20,7 +20,7 @@ from cardan_exudyn.studies.bench_ladders import yardstick
 from reference.engine import ReferenceOptions
 from reference.paper import paper_cases, paper_scene
 from reference.scene import Scene, replace
-from reference.schema import Result
+from reference.schema import Result, Status
 
 __all__ = ["SPEED_RATIO_TARGET", "EFFICIENCY_TARGET", "FRICTION_COST_TARGET",
            "PAPER_EXUDYN_TARGET_S", "PAPER_REFERENCE_TARGET_S", "TARGETS", "PAPER_EXUDYN_STEPS",
@@ -56,7 +56,7 @@ def select(rows: pd.DataFrame, **values: Any) -> pd.DataFrame:
 
 def best(rows: pd.DataFrame, error: str, level: float) -> pd.Series | None:
     """The ok row with the least wall time per simulated second whose ``error`` is <= ``level``."""
-    ok = rows[(rows["status"] == "ok") & (rows[error] <= level) & rows["wall_per_simulated_s"].notna()]
+    ok = rows[(rows["status"] == Status.OK) & (rows[error] <= level) & rows["wall_per_simulated_s"].notna()]
     if ok.empty:
         return None
     return ok.loc[ok["wall_per_simulated_s"].idxmin()]

@@ -291,7 +291,7 @@ def _where_reference_runs(record: dict[str, Any], cls: str, reasons: list[str]) 
         return _verdict(cls, "ok", True, "agree: ok")
     if cls == "drift":
         return _verdict(cls, "ok", False, "wrong answer with status ok", "; ".join(reasons))
-    if cls == "self_locking":
+    if cls == Status.SELF_LOCKING:
         return _verdict(cls, "ok", False, "Exudyn locks, the reference does not",
                         f"reference loop gain max {number(as_float(record.get('ref_loop_gain_max')), '.3g')}"
                         f" < 1; Exudyn: {exu_reason}")
@@ -301,9 +301,9 @@ def _where_reference_runs(record: dict[str, Any], cls: str, reasons: list[str]) 
 
 def _where_reference_locks(record: dict[str, Any], cls: str, reasons: list[str]) -> dict[str, Any]:
     """The verdict where the reference's friction fixed point has no solution: the joint locks."""
-    if cls == "self_locking":
+    if cls == Status.SELF_LOCKING:
         return _verdict(cls, "self_locking", True, "agree: self-locking")
-    if cls == "integration_failure":
+    if cls == Status.INTEGRATION_FAILURE:
         return _verdict(cls, "self_locking", True, "agree: fails where the joint locks",
                         f"Exudyn {record.get('exu_status')} instead of a self-locking verdict: "
                         f"{str(record.get('exu_reason') or '')[:120]}")
@@ -360,7 +360,7 @@ class StressMap:
         return {
             "cells": int(len(c)),
             "classes": {k: int(v) for k, v in c["cell_class"].value_counts().items()},
-            "reference_self_locking": int((c["reference"] == "self_locking").sum()),
+            "reference_self_locking": int((c["reference"] == Status.SELF_LOCKING).sum()),
             "disagreements": int((~c["agrees"]).sum()),
             "categories": {k: int(v) for k, v in c["category"].value_counts().items()},
         }

@@ -37,6 +37,7 @@ from cardan_exudyn.studies.stress_map import (
     run_map,
 )
 from cardan_exudyn.sweep import environment
+from reference.schema import Status
 
 PARTS = ("map", "long")
 #: Where the parts that left ``cardan stress`` now live.
@@ -179,7 +180,7 @@ def summary_lines(report: StressReport, out: str | os.PathLike) -> list[str]:
 
 def class_mark(r: pd.Series) -> str:
     """Class letter, ``*`` where the reference self-locks, ``!`` where the engines disagree."""
-    return (SYMBOLS[r["cell_class"]] + ("*" if r["reference"] == "self_locking" else "")
+    return (SYMBOLS[r["cell_class"]] + ("*" if r["reference"] == Status.SELF_LOCKING else "")
             + ("!" if not r["agrees"] else ""))
 
 

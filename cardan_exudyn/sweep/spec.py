@@ -24,12 +24,13 @@ from typing import Any
 import numpy as np
 
 if sys.version_info >= (3, 11):
-    import tomllib
+    pass
 else:  # Python 3.10
-    import tomli as tomllib
+    pass
 
 from cardan_exudyn.io import to_jsonable
 from reference.scene import Scene, scene_to_dict
+from reference.scene_files import read_toml
 
 __all__ = ["SweepError", "Distribution", "RandomSpec", "SweepSpec", "CaseFunction",
            "DEFAULT_FUNCTION", "grid_values", "function_name", "resolve_function", "flatten_paths",
@@ -508,18 +509,7 @@ def spec_from_mapping(data: Mapping[str, Any], base_dir: str | os.PathLike | Non
 
 def read_spec_file(path: str | os.PathLike) -> dict[str, Any]:
     """The raw table of a sweep spec TOML file; :class:`SweepError` if unreadable or not TOML."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SweepError(f"cannot read sweep spec {str(path)!r}: {exc.strerror}") from None
-    except UnicodeDecodeError as exc:
-        raise SweepError(f"sweep spec {str(path)!r} is not UTF-8 text (byte {exc.start}); a spec is a "
-                         "TOML file") from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepError(f"sweep spec {str(path)!r} is not valid TOML: {exc}") from None
+    return read_toml(path, "sweep spec", "a spec", SweepError)
 
 
 def load_spec(path: str | os.PathLike) -> SweepSpec:
