@@ -309,10 +309,14 @@ def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutio
                                f"of engine {engine!r}")
 
 
-def run_engines(scene: Scene, engines: list[str], options: Mapping[str, Any],
-                progress: Callable[[str], None] | None) -> tuple[dict[str, Result], dict[str, float]]:
+def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],
+                progress: Callable[[str], None] | None = None,
+                runner: Callable[..., Result] = run) -> tuple[dict[str, Result], dict[str, float]]:
     """Each engine's result and wall time [s], in order; engines in :data:`SAMPLED_ENGINES` are
-    sampled at the step of the first engine that reports one, unless the scene sets it."""
+    sampled at the step of the first engine that reports one, unless the scene sets it.
+
+    ``runner(scene, engine, options)`` runs one engine: :func:`cardan_exudyn.engines.run`, or a
+    caching wrapper of it (the pytest plugin's)."""
     results, walls = {}, {}
     base_dt = None
     for engine in engines:
@@ -322,7 +326,7 @@ def run_engines(scene: Scene, engines: list[str], options: Mapping[str, Any],
         if progress:
             progress(f"{scene.name}: running {engine}")
         start = time.perf_counter()
-        results[engine] = run(run_scene, engine, options.get(engine))
+        results[engine] = runner(run_scene, engine, options.get(engine))
         walls[engine] = time.perf_counter() - start
         if base_dt is None:
             base_dt = results[engine].summary.dt

@@ -27,7 +27,8 @@ from cardan_exudyn.accuracy import (
     error_estimate,
     mean_values,
 )
-from cardan_exudyn.comparison import COMPARED, SAMPLED_ENGINES, check_request, join_on_input_angle
+from cardan_exudyn.comparison import COMPARED, check_request, join_on_input_angle
+from cardan_exudyn.comparison import run_engines as comparison_runs
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.report.format import is_number, markdown_table, number
 from reference.scene import Scene, replace
@@ -241,18 +242,10 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
 
 def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],
                 run: Callable[..., Result]) -> dict[str, Result]:
-    """Each engine's run of ``scene`` (every step a row), as :func:`cardan_exudyn.compare`
-    makes them: engines that only sample an exact solution are sampled at the first step."""
+    """Each engine's run of ``scene`` with every step a row, as :func:`cardan_exudyn.compare`
+    makes them (:func:`cardan_exudyn.comparison.run_engines`), through ``run``."""
     scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
-    results: dict[str, Result] = {}
-    base_dt = None
-    for engine in engines:
-        run_scene = scene
-        if engine in SAMPLED_ENGINES and base_dt is not None and scene.numerics.dt is None:
-            run_scene = replace(scene, **{"numerics.dt": base_dt})
-        results[engine] = run(run_scene, engine, options.get(engine))
-        base_dt = base_dt if base_dt is not None else results[engine].summary.dt
-    return results
+    return comparison_runs(scene, engines, options, runner=run)[0]
 
 
 def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
