@@ -13,7 +13,7 @@ instantaneous efficiency of eq. (18), ``1 - power_loss / power_in`` (NaN where p
 energy zero at the joint centre).
 
 Per pair, ``<pair>_fx, _fy, _fz`` [N] and ``<pair>_mx, _my, _mz`` [N m]: the force and moment that
-body ``a`` of the pair exerts on body ``b`` (see :data:`reference.scene.PAIR_BODIES`), about the
+body ``a`` of the pair exerts on body ``b`` (see :data:`reference.joint.PAIR_BODIES`), about the
 pair's origin (on the axis, moving with body ``b`` when a pair with mounting errors slides), in
 the pair frame (z along the pair axis) attached to body ``a``. The constraint
 part excludes the applied friction; friction appears in ``<pair>_friction_torque`` [N m] and

@@ -1,4 +1,4 @@
-"""Measured data from the test rig: readers, conditioning, measured efficiency (issue 5).
+"""Measured data from the test rig: readers, conditioning, measured efficiency.
 
 The public face::
 

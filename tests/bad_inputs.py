@@ -1,4 +1,4 @@
-"""Bad input at every entry point: the cases that ``tests/test_hardening.py`` runs (issue 8).
+"""Bad input at every entry point: the cases that ``tests/test_hardening.py`` runs.
 
 Every entry point must reject bad input with one clear line naming what is wrong: the ``cardan``
 command line (every subcommand, ``cardan rig ...`` included) exits with status 2, one line on
@@ -141,7 +141,7 @@ _RIG_FILE = {"rig.csv": _rig_csv()}
 
 
 def _api_load_missing(d: Path) -> Any:
-    """reference.scene.load_scene("missing.toml")"""
+    """reference.scene_files.load_scene("missing.toml")"""
     return load_scene(d / "missing.toml")
 
 

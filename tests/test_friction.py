@@ -180,7 +180,7 @@ def test_sign_band_does_not_change_the_0deg_result():
     """At 0 deg no spider pair moves: every positive band gives the same mean efficiency (the
     default band does not depend on rounding), up to the friction fixed-point tolerance (1e-6
     relative, measured spread 3e-9); the exact sign does not give a number."""
-    from cardan_exudyn.studies.coupling import sign_band_study
+    from cardan_exudyn.studies.friction_numerics import sign_band_study
 
     rows = sign_band_study(["paper-0deg"], [0.0, 1e-6, 1e-3, 1e-1])
     assert rows[0]["status"] != "ok"
@@ -194,7 +194,7 @@ def test_converged_coupling_beats_lagged_at_every_step():
     """`cardan study coupling --quick`: at 100, 200, 400 steps per revolution the converged
     scheme's error of mean efficiency is below the lagged scheme's, and it falls by more than 4
     over the ladder (measured 7.8)."""
-    from cardan_exudyn.studies.coupling import COUPLING_QUICK, coupling_study
+    from cardan_exudyn.studies.friction_numerics import COUPLING_QUICK, coupling_study
 
     rows = coupling_study(COUPLING_QUICK["names"], COUPLING_QUICK["ladder"])
     err = {(r["coupling"], r["steps_per_revolution"]): abs(r["error"]) for r in rows}

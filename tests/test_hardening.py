@@ -1,4 +1,4 @@
-"""Hardening (issue 8): bad input at every entry point (the cases of ``tests/bad_inputs.py``, one
+"""Hardening: bad input at every entry point (the cases of ``tests/bad_inputs.py``, one
 test each), outputs written atomically when a command fails or is interrupted half-way, and no NaN
 or infinite efficiency printed for a failed run."""
 
@@ -251,7 +251,7 @@ def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
 
 def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
     """`cardan study --out`: the plot fails after the CSV and JSON are written."""
-    import cardan_exudyn.studies.coupling as studies
+    import cardan_exudyn.studies.friction_numerics as studies
 
     out = tmp_path / "study"
     _previous(out)

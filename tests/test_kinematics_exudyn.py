@@ -24,7 +24,7 @@ def test_auto_step_meets_accuracy(beta_deg):
     accuracy = 1e-5
     result = run(balanced_scene(beta_deg, rpm=2000, gravity=(0, 0, 0), accuracy=accuracy))
     assert result.success
-    # the step model K(beta) h^2 is fitted within 10 % (cardan_exudyn/stepsize.py)
+    # the step model K(beta) h^2 is fitted within 10 % (cardan_exudyn/model/stepsize.py)
     assert ratio_error(result) <= 1.1 * accuracy
 
 

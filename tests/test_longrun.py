@@ -1,4 +1,4 @@
-"""Long runs (issue 8, ``cardan_exudyn.studies.longrun``): drift over thousands of revolutions with
+"""Long runs (``cardan_exudyn.studies.longrun``): drift over thousands of revolutions with
 friction, and energy conservation of the free-spinning frictionless joint.
 
 The library measures; the verdicts are here: :data:`TOLERANCES` holds each tolerance with its

@@ -433,7 +433,7 @@ STRONG_SPIDER_FRICTION = {"base": "paper", "shaft_angle_deg": 30.0, "speed_rpm":
                           "gravity": True, "errors": None}
 #: found by hypothesis: Exudyn reported self_locking at 0 deg (spider pairs at rest, their friction
 #: rounding noise that the relative fixed-point tolerance could never meet); fixed in
-#: cardan_exudyn/friction.py (REST_FLOOR); lagged, the growth of that noise out of rounding was
+#: cardan_exudyn/model/coupling.py (REST_FLOOR); lagged, the growth of that noise out of rounding was
 #: taken for the geometric growth of a locking loop
 SPIDER_AT_REST = {"base": "paper", "shaft_angle_deg": 0.0, "speed_rpm": 1.0, "direction": 1, "load": 0.0,
                   "f_spider": 0.5, "f_frame": 0.0, "coupling": "converged", "gravity": True,

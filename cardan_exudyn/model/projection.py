@@ -94,7 +94,7 @@ def project_velocities(states: dict[str, dict[str, np.ndarray]],
     Parameters
     ----------
     states : dict
-        Per body ``t, r, v, A, omega`` (n rows), as :func:`cardan_exudyn.model.solve.body_states`.
+        Per body ``t, r, v, A, omega`` (n rows), as :func:`cardan_exudyn.model.postprocess.body_states`.
     pairs : dict
         Per pair the geometry of :func:`constraint_jacobian`.
     mass, inertia_node : dict

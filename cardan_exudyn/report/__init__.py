@@ -1,0 +1,5 @@
+"""What every report shares: :mod:`~cardan_exudyn.report.format` (the one number and markdown
+table formatter, also the CLI's) and :mod:`~cardan_exudyn.report.plots` (figure functions that
+take data and return a Figure). The reports themselves are written by the studies
+(``cardan_exudyn/studies/*``) and :mod:`rigdata.report`.
+"""

@@ -1,14 +1,20 @@
-"""Studies: jobs built on the engines (the paper reproduction, calibration, comparison reports,
-tolerance studies, benchmarks, stress tests, long runs, coupling studies).
+"""Studies: jobs built on the engines, each a ``cardan`` subcommand.
 
-Each study module registers its own ``cardan`` subcommand: ``register(subparsers)`` adds its
-parser and sets ``func`` to a handler ``(args) -> exit status``. Only :mod:`cardan_exudyn.cli`
-imports this package; library code never does.
+The modules named in :data:`COMMANDS` register their subcommand: ``register(subparsers)`` adds
+its parser and sets ``func`` to a handler ``(args) -> exit status``. The other modules are their
+parts (``bench_*``, ``stress_*``, ``longrun_*``, ``reproduce_report``) or research scripts behind
+a document (``mujoco_settings``: ``docs/mujoco.md``). Only :mod:`cardan_exudyn.cli` imports this
+package; library code never does.
+
+- ``reproduce``: the paper's studies, the main report; ``calibrate``: the calibrated set;
+- ``compare``: the ``cardan compare`` report over :mod:`cardan_exudyn.comparison`;
+- ``tolerance``: mounting errors, the paper's case and Monte Carlo;
+- ``friction_numerics``: ``cardan study`` (friction coupling error against step, sign band);
+- ``bench``: run time against error; ``stress``: stability map and long runs.
 """
 
 from __future__ import annotations
 
-COMMANDS: tuple[str, ...] = ("reproduce", "bench", "stress", "coupling", "calibrate", "compare",
-                             "tolerance")
-"""Modules of this package that register a subcommand, in the order ``cardan --help`` lists them.
-A module is added here when its ``register`` exists."""
+COMMANDS: tuple[str, ...] = ("reproduce", "bench", "stress", "friction_numerics", "calibrate",
+                             "compare", "tolerance")
+"""Modules of this package that register a subcommand, in the order ``cardan --help`` lists them."""

@@ -1,4 +1,4 @@
-"""Long runs (issue 8): drift over thousands of revolutions, and energy conservation.
+"""Long runs: drift over thousands of revolutions, and energy conservation.
 
 Entry point: :func:`long_runs` (``quick=True``: about 20-30 s). The pieces: what runs
 (:mod:`.longrun_plan`), the measurements (:mod:`.longrun_measures`), the headline figures

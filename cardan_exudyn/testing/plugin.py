@@ -76,7 +76,8 @@ class SceneFactory:
         try:
             return make_scene(source, self.root, **changes)
         except SceneError as exc:
-            pytest.fail(f"cardan_scene: {exc}", pytrace=False)
+            message = f"cardan_scene: {exc}"
+        pytest.fail(message, pytrace=False)  # outside the except: no chained traceback
 
 
 @pytest.fixture(scope="session")
