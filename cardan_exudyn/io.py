@@ -10,12 +10,13 @@ import contextlib
 import json
 import math
 import os
+import secrets
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from enum import Enum
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
@@ -49,21 +50,45 @@ def to_jsonable(value: Any) -> Any:
     return value
 
 
-def atomic_write(path: str | os.PathLike, write: Any) -> None:
-    """Write one file atomically and durably: ``write(f)`` fills a binary temporary sibling,
-    which is flushed, fsync'ed and renamed onto ``path``."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+@contextlib.contextmanager
+def atomic_open(path: str | os.PathLike, mode: str = "wb", **kwargs: Any) -> Iterator[IO]:
+    """Open a temporary sibling of ``path``; on success flush, fsync and rename it onto ``path``.
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; its folder must exist.
+    mode : {"wb", "w"}
+        Binary or text.
+    **kwargs
+        Passed to :func:`open` (``encoding``, ``newline``).
+
+    Yields
+    ------
+    file object
+        Write to it; on an exception (an interruption included) the temporary file is removed
+        and the target is untouched.
+    """
+    target = Path(path)
+    tmp = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
+    # os.open applies the umask to 0o666, as open() would; mkstemp would leave the file 0o600
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     try:
-        with open(tmp, "wb") as f:
-            write(f)
+        with os.fdopen(fd, mode, **kwargs) as f:
+            yield f
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, path)
+        os.replace(tmp, target)
     except BaseException:  # no half-written temporary file left behind
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def atomic_write(path: str | os.PathLike, write: Callable[[IO], Any]) -> None:
+    """Write one binary file atomically and durably: ``write(f)`` fills it (:func:`atomic_open`)."""
+    with atomic_open(path, "wb") as f:
+        write(f)
 
 
 def dumps(data: Any) -> str:

@@ -13,19 +13,17 @@ renames it over the target, so a failure leaves either the old file or none, nev
 
 from __future__ import annotations
 
-import contextlib
 import datetime
 import io
 import os
-import secrets
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from pathlib import Path
-from typing import IO
 
 import numpy as np
 import pandas as pd
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
+from cardan_exudyn.io import atomic_open
 from rigdata.units import split_header
 
 #: Column names recognised as time by the writers (the first such column is the time axis).
@@ -34,40 +32,6 @@ _TIME_NAMES = ("time", "t", "x_value", "zeit")
 _LVM_RESERVED = {"writer_version", "reader_version", "separator", "decimal_separator", "multi_headings",
                  "x_columns", "time_pref", "channels", "samples", "y_unit_label", "x_dimension", "x0",
                  "delta_x", "***end_of_header***", "x_value"}
-
-
-@contextlib.contextmanager
-def atomic_write(path: str | os.PathLike, mode: str = "w", **kwargs) -> Iterator[IO]:
-    """Open a temporary file next to ``path``; on success fsync it and rename it to ``path``.
-
-    Parameters
-    ----------
-    path : path-like
-        Target file; its folder must exist.
-    mode : {"w", "wb"}
-        Text or binary.
-    **kwargs
-        Passed to :func:`open` (``encoding``, ``newline``).
-
-    Yields
-    ------
-    file object
-        Write to it; on an exception the temporary file is removed and the target untouched.
-    """
-    target = Path(path)
-    tmp = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
-    # os.open applies the umask to 0o666, as open() would; mkstemp would leave the file 0o600
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
-    try:
-        with os.fdopen(fd, mode, **kwargs) as f:
-            yield f
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
 
 
 def _check(table: Mapping[str, np.ndarray], units: Mapping[str, str],
@@ -145,7 +109,7 @@ def write_csv(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
         lines += [sep.join(columns), sep.join(units[k] for k in columns)]
     else:
         lines.append(sep.join(f"{k} [{units[k]}]" for k in columns))
-    with atomic_write(path, "w", encoding="utf-8", newline="") as f:
+    with atomic_open(path, "w", encoding="utf-8", newline="") as f:
         f.write("\n".join(lines) + "\n")
         f.write(_numbers(columns, sep, decimal))
     return Path(path)
@@ -237,7 +201,7 @@ def write_lvm(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
             # the X field stays in every row, empty
             rows_text = ["\t" + line.split("\t", 1)[1] for line in rows_text]
         out += rows_text
-    with atomic_write(path, "w", encoding="utf-8", newline="") as f:
+    with atomic_open(path, "w", encoding="utf-8", newline="") as f:
         f.write("\r\n".join(out) + "\r\n")
     return Path(path)
 
@@ -274,6 +238,6 @@ def write_tdms(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: 
         props = {"unit_string": units[name], "wf_start_offset": float(t[0]), "wf_increment": dt,
                  "wf_samples": values.size}
         objects.append(ChannelObject("Rig", name, values, properties=props))
-    with atomic_write(path, "wb") as f, TdmsWriter(f) as writer:
+    with atomic_open(path, "wb") as f, TdmsWriter(f) as writer:
         writer.write_segment(objects)
     return Path(path)
