@@ -106,6 +106,20 @@ def test_engine_runs_go_through_the_dispatch():
     assert offenders == []
 
 
+def test_tests_run_engines_through_the_dispatch():
+    """Tests run engines as users do, through cardan_exudyn.run; only the reference package's own
+    tests (test_reference_*.py) call its engine directly, as a user without Exudyn would."""
+    offenders = []
+    for path in sorted((ROOT / "tests").glob("test_*.py")):
+        if path.name.startswith("test_reference_"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.module in ENGINE_RUN_MODULES:
+                offenders += [f"{path.name}: from {node.module} import run"
+                              for a in node.names if a.name == "run"]
+    assert offenders == []
+
+
 def test_module_sizes():
     """No product module over 600 lines."""
     assert {m: n for m, n in module_lines().items() if n > MAX_MODULE_LINES} == {}

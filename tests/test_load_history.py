@@ -7,8 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cardan_exudyn import run as run_exudyn
-from reference.engine import run as run_reference
+from cardan_exudyn import run
 from reference.paper import named_scene
 from reference.scene import AngleDrive, Load, scene_from_dict, scene_to_dict
 from reference.scene_files import load_scene
@@ -66,8 +65,8 @@ def test_load_history_round_trips_through_toml(tmp_path):
 
 def test_flat_history_equals_constant_load():
     """A flat two-sample history gives the constant load's result to rounding (reference)."""
-    flat = run_reference(driven(Load((0.2, 0.2), (0.0, SPAN))))
-    constant = run_reference(driven(Load(0.2)))
+    flat = run(driven(Load((0.2, 0.2), (0.0, SPAN))), "reference")
+    constant = run(driven(Load(0.2)), "reference")
     assert flat.summary.mean_efficiency == pytest.approx(constant.summary.mean_efficiency,
                                                             rel=0, abs=1e-12)
 
@@ -75,7 +74,7 @@ def test_flat_history_equals_constant_load():
 def test_load_history_energy_balance_and_torque_out_column():
     """The reference's table carries the history; input work = output + loss + energy change."""
     scene = driven(varying())
-    result = run_reference(scene)
+    result = run(scene, "reference")
     assert result.summary.status == "ok"
     table = result.table
     np.testing.assert_allclose(table["torque_out"], scene.load.at(table["t"]), rtol=0, atol=1e-15)
@@ -88,7 +87,7 @@ def test_load_history_exudyn_matches_reference():
     Exudyn at its automatic step for 1e-5 speed-ratio accuracy: its mean-efficiency error on the
     rig scenes was 2e-6..1e-5 (README); 3e-5 allows the friction's under-resolved sign ramps."""
     scene = driven(varying())
-    ref, exu = run_reference(scene), run_exudyn(scene)
+    ref, exu = run(scene, "reference"), run(scene)
     assert exu.summary.status == "ok"
     assert exu.summary.mean_efficiency == pytest.approx(ref.summary.mean_efficiency, abs=3e-5)
     t = exu.table["t"].to_numpy()
@@ -99,9 +98,10 @@ def test_load_history_exudyn_matches_reference():
 
 
 def test_mujoco_refuses_load_history():
-    """MuJoCo takes constant loads only and says so."""
-    from cardan_exudyn.mujoco_engine import run as run_mujoco
+    """MuJoCo takes constant loads only and says so, through the dispatch."""
+    pytest.importorskip("mujoco")
+    from cardan_exudyn.engines import EngineUnavailable
 
     scene = replace(named_scene("rig-frictionless"), load=Load((0.2, 0.2), (0.0, 10.0)))
-    with pytest.raises(NotImplementedError, match="load history"):
-        run_mujoco(scene)
+    with pytest.raises(EngineUnavailable, match="load history"):
+        run(scene, "mujoco")

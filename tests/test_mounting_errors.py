@@ -16,7 +16,6 @@ from scipy.interpolate import CubicSpline
 import cardan_exudyn
 from reference import kinematics, rccc
 from reference.dynamics import dynamics_columns
-from reference.engine import run
 from reference.friction import friction_from_columns
 from reference.joint import ERROR_NAMES, PAIR_NAMES
 from reference.joint_motion import ideal_pair_origins, joint_motion
@@ -133,7 +132,7 @@ def test_energy_balance_closes_with_sliding_pairs(key):
     energies from the kinematics alone; a wrong moment arm, slide sign or missing axial friction
     term breaks the balance by the sliding work, which is 1e-4..1e-2 of the input work here.
     """
-    summary = run(_error_scene(key)).summary
+    summary = cardan_exudyn.run(_error_scene(key), "reference").summary
     assert summary.status == "ok"
     sliding = sum(summary.pair_sliding_loss_work[p] for p in CYLINDRICAL)
     assert sliding > 1e-5 * summary.input_work
@@ -143,7 +142,7 @@ def test_energy_balance_closes_with_sliding_pairs(key):
 @pytest.mark.parametrize("key", list(ERROR_SCENES))
 def test_friction_is_the_law_of_the_reported_reactions_and_slides(key):
     scene = _error_scene(key)
-    table = run(scene).table
+    table = cardan_exudyn.run(scene, "reference").table
     law = friction_from_columns(scene, table)
     for pair in PAIR_NAMES:
         torque, force = law[pair]
@@ -155,7 +154,7 @@ def test_friction_is_the_law_of_the_reported_reactions_and_slides(key):
 
 
 def test_ideal_joint_has_no_sliding_work():
-    summary = run(one_revolution("rig-calibrated")).summary
+    summary = cardan_exudyn.run(one_revolution("rig-calibrated"), "reference").summary
     assert all(summary.pair_sliding_loss_work[p] == 0.0 for p in CYLINDRICAL)
 
 

@@ -25,7 +25,6 @@ from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.model.build import build_model
 from cardan_exudyn.model.postprocess import body_states
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES
-from reference.engine import run as reference_run
 from reference.kinematics import speed_ratio
 from reference.paper import named_scene
 from reference.scene import replace
@@ -153,7 +152,7 @@ def test_speed_ratio_is_second_order(node_type, built):
 
 @pytest.fixture(scope="module")
 def reference_efficiency():
-    return reference_run(_scene("paper-10deg", 200)).summary.mean_efficiency
+    return run(_scene("paper-10deg", 200), "reference").summary.mean_efficiency
 
 
 @pytest.mark.parametrize("node_type", NODE_TYPES)

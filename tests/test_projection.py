@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import ExudynOptions, run
-from reference.engine import run as reference_run
 from reference.kinematics import speed_ratio
 from reference.paper import named_scene
 from reference.scene import replace
@@ -55,7 +54,7 @@ def test_projection_with_mounting_errors_matches_the_reference_engine():
                     **{"revolutions": 1, "numerics.dt": 2 * math.pi / 6.0 / 60})
     ex = run(scene, options=ExudynOptions(velocity_projection=True))
     plain = run(scene)
-    ref = reference_run(scene)
+    ref = run(scene, "reference")
     assert ex.success and ref.success
     w_ref = ref.table["omega_out"].to_numpy()
     n = min(len(w_ref), len(ex.table))

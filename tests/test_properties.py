@@ -100,11 +100,10 @@ from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from test_energy import balance_residual
 
-from cardan_exudyn import run as exudyn_run
+from cardan_exudyn import run as run_engine
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import error_coefficient
 from reference.engine import ReferenceOptions
-from reference.engine import run as reference_run
 from reference.joint import PAIR_KIND, PAIR_NAMES
 from reference.paper import named_scene
 from reference.scene import COUPLINGS, Numerics, replace
@@ -193,8 +192,8 @@ def scene_of(cell: dict):
 def run_cell(cell: dict, engine: str, node_type: str = "Rxyz"):
     scene = scene_of(cell)
     if engine == "reference":
-        return scene, reference_run(scene)
-    return scene, exudyn_run(scene, options=ExudynOptions(node_type=node_type))
+        return scene, run_engine(scene, "reference")
+    return scene, run_engine(scene, options=ExudynOptions(node_type=node_type))
 
 
 # --------------------------------------------------------------------------- measures
@@ -546,7 +545,7 @@ def check_locking_between_samples(angle_deg: float, samples: int) -> None:
             "load": 2.0, "f_spider": 0.42, "f_frame": 0.2, "coupling": "converged", "gravity": True,
             "errors": None}
     scene = scene_of(cell)
-    result = reference_run(scene, ReferenceOptions(samples_per_revolution=samples))
+    result = run_engine(scene, options=ReferenceOptions(samples_per_revolution=samples))
     check_status_contract(result, "reference")
     if result.success:
         check_finite(result, "reference")
@@ -595,6 +594,6 @@ def test_uncoupled_without_load_has_no_efficiency():
     cell = {"base": "paper", "shaft_angle_deg": 20.0, "speed_rpm": 1000.0, "direction": 1,
             "load": 0.0, "f_spider": 0.5, "f_frame": 0.2, "coupling": "uncoupled",
             "gravity": False, "errors": None}
-    s = reference_run(scene_of(cell)).summary
+    s = run_engine(scene_of(cell), "reference").summary
     eta = s.mean_efficiency
     assert s.status != "ok" or eta is None or math.isnan(eta) or 0.0 <= eta <= 1.0, eta
