@@ -156,6 +156,24 @@ def test_no_private_names_imported_across_modules():
     assert offenders == []
 
 
+def test_broad_excepts_reraise_or_say_why():
+    """``except Exception`` / ``except BaseException`` / bare ``except`` either re-raise (clean-up)
+    or stand at a boundary that records the error, with a comment on the line saying so: a bug is
+    never turned into a result silently."""
+    offenders = []
+    for module, text in _product_sources():
+        lines = text.splitlines()
+        for node in ast.walk(ast.parse(text)):
+            if not isinstance(node, ast.ExceptHandler):
+                continue
+            broad = node.type is None or (isinstance(node.type, ast.Name)
+                                          and node.type.id in ("Exception", "BaseException"))
+            reraises = any(isinstance(n, ast.Raise) and n.exc is None for n in ast.walk(node))
+            if broad and not reraises and "#" not in lines[node.lineno - 1]:
+                offenders.append(f"{module}:{node.lineno}")
+    assert offenders == []
+
+
 def test_no_banner_comments():
     """Comments say why; no decorative banner lines."""
     banner = re.compile(r"^\s*#\s*[-=#*]{4,}", re.MULTILINE)
