@@ -182,6 +182,13 @@ def test_no_banner_comments():
     assert offenders == []
 
 
+def test_every_subpackage_names_its_face():
+    """Every package of the product declares ``__all__`` (names or submodules) in its __init__."""
+    missing = [str(p.relative_to(ROOT)) for pkg in PACKAGES for p in (ROOT / pkg).rglob("__init__.py")
+               if "__all__" not in p.read_text(encoding="utf-8")]
+    assert missing == []
+
+
 @pytest.mark.parametrize("package", PACKAGES)
 def test_public_face(package):
     """Each package names its public API in ``__all__``; every name resolves and ``dir`` shows it."""

@@ -14,3 +14,6 @@
 
 Run scenes through :func:`cardan_exudyn.run` (the engine dispatch), not through this package.
 """
+
+__all__ = ["build", "options", "solve", "postprocess", "friction_law", "coupling", "rotations",
+           "projection", "stepsize"]

@@ -3,3 +3,5 @@ table formatter, also the CLI's) and :mod:`~cardan_exudyn.report.plots` (figure 
 take data and return a Figure). The reports themselves are written by the studies
 (``cardan_exudyn/studies/*``) and :mod:`rigdata.report`.
 """
+
+__all__ = ["format", "plots"]

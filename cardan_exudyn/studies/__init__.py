@@ -15,6 +15,8 @@ package; library code never does.
 
 from __future__ import annotations
 
+__all__ = ["COMMANDS"]
+
 COMMANDS: tuple[str, ...] = ("reproduce", "bench", "stress", "friction_numerics", "calibrate",
                              "compare", "tolerance")
 """Modules of this package that register a subcommand, in the order ``cardan --help`` lists them."""
