@@ -15,8 +15,7 @@ pandas and matplotlib load only when a run or a report needs them.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from reference.lazy import lazy_face
 
 __all__ = [
     "run", "make_options", "options_class", "ENGINES", "EngineUnavailable",
@@ -37,18 +36,8 @@ _LAZY = {
     "Summary": "reference.schema",
     "Status": "reference.schema",
     "OptionsError": "reference.schema",
+    "sweep": "cardan_exudyn.sweep",
 }
 
 
-def __getattr__(name: str) -> Any:
-    if name == "sweep":
-        return importlib.import_module("cardan_exudyn.sweep")
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'cardan_exudyn' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)

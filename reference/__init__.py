@@ -26,8 +26,7 @@ first, so it imports nothing itself (the engine's modules and scipy load only wh
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from reference.lazy import lazy_face
 
 _HOMES = {
     "reference.validation": ("SceneError", "DEG", "RPM"),
@@ -44,13 +43,4 @@ _LAZY = {name: module for module, names in _HOMES.items() for name in names}
 __all__ = list(_LAZY)
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'reference' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)

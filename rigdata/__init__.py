@@ -31,8 +31,7 @@ modules behind them pull in scipy, pandas and the engines (about a second).
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from reference.lazy import lazy_face
 
 __all__ = ["read", "read_table", "measure", "Measurement", "validate", "Validation", "MODEL_ENGINES",
            "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer", "Conditioning",
@@ -50,15 +49,4 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    module_name = _WHERE.get(name)
-    if module_name is None:
-        raise AttributeError(f"module 'rigdata' has no attribute {name!r}")
-    module = importlib.import_module(module_name)
-    value = module if module_name.endswith(f".{name}") else getattr(module, name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _WHERE)

@@ -136,11 +136,12 @@ def test_dict_rejects_non_table():
 
 
 def test_public_face_is_lazy():
-    """``import reference`` imports none of its modules (every ``import reference.x`` runs it);
-    each public name resolves to its home module's object on first use."""
+    """``import reference`` imports none of its modules but the stdlib-only face helper
+    ``reference.lazy`` (every ``import reference.x`` runs it); each public name resolves to its
+    home module's object on first use."""
     code = "import sys, reference; print(sorted(m for m in sys.modules if m.startswith('reference')))"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert loaded.stdout.strip() == "['reference']"
+    assert loaded.stdout.strip() == "['reference', 'reference.lazy']"
     assert reference.Scene is reference.scene.Scene and reference.load_scene is load_scene
     assert reference.run is reference.engine.run and reference.SceneError is SceneError
     assert set(reference.__all__) <= set(dir(reference))

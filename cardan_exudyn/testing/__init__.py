@@ -14,8 +14,7 @@ comparison behind :func:`assert_engines_agree` pulls in pandas and scipy.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from reference.lazy import lazy_face
 
 __all__ = ["assert_efficiency", "assert_engines_agree", "CardanToleranceWarning", "DEFAULT_COLUMNS",
            "CachingRunner", "RunRecord", "make_scene"]
@@ -31,13 +30,4 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'cardan_exudyn.testing' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)
