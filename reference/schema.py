@@ -288,7 +288,8 @@ def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tu
     return theta_0, theta_0 + sign * 2.0 * math.pi * n, max(n, 0)
 
 
-def _cumulative(y: np.ndarray, t: np.ndarray) -> np.ndarray:
+def cumulative(y: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Trapezoidal integral of ``y dt`` from the first row to each row."""
     out = np.zeros_like(t)
     out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))
     return out
@@ -300,7 +301,7 @@ def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
 
     ``theta`` must be monotonic; the ends are interpolated linearly in theta.
     """
-    cum = _cumulative(np.asarray(y, float), np.asarray(t, float))
+    cum = cumulative(np.asarray(y, float), np.asarray(t, float))
     th = np.asarray(theta, float)
     if th[-1] < th[0]:
         th, cum, theta_0, theta_1 = -th, cum, -theta_0, -theta_1

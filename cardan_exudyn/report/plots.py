@@ -120,8 +120,9 @@ def efficiency_against_paper(rows, x: str, xlabel: str, ax=None):
     return fig
 
 
-def save(fig, path) -> None:
-    fig.savefig(path, dpi=130)
+def save(fig, path, dpi: int = 130) -> None:
+    """Write ``fig`` to ``path`` and close it."""
+    fig.savefig(path, dpi=dpi)
     plt.close(fig)
 
 

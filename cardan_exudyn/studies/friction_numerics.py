@@ -154,15 +154,13 @@ def run_study(kind: str, quick: bool = False, progress: Progress | None = None) 
 
 def markdown(rows: Sequence[Mapping[str, Any]], columns: Sequence[str]) -> str:
     """``rows`` as a markdown table (a failed run's missing numbers as '-')."""
-    return markdown_table(rows, columns, {c: f for c, f in FORMATS.items() if c in columns})
+    return markdown_table(rows, columns, FORMATS)
 
 
 def _plot_coupling(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
     """Error of mean efficiency against steps per revolution and against wall time, log-log."""
-    import matplotlib  # import cost: matplotlib only when a study is written
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # import cost: matplotlib only when a study is written
+    from cardan_exudyn.report.plots import plt, save
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     ok = [r for r in rows if r["status"] == Status.OK]
@@ -185,16 +183,13 @@ def _plot_coupling(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
                 title="error against cost")
     axes[0].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path, dpi=120)
 
 
 def _plot_band(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
     """Mean efficiency against the sign band, one line per scene."""
-    import matplotlib  # import cost: matplotlib only when a study is written
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # import cost: matplotlib only when a study is written
+    from cardan_exudyn.report.plots import plt, save
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for name in sorted({r["scene"] for r in rows}):
@@ -206,8 +201,7 @@ def _plot_band(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
     ax.legend()
     ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path, dpi=120)
 
 
 def write_study(kind: str, rows: Sequence[Mapping[str, Any]], out: str | Path) -> Path:

@@ -93,7 +93,6 @@ from cardan_exudyn.model.postprocess import body_states, mechanical_energy, post
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.longrun_measures import (
     at_revolutions,
-    cumulative,
     energy_measures,
     pair_violations,
     per_revolution_max,
@@ -117,7 +116,7 @@ from cardan_exudyn.studies.longrun_plan import (
 from cardan_exudyn.studies.longrun_summary import summarise
 from reference.engine import ReferenceOptions
 from reference.scene import Scene, replace
-from reference.schema import Status
+from reference.schema import Status, cumulative
 
 Say = Callable[[str], None]
 #: An energy case: label, function, its arguments but the label, engine, spectral radius, steps.

@@ -97,13 +97,6 @@ def at_revolutions(values: np.ndarray, theta: np.ndarray, revolutions: int) -> n
     return np.interp(2.0 * math.pi * np.arange(revolutions + 1), th, values)
 
 
-def cumulative(y: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Trapezoidal integral of ``y dt`` from the first row to each row."""
-    out = np.zeros_like(t)
-    out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))
-    return out
-
-
 def whole_revolutions(theta: np.ndarray) -> int:
     """Whole input revolutions turned; 1e-6 of a revolution short counts as whole (the input
     angle of a 2000-revolution run ends 7e-8 rad short of 2000 turns: the rounding of its update

@@ -200,29 +200,11 @@ def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
     return out
 
 
-def cell_rxyz(scene: Scene, engine: str) -> dict[str, Any]:
-    """Sweep case function: one map cell with Rxyz nodes."""
-    return _cell(scene, engine, "Rxyz")
-
-
-def cell_ep(scene: Scene, engine: str) -> dict[str, Any]:
-    """Sweep case function: one map cell with Euler-parameter nodes."""
-    return _cell(scene, engine, "EP")
-
-
-def cell_rotveclg(scene: Scene, engine: str) -> dict[str, Any]:
-    """Sweep case function: one map cell with Lie-group rotation-vector nodes."""
-    return _cell(scene, engine, "RotVecLG")
-
-
-def _cell(scene: Scene, engine: str, node_type: str) -> dict[str, Any]:
+def cell(scene: Scene, engine: str, node_type: str) -> dict[str, Any]:
+    """Sweep case function: one map cell with ``node_type`` nodes (a ``function_args`` value)."""
     if engine != ENGINE:
         raise ValueError(f"stress cells compare {ENGINE} with the {REFERENCE}; engine {engine!r}")
     return measure_cell(scene, node_type)
-
-
-CELL_FUNCTIONS = {"Rxyz": f"{__name__}:cell_rxyz", "EP": f"{__name__}:cell_ep",
-                  "RotVecLG": f"{__name__}:cell_rotveclg"}
 
 
 def as_float(value: Any) -> float:
@@ -376,7 +358,7 @@ def sweep_specs(quick: bool = False) -> dict[str, SweepSpec]:
                     {"id": cell_id(panel, angle, x), **panel.overrides(angle, x)})
     base = base_scene()
     return {node: SweepSpec(scene=base, engine=ENGINE, cases=tuple(cases),
-                            function=CELL_FUNCTIONS[node])
+                            function=f"{__name__}:cell", function_args={"node_type": node})
             for node, cases in groups.items()}
 
 

@@ -279,10 +279,8 @@ def write_monte_carlo(folder: Path, table, ok_table, sens, summary: Mapping[str,
 
 def _plots(folder: Path, table, params: Sequence[str], eta0: float) -> None:
     """The histogram of the mean efficiency and its scatter against each error."""
-    import matplotlib  # import cost: matplotlib only when a study is written
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # import cost: matplotlib only when a study is written
+    from cardan_exudyn.report.plots import plt, save
 
     if "mean_efficiency" not in table or table.empty:
         return
@@ -295,13 +293,13 @@ def _plots(folder: Path, table, params: Sequence[str], eta0: float) -> None:
     ax.set(xlabel="mean efficiency [-]", ylabel="samples", title="Monte Carlo: mean efficiency")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(folder / "efficiency_histogram.png", dpi=120)
-    plt.close(fig)
+    save(fig, folder / "efficiency_histogram.png", dpi=120)
     _scatter(folder / "efficiency_vs_errors.png", table, params, eta, eta0)
 
 
 def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: float) -> None:
-    import matplotlib.pyplot as plt  # import cost: matplotlib only when a study is written
+    # import cost: matplotlib only when a study is written
+    from cardan_exudyn.report.plots import plt, save
 
     cols = min(3, len(params))
     rows = math.ceil(len(params) / cols)
@@ -313,8 +311,7 @@ def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: fl
     for ax in axes.ravel()[len(params):]:
         ax.set_visible(False)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path, dpi=120)
 
 
 def _report(summary: Mapping[str, Any], sens) -> str:
@@ -375,10 +372,8 @@ def paper_report(out: str | Path, engines: Sequence[str] = ("reference", "exudyn
 
 def _breakdown_plot(path: Path, rows) -> None:
     """Stacked bars of each pair's loss change per (parameters, coupling, engine) that ran ok."""
-    import matplotlib  # import cost: matplotlib only when a report is written
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # import cost: matplotlib only when a report is written
+    from cardan_exudyn.report.plots import plt, save
 
     ok = rows[(rows.status_errors == Status.OK) & (rows.status_ideal == Status.OK)]
     if ok.empty:
@@ -397,8 +392,7 @@ def _breakdown_plot(path: Path, rows) -> None:
     ax.set_title("Where the stated errors' efficiency change comes from (rig case)")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path, dpi=120)
 
 
 PAPER_COLUMNS = ["parameters", "coupling", "engine", "eta_ideal", "eta_errors", "change", "relative_change",

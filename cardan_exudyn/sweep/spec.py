@@ -15,18 +15,12 @@ import importlib
 import json
 import math
 import os
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-if sys.version_info >= (3, 11):
-    pass
-else:  # Python 3.10
-    pass
 
 from cardan_exudyn.io import to_jsonable
 from reference.scene import Scene, scene_to_dict
