@@ -414,3 +414,17 @@ def test_bad_input(tmp_path, name, content, kwargs, pattern):
         path.write_bytes(content)
     with pytest.raises(RigDataError, match=re.escape(str(path)) + ": " + pattern):
         read(path, **kwargs)
+
+
+@pytest.mark.parametrize("text, decimal, expected", [
+    ("2.5", ".", 2.5), (" 2.5 ", ".", 2.5), ("1,5", ",", 1.5), ("-3e-2", ".", -0.03),
+    ("1_0", ".", None), ("1,5", ".", None), ("abc", ".", None), ("0x10", ".", None),
+], ids=["point", "spaces", "comma-decimal", "exponent", "underscore", "comma-in-point-file", "text",
+        "hex"])
+def test_cell_value_accepts_only_what_a_rig_file_writes(text, decimal, expected):
+    """A cell is a number only in the forms rig files write (``float`` alone would take
+    ``1_0``); anything else is NaN, reported as a text cell, never a crash."""
+    from rigdata.readers.table import cell_value
+
+    value = cell_value(text, decimal)
+    assert math.isnan(value) if expected is None else value == pytest.approx(expected)

@@ -17,13 +17,12 @@ from typing import Any
 import numpy as np
 
 from rigdata.readers.channels import column_unit, time_column
-from rigdata.readers.table import RawTable, TextCells, find_text_cells
+from rigdata.readers.table import RawTable, TextCells, find_text_cells, is_number
 from rigdata.record import RigDataError
 from rigdata.units import lookup
 
-__all__ = ["Layout", "is_number", "layout", "preamble", "read_delimited"]
+__all__ = ["Layout", "layout", "preamble", "read_delimited"]
 
-NUMBER = re.compile(r"^[+-]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][+-]?\d+)?$|^[+-]?(?:nan|inf|infinity)$", re.I)
 COMMA_NUMBER = re.compile(r"^[+-]?\d*,\d+(?:[eE][+-]?\d+)?$")
 #: Separators tried, in order of preference on a tie (None: runs of blanks).
 SEPARATORS = ("\t", ";", ",", "|", None)
@@ -39,11 +38,6 @@ class Layout:
     units_row: int | None    # line index of a units row, if any
     first: int               # line index of the first data row
     width: int               # fields per data row
-
-
-def is_number(text: str) -> bool:
-    """True when ``text`` reads as a number (decimal point or comma, NaN and infinity included)."""
-    return bool(NUMBER.match(text.strip().strip('"')))
 
 
 def split(line: str, sep: str | None) -> list[str]:

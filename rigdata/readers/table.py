@@ -8,6 +8,7 @@ error can quote them.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -16,7 +17,7 @@ import numpy as np
 
 from rigdata.record import RigDataError
 
-__all__ = ["FORMATS", "RawTable", "TextCells", "find_text_cells", "cell_value"]
+__all__ = ["FORMATS", "NUMBER", "RawTable", "TextCells", "find_text_cells", "cell_value", "is_number"]
 
 FORMATS = ("csv", "lvm", "tdms")
 #: How many non-numeric cells of a column a RawTable keeps the text of.
@@ -105,12 +106,23 @@ class RawTable:
         return np.asarray(self.columns[column], dtype=float)
 
 
+NUMBER = re.compile(r"^[+-]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][+-]?\d+)?$|^[+-]?(?:nan|inf|infinity)$", re.I)
+"""A number as a rig file writes one: decimal point or comma, exponent, NaN and infinity."""
+
+
+def is_number(text: str) -> bool:
+    """True when ``text`` reads as a number (decimal point or comma, NaN and infinity included)."""
+    return bool(NUMBER.match(text.strip().strip('"')))
+
+
 def cell_value(text: str, decimal: str = ".") -> float:
-    """A text cell as a number the way lvm_read reads one: ``float`` after the decimal mark is
-    replaced by a point, NaN where that fails."""
+    """A text cell as a number: the cells :func:`is_number` accepts, with the decimal mark
+    replaced by a point; NaN for any other text (``float`` alone would also take ``"1_0"``)."""
+    if not is_number(text):
+        return math.nan
     try:
         return float(text.replace(decimal, "."))
-    except ValueError:
+    except ValueError:  # a comma where the file's decimal mark is a point
         return math.nan
 
 
