@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from reference.joint import PAIR_KIND, PAIR_NAMES, Pair
+from reference.joint import PAIR_KIND, Pair
 from reference.scene import Scene
 
 
@@ -98,5 +98,5 @@ def pair_power_loss(torque: Any, force: Any, omega_rel: Any, slide_rel: Any) -> 
     return -(np.asarray(torque) * np.asarray(omega_rel) + np.asarray(force) * np.asarray(slide_rel))
 
 
-__all__ = ["PAIR_NAMES", "friction_from_columns", "friction_magnitudes", "pair_friction",
+__all__ = ["friction_from_columns", "friction_magnitudes", "pair_friction",
            "pair_power_loss", "regularised_sign"]

@@ -157,9 +157,6 @@ class Pairs:
         return [(name, getattr(self, name)) for name in PAIR_NAMES]
 
 
-MAX_SHAFT_ANGLE_DEG = 90.0
-
-
 @dataclass(frozen=True)
 class Geometry:
     """Joint geometry.

@@ -84,7 +84,6 @@ LOCAL_AXES = {
     # output: local z is the shaft axis pointing away from the joint (canonical x).
     "output": np.column_stack([_E[1], _E[2], _E[0]]),
 }
-SHAFT_AXIS_LOCAL = {"input": 1, "spider": 2, "output": 2}
 
 
 def com_from_static_moments(static_moments: np.ndarray, mass: float) -> np.ndarray:

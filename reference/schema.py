@@ -84,7 +84,6 @@ class OptionsError(ValueError):
 MEAN_KEYS = ("revolutions", "window_start_s", "window_duration_s", "input_work", "output_work",
              "loss_work", "mean_efficiency", "mean_instantaneous_efficiency", "work_ratio",
              "mean_torque_in", "mean_speed_in")
-COST_KEYS = ("steps", "newton_iterations", "jacobian_evaluations", "ode_evaluations")
 
 
 @dataclass

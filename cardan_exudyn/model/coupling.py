@@ -113,8 +113,7 @@ class FrictionCoupling:
             if pair.friction_coefficient <= 0.0:
                 continue
             frame = model.pair_frames[name]
-            law = PairLaw(PAIR_KIND[name] == "cylindrical", pair.friction_coefficient,
-                          pair.journal_diameter, pair.moment_lever)
+            law = PairLaw.of(PAIR_KIND[name], pair)
             p = _PairData(name=name, kind=PAIR_KIND[name], law=law, joint=model.joints[name],
                           bodies=PAIR_BODIES[name], local=model.marker_local[name],
                           axis_local=frame[:, 2].copy())

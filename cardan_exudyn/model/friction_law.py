@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 __all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "bdf2_weights"]
 
@@ -55,10 +56,17 @@ class PairLaw:
     d: float
     lever: float
 
+    @classmethod
+    def of(cls, kind: str, pair: Any) -> PairLaw:
+        """The law of a scene's pair (:class:`reference.joint.Pair`) of ``kind`` ("revolute" or
+        "cylindrical")."""
+        return cls(kind == "cylindrical", pair.friction_coefficient, pair.journal_diameter,
+                   pair.moment_lever)
 
-@dataclass(frozen=True)
-class FrictionLoads:
-    """Friction on body ``b`` of a pair.
+
+class FrictionLoads(NamedTuple):
+    """Friction on body ``b`` of a pair (a NamedTuple: built once per pair after every Newton
+    solve, where a frozen dataclass costs a third of the law).
 
     Attributes
     ----------

@@ -186,8 +186,7 @@ def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
     for name, pair in scene.joint.pairs.items():
         if pair.friction_coefficient <= 0.0:
             continue
-        law = PairLaw(PAIR_KIND[name] == "cylindrical", pair.friction_coefficient,
-                      pair.journal_diameter, pair.moment_lever)
+        law = PairLaw.of(PAIR_KIND[name], pair)
         rows = zip(*(cols[f"{name}_{s}"].tolist()
                      for s in ("fx", "fy", "mx", "my", "omega_rel", "slide_rel")), strict=True)
         loads = [pair_loads(law, *row, scene.friction.sign_band) for row in rows]

@@ -8,7 +8,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from reference.joint import PAIR_NAMES  # noqa: E402
 from reference.schema import Status  # noqa: E402
 
 
@@ -35,35 +34,6 @@ def speed_ratio(tables: dict[str, object], ax=None):
     """omega_out/omega_in against input angle, one line per labelled table."""
     return _against_input_angle(tables, lambda t: t["omega_out"] / t["omega_in"],
                                 "omega_out / omega_in [-]", ax)
-
-
-def input_torque(tables: dict[str, object], ax=None):
-    """Drive torque against input angle, one line per labelled table."""
-    return _against_input_angle(tables, lambda t: t["torque_in"], "input torque [N m]", ax)
-
-
-def reactions(table, title: str = "", axes=None):
-    """Per pair: magnitude of the radial force and of the bending moment against input angle."""
-    if axes is None:
-        fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
-    fig = axes[0].figure
-    angle = np.degrees(table["theta_in"]) % 360
-    for pair in PAIR_NAMES:
-        f = np.hypot(table[f"{pair}_fx"], table[f"{pair}_fy"])
-        m = np.hypot(table[f"{pair}_mx"], table[f"{pair}_my"])
-        axes[0].plot(angle, f, ".", ms=1.5, label=pair)
-        axes[1].plot(angle, m, ".", ms=1.5, label=pair)
-    axes[0].set_ylabel("radial reaction force [N]")
-    axes[1].set_ylabel("bending reaction moment [N m]")
-    for ax in axes:
-        ax.set_xlabel("input angle [deg]")
-        ax.set_xlim(0, 360)
-        ax.set_yscale("log")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, markerscale=6)
-    if title:
-        fig.suptitle(title)
-    return fig
 
 
 def efficiency_history(tables: dict[str, object], title: str = "", ax=None, ylim=(0.0, 1.05)):

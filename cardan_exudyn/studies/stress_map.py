@@ -77,7 +77,6 @@ EXUDYN_FAILURES = ("integration_failure", "diverged", "incomplete", "no_whole_re
                    "loop_does_not_close")
 X_LABELS = {"friction": "friction coefficient (all pairs)", "rpm": "input speed [rpm]",
             "steps": "steps per input revolution"}
-NODE_TYPES = ("Rxyz", "EP", "RotVecLG")
 
 
 @dataclass(frozen=True)
