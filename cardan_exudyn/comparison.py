@@ -37,7 +37,7 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import CubicSpline
 
-from cardan_exudyn.engines import engine_of, get_engine, run
+from cardan_exudyn.engines import get_engine, resolve, run
 from cardan_exudyn.report.format import is_number, markdown_table
 from reference.joint import PAIR_NAMES
 from reference.scene import Scene, replace
@@ -304,9 +304,7 @@ def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutio
     for engine, value in options.items():
         if engine not in engines:
             raise OptionsError(f"`options` for {engine!r}, which is not among {engines!r}")
-        if engine_of(value) != engine:
-            raise OptionsError(f"`options[{engine!r}]` are {type(value).__name__}, not the options "
-                               f"of engine {engine!r}")
+        resolve(engine, value)  # options of another engine's class: OptionsError
 
 
 def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],

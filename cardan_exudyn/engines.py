@@ -90,6 +90,32 @@ def engine_of(options: Any) -> str:
                        f"got {type(options).__name__}")
 
 
+DEFAULT_ENGINE = "exudyn"
+
+
+def resolve(engine: str | None = None, options: Any = None, **option_values: Any) -> tuple[str, Any]:
+    """The engine and an instance of its options from what a caller gave (see :func:`run`).
+
+    Raises
+    ------
+    EngineUnavailable
+        An unknown or uninstalled engine.
+    OptionsError
+        Both ``options`` and option keywords, unknown or out-of-range keywords, or options of
+        another engine's class.
+    """
+    if options is not None and option_values:
+        raise OptionsError("give `options` or option keywords, not both")
+    if engine is None:
+        engine = engine_of(options) if options is not None else DEFAULT_ENGINE
+    if options is None:
+        return engine, make_options(engine, **option_values)
+    if engine_of(options) != engine:
+        raise OptionsError(f"`options` are {type(options).__name__}, not the options of "
+                           f"engine {engine!r}")
+    return engine, options
+
+
 def run(scene: Scene, engine: str | None = None, options: Any = None, **option_values: Any) -> Result:
     """Run ``scene`` with an engine.
 
@@ -109,15 +135,7 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
     OptionsError
         Options of another engine's class, unknown or out-of-range option values.
     """
-    if engine is None:
-        engine = engine_of(options) if options is not None else "exudyn"
-    if options is not None and option_values:
-        raise OptionsError("give `options` or option keywords, not both")
-    if options is None and option_values:
-        options = make_options(engine, **option_values)
-    if options is not None and engine_of(options) != engine:
-        raise OptionsError(f"`options` are {type(options).__name__}, not the options of "
-                           f"engine {engine!r}")
+    engine, options = resolve(engine, options, **option_values)
     run_function = get_engine(engine)
     try:
         return run_function(scene, options)

@@ -14,14 +14,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from cardan_exudyn.accuracy import ErrorEstimate, error_estimate
-from cardan_exudyn.engines import engine_of, make_options
+from cardan_exudyn.engines import resolve
 from cardan_exudyn.engines import run as run_engine
 from reference.scene import Scene
-from reference.schema import OptionsError, Result, Status
+from reference.schema import Result, Status
 
-__all__ = ["DEFAULT_ENGINE", "RunRecord", "CachingRunner"]
+__all__ = ["RunRecord", "CachingRunner"]
 
-DEFAULT_ENGINE = "exudyn"
 
 
 @dataclass
@@ -100,15 +99,7 @@ class CachingRunner:
         """
         if not isinstance(scene, Scene):
             raise TypeError(f"`scene` must be a reference.scene.Scene, got {type(scene).__name__}")
-        if options is not None and option_values:
-            raise OptionsError("give `options` or option keywords, not both")
-        if engine is None:
-            engine = engine_of(options) if options is not None else DEFAULT_ENGINE
-        if options is None:
-            options = make_options(engine, **option_values)
-        elif engine_of(options) != engine:
-            raise OptionsError(f"`options` are {type(options).__name__}, not the options of "
-                               f"engine {engine!r}")
+        engine, options = resolve(engine, options, **option_values)
         return scene, engine, options
 
     def error_estimate(self, result: Result) -> ErrorEstimate | None:
