@@ -29,7 +29,6 @@ from typing import Any
 
 import mujoco
 import numpy as np
-import pandas as pd
 
 from reference.joint import PAIR_BODIES, PAIR_NAMES
 from reference.kinematics import body_motions, pair_frames_in_body_a, rot_z
@@ -40,8 +39,7 @@ from reference.schema import (
     Status,
     Summary,
     instantaneous_efficiency,
-    mean_values,
-    table_columns,
+    result_table,
 )
 
 ENGINE_NAME = "mujoco"
@@ -581,19 +579,14 @@ def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
     summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
     summary.extras["max_drive_error_rad"] = violation["max_drive_error_rad"]
     if summary.success:
-        means = mean_values(cols, scene.record.skip_revolutions)
-        if means.get("revolutions", 0) < 1:
-            summary.fail(Status.NO_WHOLE_REVOLUTION, means.get("mean_status", ""))
-        elif summary.max_constraint_violation_rad > VIOLATION_LIMIT_RAD:
+        means = summary.whole_revolution_means(cols, scene.record.skip_revolutions)
+        if means is not None and summary.max_constraint_violation_rad > VIOLATION_LIMIT_RAD:
             summary.fail(Status.CONSTRAINT_VIOLATED, (
                 f"the output axis left its bearing by up to "
                 f"{summary.max_constraint_violation_rad:.3g} rad (limit {VIOLATION_LIMIT_RAD:g}):"
                 " the loop closure is too soft for this time step and these settings"))
-        else:
+        elif means is not None:
             summary.set_means(means)
-    table = None
-    if scene.record.timeseries:
-        every = scene.record.every
-        table = pd.DataFrame({c: cols[c][::every] for c in table_columns()})
+    table = result_table(cols, scene.record.every) if scene.record.timeseries else None
     summary.wall_time_s = time.perf_counter() - start
     return Result(table, summary)

@@ -42,8 +42,7 @@ from reference.schema import (
     Result,
     Status,
     Summary,
-    mean_values,
-    table_columns,
+    result_table,
     whole_revolution_window,
 )
 from reference.validation import check_steps
@@ -544,22 +543,14 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary) -> Any:
             f"{columns['friction_loop_gain'][first]:.3g}): no consistent friction"))
     if summary.success:
         _means(scene, motion, columns, options, summary)
-    table = None
-    if scene.record.timeseries:
-        import pandas as pd  # pandas takes ~0.5 s to import; only a recorded table needs it
-
-        every = scene.record.every
-        table = pd.DataFrame({c: columns[c][::every]
-                              for c in table_columns() + list(EXTRA_COLUMNS)})
-    return table
+    return result_table(columns, scene.record.every, EXTRA_COLUMNS) if scene.record.timeseries else None
 
 
 def _means(scene: Scene, motion: InputMotion, columns: dict[str, np.ndarray],
            options: ReferenceOptions, summary: Summary) -> None:
     """The means over whole revolutions, the works from :func:`work_quadrature`."""
-    means = mean_values(columns, scene.record.skip_revolutions)
-    if means.get("revolutions", 0) < 1:
-        summary.fail(Status.NO_WHOLE_REVOLUTION, means.get("mean_status", ""))
+    means = summary.whole_revolution_means(columns, scene.record.skip_revolutions)
+    if means is None:
         return
     means.update(work_quadrature(scene, motion, columns, options))
     if means.pop("self_locking_nodes"):

@@ -189,8 +189,18 @@ class Summary:
                 self.pair_sliding_loss_work[key[len("loss_work_"):-len("_sliding")]] = value
             elif key.startswith("loss_work_"):
                 self.pair_loss_work[key[len("loss_work_"):]] = value
-            elif key != "mean_status":
+            else:
                 self.extras[key] = value
+
+    def whole_revolution_means(self, columns: Mapping[str, np.ndarray],
+                               skip_revolutions: float) -> dict[str, Any] | None:
+        """:func:`mean_values` of ``columns``; None, with status ``no_whole_revolution`` and the
+        reason, when there is no whole revolution to average over (every engine's rule)."""
+        means = mean_values(columns, skip_revolutions)
+        if means["revolutions"] < 1:
+            self.fail(Status.NO_WHOLE_REVOLUTION, means["mean_status"])
+            return None
+        return means
 
     def clear_means(self) -> None:
         """Forget the means (a run that turned out not ``ok`` after averaging)."""
@@ -271,6 +281,14 @@ class Result:
         """One minus lost over input work over whole revolutions (None unless ``ok``)."""
         return self.summary.mean_efficiency
 
+
+
+def result_table(columns: Mapping[str, np.ndarray], every: int, extra: tuple[str, ...] = ()) -> Any:
+    """The time table of a result: the schema's columns (and an engine's ``extra`` ones), every
+    ``every``-th row, as a pandas DataFrame."""
+    import pandas as pd  # pandas takes ~0.5 s to import; only a recorded table needs it
+
+    return pd.DataFrame({c: columns[c][::every] for c in table_columns() + list(extra)})
 
 
 def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tuple[float, float, int]:

@@ -25,8 +25,7 @@ from reference.schema import (
     Result,
     Status,
     Summary,
-    mean_values,
-    table_columns,
+    result_table,
 )
 from reference.validation import check_steps
 
@@ -171,12 +170,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
             summary.fail(Status.INTEGRATION_FAILURE, f"no usable output: {exc}")
         return Result(None, summary)
     _check_columns(scene, model, columns, summary, options)
-    table = None
-    if scene.record.timeseries:
-        import pandas as pd
-
-        every = scene.record.every
-        table = pd.DataFrame({c: columns[c][::every] for c in table_columns()})
+    table = result_table(columns, scene.record.every) if scene.record.timeseries else None
     return Result(table, summary)
 
 
@@ -200,10 +194,8 @@ def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarr
             summary.fail(Status.INCOMPLETE, f"torque drive turned {turned / (2 * math.pi):.3g} of "
                                             f"{scene.revolutions:g} revolutions in the time allowed")
     if summary.success:
-        means = mean_values(columns, scene.record.skip_revolutions)
-        if means.get("revolutions", 0) < 1:
-            summary.fail(Status.NO_WHOLE_REVOLUTION, means.get("mean_status", ""))
-        else:
+        means = summary.whole_revolution_means(columns, scene.record.skip_revolutions)
+        if means is not None:
             summary.set_means(means)
 
 
