@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.engines import get_engine, run
+from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import to_jsonable
 from reference.paper import named_scene
 from reference.scene import Scene
@@ -295,8 +295,11 @@ def validate(source: Source, scene: Scene | str = "rig-calibrated",
     """
     say = progress or (lambda line: None)
     base = named_scene(scene) if isinstance(scene, str) else scene
-    for engine in engines:
-        get_engine(engine)  # an unknown engine fails now, not after the measurement
+    for engine in engines:  # fail now, not after the measurement
+        if engine not in MODEL_ENGINES:
+            get_engine(engine)  # unknown or not installed: its own message
+            raise EngineUnavailable(f"engine {engine!r} cannot be driven by a measurement (angle "
+                                    f"and load histories): use {' and/or '.join(MODEL_ENGINES)}")
     record, pair = as_record(source, **read_options), _pair(transducers)
     say("conditioning")
     cond = condition(record, base.joint.geometry.shaft_angle, conditioning)

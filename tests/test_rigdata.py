@@ -222,3 +222,16 @@ def test_import_rigdata_is_light():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split("\n")[:2] == ["[]", "rigdata.readers"]
     assert set(rigdata.__all__) <= set(dir(rigdata))
+
+
+def test_validate_refuses_an_engine_that_takes_no_histories_before_measuring(tmp_path, monkeypatch):
+    """MuJoCo takes no angle or load history: validate says so before reading the file."""
+    import rigdata
+    from cardan_exudyn.engines import EngineUnavailable
+
+    def never(*args, **kwargs):
+        raise AssertionError("the file was read")
+
+    monkeypatch.setattr(rigdata.validation, "as_record", never)
+    with pytest.raises(EngineUnavailable, match="cannot be driven by a measurement"):
+        rigdata.validate(tmp_path / "rig.csv", engines=("mujoco",))
