@@ -15,6 +15,7 @@ import importlib
 import os
 import sys
 from importlib.metadata import entry_points
+from typing import TYPE_CHECKING
 
 import tomli_w
 
@@ -36,18 +37,12 @@ from cardan_exudyn.engines import ENGINES, EngineUnavailable, run
 from cardan_exudyn.io import OutputError, dumps, write_result
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies import COMMANDS
-from cardan_exudyn.sweep import (
-    SweepError,
-    SweepIncomplete,
-    SweepSpec,
-    looks_like_path,
-    read_spec_file,
-    run_sweep,
-    spec_from_mapping,
-)
 from reference.scene import scene_to_dict
 from reference.schema import OptionsError, Status, Summary
 from reference.validation import SceneError
+
+if TYPE_CHECKING:
+    from cardan_exudyn.sweep import SweepSpec
 
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for a program the pipe ended
 
@@ -104,6 +99,9 @@ def cmd_scene(args: argparse.Namespace) -> int:
 
 def sweep_spec_from_args(args: argparse.Namespace) -> SweepSpec:
     """The sweep spec of ``cardan sweep``: the SPEC file, with the command-line options applied."""
+    # import cost: the sweep package (process pools, Dask hooks) loads for `cardan sweep` only
+    from cardan_exudyn.sweep import SweepError, looks_like_path, read_spec_file, spec_from_mapping
+
     data = read_spec_file(args.spec) if args.spec else {}
     if args.scene is not None:
         scene = args.scene
@@ -128,6 +126,8 @@ def sweep_spec_from_args(args: argparse.Namespace) -> SweepSpec:
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     """``cardan sweep``: exit 0 when no case failed, 3 when one did, 4 when the sweep stopped."""
+    from cardan_exudyn.sweep import SweepError, SweepIncomplete, run_sweep  # as above
+
     out_folder(args.out, replace=False)
     try:
         spec = sweep_spec_from_args(args)
