@@ -26,7 +26,6 @@ factor a check multiplies an estimate by; the table is in ``docs/pytest.md``.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -37,7 +36,7 @@ from cardan_exudyn.engines import make_options, options_class
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.report.format import is_number
 from reference.scene import Scene, replace, scene_from_dict
-from reference.schema import MEAN_KEYS, Result, Summary
+from reference.schema import MEAN_KEYS, Result, Summary, after_revolutions
 from reference.validation import SceneError
 
 __all__ = ["SAFETY_FACTOR", "STEP_ORDERS", "ESTIMATED_MEANS", "AccuracyError", "ErrorEstimate",
@@ -223,8 +222,7 @@ def row_changes(coarse: Any, fine: Any, dt: float, skip_revolutions: float = 0.0
     t_coarse, t_fine = coarse["t"].to_numpy(float)[:n], fine["t"].to_numpy(float)[:n]
     if n == 0 or np.max(np.abs(t_coarse - t_fine)) > 1e-6 * dt:
         return {}
-    theta = coarse["theta_in"].to_numpy(float)[:n]
-    keep = np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
+    keep = after_revolutions(coarse["theta_in"].to_numpy(float)[:n], skip_revolutions)
     out = {}
     for c in coarse.columns:
         if c == "t" or c not in fine:

@@ -41,7 +41,7 @@ from cardan_exudyn.engines import get_engine, resolve, run
 from cardan_exudyn.report.format import is_number, markdown_table
 from reference.joint import PAIR_NAMES
 from reference.scene import Scene, replace
-from reference.schema import OptionsError, Result, Summary, table_columns
+from reference.schema import OptionsError, Result, Summary, after_revolutions, table_columns
 
 __all__ = ["Comparison", "EngineDifference", "SUMMARY_KEYS", "COMPARED", "SAMPLED_ENGINES", "compare",
            "check_request", "run_engines", "join_on_input_angle", "column_differences",
@@ -285,8 +285,8 @@ def compare(scene: Scene, engines: Sequence[str] = ("exudyn", "reference"),
     engines = list(engines)
     options = dict(options or {})
     check_request(engines, options, skip_revolutions)
-    scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
     results, walls = run_engines(scene, engines, options, progress)
+    scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
     return Comparison(scene, skip_revolutions, results, walls,
                       differences(results, skip_revolutions))
 
@@ -315,6 +315,7 @@ def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any]
 
     ``runner(scene, engine, options)`` runs one engine: :func:`cardan_exudyn.engines.run`, or a
     caching wrapper of it (the pytest plugin's)."""
+    scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
     results, walls = {}, {}
     base_dt = None
     for engine in engines:
@@ -337,8 +338,7 @@ def differences(results: Mapping[str, Result], skip_revolutions: float) -> dict[
     base = results[base_name].table
     if base is None:
         return {}
-    theta = base["theta_in"].to_numpy(float)
-    steady = np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
+    steady = after_revolutions(base["theta_in"].to_numpy(float), skip_revolutions)
     return {engine: difference(results[base_name], results[engine], base_name, engine, steady)
             for engine in others if results[engine].table is not None}
 

@@ -291,6 +291,12 @@ def result_table(columns: Mapping[str, np.ndarray], every: int, extra: tuple[str
     return pd.DataFrame({c: columns[c][::every] for c in table_columns() + list(extra)})
 
 
+def after_revolutions(theta_in: np.ndarray, skip_revolutions: float) -> np.ndarray:
+    """Mask of the rows after the first ``skip_revolutions`` of the input angle (either sense)."""
+    theta = np.asarray(theta_in, float)
+    return np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
+
+
 def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tuple[float, float, int]:
     """Input-angle window [theta_0, theta_1] spanning whole revolutions after the skipped ones.
 

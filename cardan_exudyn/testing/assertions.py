@@ -11,7 +11,6 @@ A run that did not end ``ok`` fails the check with its status and reason.
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -28,11 +27,11 @@ from cardan_exudyn.accuracy import (
     mean_values,
 )
 from cardan_exudyn.comparison import COMPARED, check_request, join_on_input_angle
-from cardan_exudyn.comparison import run_engines as comparison_runs
+from cardan_exudyn.comparison import run_engines as comparison_runs  # with the session cache
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.report.format import is_number, markdown_table, number
-from reference.scene import Scene, replace
-from reference.schema import Result
+from reference.scene import Scene
+from reference.schema import Result, after_revolutions
 
 __all__ = ["MAX_RELATIVE_ERROR", "ROUNDING", "DEFAULT_COLUMNS", "CardanToleranceWarning", "Limit",
            "Check", "assert_efficiency", "assert_engines_agree", "tolerance"]
@@ -240,14 +239,6 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
             ["expected", engine], {engine: estimate}))
 
 
-def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],
-                run: Callable[..., Result]) -> dict[str, Result]:
-    """Each engine's run of ``scene`` with every step a row, as :func:`cardan_exudyn.compare`
-    makes them (:func:`cardan_exudyn.comparison.run_engines`), through ``run``."""
-    scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
-    return comparison_runs(scene, engines, options, runner=run)[0]
-
-
 def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
     """The scale of a mean value: a work's is the input work (a zero loss has a scale too), any
     other's its magnitude (None)."""
@@ -275,7 +266,7 @@ def check_columns(names: Sequence[str], base: Result, other: Result,
         return []
     joined, _ = join_on_input_angle(base.table, other.table)
     theta = base.table["theta_in"].to_numpy(float)
-    keep = np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
+    keep = after_revolutions(theta, skip_revolutions)
     checks = []
     for name in names:
         first = base.table[name].to_numpy(float)[keep]
@@ -349,7 +340,7 @@ def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "refe
     check_request(engines, options, skip_revolutions)
     means, table_columns = check_names(list(columns or DEFAULT_COLUMNS))
     run = run or run_engine
-    results = run_engines(scene, engines, options, run)
+    results = comparison_runs(scene, engines, options, runner=run)[0]
     if failed_runs(results):
         raise AssertionError(failed_runs(results))
     estimates = {engine: estimate_of(result, run, skip_revolutions) for engine, result in results.items()}
