@@ -10,11 +10,11 @@ from typing import Any
 
 import pandas as pd
 
+from cardan_exudyn.report.environment import environment
 from cardan_exudyn.studies.bench_audit import skip_audit
 from cardan_exudyn.studies.bench_configs import ENGINE_NAMES, SCENES, BenchError, Progress
 from cardan_exudyn.studies.bench_ladders import work_precision
 from cardan_exudyn.studies.bench_targets import evaluate_targets, paper_scenes_timing
-from cardan_exudyn.sweep import environment
 from reference.schema import Status
 
 __all__ = ["BenchResult", "check_inputs", "run_bench"]

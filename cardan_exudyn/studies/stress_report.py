@@ -20,6 +20,7 @@ import pandas as pd
 
 from cardan_exudyn.io import atomic_directory, check_output_folder, dumps
 from cardan_exudyn.report import plots
+from cardan_exudyn.report.environment import environment
 from cardan_exudyn.report.format import markdown_table
 from cardan_exudyn.studies.longrun import LongRuns, long_runs
 from cardan_exudyn.studies.longrun_report import markdown as long_markdown
@@ -36,7 +37,6 @@ from cardan_exudyn.studies.stress_map import (
     as_float,
     run_map,
 )
-from cardan_exudyn.sweep import environment
 from reference.schema import Status
 
 PARTS = ("map", "long")

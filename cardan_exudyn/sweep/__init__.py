@@ -34,7 +34,7 @@ from cardan_exudyn.sweep.records import (
     statistics,
     summary_outputs,
 )
-from cardan_exudyn.sweep.runner import environment, run_sweep
+from cardan_exudyn.sweep.runner import run_sweep
 from cardan_exudyn.sweep.spec import (
     DEFAULT_FUNCTION,
     CaseFunction,
@@ -54,5 +54,5 @@ __all__ = [
     "SweepIncomplete", "spec_from_mapping", "read_spec_file", "load_spec", "looks_like_path",
     "flatten_paths", "Case", "Plan", "make_plan", "expand_cases", "run_case", "default_workers",
     "read_records", "results_table", "statistics", "scalar_summary", "summary_outputs",
-    "environment", "DEFAULT_FUNCTION", "PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE",
+    "DEFAULT_FUNCTION", "PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE",
 ]

@@ -24,22 +24,18 @@ records; only the driver writes files.
 
 from __future__ import annotations
 
-import contextlib
-import datetime
 import json
 import os
-import platform
-import subprocess
 import sys
 import time
 from collections.abc import Mapping
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from cardan_exudyn.io import OutputError, check_output_folder, to_jsonable
+from cardan_exudyn.report.environment import environment
 from cardan_exudyn.sweep.executors import Emit, connect, default_workers, run_dask, run_in_process, run_pool
 from cardan_exudyn.sweep.plan import Case, Plan, make_plan
 from cardan_exudyn.sweep.records import (
@@ -62,8 +58,6 @@ from reference.schema import Status
 __all__ = ["run_sweep", "environment"]
 
 # packages whose versions head sweep.json
-ENVIRONMENT_PACKAGES = ("cardan-exudyn", "numpy", "scipy", "exudyn", "distributed", "pandas",
-                        "mujoco", "matplotlib")
 
 
 def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
@@ -227,34 +221,3 @@ class Progress:
     def close(self) -> None:
         if self._bar is not None:
             self._bar.close()
-
-
-def environment() -> dict[str, Any]:
-    """Versions, CPU, date and commit, for the head of ``sweep.json`` (and other reports)."""
-    versions = {}
-    for package in ENVIRONMENT_PACKAGES:
-        try:
-            versions[package] = metadata.version(package)
-        except metadata.PackageNotFoundError:
-            versions[package] = None
-    return {"python": platform.python_version(), "platform": platform.platform(),
-            "machine": platform.machine(), "cpu": _cpu_model(),
-            "cpu_count": os.cpu_count(), "packages": versions, "commit": _git_commit(),
-            "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
-
-
-def _cpu_model() -> str:
-    with contextlib.suppress(OSError):
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    return platform.processor() or "unknown"
-
-
-def _git_commit() -> str | None:
-    try:
-        proc = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
-                              capture_output=True, text=True, timeout=5)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return proc.stdout.strip() or None if proc.returncode == 0 else None
