@@ -95,7 +95,7 @@ def _series(table: Any) -> dict[str, np.ndarray]:
                 "torque_in": table["torque_in"].to_numpy()}
 
 
-def model_sensitivities(c: Conditioned, base: Scene, delta: float, baseline: float,
+def model_sensitivities(c: Conditioned, base: Scene, delta: float, baseline: float | None = None,
                         points_per_revolution: int = 120) -> dict[str, float]:
     """What the computed efficiency owes to the measurement (reference engine).
 
@@ -105,8 +105,9 @@ def model_sensitivities(c: Conditioned, base: Scene, delta: float, baseline: flo
     base : Scene
     delta : float
         Load offset to difference over [N m].
-    baseline : float
-        The reference engine's mean efficiency on the measured scene [-].
+    baseline : float, optional
+        The reference engine's mean efficiency on the measured scene [-], when already run (else
+        it is run here).
     points_per_revolution : int
         See :func:`measured_scene`.
 
@@ -122,5 +123,6 @@ def model_sensitivities(c: Conditioned, base: Scene, delta: float, baseline: flo
         result = engines.run(measured_scene(c, base, points_per_revolution, **changes), "reference")
         return float(result.mean_efficiency) if result.success else float("nan")
 
+    baseline = eta() if baseline is None else baseline
     return {"load": (eta(load_offset=delta) - baseline) / delta, "load_delta": delta,
             "phase_ambiguity": eta(phase_shift=math.pi) - baseline}

@@ -249,14 +249,11 @@ class Validation:
         return to_jsonable(out)
 
 
-def _reference_efficiency(computed: Mapping[str, dict], cond: Conditioned, base: Scene) -> float:
-    """The reference engine's mean efficiency on the measured scene: its run's when it ran
-    ``ok``, else a run of its own (NaN when that fails)."""
-    ref = computed.get("reference")
-    if ref is not None and ref["status"] == Status.OK:
-        return float(ref["mean_efficiency"])
-    result = run(measured_scene(cond, base), "reference")
-    return float(result.mean_efficiency) if result.success else float("nan")
+def _ok_efficiency(computed: Mapping[str, Any] | None) -> float | None:
+    """The mean efficiency of a computed run that ended ``ok`` (None otherwise)."""
+    if computed is None or computed["status"] != Status.OK:
+        return None
+    return float(computed["mean_efficiency"])
 
 
 def validate(source: Source, scene: Scene | str = "rig-calibrated",
@@ -315,6 +312,6 @@ def validate(source: Source, scene: Scene | str = "rig-calibrated",
         if sens is None:
             say("model sensitivities (load offset, yoke half turn)")
             sens = model_sensitivities(cond, base, pair[1].accuracy_limit / SQRT3,
-                                       _reference_efficiency(computed, cond, base))
+                                       _ok_efficiency(computed.get("reference")))
         comparisons[engine] = compare(measured, computed[engine], sens)
     return Validation(record, cond, measured, model, computed, comparisons, sens or {}, pair)
