@@ -2,19 +2,25 @@
 the study modules register (:data:`cardan_exudyn.studies.COMMANDS`) and those other packages
 register under the ``cardan.commands`` entry-point group (``cardan rig``).
 
-Exit status: 0 success; 2 bad input (one line on stderr naming the argument, no traceback);
-3 the simulation failed or is physically meaningless (the reason is in the summary ``status``);
-4 (``cardan sweep``) the sweep stopped before every case ran (rerun the command to resume);
-130 interrupted; 141 the reader of the output went away (``cardan run --json | head -1``).
+Exit status: 0 success; 2 bad input (one line on stderr naming the argument, no traceback), an
+output another command is writing, or a disk that refuses the output (full, read-only; the
+previous output is kept); 3 the simulation failed or is physically meaningless (the reason is in
+the summary ``status``); 4 (``cardan sweep``) the sweep stopped before every case ran (rerun the
+command to resume); 130 interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing recorded as
+failed, the previous output kept, rerunning resumes a sweep; 141 the reader of the output went
+away (``cardan run --json | head -1``).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
 import sys
+from collections.abc import Iterator
 from importlib.metadata import entry_points
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import tomli_w
@@ -22,8 +28,8 @@ import tomli_w
 from cardan_exudyn.arguments import (
     EXIT_BAD_INPUT,
     EXIT_FAILED,
+    EXIT_INACCURATE,
     EXIT_INCOMPLETE,
-    EXIT_INTERRUPTED,
     EXIT_OK,
     BadInput,
     add_scene_options,
@@ -34,10 +40,19 @@ from cardan_exudyn.arguments import (
     scene_from_args,
 )
 from cardan_exudyn.engines import ENGINES, EngineUnavailable, run
-from cardan_exudyn.io import OutputError, dumps, write_result
+from cardan_exudyn.interrupts import Terminated, exit_status, terminate_raises
+from cardan_exudyn.io import (
+    WRITE_ERRORS,
+    OutputError,
+    dumps,
+    output_lock,
+    result_files,
+    write_error,
+    write_result,
+)
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies import COMMANDS
-from reference.scene import scene_to_dict
+from reference.scene import Scene, scene_to_dict
 from reference.schema import OptionsError, Status, Summary
 from reference.validation import SceneError
 
@@ -55,39 +70,74 @@ class _Parser(argparse.ArgumentParser):
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """``cardan run``: exit 0 when the run ended ok, 3 otherwise."""
+    """``cardan run``: exit 0 when the run ended ok, 3 when it did not, 5 when it ended ok but its
+    estimated mean-efficiency error exceeds ``--accuracy`` (``accuracy_met`` false, a warning)."""
     if args.engine not in ENGINES:
         raise BadInput(f"`--engine` must be one of {sorted(ENGINES)}, got {args.engine!r}")
     out_folder(args.out)
     scene = scene_from_args(args)
+    _warn_given_step(scene)
     result = run(scene, args.engine)
     if args.out:
         write_result(result, args.out)
     if args.json:
         print(dumps(result.summary))
     else:
-        _print_summary(result.summary, args.out)
+        _print_summary(result.summary, args.out, result_files(result))
+    if result.success and result.summary.accuracy_met is False:
+        return EXIT_INACCURATE
     return EXIT_OK if result.success else EXIT_FAILED
 
 
+def _warn_given_step(scene: Scene) -> None:
+    """Before a run at a given ``--dt``: a warning on stderr when the a-priori error model of the
+    time-stepping engine (Exudyn) predicts more than the target accuracy (at the largest loss;
+    the run then measures it)."""
+    if scene.numerics.dt is None:
+        return
+    from cardan_exudyn.model.stepsize import predicted_error  # the Exudyn engine's step model
+
+    predicted = predicted_error(scene)
+    if predicted is not None and predicted > scene.numerics.accuracy:
+        print(f"warning: dt {scene.numerics.dt:g} s may miss the accuracy (time-stepping engines) "
+              f"{scene.numerics.accuracy:g}: predicted mean-efficiency error up to {predicted:.2g}",
+              file=sys.stderr)
+
+
 def _no_work(s: Summary) -> str:
-    """What a run with status ok prints for an efficiency that is 0/0 (no input work, e.g. a joint
-    spinning free), instead of 'nan'."""
+    """What a run with status ok prints for an efficiency that is undefined (no work transmitted
+    or lost, e.g. a joint spinning free), instead of 'nan'; the warnings say why."""
     return f"undefined (input work {number(s.input_work, '.3g')} J)"
 
 
-def _print_summary(s: Summary, out: str | None) -> None:
+def _flow(s: Summary) -> str:
+    """The direction of the power flow, when it is not the paper's (input to output)."""
+    if s.power_flow in (None, "input_to_output"):
+        return ""
+    return f", power flow {s.power_flow}"
+
+
+def _error_text(s: Summary) -> str:
+    """`` +- 2.1e-04 (estimated, accuracy met)`` after the mean efficiency; empty without one."""
+    if s.efficiency_error_estimate is None:
+        return ""
+    met = {True: "accuracy met", False: "ACCURACY NOT MET"}.get(s.accuracy_met, "no target")
+    return f" +- {s.efficiency_error_estimate:.2g} (estimated, {met})"
+
+
+def _print_summary(s: Summary, out: str | None, files: list[str]) -> None:
     if s.status != Status.OK:
         print(f"status: {s.status}: {s.reason}", file=sys.stderr)
         return
     print(f"scene {s.scene['name']} with {s.engine} {s.engine_version}: "
-          f"mean efficiency {number(s.mean_efficiency, '.6f', _no_work(s))} "
-          f"(time average of eq. (18): "
-          f"{number(s.mean_instantaneous_efficiency, '.6f', 'undefined, P_in = 0 at some instant')}) "
+          f"mean efficiency {number(s.mean_efficiency, '.6f', _no_work(s))}{_error_text(s)}{_flow(s)} "
+          f"(time average of eq. (18): {number(s.mean_instantaneous_efficiency, '.6f', 'undefined')}) "
           f"over {s.revolutions} revolutions; dt {number(s.dt, '.3g')} s, "
           f"{s.steps} steps, {s.wall_time_s:.3g} s wall")
+    for warning in s.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     if out:
-        print(f"wrote {out}/timeseries.csv and {out}/summary.json")
+        print("wrote " + " and ".join(f"{out}/{name}" for name in files))
 
 
 def cmd_scene(args: argparse.Namespace) -> int:
@@ -222,21 +272,51 @@ def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the ``cardan`` command ``argv`` (default: the process's arguments); the exit status."""
+    """Run the ``cardan`` command ``argv`` (default: the process's arguments); the exit status.
+
+    SIGTERM raises :class:`cardan_exudyn.interrupts.Terminated` while the command runs, so it
+    stops as Ctrl-C does (cleanup, previous output kept, exit 143 instead of 130)."""
     args = build_parser().parse_args(argv)
+    with terminate_raises():
+        return _run_command(args)
+
+
+def _run_command(args: argparse.Namespace) -> int:
     try:
-        status = args.func(args)
-        sys.stdout.flush()  # a reader that went away shows here, not at interpreter exit
+        with _holding_output(args):
+            status = args.func(args)
+            sys.stdout.flush()  # a reader that went away shows here, not at interpreter exit
         return status
     except (SceneError, OptionsError, EngineUnavailable, BadInput, OutputError) as exc:
         print(f"cardan {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        print(f"cardan {args.command}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as exc:  # Ctrl-C, SIGTERM (Terminated), a sweep's SweepInterrupted
+        what = "terminated" if isinstance(exc, Terminated) or exit_status(exc) != 130 else "interrupted"
+        print(f"cardan {args.command}: {what}" + (f": {exc}" if str(exc) else ""), file=sys.stderr)
+        return exit_status(exc)  # 128 + the signal: 130 Ctrl-C, 143 SIGTERM
     except BrokenPipeError:
         _discard_stdout()
         return EXIT_BROKEN_PIPE
+    except OSError as exc:
+        if exc.errno not in WRITE_ERRORS:
+            raise
+        print(f"cardan {args.command}: error: {write_error(exc, exc.filename or 'the output')}",
+              file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+
+@contextlib.contextmanager
+def _holding_output(args: argparse.Namespace) -> Iterator[None]:
+    """Hold the command's ``--out`` (:func:`cardan_exudyn.io.output_lock`) from its start, so a
+    second command writing there is refused at once; when the output's folder does not exist yet,
+    the writer locks it when it makes it. A path the command will refuse is left to it."""
+    out = getattr(args, "out", None)
+    if not isinstance(out, str) or not out.strip() or Path(out).name in ("", ".", "..") \
+            or not Path(out).parent.is_dir():
+        yield
+        return
+    with output_lock(out):
+        yield
 
 
 def _discard_stdout() -> None:

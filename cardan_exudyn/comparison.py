@@ -42,9 +42,10 @@ from cardan_exudyn.report.format import is_number, markdown_table
 from reference.joint import PAIR_NAMES
 from reference.scene import Scene, replace
 from reference.schema import OptionsError, Result, Summary, after_revolutions, table_columns
+from reference.validation import require_scene
 
 __all__ = ["Comparison", "EngineDifference", "SUMMARY_KEYS", "COMPARED", "SAMPLED_ENGINES", "compare",
-           "check_request", "run_engines", "join_on_input_angle", "column_differences",
+           "check_request", "engine_list", "run_engines", "join_on_input_angle", "column_differences",
            "summary_values"]
 
 MEAN_KEYS = ("mean_efficiency", "mean_instantaneous_efficiency", "work_ratio", "input_work",
@@ -129,11 +130,12 @@ class Comparison:
 
     def engine_record(self, engine: str) -> dict[str, Any]:
         """What the report says about one engine's run: status, reason, version, wall time [s],
-        step [s], steps, and the :data:`SUMMARY_KEYS` the run has a value for."""
+        step [s], steps, the direction of the power flow, and the :data:`SUMMARY_KEYS` the run
+        has a value for."""
         s = self.results[engine].summary
         return {"status": s.status.value, "reason": s.reason, "engine_version": s.engine_version,
                 "wall_time_s": self.wall_time_s[engine], "dt": s.dt, "steps": s.steps,
-                **summary_values(s)}
+                "power_flow": s.power_flow, **summary_values(s)}
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON report (``comparison.json``, ``cardan compare --json``): no time tables."""
@@ -274,25 +276,58 @@ def compare(scene: Scene, engines: Sequence[str] = ("exudyn", "reference"),
 
     Raises
     ------
+    TypeError
+        ``scene`` not a Scene, ``engines`` a string or holding something else than names,
+        ``options`` not a mapping, ``skip_revolutions`` not a number, ``progress`` not callable.
     ValueError
-        Fewer than two engines, an engine twice, or a negative ``skip_revolutions``.
+        Fewer than two engines, an engine twice, a negative ``skip_revolutions`` or one that
+        leaves none of the scene's revolutions.
     EngineUnavailable
         An engine that is unknown, not installed, or cannot run the scene (before any engine
         runs, except for the last reason).
     OptionsError
         Options for an engine not compared, or of another engine's class.
     """
-    engines = list(engines)
+    require_scene(scene)
+    engines = engine_list(engines)
+    if options is not None and not isinstance(options, Mapping):
+        raise TypeError(f"`options` must be a mapping of engine name to options, got "
+                        f"{type(options).__name__} {options!r:.80}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"`progress` must be callable or None, got {type(progress).__name__}")
     options = dict(options or {})
     check_request(engines, options, skip_revolutions)
+    if skip_revolutions >= scene.revolutions:
+        raise ValueError(f"`skip_revolutions` = {skip_revolutions!r} leaves nothing of the scene's "
+                         f"{scene.revolutions!r} revolutions to compare: it must be below them")
     results, walls = run_engines(scene, engines, options, progress)
     scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
     return Comparison(scene, skip_revolutions, results, walls,
                       differences(results, skip_revolutions))
 
 
+def engine_list(engines: Any) -> list[str]:
+    """``engines`` as a list of engine names; ``TypeError`` naming the argument for a single
+    string (``"exudyn,reference"`` is one name, not two) or anything that is not a sequence of
+    strings."""
+    if isinstance(engines, (str, bytes)):
+        raise TypeError(f"`engines` must be a sequence of engine names such as ['exudyn', 'reference'], "
+                        f"not one string: got {engines!r:.80}")
+    if not hasattr(engines, "__iter__"):
+        raise TypeError(f"`engines` must be a sequence of engine names, got {type(engines).__name__}")
+    out = list(engines)
+    wrong = [e for e in out if not isinstance(e, str)]
+    if wrong:
+        raise TypeError(f"`engines` must hold engine names (strings), got {wrong[0]!r:.80} in {out!r:.120}")
+    return out
+
+
 def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutions: float) -> None:
     """Refuse a comparison that cannot be made, before any engine runs."""
+    engines = engine_list(engines)
+    if isinstance(skip_revolutions, bool) or not isinstance(skip_revolutions, (int, float, np.integer,
+                                                                               np.floating)):
+        raise TypeError(f"`skip_revolutions` must be a number of revolutions, got {skip_revolutions!r:.80}")
     if len(engines) < 2:
         raise ValueError(f"`engines` needs at least two engines, got {engines!r}")
     if len(set(engines)) != len(engines):

@@ -15,6 +15,7 @@ from typing import Any
 
 from reference.scene import Scene
 from reference.schema import OptionsError, Result
+from reference.validation import require_scene
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,10 @@ class EngineUnavailable(ValueError):
 
 
 def _entry(name: str) -> Engine:
-    if not isinstance(name, str) or name not in ENGINES:
+    if not isinstance(name, str):
+        raise TypeError(f"`engine` must be the name of an engine (a string, one of {sorted(ENGINES)}), "
+                        f"got {type(name).__name__} {name!r:.80}")
+    if name not in ENGINES:
         raise EngineUnavailable(f"`engine` must be one of {sorted(ENGINES)}, got {name!r}")
     return ENGINES[name]
 
@@ -130,11 +134,15 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
 
     Raises
     ------
+    TypeError
+        ``scene`` is not a Scene (:class:`reference.validation.SceneTypeError`), or ``engine``
+        not a string.
     EngineUnavailable
         Unknown or uninstalled engine, or a scene the engine cannot express.
     OptionsError
         Options of another engine's class, unknown or out-of-range option values.
     """
+    require_scene(scene)
     engine, options = resolve(engine, options, **option_values)
     run_function = get_engine(engine)
     try:

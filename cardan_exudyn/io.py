@@ -1,18 +1,24 @@
-"""Writing results: CSV time table plus JSON summary, atomically.
+"""Writing results: CSV time table plus JSON summary, atomically, one writer at a time.
 
-A command writes into a temporary sibling folder and renames it into place at the end, so an
-interrupted or failed command leaves either the complete previous output or a complete new one.
+A command writes into a new hidden sibling of its output folder and exchanges it with the
+previous one in one step when it is complete (:func:`atomic_directory`), so a command killed at
+any instant leaves the complete previous output or the complete new one; the next command
+removes what a killed one left. While a command runs, a second one writing to the same output
+is refused (:func:`output_lock`). The guarantees and their limits: ``docs/outputs.md``.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import errno
 import json
 import math
 import os
+import re
 import secrets
 import shutil
-import tempfile
+import sys
 from collections.abc import Callable, Iterator
 from enum import Enum
 from pathlib import Path
@@ -20,12 +26,15 @@ from typing import IO, Any
 
 import numpy as np
 
+from cardan_exudyn.interrupts import deferred_signals
 from reference.schema import Result, Summary
 
 
 class OutputError(ValueError):
-    """An output path cannot be written as asked (it exists and is not a folder, or its parent
-    cannot hold it); raised before anything is written. The CLI prints it, exit status 2."""
+    """An output path cannot be written as asked: it exists and is not a folder, it may not be
+    replaced, its parent cannot hold it or another command is writing it (raised before anything
+    is written), or the disk is full (the previous output is kept). The CLI prints it, exit
+    status 2."""
 
 
 def to_jsonable(value: Any) -> Any:
@@ -98,13 +107,19 @@ def dumps(data: Any) -> str:
 def check_output_folder(target: str | os.PathLike, replace: bool = True) -> Path:
     """``target`` as a folder a command may create (and, with ``replace``, replace as a whole): it
     is a folder or does not exist, and its nearest existing parent is a folder; raises
-    :class:`OutputError` otherwise."""
+    :class:`OutputError` otherwise.
+
+    A folder that is replaced as a whole must be one of its own: not the current folder, the home
+    folder, the root or a folder above one of them (however it is spelt: ``.``, ``$(pwd)``,
+    ``~/..``), and not a folder holding a ``.git`` repository."""
     target = Path(target)
     if replace and target.name in ("", ".", ".."):  # "", ".", "/", "..": a folder above the output's own
         raise OutputError(f"{str(target)!r} names no folder of its own (the current folder, a parent "
                           "or the root would be replaced)")
     if target.exists() and not target.is_dir():
         raise OutputError(f"{str(target)!r} exists and is not a folder")
+    if replace and target.is_dir():
+        _check_replaceable(target)
     parent = target.parent
     while not parent.exists() and parent != parent.parent:
         parent = parent.parent
@@ -113,36 +128,259 @@ def check_output_folder(target: str | os.PathLike, replace: bool = True) -> Path
     return target
 
 
-@contextlib.contextmanager
-def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
-    """Yield a temporary folder that replaces ``target`` only when the block succeeds.
+def _check_replaceable(folder: Path) -> None:
+    """Refuse to replace a folder that holds the current or home folder, or a repository."""
+    resolved = folder.resolve()
+    for place, what in ((Path.cwd(), "the current folder"), (Path.home(), "the home folder")):
+        with contextlib.suppress(OSError, RuntimeError):
+            place = place.resolve()
+            if place == resolved or resolved in place.parents:
+                raise OutputError(f"{str(folder)!r} is {what} or holds it: it would be replaced as a "
+                                  "whole; give a folder of its own")
+    if (folder / ".git").exists():
+        raise OutputError(f"{str(folder)!r} holds a git repository: it would be replaced as a whole; "
+                          "give a folder of its own")
 
-    Raises :class:`OutputError` before the block runs when ``target`` exists and is not a folder
-    (a file is never replaced by a folder) or its parent cannot be created."""
-    target = check_output_folder(target)
+
+# A write the disk refuses (full, over quota, over the file size limit, read-only): one line
+WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
+_LEFTOVER = re.compile(r"\.(?P<name>.+)\.cardan-(?P<kind>new|old)-(?P<pid>\d+)-[0-9a-f]+")
+_held: dict[str, int] = {}  # lock files this process holds -> nesting depth
+
+
+def write_error(exc: OSError, target: str | os.PathLike) -> OutputError:
+    """A write failure (full disk, quota, file size limit, read-only) as one line."""
+    return OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}"
+                       + (f" ({exc.filename})" if exc.filename else ""))
+
+
+def lock_path(target: str | os.PathLike) -> Path:
+    """The lock file of an output ``target``: ``.NAME.lock`` next to it."""
+    target = Path(os.path.abspath(target))
+    return target.with_name(f".{target.name}.lock")
+
+
+@contextlib.contextmanager
+def output_lock(target: str | os.PathLike) -> Iterator[None]:
+    """Hold ``target`` (an output folder or file) for this process: a second command writing to
+    it meanwhile gets :class:`OutputError` naming this one. Re-entrant within a process.
+
+    The lock is an advisory ``flock`` on ``.NAME.lock`` next to the target, removed on release;
+    its folder must exist. Without ``fcntl`` (Windows), or where the lock file cannot be created
+    (a read-only folder, which no command can write into anyway), nothing is locked."""
+    path = lock_path(target)
+    key = str(path)
+    if key in _held:
+        _held[key] += 1
+        try:
+            yield
+        finally:
+            _held[key] -= 1
+        return
+    fd = _acquire(path, target)
+    _held[key] = 1
+    try:
+        yield
+    finally:
+        del _held[key]
+        if fd is not None:
+            with contextlib.suppress(OSError):  # unlinked before the unlock: see _acquire
+                os.unlink(path)
+            os.close(fd)
+
+
+def _acquire(path: Path, target: str | os.PathLike) -> int | None:
+    """Open and lock ``path``; retried when its holder removed it between our open and lock."""
+    try:
+        import fcntl
+    except ImportError:  # Windows: no advisory lock
+        return None
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+                return None
+            raise write_error(exc, target) from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+            os.close(fd)
+            raise OutputError(f"{str(target)!r} is being written by another cardan command (process "
+                              f"{holder}); wait for it to end or choose another output") from None
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(path))
+        except FileNotFoundError:
+            same = False
+        if same:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"{os.getpid()}\n".encode("ascii"))
+            return fd
+        os.close(fd)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def clean_leftovers(target: str | os.PathLike) -> list[Path]:
+    """Remove the temporary siblings ``.NAME.cardan-new-PID-*`` and ``.NAME.cardan-old-PID-*`` of
+    ``target`` left by killed commands (their process is gone); when ``target`` itself is
+    missing and a killed swap left the previous output aside (``old``), put it back first.
+
+    Returns the leftovers found (restored or removed)."""
+    target = Path(target)
+    if not target.parent.is_dir():
+        return []
+    found = []
+    for entry in target.parent.iterdir():
+        match = _LEFTOVER.fullmatch(entry.name)
+        if match and match["name"] == target.name and not _alive(int(match["pid"])):
+            found.append((match["kind"], entry))
+    if not os.path.lexists(target):
+        olds = sorted((e for kind, e in found if kind == "old"), key=lambda e: e.stat().st_mtime)
+        if olds:
+            os.rename(olds[-1], target)
+    for _, entry in found:
+        _remove(entry)
+    return [e for _, e in found]
+
+
+def _remove(path: Path) -> None:
+    """Delete a folder (or the symbolic link an output folder may have been) if it exists."""
+    if path.is_symlink():
+        path.unlink()
+    elif path.exists():
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def _sibling(target: Path, kind: str) -> Path:
+    return target.with_name(f".{target.name}.cardan-{kind}-{os.getpid()}-{secrets.token_hex(4)}")
+
+
+def _renameat2():
+    """libc's ``renameat2`` (Linux >= 3.15, glibc >= 2.28), or ``None``."""
+    try:
+        function = ctypes.CDLL(None, use_errno=True).renameat2
+    except (AttributeError, OSError, TypeError):
+        return None
+    function.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    function.restype = ctypes.c_int
+    return function
+
+
+_RENAMEAT2 = _renameat2() if sys.platform.startswith("linux") else None
+_AT_FDCWD, _RENAME_EXCHANGE = -100, 2
+
+
+def exchange(a: str | os.PathLike, b: str | os.PathLike) -> bool:
+    """Swap two existing paths in one atomic step (Linux ``renameat2(RENAME_EXCHANGE)``).
+
+    Returns False where the system or the file system cannot (the caller falls back to two
+    renames); raises :class:`OSError` for any other failure."""
+    if _RENAMEAT2 is None:
+        return False
+    if _RENAMEAT2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP, errno.EOPNOTSUPP):
+        return False
+    raise OSError(code, os.strerror(code), os.fspath(a), None, os.fspath(b))
+
+
+def _swap(new: Path, target: Path) -> None:
+    """Put the complete folder ``new`` at ``target``; the previous one is removed after. Ctrl-C
+    and SIGTERM wait for the renames (:func:`cardan_exudyn.interrupts.deferred_signals`)."""
+    with deferred_signals():
+        if not os.path.lexists(target):
+            os.rename(new, target)
+            return
+        if exchange(new, target):  # one step: at every instant target is the previous or the new
+            old = new
+        else:  # two steps: between them the previous is at `old`, and clean_leftovers puts it
+            old = _sibling(target, "old")  # back if this process is killed there
+            os.replace(target, old)
+            try:
+                os.replace(new, target)
+            except BaseException:
+                if not os.path.lexists(target):
+                    os.replace(old, target)
+                raise
+    _remove(old)
+
+
+def _fsync_tree(folder: Path) -> None:
+    """Files and folders under ``folder`` on disk before the swap (a power cut then finds the new
+    output complete, not files of zero length)."""
+    for root, _, files in os.walk(folder):
+        for name in [*files, "."]:
+            fd = os.open(os.path.join(root, name), os.O_RDONLY)
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+
+
+def _make_parents(target: Path) -> None:
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create the folder of {str(target)!r}: {exc.strerror}") from None
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    old = None
-    try:
-        if target.exists():
-            old = target.with_name(f".{target.name}.old-{os.getpid()}")
-            os.replace(target, old)
-        os.replace(tmp, target)
-    except BaseException:  # put the previous output back; the new one is dropped
-        if old is not None and not target.exists():
-            os.replace(old, target)
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
+    """Yield a new empty folder that replaces ``target`` only when the block succeeds.
+
+    The folder is ``.NAME.cardan-new-PID-*`` next to ``target``, made with the permissions the
+    umask gives. When the block ends, its files are fsync'ed and it takes the place of
+    ``target`` in one atomic exchange (where the file system cannot exchange: two renames, see
+    :func:`clean_leftovers`); on an exception (an interruption included) it is removed and
+    ``target`` is untouched. The command holds :func:`output_lock` throughout and first removes
+    the leftovers of killed commands.
+
+    Raises
+    ------
+    OutputError
+        Before the block runs: ``target`` exists and is not a folder (a file is never replaced
+        by a folder), may not be replaced (:func:`check_output_folder`), its parent cannot be
+        made, or another command is writing it. After: the disk is full or the output cannot
+        be written (:data:`WRITE_ERRORS`); the previous output is kept.
+    """
+    target = check_output_folder(target)
+    _make_parents(target)
+    with output_lock(target):
+        clean_leftovers(target)
+        new = _sibling(target, "new")
+        try:
+            os.mkdir(new, 0o777)  # not mkdtemp, which makes it 0o700 whatever the umask
+        except OSError as exc:
+            raise write_error(exc, target) from None
+        try:
+            yield new
+            _fsync_tree(new)
+            _swap(new, target)
+        except OSError as exc:
+            shutil.rmtree(new, ignore_errors=True)
+            if exc.errno in WRITE_ERRORS:
+                raise write_error(exc, target) from None
+            raise
+        except BaseException:
+            shutil.rmtree(new, ignore_errors=True)
+            raise
+
+
+def result_files(result: Result) -> list[str]:
+    """The files :func:`write_result_files` writes for ``result``: ``timeseries.csv`` only when a
+    table was recorded (``record.timeseries``), then ``summary.json``."""
+    return (["timeseries.csv"] if result.table is not None else []) + ["summary.json"]
 
 
 def write_result_files(result: Result, folder: Path) -> None:

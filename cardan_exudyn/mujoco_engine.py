@@ -578,14 +578,15 @@ def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
     summary.max_constraint_violation_m = violation["max_constraint_violation_m"]
     summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
     summary.extras["max_drive_error_rad"] = violation["max_drive_error_rad"]
-    if summary.success:
+    if summary.success and summary.max_constraint_violation_rad > VIOLATION_LIMIT_RAD:
+        # before the means: a loop that does not hold explains whatever they would say
+        summary.fail(Status.CONSTRAINT_VIOLATED, (
+            f"the output axis left its bearing by up to "
+            f"{summary.max_constraint_violation_rad:.3g} rad (limit {VIOLATION_LIMIT_RAD:g}):"
+            " the loop closure is too soft for this time step and these settings"))
+    elif summary.success:
         means = summary.whole_revolution_means(cols, scene.record.skip_revolutions)
-        if means is not None and summary.max_constraint_violation_rad > VIOLATION_LIMIT_RAD:
-            summary.fail(Status.CONSTRAINT_VIOLATED, (
-                f"the output axis left its bearing by up to "
-                f"{summary.max_constraint_violation_rad:.3g} rad (limit {VIOLATION_LIMIT_RAD:g}):"
-                " the loop closure is too soft for this time step and these settings"))
-        elif means is not None:
+        if means is not None:
             summary.set_means(means)
     table = result_table(cols, scene.record.every) if scene.record.timeseries else None
     summary.wall_time_s = time.perf_counter() - start

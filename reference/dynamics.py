@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reference.bands import sign_bands
 from reference.friction import friction_magnitudes, pair_power_loss, regularised_sign
 from reference.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
 from reference.joint_motion import JointMotion, joint_motion
@@ -284,6 +285,13 @@ def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str,
     return np.stack(out, -1)
 
 
+def slot_bands(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
+    """Width of each slot's sign ramp [m/s] (:func:`reference.bands.sign_bands`), shape (K,)."""
+    bands = sign_bands(scene)
+    return np.array([bands[pair].rotation if kind == "torque" else bands[pair].sliding
+                     for pair, kind in slots], dtype=float)
+
+
 @dataclass
 class FixedPoint:
     """Outcome of the friction fixed point, per sample.
@@ -377,13 +385,16 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                    theta_tt: np.ndarray | None = None,
                    torque_in: float | np.ndarray | None = None,
                    method: str = "auto",
-                   load_torque: float | np.ndarray | None = None) -> tuple[JointMotion, FixedPoint]:
+                   load_torque: float | np.ndarray | None = None,
+                   bands: np.ndarray | None = None) -> tuple[JointMotion, FixedPoint]:
     """Reactions, friction and the drive unknown for every sample.
 
     Exactly one of ``theta_tt`` (inverse dynamics: the drive torque is the unknown) and
     ``torque_in`` (forward dynamics: the input acceleration is the unknown) is given.
     ``method`` chooses the kinematics (:func:`reference.joint_motion.joint_motion`);
-    ``load_torque`` [N m] the output load per sample (None: the scene's constant load).
+    ``load_torque`` [N m] the output load per sample (None: the scene's constant load);
+    ``bands`` the sign ramps' widths (None: :func:`slot_bands`, looked up by the scene, whose
+    hash a caller solving one sample at a time may save by passing them).
 
     Returns
     -------
@@ -416,7 +427,9 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
         wrenches = friction_matrix(pair, friction_slots(scene))[:n]
     slots = friction_slots(scene)
     both = np.linalg.solve(matrix, np.concatenate([rhs[..., None], wrenches], -1))
-    signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide_rel), scene.friction.sign_band)
+    if bands is None:
+        bands = slot_bands(scene, slots)
+    signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide_rel), bands)
              if slots else np.zeros(theta.shape + (0,)))
     law = FrictionLaw(scene, slots)
     if scene.friction.coupling == "uncoupled":  # evaluated on the frictionless reactions only

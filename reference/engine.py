@@ -10,11 +10,11 @@ comes from the same Newton-Euler system with the drive torque given.
 The mean values that matter (input, output and lost work, hence the mean efficiency) are not
 taken from the time table but by Gauss-Legendre quadrature over the whole-revolution window, on
 panels that break at every kink of the integrand: the edges of each friction sign ramp
-(relative surface speed = +-``sign_band``) and the knots of an angle history. Inside a panel
-the integrand is smooth, so the quadrature converges exponentially; the mean efficiency is
-stable to 1e-8 and better as the panels are refined (tested). The time-averaged instantaneous
-efficiency is taken from the table like every engine does (it has poles where the input power
-crosses zero, so it has no exact value to converge to).
+(relative surface speed = +- the pair's band, :mod:`reference.bands`) and the knots of an angle
+history. Inside a panel the integrand is smooth, so the quadrature converges exponentially; the
+mean efficiency is stable to 1e-8 and better as the panels are refined (tested). The
+time-averaged instantaneous efficiency is taken from the table like every engine does (it has
+poles where the input power crosses zero, so it has no exact value to converge to).
 """
 
 from __future__ import annotations
@@ -27,12 +27,15 @@ from typing import Any
 
 import numpy as np
 
+from reference.bands import sign_bands
 from reference.dynamics import (
     dynamics_columns,
     friction_slots,
+    slot_bands,
     slot_speeds,
     solve_dynamics,
 )
+from reference.histories import run_clock
 from reference.joint import PAIR_NAMES
 from reference.joint_motion import joint_motion
 from reference.loop_closure import LoopClosureError
@@ -45,7 +48,7 @@ from reference.schema import (
     result_table,
     whole_revolution_window,
 )
-from reference.validation import check_steps
+from reference.validation import check_steps, require_scene
 
 ENGINE_NAME = "reference"
 ENGINE_VERSION = "reference-0.2"
@@ -170,11 +173,12 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
     w0 = drive.initial_speed
     t_max = drive.time_allowed(target)  # the span every engine allows
     count = {"n": 0}
+    bands = slot_bands(scene, friction_slots(scene))  # once: one sample per call below
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         count["n"] += 1
         _, fixed = solve_dynamics(scene, y[:1], y[1:], torque_in=drive.torque,
-                                  load_torque=scene.load.at(np.array([t])))
+                                  load_torque=scene.load.at(np.array([t])), bands=bands)
         if fixed.self_locking[0]:
             raise SelfLocking(t, float(y[0]))
         return np.array([y[1], fixed.x[0, -1]])
@@ -241,8 +245,9 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
                      per_revolution: int = 1024) -> np.ndarray:
     """Instants in (t_a, t_b) where a friction sign ramp starts or ends [s].
 
-    Each relative surface (or sliding) speed is sampled finely, every crossing of the ramp
-    edges ``+-sign_band`` (of 0 for the exact sign) is bracketed and refined to rounding.
+    Each relative surface (or sliding) speed is sampled finely, every crossing of its ramp
+    edges ``+-band`` (:func:`reference.dynamics.slot_bands`; of 0 for the exact sign) is
+    bracketed and refined to rounding.
     """
 
     slots = friction_slots(scene)
@@ -258,12 +263,12 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
     grid = np.linspace(t_a, t_b, n + 1)
     values = speeds(grid)
-    band = scene.friction.sign_band
+    bands = slot_bands(scene, slots)
     brackets = []
-    for level in ((-band, band) if band > 0 else (0.0,)):
-        g = values - level
+    for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
+        g = values - levels
         cell, slot = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)
-        brackets += [(grid[i], grid[i + 1], g[i, j], g[i + 1, j], j, level)
+        brackets += [(grid[i], grid[i + 1], g[i, j], g[i + 1, j], j, levels[j])
                      for i, j in zip(cell, slot, strict=True)]
     if not brackets:
         return np.zeros(0)
@@ -292,6 +297,9 @@ def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.
 
 
 GROSS_SCALE = 1e-3
+DENSE_WIDTH, DENSE_NODES = 0.125, 3
+"""Panels mostly below ``DENSE_WIDTH`` of the initial width (dense history knots) get at most
+``DENSE_NODES`` Gauss nodes: smooth between knots, error O(h^7); 9 evaluations per knot, not 24."""
 MAX_OPEN_PANELS = 20_000
 
 
@@ -391,8 +399,10 @@ def _window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
 
 
 def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.ndarray,
-                      ends: dict[str, np.ndarray], options: ReferenceOptions) -> tuple[np.ndarray, dict]:
-    """:data:`WORK_KEYS` integrated over the panels ``[lo, hi]`` [s] (:func:`adaptive_gauss`)."""
+                      ends: dict[str, np.ndarray], options: ReferenceOptions,
+                      nodes: int | None = None) -> tuple[np.ndarray, dict]:
+    """:data:`WORK_KEYS` integrated over the panels ``[lo, hi]`` [s] (:func:`adaptive_gauss`,
+    ``nodes`` per panel, default ``options.gauss_nodes``)."""
     def integrand(times: np.ndarray) -> np.ndarray:
         cols = columns_at(scene, motion, times)
         return np.stack([np.asarray(cols[k], float) for k in WORK_KEYS], -1)
@@ -400,23 +410,20 @@ def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.
     # work below a thousandth of the mechanical energy is at the scale's floor (zero input work)
     energy_scale = float(np.max(np.abs(ends["energy_kinetic"])) + np.max(np.abs(ends["energy_potential"])))
     with np.errstate(invalid="ignore"):
-        return adaptive_gauss(integrand, lo, hi, options.gauss_nodes, options.quadrature_rtol,
+        return adaptive_gauss(integrand, lo, hi, nodes or options.gauss_nodes, options.quadrature_rtol,
                               scale_floor=GROSS_SCALE * energy_scale)
 
 
-def _work_means(work: dict[str, float], angle: float, ends: dict[str, np.ndarray]) -> dict[str, Any]:
-    """Summary keys from the works [J] over the window of input ``angle`` [rad]."""
+def _work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
+    """Summary keys from the works [J] over the window (the means derived from them are
+    :func:`reference.schema.mean_values`')."""
     out = {"input_work": work["power_in"], "output_work": work["power_out"],
            "loss_work": work["power_loss"]}
     for pair in PAIR_NAMES:
         out[f"loss_work_{pair}"] = work[f"power_loss_{pair}"]
         out[f"loss_work_{pair}_sliding"] = work[f"power_loss_{pair}_sliding"]
-    w_in = out["input_work"]
-    out["mean_efficiency"] = 1.0 - out["loss_work"] / w_in if w_in != 0 else float("nan")
-    out["work_ratio"] = out["output_work"] / w_in if w_in != 0 else float("nan")
-    out["mean_torque_in"] = w_in / angle
     energy = ends["energy_kinetic"] + ends["energy_potential"]
-    out["energy_balance_residual"] = float(w_in - out["output_work"] - out["loss_work"]
+    out["energy_balance_residual"] = float(out["input_work"] - out["output_work"] - out["loss_work"]
                                            - (energy[1] - energy[0]))
     return out
 
@@ -427,9 +434,8 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
 
     Returns the summary keys ``input_work``, ``output_work``, ``loss_work`` [J],
     ``loss_work_<pair>`` and its axial-friction part ``loss_work_<pair>_sliding`` [J] (zero in
-    the ideal joint), ``mean_efficiency``, ``work_ratio`` [-], ``mean_torque_in`` [N m],
-    ``energy_balance_residual`` (W_in - W_out - W_loss - change of mechanical energy [J], zero up
-    to rounding for an exact solution), ``quadrature`` (how it was done) and
+    the ideal joint), ``energy_balance_residual`` (W_in - W_out - W_loss - change of mechanical
+    energy [J], zero up to rounding for an exact solution), ``quadrature`` (how it was done) and
     ``self_locking_nodes`` (friction locks at some node); empty when there is no whole revolution.
     """
     theta, t = table["theta_in"], table["t"]
@@ -446,12 +452,14 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     knots = knots[(knots > t_a) & (knots < t_end)]
     edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
     lo, hi = initial_panels(edges, period / options.panels_per_revolution)
+    dense = lo.size and np.median(hi - lo) < DENSE_WIDTH * period / options.panels_per_revolution
+    nodes = min(options.gauss_nodes, DENSE_NODES) if dense else options.gauss_nodes
     ends = columns_at(scene, motion, np.array([t_a, t_b]))
-    values, info = _integrate_powers(scene, motion, lo, hi, ends, options)
+    values, info = _integrate_powers(scene, motion, lo, hi, ends, options, nodes)
     work = dict(zip(WORK_KEYS, (repeats * values).tolist(), strict=True))
-    out = _work_means(work, theta_1 - theta_0, ends)
+    out = _work_means(work, ends)
     out["quadrature"] = {"method": "adaptive Gauss-Legendre panels",
-                         "nodes_per_panel": options.gauss_nodes,
+                         "nodes_per_panel": nodes,
                          "rtol": options.quadrature_rtol,
                          "sign_breakpoints": int(kinks.size), "knots": int(knots.size),
                          "revolutions_integrated": n // repeats,
@@ -497,18 +505,22 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
     Result
         Time table (the schema's columns plus :data:`EXTRA_COLUMNS`, every
         ``scene.record.every``-th row; None when ``record.timeseries`` is off) and summary: the
-        keys of :func:`reference.schema.mean_values`, with the work-based means replaced by
-        :func:`work_quadrature`'s, ``self_locking_samples`` and, when friction locks, status
-        ``self_locking`` with the first input angle where it does; status
+        keys of :func:`reference.schema.mean_values` taken from :func:`work_quadrature`'s works,
+        ``self_locking_samples`` and, when friction locks, status ``self_locking`` with the first
+        input angle where it does; status ``unphysical`` when the means are impossible; status
         ``loop_does_not_close`` (no table) when mounting errors keep the loop from closing.
     """
+    require_scene(scene)
+    if options is not None and not isinstance(options, ReferenceOptions):
+        raise OptionsError(f"`options` must be ReferenceOptions or None, got {type(options).__name__}")
     options = options or ReferenceOptions()
     start = time.perf_counter()
     summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=ENGINE_VERSION,
                       scene=scene_to_dict(scene),
                       options={k: getattr(options, k) for k in options.__dataclass_fields__})
     try:
-        table = _run(scene, options, summary)
+        clock, origin = run_clock(scene)  # histories from t = 0: the same answer at any start time
+        table = _run(clock, options, summary, origin)
     except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
         summary.fail(Status.LOOP_DOES_NOT_CLOSE, str(exc))
         table = None
@@ -516,12 +528,15 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
     return Result(table, summary)
 
 
-def _run(scene: Scene, options: ReferenceOptions, summary: Summary) -> Any:
-    """Fill ``summary``; return the time table (or None)."""
+def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: float = 0.0) -> Any:
+    """Fill ``summary``; return the time table (or None), its times ``origin`` [s] later than
+    the scene's (:func:`reference.histories.run_clock`)."""
     if scene.drive.kind == "torque":  # the ODE's cost grows with the revolutions: refuse first
         spr = options.samples_per_revolution or 360
         check_steps(scene.revolutions * spr,
                     f"{scene.revolutions:g} revolutions at {spr} samples per revolution")
+    if scene.has_friction:
+        summary.extras["sign_bands_m_s"] = {p: list(b) for p, b in sign_bands(scene).items()}
     motion = input_motion(scene, options)
     summary.status, summary.reason = Status(motion.status), motion.reason
     if scene.drive.kind == "torque":
@@ -538,24 +553,44 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary) -> Any:
         first = int(np.argmax(locked))
         summary.fail(Status.SELF_LOCKING, (
             f"friction self-locks at {int(np.count_nonzero(locked))} of {locked.size} samples, "
-            f"first at t = {t[first]:.6g} s, input angle "
+            f"first at t = {t[first] + origin:.6g} s, input angle "
             f"{math.degrees(columns['theta_in'][first]):.6g} deg (loop gain "
             f"{columns['friction_loop_gain'][first]:.3g}): no consistent friction"))
     if summary.success:
         _means(scene, motion, columns, options, summary)
+    columns["t"] = t + origin
     return result_table(columns, scene.record.every, EXTRA_COLUMNS) if scene.record.timeseries else None
 
 
 def _means(scene: Scene, motion: InputMotion, columns: dict[str, np.ndarray],
            options: ReferenceOptions, summary: Summary) -> None:
-    """The means over whole revolutions, the works from :func:`work_quadrature`."""
-    means = summary.whole_revolution_means(columns, scene.record.skip_revolutions)
-    if means is None:
-        return
-    means.update(work_quadrature(scene, motion, columns, options))
-    if means.pop("self_locking_nodes"):
+    """The means over whole revolutions, every one taken from the works of :func:`work_quadrature`
+    (empty without a whole revolution: :meth:`Summary.whole_revolution_means` says so)."""
+    works = work_quadrature(scene, motion, columns, options)
+    if works.pop("self_locking_nodes", False):
         # as when it locks at a sample: no means (they were NaN or meaningless)
         summary.fail(Status.SELF_LOCKING,
                      "friction self-locks between the table's samples (at quadrature nodes)")
         return
-    summary.set_means(means)
+    diagnostics = {k: works.pop(k) for k in ("quadrature", "energy_balance_residual") if k in works}
+    means = summary.whole_revolution_means(columns, scene.record.skip_revolutions, works)
+    if means is not None:
+        summary.set_means({**means, **diagnostics})
+        _efficiency_error(scene, summary, options)
+
+
+def _efficiency_error(scene: Scene, summary: Summary, options: ReferenceOptions) -> None:
+    """The quadrature's error estimate of the mean efficiency into the summary (a first-order
+    propagation of the input and lost works' estimates, plus the ODE's ``rtol`` for a torque
+    drive), and whether it meets ``numerics.accuracy``."""
+    q, w_in, w_loss = summary.extras.get("quadrature"), summary.input_work, summary.loss_work
+    if not q or not w_in or w_loss is None or summary.mean_efficiency is None:
+        return
+    repeats = summary.revolutions / q["revolutions_integrated"] if q.get("revolutions_integrated") else 1
+    e_in = repeats * float(q["input_work_error_estimate"])
+    e_loss = repeats * float(q["loss_work_error_estimate"])
+    estimate = e_loss / abs(w_in) + abs(w_loss) * e_in / w_in ** 2
+    if scene.drive.kind == "torque":
+        estimate += options.ode_rtol * abs(summary.mean_efficiency)
+    summary.efficiency_error_estimate = estimate
+    summary.accuracy_met = bool(estimate <= scene.numerics.accuracy)

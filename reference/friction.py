@@ -17,9 +17,11 @@ reaction has the components ``(F_x, F_y)`` normal to the pair axis and bending m
 - body ``a`` receives the opposite torque and force.
 
 ``s`` is the sign of the relative motion of ``b`` with respect to ``a``, regularised by a linear
-ramp of width ``sign_band`` in *surface speed* [m/s]: ``s(v) = clip(v / band, -1, 1)``; for the
+ramp of width ``band`` in *surface speed* [m/s]: ``s(v) = clip(v / band, -1, 1)``; for the
 rotation the surface speed is ``omega_rel d / 2``. With ``band = 0`` it is the exact ``sign``
-(``sign(0) = 0``). Outside the band the law is exactly the paper's.
+(``sign(0) = 0``). Outside the band the law is exactly the paper's. Each pair has its own band
+for the rotation and for the sliding (:func:`reference.bands.sign_bands`: by default relative to
+the pair's characteristic speed, so the same at every input speed in relative terms).
 
 The power dissipated in a pair is ``-(M_z omega_rel + F_z v_slide) >= 0``.
 """
@@ -31,16 +33,25 @@ from typing import Any
 
 import numpy as np
 
+from reference.bands import sign_bands
 from reference.joint import PAIR_KIND, Pair
 from reference.scene import Scene
 
 
-def regularised_sign(speed: Any, band: float) -> np.ndarray:
-    """``clip(speed / band, -1, 1)``; the exact sign when ``band`` is 0."""
+def regularised_sign(speed: Any, band: Any) -> np.ndarray:
+    """``clip(speed / band, -1, 1)``; the exact sign where ``band`` is 0.
+
+    ``band`` [m/s] is a scalar or an array broadcasting with ``speed`` [m/s] (one band per
+    friction value along the last axis).
+    """
     speed = np.asarray(speed, dtype=float)
-    if band <= 0.0:
+    band = np.asarray(band, dtype=float)
+    if np.all(band > 0.0):
+        return np.clip(speed / band, -1.0, 1.0)
+    if not np.any(band > 0.0):
         return np.sign(speed)
-    return np.clip(speed / band, -1.0, 1.0)
+    ramp = np.clip(speed / np.where(band > 0.0, band, 1.0), -1.0, 1.0)
+    return np.where(band > 0.0, ramp, np.sign(speed))
 
 
 def friction_magnitudes(pair: Pair, force_normal: Any, moment_normal: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -58,13 +69,15 @@ def friction_magnitudes(pair: Pair, force_normal: Any, moment_normal: Any) -> tu
 
 
 def pair_friction(pair: Pair, kind: str, fx: Any, fy: Any, mx: Any, my: Any, omega_rel: Any,
-                  slide_rel: Any, sign_band: float) -> tuple[np.ndarray, np.ndarray]:
+                  slide_rel: Any, sign_band: float,
+                  slide_band: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Friction torque about and force along the pair axis, acting on body ``b`` of the pair.
 
     Parameters are arrays over time samples (or scalars): the reaction components normal to the
     axis in any frame whose z is the pair axis, and the relative angular and sliding speed of
-    ``b`` with respect to ``a``. A revolute pair gets no axial force (its sliding is
-    constrained). A pair with zero coefficient gets zeros.
+    ``b`` with respect to ``a``; the ramp widths [m/s] of the rotation's sign (``sign_band``, in
+    surface speed) and of the sliding's (``slide_band``; None: ``sign_band``). A revolute pair
+    gets no axial force (its sliding is constrained). A pair with zero coefficient gets zeros.
     """
     if kind not in ("revolute", "cylindrical"):
         raise ValueError(f"unknown pair kind {kind!r}")
@@ -76,20 +89,21 @@ def pair_friction(pair: Pair, kind: str, fx: Any, fy: Any, mx: Any, my: Any, ome
     if kind == "revolute":
         force = np.zeros_like(torque)
     else:
-        force = -regularised_sign(slide_rel, sign_band) * force_mag
+        force = -regularised_sign(slide_rel, sign_band if slide_band is None else slide_band) * force_mag
     return torque, force
 
 
 def friction_from_columns(scene: Scene,
                           columns: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Friction torque and force of every pair from result-schema columns (reactions, speeds)."""
+    """Friction torque and force of every pair from result-schema columns (reactions, speeds),
+    with the scene's sign bands (:func:`reference.bands.sign_bands`)."""
     out = {}
-    band = scene.friction.sign_band
+    bands = sign_bands(scene)
     for name, pair in scene.joint.pairs.items():
         c = {s: np.asarray(columns[f"{name}_{s}"], dtype=float)
              for s in ("fx", "fy", "mx", "my", "omega_rel", "slide_rel")}
         out[name] = pair_friction(pair, PAIR_KIND[name], c["fx"], c["fy"], c["mx"], c["my"],
-                                  c["omega_rel"], c["slide_rel"], band)
+                                  c["omega_rel"], c["slide_rel"], *bands[name])
     return out
 
 

@@ -33,7 +33,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.inertia import inertia_problems, rotate_inertia, shift_inertia_to_com
-from reference.validation import DEG, SceneError, finite, non_negative, positive, set_field, vector
+from reference.validation import (
+    DEG,
+    SceneError,
+    finite,
+    non_negative,
+    positive,
+    require_instance,
+    set_field,
+    vector,
+)
 
 BODY_NAMES = ("input", "spider", "output")
 """The moving bodies, in chain order."""
@@ -152,6 +161,10 @@ class Pairs:
     spider_output: Pair = field(default_factory=Pair)
     output_frame: Pair = field(default_factory=Pair)
 
+    def __post_init__(self) -> None:
+        for name in PAIR_NAMES:
+            require_instance(name, getattr(self, name), Pair, "a Pair")
+
     def items(self) -> list[tuple[str, Pair]]:
         """``(name, pair)`` in chain order, :data:`PAIR_NAMES`."""
         return [(name, getattr(self, name)) for name in PAIR_NAMES]
@@ -258,6 +271,9 @@ class Joint:
     errors: MountingErrors = field(default_factory=MountingErrors)
 
     def __post_init__(self) -> None:
+        for name, cls in (("input", Body), ("spider", Body), ("output", Body), ("geometry", Geometry),
+                          ("pairs", Pairs), ("errors", MountingErrors)):
+            require_instance(name, getattr(self, name), cls, f"a {cls.__name__}")
         twist = self.errors.alpha4 - self.geometry.shaft_angle
         if not abs(twist) < 0.5 * math.pi:
             raise SceneError(f"`errors.alpha4` minus the shaft angle (the frame's twist) must be in "

@@ -29,7 +29,7 @@ import numpy as np
 
 from reference.joint import Body, Geometry, Joint, Pair, Pairs
 from reference.scene import Load, Record, Scene, SpeedDrive, replace
-from reference.validation import DEG, RPM, SceneError
+from reference.validation import DEG, RPM, SceneError, SceneTypeError, finite
 
 try:
     import tomllib
@@ -273,6 +273,14 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
         discrete choices), or calibration parameter values [m] (applied with the calibrated
         set's discrete choices; used by ``cardan calibrate``).
     """
+    shaft_angle_deg = finite("shaft_angle_deg", shaft_angle_deg)
+    if speed_rpm is not None:
+        speed_rpm = finite("speed_rpm", speed_rpm)
+    if not isinstance(friction, bool):
+        raise SceneTypeError(f"`friction` must be True or False, got {friction!r:.80}")
+    if not isinstance(parameters, (str, dict)):
+        raise SceneTypeError(f"`parameters` must be 'plain', 'calibrated' or a dict of parameter values, "
+                             f"got {parameters!r:.80}")
     if isinstance(parameters, str) and parameters not in PARAMETER_SETS:
         raise SceneError(f"parameter set must be one of {list(PARAMETER_SETS)}, got {parameters!r}")
     rpm = value("case.multibody.speed") if speed_rpm is None else speed_rpm
@@ -320,6 +328,9 @@ def rig_scene(friction: bool = True, parameters: str = "plain", errors: bool = F
     errors : bool
         Apply the section's tolerances (:func:`paper_errors`); otherwise the ideal geometry.
     """
+    for name, flag in (("friction", friction), ("errors", errors)):
+        if not isinstance(flag, bool):
+            raise SceneTypeError(f"`{name}` must be True or False, got {flag!r:.80}")
     joint = paper_joint(value("case.rig.shaft_angle"), friction=False)
     f = value("case.rig.friction") if friction else 0.0
     pairs = Pairs(**{n: Pair(f, p.journal_diameter, p.moment_lever) for n, p in joint.pairs.items()})
@@ -363,7 +374,10 @@ def named_scene(name: str) -> Scene:
     SceneError
         An unknown name.
     """
-    rig = _RIG.match(name) if isinstance(name, str) else None
+    if not isinstance(name, str):
+        raise SceneTypeError(f"`name` must be a scene name (a string such as 'paper-10deg'), got "
+                             f"{type(name).__name__} {name!r:.80}")
+    rig = _RIG.match(name)
     if rig:
         return rig_scene(friction=not rig["fl"], parameters="calibrated" if rig["cal"] else "plain",
                          errors=bool(rig["err"]))

@@ -20,9 +20,11 @@ from typing import Any, Union
 
 import numpy as np
 
+from reference.histories import CubicPieces, LinearHistory, first_turn, largest_slope
 from reference.joint import PAIR_NAMES, Body, Geometry, Joint, MountingErrors, Pair, Pairs
 from reference.validation import (
     DEG,
+    MAX_STEPS,
     RPM,
     SceneError,
     check_history,
@@ -31,9 +33,14 @@ from reference.validation import (
     is_sequence,
     non_negative,
     positive,
+    require_instance,
+    require_scene,
     set_field,
     vector,
 )
+
+MAX_ITERATIONS = 10_000
+"""Most friction updates per step ``FrictionSettings.max_iterations`` may ask for."""
 
 UNIT_ALIASES = {
     "shaft_angle": ("_deg", DEG),
@@ -71,7 +78,9 @@ class AngleDrive:
     Attributes
     ----------
     time : tuple of float
-        Sample times [s], strictly increasing, at least 4 samples.
+        Sample times [s], strictly increasing, at least 4 samples. The run starts at the first
+        (engines run on a clock that starts there: :func:`reference.histories.run_clock`), so
+        a history may start at any time.
     angle : tuple of float
         Input angle at those times [rad].
     """
@@ -88,33 +97,34 @@ class AngleDrive:
         set_field(self, "angle", tuple(a.tolist()))
 
     def spline(self) -> Any:
-        """The history as a ``scipy.interpolate.CubicSpline``: angle [rad] of time [s]."""
-        from scipy.interpolate import CubicSpline  # scipy.interpolate takes ~1 s to import
+        """The history as a ``scipy.interpolate.CubicSpline``: angle [rad] of time [s] (built once,
+        then cached)."""
+        cached = self.__dict__.get("_spline")
+        if cached is None:
+            from scipy.interpolate import CubicSpline  # scipy.interpolate takes ~1 s to import
 
-        return CubicSpline(np.asarray(self.time), np.asarray(self.angle))
+            cached = CubicSpline(np.asarray(self.time), np.asarray(self.angle))
+            object.__setattr__(self, "_spline", cached)
+        return cached
+
+    def evaluator(self) -> CubicPieces:
+        """The spline at one instant in plain floats, O(log n) per call (engines' user
+        functions; :class:`reference.histories.CubicPieces`)."""
+        return CubicPieces(self.spline())
+
+    def shifted(self, origin: float) -> AngleDrive:
+        """The same history on a clock that reads ``t - origin`` [s]."""
+        return AngleDrive(tuple((np.asarray(self.time) - origin).tolist()), self.angle)
 
     def max_speed(self) -> float:
-        """Largest input speed of the history [rad/s] (sampled 20 times per sample interval)."""
-        s = self.spline().derivative()
-        t = np.linspace(self.time[0], self.time[-1], 20 * len(self.time))
-        return float(np.max(np.abs(s(t))))
+        """Largest input speed of the history [rad/s] (exact, from the spline's pieces)."""
+        return largest_slope(self.spline())
 
     def time_to_turn(self, angle: float) -> float:
         """First time [s] at which the input has turned ``angle`` [rad] either way from its
         start, to rounding; the history's last time if it never turns that far."""
-        from scipy.optimize import brentq  # scipy.optimize takes ~0.5 s to import
-
-        spline = self.spline()
-        t0 = self.time[0]
-        grid = np.linspace(t0, self.time[-1], 50 * len(self.time))
-        turned = np.maximum.accumulate(np.abs(spline(grid) - spline(t0)))
-        k = int(np.searchsorted(turned, angle))
-        if k >= grid.size:
-            return float(grid[-1])
-        if k == 0:
-            return float(t0)
-        return float(brentq(lambda t: abs(spline(t) - spline(t0)) - angle, grid[k - 1], grid[k],
-                            xtol=1e-15, rtol=4 * np.finfo(float).eps))
+        t = first_turn(self.spline(), angle)
+        return float(self.time[-1]) if t is None else t
 
 
 @dataclass(frozen=True)
@@ -161,7 +171,10 @@ class Load:
         interpolated linearly in between and held at the end values outside (a measured brake
         torque, :mod:`rigdata`; linear so that the load never overshoots its samples).
     time : tuple of float or None
-        Sample times [s] of a torque history, strictly increasing, at least 2.
+        Sample times [s] of a torque history, strictly increasing, at least 2. The load shares
+        the scene's clock with an angle history (the run starts at the angle history's first
+        sample); with any other drive the run starts at the load history's first sample
+        (:func:`reference.histories.time_origin`), so histories may start at any time.
     """
 
     torque: float | tuple = 0.0
@@ -188,12 +201,29 @@ class Load:
         """Load torque [N m] at the instants ``t`` [s] (any shape)."""
         if self.time is None:
             return np.full(np.shape(t), self.torque)
-        return np.interp(t, self.time, self.torque)
+        return self.evaluator().at(t)
+
+    def evaluator(self) -> LinearHistory | None:
+        """A history at one instant in plain floats, O(log n) per call (engines' user
+        functions; :class:`reference.histories.LinearHistory`, built once); None when constant."""
+        if self.time is None:
+            return None
+        cached = self.__dict__.get("_history")
+        if cached is None:
+            cached = LinearHistory(self.time, self.torque)
+            object.__setattr__(self, "_history", cached)
+        return cached
+
+    def shifted(self, origin: float) -> Load:
+        """The same load on a clock that reads ``t - origin`` [s] (a constant: itself)."""
+        if self.time is None:
+            return self
+        return Load(self.torque, tuple((np.asarray(self.time) - origin).tolist()))
 
     @property
     def knots(self) -> np.ndarray:
         """Instants [s] where a history's slope changes (empty for a constant torque)."""
-        return np.zeros(0) if self.time is None else np.asarray(self.time)
+        return np.zeros(0) if self.time is None else self.evaluator().time
 
     def mean(self) -> float:
         """The constant torque, or the time average of the history [N m]."""
@@ -214,11 +244,14 @@ class Numerics:
     dt : float or None
         Time step [s]; None lets the engine choose it from ``accuracy`` and the scene.
     accuracy : float
-        Target for the maximum relative error of omega_out/omega_in [-] when ``dt`` is None.
+        Target absolute error of the mean efficiency [-] (the headline number), also the target
+        relative error of omega_out/omega_in. A time-stepping engine chooses its step to meet
+        both when ``dt`` is None, and every run reports its estimated mean-efficiency error
+        (``Summary.efficiency_error_estimate``, ``accuracy_met``; ``docs/accuracy.md``).
     """
 
     dt: float | None = None
-    accuracy: float = 1e-5
+    accuracy: float = 1e-3
 
     def __post_init__(self) -> None:
         if self.dt is not None:
@@ -231,6 +264,8 @@ class Numerics:
 
 
 COUPLINGS = ("converged", "lagged", "uncoupled")
+DEFAULT_SIGN_BAND_RELATIVE = 1e-3
+"""Default ``FrictionSettings.sign_band_relative`` [-] (``docs/paper.md``, "Friction at every speed")."""
 
 
 @dataclass(frozen=True)
@@ -248,10 +283,18 @@ class FrictionSettings:
         the loss (a first-order estimate, used to explain the paper's tolerance figure; the
         energy balance then misses the loss). The reference engine has no time step: it solves
         the converged fixed point for ``"converged"`` and ``"lagged"`` alike.
-    sign_band : float
-        Relative surface speed [m/s] below which ``sign()`` of eqs. (3), (5) is replaced by a
-        linear ramp ``clip(v / sign_band, -1, 1)``. The surface speed of a rotating journal is
-        ``|omega_rel| d / 2``; a sliding pair uses its sliding speed. 0 means the exact sign.
+    sign_band : float or None
+        One absolute ramp width [m/s] for every pair: below it ``sign()`` of eqs. (3), (5) is
+        replaced by a linear ramp ``clip(v / sign_band, -1, 1)`` of the relative surface speed
+        ``v`` (``omega_rel d / 2`` for the rotation of a journal, the sliding speed for axial
+        friction); 0 means the exact sign. None (default): the relative band below.
+    sign_band_relative : float or None
+        Ramp width of each pair as a fraction of the pair's characteristic speed [-] (its RMS
+        surface, or sliding, speed over an input revolution at the drive's speed;
+        :func:`reference.bands.sign_bands`), so that the regularisation removes the same share
+        of friction at every speed; 0 means the exact sign. None: 1e-3
+        (:data:`DEFAULT_SIGN_BAND_RELATIVE`) unless ``sign_band`` is given. Give at most
+        one of the two.
     tolerance : float
         Converged coupling: the fixed point is accepted when the largest change of a friction
         load is below ``tolerance`` times the largest friction load (forces counted as the
@@ -261,21 +304,37 @@ class FrictionSettings:
     """
 
     coupling: str = "converged"
-    sign_band: float = 1e-3
+    sign_band: float | None = None
+    sign_band_relative: float | None = None
     tolerance: float = 1e-6
     max_iterations: int = 20
 
     def __post_init__(self) -> None:
-        if self.coupling not in COUPLINGS:
+        if not isinstance(self.coupling, str) or self.coupling not in COUPLINGS:
             raise SceneError(f"`coupling` must be one of {list(COUPLINGS)}, got {self.coupling!r}")
-        set_field(self, "sign_band", non_negative("sign_band", self.sign_band))
+        if self.sign_band is not None and self.sign_band_relative is not None:
+            raise SceneError(
+                f"give either `sign_band` (absolute, m/s) or `sign_band_relative` (fraction of each "
+                f"pair's speed), not both; got {self.sign_band!r} and {self.sign_band_relative!r}")
+        for name in ("sign_band", "sign_band_relative"):
+            if getattr(self, name) is not None:
+                set_field(self, name, non_negative(name, getattr(self, name)))
         tol = positive("tolerance", self.tolerance)
         if tol >= 1.0:
             raise SceneError(f"`tolerance` must be < 1, got {tol!r}")
         set_field(self, "tolerance", tol)
         if (isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int)
-                or self.max_iterations < 2):
-            raise SceneError(f"`max_iterations` must be an integer >= 2, got {self.max_iterations!r}")
+                or not 2 <= self.max_iterations <= MAX_ITERATIONS):
+            raise SceneError(f"`max_iterations` must be an integer in [2, {MAX_ITERATIONS}], "
+                             f"got {self.max_iterations!r:.40}")
+
+    @property
+    def relative_band(self) -> float | None:
+        """The relative ramp width in effect [-]: ``sign_band_relative``, its default 1e-3, or
+        None when the absolute ``sign_band`` is given."""
+        if self.sign_band is not None:
+            return None
+        return DEFAULT_SIGN_BAND_RELATIVE if self.sign_band_relative is None else self.sign_band_relative
 
 
 @dataclass(frozen=True)
@@ -299,8 +358,9 @@ class Record:
     def __post_init__(self) -> None:
         if not isinstance(self.timeseries, bool):
             raise SceneError(f"`timeseries` must be true or false, got {self.timeseries!r}")
-        if isinstance(self.every, bool) or not isinstance(self.every, int) or self.every < 1:
-            raise SceneError(f"`every` must be an integer >= 1, got {self.every!r}")
+        if isinstance(self.every, bool) or not isinstance(self.every, int) \
+                or not 1 <= self.every <= MAX_STEPS:
+            raise SceneError(f"`every` must be an integer in [1, {MAX_STEPS}], got {self.every!r:.40}")
         set_field(self, "skip_revolutions", non_negative("skip_revolutions", self.skip_revolutions))
 
 
@@ -329,8 +389,12 @@ class Scene:
     description: str = ""
 
     def __post_init__(self) -> None:
-        if not isinstance(self.drive, (SpeedDrive, AngleDrive, TorqueDrive)):
-            raise SceneError(f"`drive` must be a speed, angle or torque drive, got {self.drive!r}")
+        require_instance("joint", self.joint, Joint, "a Joint")
+        require_instance("drive", self.drive, (SpeedDrive, AngleDrive, TorqueDrive),
+                         "a speed, angle or torque drive (SpeedDrive, AngleDrive, TorqueDrive)")
+        for name, cls in (("load", Load), ("numerics", Numerics), ("friction", FrictionSettings),
+                          ("record", Record)):
+            require_instance(name, getattr(self, name), cls, f"a {cls.__name__}")
         for name in ("name", "description"):
             if not isinstance(getattr(self, name), str):
                 raise SceneError(f"`{name}` must be a string, got {getattr(self, name)!r}")
@@ -393,7 +457,7 @@ def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
     _to_si(data, names, where)
     unknown = sorted(set(data) - names - {"kind"})
     if unknown:
-        raise SceneError(f"[{where}] unknown key(s) {unknown}; allowed: {sorted(names)}")
+        raise SceneError(f"[{where}] unknown key(s) {unknown}; allowed: {_allowed_keys(cls, names)}")
     kwargs = {}
     for key, value in data.items():
         if key == "kind":
@@ -414,6 +478,13 @@ def _build(cls: type, data: Mapping[str, Any], path: str) -> Any:
         return cls(**kwargs)
     except (SceneError, TypeError) as exc:  # TypeError: a value of the wrong kind for a field
         raise SceneError(f"[{where}] {exc}") from None
+
+
+def _allowed_keys(cls: type, names: set[str]) -> list[str]:
+    """The keys a table of ``cls`` takes, for messages: its fields, their unit-suffixed aliases
+    and, for a drive, ``kind``."""
+    aliases = {base + suffix for base, (suffix, _) in UNIT_ALIASES.items() if base in names}
+    return sorted(names | aliases | ({"kind"} if cls in DRIVES.values() else set()))
 
 
 def _build_drive(data: Mapping[str, Any], path: str) -> Drive:
@@ -489,10 +560,12 @@ def replace(scene: Scene, **changes: Any) -> Scene:
     SceneError
         An unknown path or an invalid value.
     """
-    data = scene_to_dict(scene)
+    data = scene_to_dict(require_scene(scene))
     for dotted, value in changes.items():
         node = data
         *parents, leaf = dotted.split(".")
+        if not all(parents) or not leaf:
+            raise SceneError(f"unknown scene field {dotted!r}")
         for key in parents:
             if not isinstance(node.get(key), dict):
                 raise SceneError(f"unknown scene field {dotted!r}")

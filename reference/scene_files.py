@@ -15,7 +15,7 @@ from typing import Any
 
 from reference.paper import named_scene
 from reference.scene import UNIT_ALIASES, Scene, scene_from_dict, scene_to_dict
-from reference.validation import SceneError
+from reference.validation import SceneError, SceneTypeError
 
 try:
     import tomllib
@@ -56,6 +56,8 @@ def read_toml(path: str | pathlib.Path, what: str, noun: str,
     error : type
         The exception to raise (the caller's own input-error type).
     """
+    if not isinstance(path, (str, pathlib.PurePath)) or not str(path).strip():
+        raise error(f"the {what} must be a path (str or pathlib.Path) naming a file, got {path!r:.80}")
     path = pathlib.Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -90,6 +92,9 @@ def load_scene(path: str | pathlib.Path) -> Scene:
         The file cannot be read, is not TOML, or does not describe a valid scene; the message
         starts with the path.
     """
+    if not isinstance(path, (str, pathlib.PurePath)):
+        raise SceneTypeError(f"`path` must be a str or pathlib.Path naming a scene file, got "
+                             f"{type(path).__name__} {path!r:.80}")
     data = read_toml(path, "scene file", "a scene", SceneError)
     try:
         return scene_from_mapping(data)
@@ -110,8 +115,13 @@ def scene_from_mapping(data: Mapping[str, Any]) -> Scene:
     -------
     Scene
     """
+    if not isinstance(data, Mapping):
+        raise SceneTypeError(f"`data` must be a mapping (a scene table), got {type(data).__name__} "
+                             f"{data!r:.80}")
     data = dict(data)
     base = data.pop("base", None)
     if base is not None:
+        if not isinstance(base, str):
+            raise SceneTypeError(f"`base` must be the name of a scene (a string), got {base!r:.80}")
         data = _merge(scene_to_dict(named_scene(base)), data)
     return scene_from_dict(data)

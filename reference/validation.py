@@ -24,8 +24,38 @@ MAX_STEPS = 10_000_000
 before it starts: e.g. ``dt = 1e-12`` s would take days and more memory than a machine has."""
 
 
+MAX_MAGNITUDE = 1e12
+"""Largest magnitude of any number of a scene, in its SI unit. Far beyond every Cardan joint
+(the largest drive shafts carry about 1e7 N m and turn below 1e4 rad/s), and far enough below
+overflow (1e308) that products of a few such numbers stay finite: a value above it is a typing
+error or an absurd input, refused before any engine runs instead of ending in NaN or overflow."""
+
+
 class SceneError(ValueError):
     """A scene (or one of its parts) is invalid; the message names the field and the value."""
+
+
+class SceneTypeError(SceneError, TypeError):
+    """A scene field (or an argument where a scene is expected) of the wrong type: both a
+    :class:`SceneError` (the command line's one-line error, exit 2) and a ``TypeError``."""
+
+
+def require_scene(value: Any, name: str = "scene") -> Any:
+    """``value`` when it is a :class:`reference.scene.Scene`; :class:`SceneTypeError` naming
+    ``name`` otherwise (the check of every public function that takes a scene)."""
+    if type(value).__name__ != "Scene" or not hasattr(value, "drive"):  # no import: scene.py imports this
+        hint = " (a named scene: reference.named_scene(name); a file: reference.load_scene(path))" \
+            if isinstance(value, (str, bytes)) else ""
+        raise SceneTypeError(f"`{name}` must be a Scene, got {type(value).__name__} {value!r:.80}{hint}")
+    return value
+
+
+def require_instance(name: str, value: Any, cls: type | tuple[type, ...], what: str) -> Any:
+    """``value`` when it is an instance of ``cls``; :class:`SceneTypeError` naming ``name`` and
+    ``what`` it must be otherwise."""
+    if not isinstance(value, cls):
+        raise SceneTypeError(f"`{name}` must be {what}, got {type(value).__name__} {value!r:.80}")
+    return value
 
 
 def is_sequence(value: Any) -> bool:
@@ -49,10 +79,16 @@ def finite(name: str, value: Any) -> float:
         The value, unit unchanged.
     """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise SceneError(f"`{name}` must be a number, got {value!r}")
-    value = float(value)
+        raise SceneTypeError(f"`{name}` must be a number, got {value!r:.80}")
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond the float range
+        raise SceneError(f"`{name}` must be at most {MAX_MAGNITUDE:g} in magnitude, "
+                         f"got {value:.3e}") from None
     if not math.isfinite(value):
         raise SceneError(f"`{name}` must be finite, got {value!r}")
+    if abs(value) > MAX_MAGNITUDE:
+        raise SceneError(f"`{name}` must be at most {MAX_MAGNITUDE:g} in magnitude (SI units), got {value!r}")
     return value
 
 
@@ -97,6 +133,8 @@ def vector(name: str, value: Any, shape: tuple[int, ...]) -> tuple:
         raise SceneError(f"`{name}` must have shape {shape}, got shape {arr.shape}: {value!r}")
     if not np.all(np.isfinite(arr)):
         raise SceneError(f"`{name}` must be finite, got {value!r}")
+    if np.any(np.abs(arr) > MAX_MAGNITUDE):
+        raise SceneError(f"`{name}` must be at most {MAX_MAGNITUDE:g} in magnitude (SI units), got {value!r}")
     return tuple(map(tuple, arr.tolist())) if arr.ndim == 2 else tuple(arr.tolist())  # Python floats
 
 
@@ -106,9 +144,12 @@ def float_array(name: str, value: Any) -> np.ndarray | None:
     if not is_sequence(value):
         return None
     try:
-        return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise SceneError(f"{name} must be numbers, got {value!r}") from None
+        arr = np.asarray(value)
+        if arr.dtype.kind not in "iuf" and arr.size:  # text, booleans, ragged or nested objects
+            raise TypeError
+        return np.asarray(arr, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise SceneTypeError(f"{name} must be numbers, got {value!r:.80}") from None
 
 
 def check_history(t: np.ndarray | None, values: np.ndarray | None, raw_time: Any, raw_values: Any,
@@ -137,6 +178,9 @@ def check_history(t: np.ndarray | None, values: np.ndarray | None, raw_time: Any
                          f"got {np.shape(raw_values) if values is not None else raw_values!r}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(values))):
         raise SceneError(f"{prefix}`time` and `{values_name}` must be finite")
+    if np.any(np.abs(t) > MAX_MAGNITUDE) or np.any(np.abs(values) > MAX_MAGNITUDE):
+        raise SceneError(f"{prefix}`time` and `{values_name}` must be at most {MAX_MAGNITUDE:g} in "
+                         "magnitude (SI units)")
     if np.any(np.diff(t) <= 0):
         i = int(np.argmax(np.diff(t) <= 0))
         raise SceneError(f"{prefix}`time` must be strictly increasing, got {float(t[i])!r} "

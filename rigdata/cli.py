@@ -26,7 +26,6 @@ from cardan_exudyn.engines import EngineUnavailable
 from cardan_exudyn.io import OutputError
 from cardan_exudyn.report.format import number
 from reference.joint import PAIR_NAMES
-from reference.paper import named_scene
 from reference.scene import Scene, replace
 from reference.schema import Status
 from reference.validation import SceneError
@@ -54,17 +53,6 @@ def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
             raise BadInput(f"{option} expects CHANNEL=VALUE, got {item!r}")
         out[key.strip()] = value.strip()
     return out
-
-
-def _seed(text: str) -> int:
-    """A non-negative integer (a seed, a number of draws)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
-    return value
 
 
 def _shaft_angle(text: str) -> float:
@@ -142,7 +130,8 @@ def cmd_inspect(args: argparse.Namespace) -> int:
 def cmd_measure(args: argparse.Namespace) -> int:
     """``cardan rig measure``: measured efficiency with its uncertainty (:func:`rigdata.measure`)."""
     rec = _read(args)
-    m = rigdata.measure(rec, args.angle, conditioning=_conditioning(args), transducers=_transducers(args),
+    angle = 15.0 if args.angle is None else args.angle  # the paper's rig case
+    m = rigdata.measure(rec, angle, conditioning=_conditioning(args), transducers=_transducers(args),
                         monte_carlo=_draws(args), seed=args.seed)
     out = m.as_dict()
     if args.json:
@@ -157,10 +146,17 @@ def cmd_measure(args: argparse.Namespace) -> int:
 
 
 def _scene(args: argparse.Namespace) -> Scene:
-    changes = {"joint.geometry.shaft_angle_deg": args.angle}
+    """The joint the measurement drives: ``--scene`` (a named scene, or a scene file: the user's
+    own joint) with ``--angle`` and ``--friction`` when given (else the scene's own)."""
+    from rigdata.validation import as_scene  # rigdata's modules load when a rig command runs
+
+    base = as_scene(args.scene)
+    changes: dict[str, Any] = {}
+    if args.angle is not None:
+        changes["joint.geometry.shaft_angle_deg"] = args.angle
     if args.friction is not None:
         changes.update({f"joint.pairs.{p}.friction_coefficient": args.friction for p in PAIR_NAMES})
-    return replace(named_scene(args.scene), **changes)
+    return replace(base, **changes) if changes else base
 
 
 def _engines(text: str) -> tuple[str, ...]:
@@ -243,8 +239,9 @@ def _file_options(p: argparse.ArgumentParser) -> None:
 
 
 def _measure_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--angle", type=_shaft_angle, default=15.0,
-                   help="shaft angle [deg] (default 15, the paper's rig case)")
+    p.add_argument("--angle", type=_shaft_angle, default=None,
+                   help="shaft angle [deg] (default: validate the scene's, measure 15, the paper's "
+                        "rig case)")
     p.add_argument("--cutoff-harmonics", type=arguments.number("-", positive=True), default=10.0,
                    help="low-pass cut-off in input shaft harmonics (default 10)")
     p.add_argument("--settle", type=arguments.number("rev", non_negative=True), default=0.25,
@@ -252,19 +249,24 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--derivative", choices=("savgol", "spline"), default="savgol")
     p.add_argument("--full-scale", type=arguments.number("N m", positive=True), default=100.0,
                    help="transducer full scale [N m] (default 100, paper)")
-    p.add_argument("--accuracy-class", type=arguments.number("%", non_negative=True), default=0.1,
+    p.add_argument("--accuracy-class", type=arguments.number("%", non_negative=True, maximum=100.0),
+                   default=0.1,
                    help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
     p.add_argument("--zero-drift", type=arguments.number("N m", non_negative=True), default=0.01,
                    help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
-    p.add_argument("--mc", type=_seed, default=2000,
-                   help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only)")
-    p.add_argument("--seed", type=_seed, default=0, help="seed of the Monte Carlo draws")
+    p.add_argument("--mc", type=arguments.count("--mc", minimum=0), default=2000,
+                   help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only; at most "
+                        f"{arguments.COUNT_LIMITS['--mc']})")
+    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=0,
+                   help="seed of the Monte Carlo draws")
 
 
 def _validate_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
-    p.add_argument("--scene", default="rig-calibrated",
-                   help="named scene of the joint (default rig-calibrated; drive and load replaced)")
+    p.add_argument("--scene", default="rig-calibrated", metavar="NAME|FILE",
+                   help="the joint: a named scene or a scene TOML file (your own joint; may start "
+                        "from base = \"rig-calibrated\"); its drive and load are replaced by the "
+                        "measurement's (default rig-calibrated)")
     p.add_argument("--friction", type=arguments.number("-", non_negative=True),
                    help="friction coefficient of every pair (default: the scene's, 0.42 for the rig)")
     p.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")
@@ -275,7 +277,8 @@ def _synthetic_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
     p.add_argument("--revolutions", type=arguments.number("rev", positive=True), default=5.0)
     p.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
-    p.add_argument("--seed", type=_seed, default=1, help="seed of the drawn transducer errors and noise")
+    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=1,
+                   help="seed of the drawn transducer errors and noise")
     p.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
     p.add_argument("--json", action="store_true", help="print the settings used as JSON")
 

@@ -33,6 +33,7 @@ from scipy.optimize import minimize_scalar
 
 from reference.kinematics import speed_ratio
 from rigdata.record import SHAFTS, RigDataError, RigRecord
+from rigdata.units import check_magnitudes
 
 DERIVATIVES = ("savgol", "spline")
 
@@ -65,6 +66,15 @@ class Conditioning:
     phase: float | None = None
 
     def __post_init__(self) -> None:
+        for name in ("cutoff_harmonics", "settle_revolutions", "phase"):
+            value = getattr(self, name)
+            if (value is not None or name != "phase") and (
+                    isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))):
+                raise TypeError(f"`{name}` must be a number, got {value!r:.80}")
+        if self.phase is not None and not math.isfinite(self.phase):
+            raise ValueError(f"`phase` must be finite [rad] or None, got {self.phase!r}")
+        if not isinstance(self.derivative, str):
+            raise TypeError(f"`derivative` must be one of {DERIVATIVES}, got {self.derivative!r:.80}")
         if not (math.isfinite(self.cutoff_harmonics) and self.cutoff_harmonics >= 2.0):
             raise ValueError(f"`cutoff_harmonics` must be >= 2 (Hooke's joint's 2nd harmonic), got "
                              f"{self.cutoff_harmonics!r}")
@@ -73,8 +83,10 @@ class Conditioning:
             raise ValueError(f"`filter_order` must be an integer in 1..10, got {self.filter_order!r}")
         if self.derivative not in DERIVATIVES:
             raise ValueError(f"`derivative` must be one of {DERIVATIVES}, got {self.derivative!r}")
-        if not (math.isfinite(self.settle_revolutions) and self.settle_revolutions >= 0):
-            raise ValueError(f"`settle_revolutions` must be >= 0, got {self.settle_revolutions!r}")
+        if not (math.isfinite(self.settle_revolutions) and 0 <= self.settle_revolutions <= 1e6):
+            raise ValueError(f"`settle_revolutions` must be in [0, 1e6], got {self.settle_revolutions!r}")
+        if self.cutoff_harmonics > 1e6:
+            raise ValueError(f"`cutoff_harmonics` must be at most 1e6, got {self.cutoff_harmonics!r}")
 
 
 @dataclass(frozen=True)
@@ -262,6 +274,47 @@ def _trim_to_revolutions(t: np.ndarray, angle: np.ndarray, edges: np.ndarray | N
     return t_a, t_b, n
 
 
+def _checked(record: RigRecord, shaft_angle: float,
+             options: Conditioning | None) -> tuple[RigRecord, float, Conditioning]:
+    """The arguments of :func:`condition`, refused when of the wrong type or out of range, and the
+    record when it is too short, has a dead transducer or absurd values."""
+    if not isinstance(record, RigRecord):
+        raise TypeError(f"`record` must be a RigRecord (rigdata.read(path) reads one), got "
+                        f"{type(record).__name__} {record!r:.80}")
+    if isinstance(shaft_angle, bool) or not isinstance(shaft_angle, (int, float, np.number)):
+        raise TypeError(f"`shaft_angle` must be a number [rad], got {shaft_angle!r:.80}")
+    if not (math.isfinite(shaft_angle) and 0.0 <= shaft_angle < 0.5 * math.pi):
+        raise ValueError(f"`shaft_angle` must be in [0, pi/2) rad, got {shaft_angle!r}")
+    options = Conditioning() if options is None else options
+    if not isinstance(options, Conditioning):
+        raise TypeError(f"`options` must be a Conditioning or None, got {type(options).__name__}")
+    fewest = 3 * (2 * math.ceil(options.filter_order / 2) + 1) + 1  # sosfiltfilt's padding + 1
+    if record.time.size < fewest:
+        raise RigDataError(f"too short: {record.time.size} samples; the zero-phase filter of order "
+                           f"{options.filter_order} needs at least {fewest}", file=record.file,
+                           channel="time")
+    check_magnitudes(record.time, record.channels, file=record.file)
+    for name in ("torque_in", "torque_out", "speed_in", "speed_out"):
+        values = record.channels.get(name)
+        if values is not None and not np.any(values):
+            what = "the shaft does not turn, or " if name.startswith("speed") else ""
+            raise RigDataError(f"reads 0 at every sample: {what}a dead or unplugged transducer (or the "
+                               "wrong column: --map)", file=record.file, channel=name)
+    return record, float(shaft_angle), options
+
+
+def _shafts_turn_together(record: RigRecord, angles: dict[str, np.ndarray]) -> None:
+    """A Cardan joint's output turns as far as its input (to within the Hooke error, under a
+    quarter turn): refuse an output channel that says otherwise (dead, stuck or mis-scaled)."""
+    turned = {s: abs(float(angles[s][-1] - angles[s][0])) / (2 * math.pi) for s in SHAFTS}
+    if not 0.5 * turned["in"] - 0.25 <= turned["out"] <= 2.0 * turned["in"] + 0.25:
+        channel = "speed_out" if "speed_out" in record.channels else "angle_out"
+        raise RigDataError(f"the output shaft turns {turned['out']:.3g} revolutions while the input turns "
+                           f"{turned['in']:.3g}: the shafts of a Cardan joint turn together (a dead, stuck "
+                           "or mis-scaled transducer, or the wrong unit: --unit)", file=record.file,
+                           channel=channel)
+
+
 def condition(record: RigRecord, shaft_angle: float, options: Conditioning | None = None) -> Conditioned:
     """Condition a record (see the module docstring).
 
@@ -272,7 +325,7 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
         The joint's shaft angle [rad] (for the phase estimate).
     options : Conditioning, optional
     """
-    options = options or Conditioning()
+    record, shaft_angle, options = _checked(record, shaft_angle, options)
     t = record.time
     dt = record.dt
     angles, edges = {}, {}
@@ -282,6 +335,7 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
     mean_speed = abs(angles["in"][-1] - angles["in"][0]) / duration
     if mean_speed <= 0:
         raise RigDataError("the input shaft does not turn", file=record.file, channel="angle_in")
+    _shafts_turn_together(record, angles)
     cutoff = options.cutoff_harmonics * mean_speed / (2 * math.pi)
     rate = 1.0 / dt
     filt = {name: lowpass(angles[s], cutoff, rate, options.filter_order)

@@ -97,6 +97,19 @@ def _works(c: Conditioned, t_a: float, t_b: float, torque_in, torque_out) -> tup
     return float(w @ (torque_in * c.speed_in)), float(w @ (torque_out * c.speed_out))
 
 
+MAX_DRAWS = 100_000
+"""Most Monte Carlo draws of one measurement: its 95 % interval is settled long before (the
+draws are held in memory, eight bytes each, and filtered in chunks of 200)."""
+
+
+def check_draws(monte_carlo: object, seed: object) -> None:
+    """``ValueError`` naming the argument unless ``monte_carlo`` is an integer in [0,
+    :data:`MAX_DRAWS`] and ``seed`` one in [0, 2**63 - 1]."""
+    for name, value, top in (("monte_carlo", monte_carlo, MAX_DRAWS), ("seed", seed, 2**63 - 1)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= top:
+            raise ValueError(f"`{name}` must be an integer in [0, {top}], got {value!r:.40}")
+
+
 def filtered_noise_factor(c: Conditioned, order: int, seed: int = 0) -> float:
     """Standard deviation of unit white noise after the conditioning low-pass [-]."""
     noise = np.random.default_rng(seed).standard_normal(c.t.size)
@@ -115,8 +128,11 @@ def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transduce
         Monte Carlo draws (0: GUM only).
     seed : int
     """
+    check_draws(monte_carlo, seed)
     transducers = transducers or Transducer()
     tin, tout = transducers if isinstance(transducers, tuple) else (transducers, transducers)
+    if not (isinstance(tin, Transducer) and isinstance(tout, Transducer)):
+        raise TypeError(f"`transducers` must be a Transducer or a pair of them, got {transducers!r:.80}")
     t_a, t_b = c.window
     weights = window_weights(c.t, t_a, t_b)
     w_in, w_out = _works(c, t_a, t_b, c.torque_in, c.torque_out)

@@ -73,14 +73,16 @@ def computed_efficiency(result: Result) -> dict[str, Any]:
     dict
         ``status`` (:class:`~reference.schema.Status`), ``reason``, ``engine``,
         ``mean_efficiency`` [-], ``work_ratio`` [-], ``mean_torque_in`` [N m] (None unless the
-        status is ok), ``wall_time_s`` [s]; and when the run is ok and recorded its time series,
-        ``series``: ``t`` [s], ``theta_in`` [rad], ``efficiency`` and ``power_ratio`` [-],
-        ``torque_in`` [N m].
+        status is ok), ``wall_time_s`` [s], ``efficiency_error_estimate`` [-] (the engine's own
+        estimate of its mean-efficiency error, :class:`~reference.schema.Summary`); and when the
+        run is ok and recorded its time series, ``series``: ``t`` [s], ``theta_in`` [rad],
+        ``efficiency`` and ``power_ratio`` [-], ``torque_in`` [N m].
     """
     s = result.summary
     out = {"status": s.status, "reason": s.reason, "engine": s.engine,
            "mean_efficiency": s.mean_efficiency, "work_ratio": s.work_ratio,
-           "mean_torque_in": s.mean_torque_in, "wall_time_s": s.wall_time_s}
+           "mean_torque_in": s.mean_torque_in, "wall_time_s": s.wall_time_s,
+           "efficiency_error_estimate": s.efficiency_error_estimate}
     if result.table is not None and result.success:
         out["series"] = _series(result.table)
     return out

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from dataclasses import asdict, dataclass, replace
 
 import numpy as np
@@ -29,6 +30,7 @@ from cardan_exudyn import engines
 from reference.engine import ReferenceOptions, columns_at, input_motion
 from reference.paper import named_scene
 from reference.scene import AngleDrive, Load, Scene
+from reference.scene import replace as replace_field
 from reference.schema import Result
 from rigdata import files
 from rigdata.record import ChannelSource, RigRecord
@@ -48,6 +50,8 @@ class RigSettings:
     scene : str
         Named scene of the joint (``reference.paper.named_scene``); its drive and load are
         replaced by the motor and brake below.
+    shaft_angle_deg : float or None
+        The joint's shaft angle [deg]; None: the scene's (15 for the rig).
     speed : float
         Mean input speed [rad/s] (paper: 6).
     ripple : tuple of float
@@ -73,6 +77,7 @@ class RigSettings:
     """
 
     scene: str = "rig-calibrated"
+    shaft_angle_deg: float | None = None
     speed: float = 6.0
     ripple: tuple = (0.01, 0.005)
     input_torque: float = 0.2
@@ -87,6 +92,26 @@ class RigSettings:
     seed: int = 1
 
     def __post_init__(self) -> None:
+        for name in ("speed", "input_torque", "revolutions", "rate", "phase", "noise", "lag"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise TypeError(f"`{name}` must be a number, got {value!r:.80}")
+        if not isinstance(self.scene, str):
+            raise TypeError(f"`scene` must be a scene name, got {self.scene!r:.80}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
+                or not 0 <= self.seed < 2**63:
+            raise ValueError(f"`seed` must be an integer in [0, 2**63), got {self.seed!r:.80}")
+        for name in ("ripple", "offsets", "drifts"):
+            value = getattr(self, name)
+            if (value is not None or name == "ripple") and not _pair_of_numbers(value):
+                none = "" if name == "ripple" else " or None"
+                raise ValueError(f"`{name}` must be two finite numbers [N m]{none}, got {value!r:.80}")
+        if not math.isfinite(self.phase):
+            raise ValueError(f"`phase` must be finite [rad], got {self.phase!r}")
+        angle = self.shaft_angle_deg
+        if angle is not None and (isinstance(angle, bool) or not isinstance(angle, (int, float))
+                                  or not 0.0 <= angle < 90.0):
+            raise ValueError(f"`shaft_angle_deg` must be in [0, 90) deg or None, got {angle!r:.80}")
         for name in ("speed", "input_torque", "revolutions", "rate"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
@@ -103,6 +128,13 @@ class RigSettings:
         if samples > MAX_SAMPLES:
             raise ValueError(f"{self.revolutions:g} revolutions at {self.speed:g} rad/s and {self.rate:g} Hz "
                              f"are {samples:.3g} samples; at most {MAX_SAMPLES:.0e} are written")
+
+
+def _pair_of_numbers(value: object) -> bool:
+    """True for a sequence of two finite numbers (booleans excluded)."""
+    return (isinstance(value, (tuple, list)) and len(value) == 2
+            and all(not isinstance(v, bool) and isinstance(v, (int, float, np.integer, np.floating))
+                    and math.isfinite(v) for v in value))
 
 
 #: Most samples a synthetic record may have (the model is evaluated at every one of them).
@@ -161,6 +193,8 @@ def true_signals(settings: RigSettings) -> Truth:
     """Run the reference engine on the rig driven by the motor; sample on the rig's grid."""
     t_knots, angle = motor_angle(settings)
     base = named_scene(settings.scene)
+    if settings.shaft_angle_deg is not None:
+        base = replace_field(base, **{"joint.geometry.shaft_angle_deg": settings.shaft_angle_deg})
     scene = replace(base, drive=AngleDrive(tuple(t_knots), tuple(angle)),
                     revolutions=1.0, record=replace(base.record, timeseries=False))
     brake, result = _brake_torque(scene, settings.input_torque)
@@ -255,8 +289,14 @@ def write(path, fmt: str, settings: RigSettings | None = None, transducer: Trans
           truth: Truth | None = None) -> dict:
     """Write a synthetic measurement file (``csv``: comma and point; ``lvm``: LabVIEW with
     decimal comma; ``tdms``). Returns the settings used (with the true efficiency)."""
-    if fmt not in FORMATS:
-        raise ValueError(f"`fmt` must be one of {FORMATS}, got {fmt!r}")
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise TypeError(f"`path` must be a str or path naming the file to write, got {path!r:.80}")
+    if not isinstance(fmt, str) or fmt not in FORMATS:
+        raise ValueError(f"`fmt` must be one of {FORMATS}, got {fmt!r:.80}")
+    for name, value, cls in (("settings", settings, RigSettings), ("transducer", transducer, Transducer),
+                             ("truth", truth, Truth)):
+        if value is not None and not isinstance(value, cls):
+            raise TypeError(f"`{name}` must be a {cls.__name__} or None, got {type(value).__name__}")
     settings = settings or RigSettings()
     truth = truth or true_signals(settings)
     table, units, used = measure(truth, settings, transducer)

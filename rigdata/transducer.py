@@ -67,10 +67,20 @@ class Transducer:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise ValueError(f"`{name}` must be a number >= 0, got {value!r}")
-        for name in ("pulses_per_rev", "adc_bits"):
+        for name, top in (("pulses_per_rev", 1_000_000), ("adc_bits", 32)):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"`{name}` must be an integer >= 1, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= top:
+                raise ValueError(f"`{name}` must be an integer in [1, {top}], got {value!r:.40}")
+        # an error class above 100 % of full scale, or a drift or full scale beyond any torque
+        # transducer, is a typing error (and overflows the uncertainty budget's squares)
+        if self.accuracy_class > 1.0:
+            raise ValueError(f"`accuracy_class` must be at most 1 (100 % of full scale), "
+                             f"got {self.accuracy_class!r}")
+        for name in ("full_scale", "zero_drift", "adc_range"):
+            if getattr(self, name) > 1e8:
+                raise ValueError(f"`{name}` must be at most 1e8, got {getattr(self, name)!r}")
+        if self.sensitivity < 1e-12:
+            raise ValueError(f"`sensitivity` must be at least 1e-12 V/(N m), got {self.sensitivity!r}")
 
     @property
     def accuracy_limit(self) -> float:

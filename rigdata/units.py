@@ -52,6 +52,30 @@ SI = {"time": "s", "torque": "N m", "speed": "rad/s", "angle": "rad",
 ACCEPTS = {"time": ("time",), "torque": ("torque", "voltage"),
            "speed": ("speed", "pulse_rate"), "angle": ("angle", "counts")}
 
+#: Largest magnitude of a record's values of each kind, in SI units: time 1e11 s (absolute clocks:
+#: LabVIEW counts seconds since 1904, about 3.8e9 s today; histories may start at any time),
+#: torque 1e8 N m (ten times the largest drive shafts built), speed 1e5 rad/s (1e6 rpm), angle
+#: 1e9 rad. Beyond these a value is a wrong unit or scale or a corrupt file, and squares of it
+#: (the uncertainty budget) would overflow.
+LIMITS = {"time": 1e11, "torque": 1e8, "speed": 1e5, "angle": 1e9}
+
+
+def check_magnitudes(time: np.ndarray, channels: dict[str, np.ndarray], file: object = None) -> None:
+    """:class:`RigDataError` naming the channel, the sample and the limit when a value of ``time``
+    [s] or a channel (SI units, keys such as ``torque_in``) exceeds :data:`LIMITS` in magnitude."""
+    for name, values in (("time", time), *channels.items()):
+        kind = name.split("_")[0]
+        limit = LIMITS.get(kind)
+        values = np.asarray(values, dtype=float)
+        if limit is None or values.size == 0:
+            continue
+        i = int(np.argmax(np.abs(values)))
+        if abs(values[i]) > limit:
+            raise RigDataError(f"{values[i]:.3g} {SI[kind]} at sample {i} exceeds the plausible {limit:g} "
+                               f"{SI[kind]} in magnitude: a wrong unit or scale (--unit, --sensitivity) "
+                               "or a corrupt file", file=file, channel=name)
+
+
 _RPM = 2.0 * math.pi / 60.0
 _LBF_IN = 0.1129848290276167      # 1 lbf in = 4.4482216152605 N x 0.0254 m
 _LBF_FT = 1.3558179483314004      # 1 lbf ft = 4.4482216152605 N x 0.3048 m

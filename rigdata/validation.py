@@ -17,6 +17,7 @@ import math
 import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -25,16 +26,17 @@ from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import to_jsonable
 from reference.paper import named_scene
 from reference.scene import Scene
+from reference.scene_files import load_scene
 from reference.schema import Status
 from rigdata.conditioning import Conditioned, Conditioning, condition
-from rigdata.efficiency import SQRT3, Measured, measured_efficiency
+from rigdata.efficiency import SQRT3, Measured, check_draws, measured_efficiency
 from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
 from rigdata.readers import read
 from rigdata.record import RigRecord
 from rigdata.transducer import PROVENANCE, Transducer
 
-__all__ = ["K", "MODEL_ENGINES", "Measurement", "Validation", "accuracy_needed", "as_record", "compare",
-           "measure", "validate"]
+__all__ = ["K", "MODEL_ENGINES", "Measurement", "Validation", "accuracy_needed", "as_record", "as_scene",
+           "compare", "measure", "validate"]
 
 #: A record, or a rig file to read.
 Source = RigRecord | str | os.PathLike
@@ -54,6 +56,20 @@ def as_record(source: Source, **read_options: Any) -> RigRecord:
             raise ValueError(f"read options {sorted(read_options)} apply to a file, not to a RigRecord")
         return source
     return read(source, **read_options)
+
+
+def as_scene(scene: Scene | str | os.PathLike) -> Scene:
+    """``scene`` itself when it is a scene; a scene TOML file (the user's own joint, a path or a
+    name ending in ``.toml``, :func:`reference.scene_files.load_scene`); else a named scene
+    (:func:`reference.paper.named_scene`). Raises ``SceneError`` naming what is wrong."""
+    if isinstance(scene, Scene):
+        return scene
+    if not isinstance(scene, (str, os.PathLike)):
+        raise TypeError(f"`scene` must be a Scene, a scene name or a scene file, got {scene!r}")
+    path = Path(scene)
+    if isinstance(scene, os.PathLike) or path.suffix.lower() == ".toml" or path.is_file():
+        return load_scene(path)
+    return named_scene(scene)
 
 
 def _pair(transducers: Transducer | tuple[Transducer, Transducer] | None) -> tuple[Transducer, Transducer]:
@@ -127,6 +143,11 @@ def measure(source: Source, shaft_angle_deg: float = 15.0, *, conditioning: Cond
     RigDataError
         A file or record that cannot be measured (fewer than one whole revolution, ...).
     """
+    if isinstance(shaft_angle_deg, bool) or not isinstance(shaft_angle_deg, (int, float, np.number)):
+        raise TypeError(f"`shaft_angle_deg` must be a number [deg], got {shaft_angle_deg!r:.80}")
+    if not (math.isfinite(shaft_angle_deg) and 0.0 <= shaft_angle_deg < 90.0):
+        raise ValueError(f"`shaft_angle_deg` must be in [0, 90) deg, got {shaft_angle_deg!r}")
+    check_draws(monte_carlo, seed)
     record = as_record(source, **read_options)
     cond = condition(record, math.radians(shaft_angle_deg), conditioning)
     measured = measured_efficiency(cond, _pair(transducers), monte_carlo=monte_carlo, seed=seed)
@@ -256,7 +277,7 @@ def _ok_efficiency(computed: Mapping[str, Any] | None) -> float | None:
     return float(computed["mean_efficiency"])
 
 
-def validate(source: Source, scene: Scene | str = "rig-calibrated",
+def validate(source: Source, scene: Scene | str | os.PathLike = "rig-calibrated",
              engines: tuple[str, ...] = MODEL_ENGINES, *, conditioning: Conditioning | None = None,
              transducers: Transducer | tuple[Transducer, Transducer] | None = None,
              monte_carlo: int = 2000, seed: int = 0, progress: Callable[[str], None] | None = None,
@@ -267,9 +288,10 @@ def validate(source: Source, scene: Scene | str = "rig-calibrated",
     ----------
     source : RigRecord, str or path-like
         A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
-    scene : Scene or str
-        Joint, shaft angle, friction and numerics of the model (its drive and load are replaced);
-        a name for :func:`reference.paper.named_scene`.
+    scene : Scene, str or path-like
+        Joint, shaft angle, friction and numerics of the model (its drive and load are replaced):
+        a scene, a scene TOML file or a name for :func:`reference.paper.named_scene`
+        (:func:`as_scene`).
     engines : tuple of str
         Engines to drive (keys of :data:`cardan_exudyn.engines.ENGINES` that take angle drives
         and load histories: :data:`MODEL_ENGINES`).
@@ -291,7 +313,11 @@ def validate(source: Source, scene: Scene | str = "rig-calibrated",
         An engine that is unknown or not installed.
     """
     say = progress or (lambda line: None)
-    base = named_scene(scene) if isinstance(scene, str) else scene
+    if isinstance(engines, (str, bytes)):
+        raise TypeError(f"`engines` must be a sequence of engine names such as ('reference', 'exudyn'), not "
+                        f"one string: got {engines!r:.80}")
+    check_draws(monte_carlo, seed)
+    base = as_scene(scene)
     for engine in engines:  # fail now, not after the measurement
         if engine not in MODEL_ENGINES:
             get_engine(engine)  # unknown or not installed: its own message

@@ -33,13 +33,17 @@ from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_m
 from reference.engine import ReferenceOptions
 from reference.joint import Body
 from reference.paper import named_scene
-from reference.scene import Load, replace, scene_from_dict
+from reference.scene import Load, Scene, replace, scene_from_dict
 from reference.scene_files import load_scene
 from reference.schema import OptionsError, Result, Status, Summary
 from reference.validation import SceneError
+from rigdata.conditioning import Conditioning
 from rigdata.readers import read
 from rigdata.record import ChannelSource, RigDataError, RigRecord
 from rigdata.synthetic import RigSettings
+from rigdata.synthetic import write as synthetic_write
+from rigdata.transducer import Transducer
+from rigdata.validation import measure, validate
 
 __all__ = ["CASES", "Case", "DIRECTORY", "ENTRY_POINTS", "MARKER"]
 
@@ -243,6 +247,88 @@ def _rig_settings_huge(d: Path) -> Any:
     return RigSettings(revolutions=1e9)
 
 
+def _api_run_none(d: Path) -> Any:
+    """cardan_exudyn.engines.run(None, "reference")"""
+    return run(None, "reference")
+
+
+def _api_run_scene_name(d: Path) -> Any:
+    """cardan_exudyn.engines.run("paper", "reference"): a name where a Scene is expected"""
+    return run("paper", "reference")
+
+
+def _api_run_engine_list(d: Path) -> Any:
+    """cardan_exudyn.engines.run(scene, ["reference"]): a list where an engine name is expected"""
+    return run(named_scene("paper-frictionless"), ["reference"])
+
+
+def _api_compare_string(d: Path) -> Any:
+    """compare(scene, "exudyn,reference"): one string, not a list of engines"""
+    return compare(named_scene("paper-frictionless"), "exudyn,reference")
+
+
+def _api_compare_none(d: Path) -> Any:
+    """compare(None, ["exudyn", "reference"])"""
+    return compare(None, ["exudyn", "reference"])
+
+
+def _api_compare_skip_all(d: Path) -> Any:
+    """compare(one-revolution scene, skip_revolutions=5): nothing left to compare"""
+    return compare(replace(named_scene("paper-frictionless"), revolutions=1.0), ["reference", "exudyn"],
+                   skip_revolutions=5.0)
+
+
+def _api_replace_none(d: Path) -> Any:
+    """reference.scene.replace(None, revolutions=2)"""
+    return replace(None, revolutions=2.0)
+
+
+def _api_scene_load_type(d: Path) -> Any:
+    """Scene(joint, drive, load=5): a number where a Load is expected"""
+    scene = named_scene("paper")
+    return Scene(scene.joint, scene.drive, load=5)
+
+
+def _api_named_scene_list(d: Path) -> Any:
+    """reference.paper.named_scene(["paper"])"""
+    return named_scene(["paper"])
+
+
+def _api_load_scene_none(d: Path) -> Any:
+    """reference.scene_files.load_scene(None)"""
+    return load_scene(None)
+
+
+def _api_rig_read_none(d: Path) -> Any:
+    """rigdata.readers.read(None)"""
+    return read(None)
+
+
+def _api_rig_measure_draws(d: Path) -> Any:
+    """rigdata.measure("rig.csv", monte_carlo=10**10)"""
+    return measure(d / "rig.csv", monte_carlo=10**10)
+
+
+def _api_rig_transducer_class(d: Path) -> Any:
+    """rigdata.Transducer(accuracy_class=1e300)"""
+    return Transducer(accuracy_class=1e300)
+
+
+def _api_rig_validate_string(d: Path) -> Any:
+    """rigdata.validate("rig.csv", "rig", "reference,exudyn"): one string, not a tuple of engines"""
+    return validate(d / "rig.csv", "rig", "reference,exudyn", monte_carlo=0)
+
+
+def _api_rig_conditioning_phase(d: Path) -> Any:
+    """rigdata.Conditioning(phase="a")"""
+    return Conditioning(phase="a")
+
+
+def _api_rig_synthetic_settings(d: Path) -> Any:
+    """rigdata.synthetic.write("x.csv", "csv", settings=5)"""
+    return synthetic_write(d / "x.csv", "csv", 5)
+
+
 # The cases, by entry point
 
 CASES: tuple[Case, ...] = (
@@ -308,7 +394,52 @@ CASES: tuple[Case, ...] = (
     Case("scene-tiny-step", "scene file", "`numerics.dt` = 1e-12 s: 6e10 steps",
          ("run", "--scene", "{d}/scene.toml", "--out", "{out}"),
          files=_scene_toml(_PAPER_FRICTIONLESS + "[numerics]\ndt = 1e-12\n"), out="folder", match="steps"),
+    Case("scene-speed-huge", "scene file", "an input speed of 1e300 rpm",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "[drive]\nspeed_rpm = 1e300\n"),
+         match="at most 1e+12 in magnitude"),
+    Case("scene-drive-typo", "scene file", "a misspelt drive key (`sped`): the message lists every key",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "[drive]\nsped = 100\n"),
+         match="allowed: ['kind', 'speed', 'speed_rpm']"),
+    Case("scene-iterations-huge", "scene file", "1e9 friction iterations per step",
+         ("scene", "--scene", "{d}/scene.toml"),
+         files=_scene_toml(_PAPER + "[friction]\nmax_iterations = 1000000000\n"), match="[2, 10000]"),
+    Case("scene-section-number", "scene file", "a number where the load table should be",
+         ("scene", "--scene", "{d}/scene.toml"), files=_scene_toml(_PAPER + "load = 5\n"),
+         match="[load] must be a table"),
     # command-line options
+    Case("run-rpm-huge", "cli", "an input speed of 1e300 rpm", ("run", "--rpm", "1e300"),
+         match="at most 1e+12"),
+    Case("tolerance-samples-huge", "cli", "1e9 Monte Carlo samples (out of memory)",
+         ("tolerance", "montecarlo", "--samples", "1e9", "--out", "{out}"), out="folder",
+         match="--samples: must be at most 100000"),
+    Case("tolerance-montecarlo-engines", "cli", "--engines (the paper case's) given to montecarlo",
+         ("tolerance", "montecarlo", "--engines", "exudyn", "--out", "{out}"), out="folder",
+         match="--engines does not apply"),
+    Case("tolerance-paper-scene-option", "cli", "a scene option given to the paper case (fixed scenes)",
+         ("tolerance", "paper", "--angle", "5", "--out", "{out}"), out="folder",
+         match="--angle does not apply"),
+    Case("tolerance-paper-samples", "cli", "--samples given to the paper case",
+         ("tolerance", "paper", "--samples", "5", "--out", "{out}"), out="folder",
+         match="--samples does not apply"),
+    Case("compare-skip-all", "cli", "--skip-revolutions beyond the run (nan columns before)",
+         ("compare", "--engines", "reference,exudyn", "--revolutions", "1", "--skip-revolutions", "5",
+          "--out", "{out}"), out="folder", match="leaves nothing"),
+    Case("sweep-workers-huge", "cli", "1e12 workers",
+         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--workers", "1000000000000",
+          "--out", "{out}"),
+         out="folder", match="at most 1024"),
+    Case("bench-repeats-huge", "cli", "1e12 timed repeats", ("bench", "--repeats", "1e12"),
+         match="at most 1000"),
+    Case("accuracy-seed-negative", "cli", "negative seed of the cell draw", ("accuracy", "--seed", "-1"),
+         match="--seed: must be >= 0"),
+    Case("rig-mc-huge", "cli", "1e9 Monte Carlo draws (out of memory)",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "1e9"), files=_RIG_FILE,
+         match="--mc: must be at most 100000"),
+    Case("rig-accuracy-class-huge", "cli", "accuracy class 1e300 %",
+         ("rig", "measure", "{d}/rig.csv", "--accuracy-class", "1e300"), files=_RIG_FILE,
+         match="--accuracy-class: must be at most 100"),
+    Case("rig-full-scale-huge", "cli", "a transducer full scale of 1e300 N m",
+         ("rig", "measure", "{d}/rig.csv", "--full-scale", "1e300"), files=_RIG_FILE, match="`full_scale`"),
     Case("run-angle-text", "cli", "non-numeric shaft angle", ("run", "--angle", "abc"),
          match="argument --angle: expected a number"),
     Case("run-rpm-inf", "cli", "infinite speed", ("run", "--rpm=-inf"), match="expected a finite number"),
@@ -455,6 +586,38 @@ CASES: tuple[Case, ...] = (
          match="does not increase at sample 2 (1.0 "),
     Case("api-rig-settings", "python api", "a synthetic record of 1e12 samples",
          call=_rig_settings_huge, expect=ValueError, match="samples"),
+    Case("api-run-none", "python api", "None where a scene is expected", call=_api_run_none,
+         expect=TypeError, match="`scene` must be a Scene"),
+    Case("api-run-scene-name", "python api", "a scene name where a Scene is expected",
+         call=_api_run_scene_name, expect=TypeError, match="named_scene"),
+    Case("api-run-engine-list", "python api", "a list where an engine name is expected",
+         call=_api_run_engine_list, expect=TypeError, match="`engine` must be the name of an engine"),
+    Case("api-compare-string", "python api", "engines as one comma-separated string",
+         call=_api_compare_string, expect=TypeError, match="not one string"),
+    Case("api-compare-none", "python api", "compare None", call=_api_compare_none, expect=TypeError,
+         match="`scene` must be a Scene"),
+    Case("api-compare-skip-all", "python api", "skip more revolutions than the scene has",
+         call=_api_compare_skip_all, expect=ValueError, match="`skip_revolutions`"),
+    Case("api-replace-none", "python api", "replace in None", call=_api_replace_none, expect=TypeError,
+         match="`scene` must be a Scene"),
+    Case("api-scene-load-type", "python api", "a number where a Load is expected", call=_api_scene_load_type,
+         expect=TypeError, match="`load` must be a Load"),
+    Case("api-named-scene-list", "python api", "a list as a scene name", call=_api_named_scene_list,
+         expect=TypeError, match="`name` must be a scene name"),
+    Case("api-load-scene-none", "python api", "None as a scene file", call=_api_load_scene_none,
+         expect=TypeError, match="`path`"),
+    Case("api-rig-read-none", "python api", "None as a rig file", call=_api_rig_read_none, expect=TypeError,
+         match="`path`"),
+    Case("api-rig-measure-draws", "python api", "1e10 Monte Carlo draws", call=_api_rig_measure_draws,
+         files=_RIG_FILE, expect=ValueError, match="`monte_carlo` must be an integer in [0, 100000]"),
+    Case("api-rig-transducer-class", "python api", "accuracy class 1e300", call=_api_rig_transducer_class,
+         expect=ValueError, match="`accuracy_class` must be at most 1"),
+    Case("api-rig-validate-string", "python api", "engines as one string", call=_api_rig_validate_string,
+         files=_RIG_FILE, expect=TypeError, match="not one string"),
+    Case("api-rig-conditioning-phase", "python api", "a text phase", call=_api_rig_conditioning_phase,
+         expect=TypeError, match="`phase` must be a number"),
+    Case("api-rig-synthetic-settings", "python api", "a number as the settings",
+         call=_api_rig_synthetic_settings, expect=TypeError, match="`settings` must be a RigSettings"),
     # rig files
     Case("rig-empty", "rig file", "empty file", ("rig", "inspect", "{d}/rig.csv"), files={"rig.csv": ""},
          match="empty file"),
@@ -504,7 +667,39 @@ CASES: tuple[Case, ...] = (
     Case("rig-one-revolution", "rig file", "less than one whole revolution after settling",
          ("rig", "measure", "{d}/rig.csv", "--mc", "0"), files={"rig.csv": _rig_csv(rows=110)},
          match="less than one whole input revolution"),
+    Case("rig-dead-torque-out", "rig file", "output torque 0 at every sample (unplugged transducer)",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "0"),
+         files={"rig.csv": _rig_csv(rows=300, row=lambda k, t: f"{t:.4f},0.2,0,6,6")},
+         match="channel 'torque_out': reads 0 at every sample"),
+    Case("rig-dead-speed-out", "rig file", "output speed 0 at every sample (unplugged transducer)",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "0"),
+         files={"rig.csv": _rig_csv(rows=300, row=lambda k, t: f"{t:.4f},0.2,0.19,6,0")},
+         match="channel 'speed_out': reads 0 at every sample"),
+    Case("rig-stuck-output", "rig file", "an output speed a thousand times too small (wrong scale)",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "0"),
+         files={"rig.csv": _rig_csv(rows=300, row=lambda k, t: f"{t:.4f},0.2,0.19,6,0.006")},
+         match="turn together"),
+    Case("rig-ten-samples", "rig file", "a file of 10 samples",
+         ("rig", "measure", "{d}/rig.csv", "--mc", "0"),
+         files={"rig.csv": _rig_csv(rows=10)}, match="too short: 10 samples"),
+    Case("rig-huge-torque", "rig file", "torques of 2e299 N m", ("rig", "inspect", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{t:.4f},2e299,1.9e299,6,6")},
+         match="exceeds the plausible 1e+08 N m"),
+    Case("rig-huge-time", "rig file", "times of 1e297 s and more", ("rig", "measure", "{d}/rig.csv"),
+         files={"rig.csv": _rig_csv(row=lambda k, t: f"{k * 1e297:.4g},0.2,0.19,6,6")},
+         match="channel 'time'"),
     # sweep specifications
+    Case("spec-samples-huge", "sweep spec", "[random] samples = 1000000000 (out of memory)", _SWEEP,
+         files=_spec('scene = "paper"\n[random]\nsamples = 1000000000\nseed = 1\n'
+                     '[random.parameters.revolutions]\ndist = "uniform"\nlow = 1\nhigh = 2\n'),
+         out="folder", match="`random.samples` must be in [1, 100000]"),
+    Case("spec-samples-float", "sweep spec", "[random] samples = 1e9 (a float)", _SWEEP,
+         files=_spec('scene = "paper"\n[random]\nsamples = 1e9\nseed = 1\n'
+                     '[random.parameters.revolutions]\ndist = "uniform"\nlow = 1\nhigh = 2\n'),
+         out="folder", match="`random.samples` must be an integer"),
+    Case("spec-grid-huge", "sweep spec", "a grid of 1e5 x 1e5 points", _SWEEP,
+         files=_spec('scene = "paper"\n[grid]\nrevolutions = {linspace = [1, 2, 100000]}\n'
+                     '"load.torque" = {linspace = [1, 2, 100000]}\n'), out="folder", match="at most 100000"),
     Case("spec-unknown-parameter", "sweep spec", "grid over a scene field that does not exist", _SWEEP,
          files=_spec('scene = "paper"\nengine = "reference"\n[grid]\n"joint.geometry.nope" = [1, 2]\n'),
          out="folder", match="unknown key(s) ['nope']"),

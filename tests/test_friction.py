@@ -57,6 +57,15 @@ def test_regularised_sign():
     assert regularised_sign(v, 0.0).tolist() == [-1.0, -1.0, -1.0, 0.0, 1.0, 1.0, 1.0]
 
 
+def test_regularised_sign_per_slot():
+    """One band per friction value along the last axis; a zero band is the exact sign there."""
+    v = np.array([[5e-4, 5e-4, -5e-4], [-2.0, 1e-9, 0.0]])
+    bands = np.array([1e-3, 0.0, 2e-3])
+    assert regularised_sign(v, bands).tolist() == [[0.5, 1.0, -0.25], [-1.0, 1.0, 0.0]]
+    assert regularised_sign(v, np.array([1e-3, 1e-3, 2e-3])).tolist() == [[0.5, 0.5, -0.25],
+                                                                          [-1.0, 1e-6, 0.0]]
+
+
 
 
 def test_lagged_loads_equal_numpy_law_of_previous_step(runs):
@@ -70,6 +79,11 @@ def test_lagged_loads_equal_numpy_law_of_previous_step(runs):
         for j, col in enumerate(("friction_torque", "friction_force")):
             applied = table[f"{name}_{col}"].to_numpy()
             expected = law[name][j]
+            if col == "friction_force" and not scene.joint.errors.any:
+                # the ideal joint cannot slide: no axial friction (the law of the table's slide
+                # speeds, solver noise, gives noise; cardan_exudyn.model.coupling)
+                assert np.all(applied == 0.0), name
+                continue
             scale = max(np.abs(expected).max(), 1e-300)
             assert np.abs(applied[2:] - expected[1:-1]).max() <= 1e-10 * scale, (name, col)
             assert abs(applied[1] - expected[0]) <= scene.friction.tolerance * scale
@@ -177,15 +191,16 @@ def test_self_locking_is_a_status_not_a_number(coupling):
 
 
 def test_sign_band_does_not_change_the_0deg_result():
-    """At 0 deg no spider pair moves: every positive band gives the same mean efficiency (the
-    default band does not depend on rounding), up to the friction fixed-point tolerance (1e-6
-    relative, measured spread 3e-9); the exact sign does not give a number."""
+    """At 0 deg no spider pair moves: every band, the exact sign included, gives the same mean
+    efficiency up to the friction fixed-point tolerance (1e-6 relative; measured: identical).
+    The ideal joint's cylindrical pairs get no axial friction (they cannot slide); before, the
+    exact sign of their solver-noise slide speeds switched the full axial force and the run
+    stopped as self-locking."""
     from cardan_exudyn.studies.friction_numerics import sign_band_study
 
     rows = sign_band_study(["paper-0deg"], [0.0, 1e-6, 1e-3, 1e-1])
-    assert rows[0]["status"] != "ok"
-    etas = [r["mean_efficiency"] for r in rows[1:]]
-    assert all(r["status"] == "ok" for r in rows[1:])
+    etas = [r["mean_efficiency"] for r in rows]
+    assert all(r["status"] == "ok" for r in rows)
     tolerance = named_scene("paper-0deg").friction.tolerance
     assert max(etas) - min(etas) <= tolerance
 

@@ -49,19 +49,34 @@ finite = st.floats(-1e3, 1e3, allow_nan=False)
 
 
 @given(fx=finite, fy=finite, mx=finite, my=finite, omega=st.floats(-100, 100), slide=st.floats(-1, 1),
-       band=st.sampled_from([0.0, 1e-4, 1e-3]), cylindrical=st.booleans())
-def test_agrees_with_the_reference_law(fx, fy, mx, my, omega, slide, band, cylindrical):
-    """Same torque and force as reference.friction.pair_friction, written independently."""
+       band=st.sampled_from([0.0, 1e-4, 1e-3]), slide_band=st.sampled_from([None, 0.0, 1e-6, 1e-2]),
+       cylindrical=st.booleans())
+def test_agrees_with_the_reference_law(fx, fy, mx, my, omega, slide, band, slide_band, cylindrical):
+    """Same torque and force as reference.friction.pair_friction, written independently, with
+    the rotation's and the sliding's own bands."""
     from reference.joint import Pair
 
     pair = Pair(friction_coefficient=0.42, journal_diameter=0.005, moment_lever=0.006)
     law = PairLaw(cylindrical, 0.42, 0.005, 0.006)
-    ours = pair_loads(law, fx, fy, mx, my, omega, slide, band)
+    ours = pair_loads(law, fx, fy, mx, my, omega, slide, band, slide_band)
     torque, force = pair_friction(pair, "cylindrical" if cylindrical else "revolute",
-                                  fx, fy, mx, my, omega, slide, band)
+                                  fx, fy, mx, my, omega, slide, band, slide_band)
     scale = 1.0 + abs(float(torque)) + abs(float(force))
     assert ours.torque == pytest.approx(float(torque), rel=1e-12, abs=1e-12 * scale)
     assert ours.force == pytest.approx(float(force), rel=1e-12, abs=1e-12 * scale)
+
+
+def test_sliding_has_its_own_band():
+    """The axial force takes its sign ramp from ``slide_band`` (the torque from ``band``); without
+    it, from ``band``."""
+    own = pair_loads(SPIDER, 5.0, 0.0, 0.0, 0.0, omega_rel=0.2, slide_rel=1e-4, band=1e-3,
+                     slide_band=4e-4)
+    shared = pair_loads(SPIDER, 5.0, 0.0, 0.0, 0.0, omega_rel=0.2, slide_rel=1e-4, band=1e-3)
+    axial = 0.42 * 5.0
+    assert own.force == pytest.approx(-0.25 * axial, rel=1e-14)
+    assert shared.force == pytest.approx(-0.1 * axial, rel=1e-14)
+    # surface speed 0.2 * 0.0025 = 5e-4 m/s: half way up the 1e-3 m/s ramp in both
+    assert own.torque == shared.torque == pytest.approx(-0.5 * 0.42 * 0.0025 * 5.0, rel=1e-14)
 
 
 @pytest.mark.parametrize("h1, h2", [(0.1, 0.1), (0.1, 0.2), (0.03, 0.01)], ids=["uniform", "shrink", "grow"])

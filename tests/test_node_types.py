@@ -9,6 +9,10 @@ efficiency. Bounds come from the measured errors (generalized-alpha, spectral ra
   halving the step must divide the error by 4 (second order; measured 3.97-3.99);
 - mean efficiency at 10 deg with friction (converged), 200 steps per revolution, minus the
   reference engine's: +5.3e-4 (Rxyz), +5.9e-4 (EP, RotVecLG); the bound is 1e-3.
+
+The input's angle coordinate (its first Rxyz angle, under every node type) is kept within
+``[-pi, pi]`` by the model's post-step hook, which records the whole revolutions it removes
+(``ExudynModel.input_turns``); the results' ``theta_in`` is the continuous angle.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import pytest
 import cardan_exudyn.model.solve as engine  # its build_model is patched to look inside the runs
 from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.model.build import build_model
-from cardan_exudyn.model.postprocess import body_states
+from cardan_exudyn.model.postprocess import body_states, stored
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES
 from reference.kinematics import speed_ratio
 from reference.paper import named_scene
@@ -163,3 +167,47 @@ def test_mean_efficiency_with_friction(node_type, built, reference_efficiency):
     eta = result.summary.mean_efficiency
     assert eta < 0.6
     assert abs(eta - reference_efficiency) <= EFFICIENCY_BOUND, (eta, reference_efficiency)
+
+
+# ------------------------------------------------------------------ the input angle coordinate
+
+
+@pytest.mark.parametrize("node_type", NODE_TYPES)
+def test_input_angle_coordinate_is_kept_within_pi(node_type, built):
+    """Constant speed, 3 revolutions: the coordinate the solver integrates stays within
+    [-pi, pi], three whole revolutions were taken out of it, and ``theta_in`` is the continuous
+    angle, ``omega t`` to rounding (the velocity-level drive holds the speed exactly)."""
+    scene = _scene("paper-10deg-frictionless", 100, revolutions=3)
+    result, model = _run(scene, node_type, built)
+    coordinate = stored(model, "input_q")[:, 4]
+    assert np.abs(coordinate).max() <= math.pi * (1.0 + 1e-15)
+    assert model.input_turns.count == 3 and len(model.input_turns.times) == 3
+    t = result.table["t"].to_numpy()
+    # the angle at 6 pi rounds at 1.8e-15; 300 steps of it and of omega t: 1e-13 is 50 x that
+    np.testing.assert_allclose(result.table["theta_in"], scene.drive.speed * t, rtol=0, atol=1e-13)
+    assert abs(result.table["theta_in"].iloc[-1] - 6.0 * math.pi) < 1e-13
+
+
+@pytest.mark.parametrize("node_type", NODE_TYPES)
+def test_angle_drive_starting_whole_revolutions_in(node_type, built):
+    """An angle history 16 revolutions in (100.5 rad) moves the joint as the same history from 0:
+    the node coordinates start at the identity either way, and the results' input angle carries
+    the 16 revolutions (the drive's offset subtracts what the coordinate lacks; before the
+    wrap the coordinate started at 0 against an offset of 100.5 rad, and Newton failed)."""
+    scene = _scene("paper-35deg-frictionless", 100, revolutions=1)
+    w = scene.drive.speed
+    t = np.linspace(0.0, 1.3 * 2.0 * math.pi / w, 60)
+    tables = []
+    for turns in (0, 16):
+        angle = 2.0 * math.pi * turns + w * t
+        history = replace(scene, drive={"kind": "angle", "time": t.tolist(), "angle": angle.tolist()})
+        result, model = _run(history, node_type, built)
+        assert model.input_turns.start == turns
+        tables.append(result.table)
+    a, b = tables
+    assert len(a) == len(b)
+    # the two runs differ by the rounding of the angles at 100 rad (1.4e-14): measured 1.4e-14
+    # in theta_in, 2.7e-12 of the speed in omega_out, 2.7e-9 N m in the drive torque
+    np.testing.assert_allclose(b["theta_in"] - 32.0 * math.pi, a["theta_in"], rtol=0, atol=1e-13)
+    np.testing.assert_allclose(b["omega_out"], a["omega_out"], rtol=0, atol=1e-10 * w)
+    np.testing.assert_allclose(b["torque_in"], a["torque_in"], rtol=0, atol=1e-7)

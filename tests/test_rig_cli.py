@@ -68,26 +68,54 @@ def test_validate_writes_the_report(lvm, tmp_path):
     assert s["computed"]["reference"]["mean_efficiency"] == pytest.approx(used["true_efficiency"], abs=2e-3)
 
 
+def test_validate_takes_the_users_joint_as_a_scene_file(lvm, tmp_path):
+    """--scene takes a scene file (the user's own joint): the model is that joint, with the
+    file's friction and shaft angle (no --angle given), and gives what the Python API gives on
+    the same file; a named scene with other friction gives another efficiency."""
+    import rigdata
+
+    path, _ = lvm
+    joint = tmp_path / "my_joint.toml"
+    joint.write_text('base = "rig-calibrated"\n[joint.geometry]\nshaft_angle_deg = 15.0\n'
+                     '[joint.pairs.frame_input]\nfriction_coefficient = 0.1\n')
+    out = tmp_path / "report"
+    proc = cardan("validate", str(path), "--scene", str(joint), "--engines", "reference", "--mc", "0",
+                  "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    s = json.loads((out / "validation.json").read_text())
+    api = rigdata.validate(str(path), joint, engines=("reference",), monte_carlo=0)
+    assert api.scene.joint.pairs.frame_input.friction_coefficient == 0.1
+    assert s["computed"]["reference"]["mean_efficiency"] == pytest.approx(
+        api.computed_efficiency["reference"], rel=0, abs=1e-12)
+    named = rigdata.validate(str(path), "rig-calibrated", engines=("reference",), monte_carlo=0)
+    assert abs(named.computed_efficiency["reference"] - api.computed_efficiency["reference"]) > 1e-4
+
+
 @pytest.mark.parametrize("args, match", [
     (["measure", "{missing}"], "no-such.csv"),
     (["measure", "{lvm}", "--map", "torque_in"], "--map expects CHANNEL=VALUE"),
     (["measure", "{lvm}", "--unit", "torque_in=furlongs"], "furlongs"),
     (["validate", "{lvm}", "--engines", "mujoco", "--out", "{out}"], "--engines"),
     (["validate", "{lvm}", "--scene", "nope", "--out", "{out}"], "unknown scene name"),
+    (["validate", "{lvm}", "--scene", "{missing_scene}", "--out", "{out}"], "no-such.toml"),
+    (["validate", "{lvm}", "--scene", "{bad_scene}", "--out", "{out}"], "unknown key(s) ['frictoin']"),
     (["measure", "{short}"], "less than one whole input revolution"),
     (["measure", "{lvm}", "--angle", "-3"], "--angle"),
     (["measure", "{lvm}", "--map", "torque_in=Nope"], "Nope"),
-], ids=["missing-file", "map-syntax", "unknown-unit", "engine", "scene", "one-revolution",
-        "angle", "map-column"])
+], ids=["missing-file", "map-syntax", "unknown-unit", "engine", "scene", "scene-file-missing",
+        "scene-file-bad-key", "one-revolution", "angle", "map-column"])
 def test_bad_input_one_line_exit_2_nothing_written(lvm, tmp_path, args, match):
     """Each bad input: exit 2, one line on stderr naming the problem, no traceback, and the
     output folder untouched."""
     path, _ = lvm
     short = tmp_path / "short.csv"
     short.write_text(CSV_ONE_REV)
+    bad_scene = tmp_path / "bad.toml"
+    bad_scene.write_text('base = "rig-calibrated"\n[joint.pairs.frame_input]\nfrictoin = 0.2\n')
     out = tmp_path / "out"
     values = {"missing": str(tmp_path / "no-such.csv"), "lvm": str(path), "out": str(out),
-              "short": str(short)}
+              "short": str(short), "missing_scene": str(tmp_path / "no-such.toml"),
+              "bad_scene": str(bad_scene)}
     proc = cardan(*[a.format(**values) for a in args])
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr

@@ -80,7 +80,8 @@ def _cell(panel: Panel, angle: float, x: float) -> dict:
 def test_cells_either_side_of_the_self_locking_boundary():
     """At 10 deg and 2000 rpm the reference self-locks between f = 0.42 and 0.6 (loop gain 0.78
     at 0.42): converged coupling agrees on both sides; the lagged scheme, which never iterates the
-    friction fixed point, runs on through the lock with a meaningless efficiency."""
+    friction fixed point, runs on through the lock, to an efficiency outside [0, 1] (-2.3e-5 on
+    4e6 J of input work) that the engine now reports as status unphysical (issue 18; it was ok)."""
     converged = Panel("friction", "", "friction", (), ())
     lagged = Panel("lagged", "", "friction", (), (), coupling="lagged")
     inside = _cell(converged, 10.0, 0.42)
@@ -91,8 +92,8 @@ def test_cells_either_side_of_the_self_locking_boundary():
         "self_locking", "self_locking", True)
     runs_on = _cell(lagged, 10.0, 0.6)
     assert runs_on["ref_status"] == "self_locking"
-    assert runs_on["exu_status"] == "ok"
-    assert runs_on["category"] == "runs on through a physical self-lock"
+    assert runs_on["exu_status"] == "unphysical"
+    assert runs_on["category"] == "agree: fails where the joint locks"
 
 
 @pytest.mark.parametrize("node_type", ["EP", "RotVecLG"])
@@ -124,11 +125,14 @@ def test_quick_command_writes_the_report_atomically(tmp_path, capsys):
     assert len(cells) == sum(len(p.angles) * len(p.x_values) for p in stress_map.panels(quick=True))
     assert set(cells["cell_class"]) <= set(stress_map.CLASSES)
     assert "error" not in set(cells["cell_class"])
-    # the quick map holds both boundary verdicts and the lagged scheme's run-on cell
-    assert {"agree: ok", "agree: self-locking", "runs on through a physical self-lock"} <= set(
+    # the quick map holds both boundary verdicts and the lagged scheme's run-on cell, whose
+    # efficiency outside [0, 1] is now status unphysical (issue 18; it ran on with status ok)
+    assert {"agree: ok", "agree: self-locking", "agree: fails where the joint locks"} <= set(
         cells["category"])
+    assert "unphysical" in set(cells["exu_status"])
     report = (out / "report.md").read_text()
-    assert "## Stability map" in report and "Every disagreement" in report
+    # no disagreement left in the quick map once the lagged run-on cell is unphysical (issue 18)
+    assert "## Stability map" in report and ("Every disagreement" in report or "0 disagreements" in report)
     assert (out / "stability_map.png").stat().st_size > 10_000
     summary = json.loads((out / "stress.json").read_text())
     assert summary["map"]["cells"] == len(cells)

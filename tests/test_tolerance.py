@@ -50,9 +50,14 @@ def test_monte_carlo_draws_reproducibly_and_reports(small_study, tmp_path):
     assert again["mean_efficiency"]["p50"] == summary["mean_efficiency"]["p50"]
     m = summary["mean_efficiency"]
     assert m["p5"] <= m["p50"] <= m["p95"] and m["max"] <= summary["ideal_mean_efficiency"] + 1e-12
-    # the spider offset a2 dominates (sliding friction, even in its sign): see the single-error test
+    # the spider offset a2 dominates (sliding friction). With the sign ramp relative to each pair's
+    # speed (reference.bands), any sliding gets the full Coulomb force of eqs. (3), (5), so the
+    # loss jumps at a2 = 0 and then grows slowly with |a2|: the rank correlation with |a2| is
+    # weak (measured -0.48), the correlation ratio (any dependence) carries it (measured 0.97,
+    # alpha3 0.25)
     sens = {r["parameter"]: r for r in summary["sensitivity"]}
-    assert sens["joint.errors.a2_mm"]["spearman_magnitude"] < -0.9
+    assert sens["joint.errors.a2_mm"]["correlation_ratio"] > 0.9
+    assert sens["joint.errors.alpha3_deg"]["correlation_ratio"] < 0.5
     for name in ("report.md", "tolerance.json", "sensitivity.csv", "efficiency_histogram.png",
                  "efficiency_vs_errors.png"):
         assert (out / "study" / name).stat().st_size > 0

@@ -15,7 +15,11 @@ Modelling choices
   z the pair axis): 17 constraints on 18 coordinates, mobility one, no redundancy.
 - Constant speed: ``ObjectConnectorCoordinate`` at velocity level on the input angle (no Python
   user function). Prescribed angle: the same connector at position level with an offset user
-  function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``.
+  function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``. A load history: a
+  ``LoadTorqueVector`` with a user function. Both user functions find the sample interval by
+  bisection and evaluate one piece in plain floats (:mod:`reference.histories`): O(log n) per
+  call, so a long measured history costs what a short one does. The model's clock starts at 0
+  whatever time the histories start at (``ExudynModel.time_origin``).
 - Gravity loads and the output load only when they are non-zero; friction loads and their user
   function only for pairs with a non-zero coefficient (``cardan_exudyn.model.coupling``).
 - Mounting errors (``scene.joint.errors``): each pair's marker frames are displaced and rotated
@@ -38,8 +42,9 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cardan_exudyn.model.coupling import FrictionCoupling
-from cardan_exudyn.model.rotations import ROTATION_COORDINATES, RotationCoordinates
+from cardan_exudyn.model.rotations import ROTATION_COORDINATES, TWO_PI, RotationCoordinates, WholeTurns
 from reference import rccc
+from reference.histories import run_clock
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.scene import AngleDrive, Scene, SpeedDrive
 
@@ -156,6 +161,11 @@ class ExudynModel:
     node_type: str = "Rxyz"  # the build_model argument
     # per body: the node's rotation coordinates (cardan_exudyn.model.rotations.ROTATION_COORDINATES)
     rotations: dict[str, RotationCoordinates] = field(default_factory=dict)
+    # whole revolutions taken out of the input's angle coordinate (_wrap_rotations)
+    input_turns: WholeTurns = field(default_factory=WholeTurns)
+    # the scene's time at the model's t = 0 [s] (reference.histories.run_clock): model.scene's
+    # histories start at 0, the results' time column adds this back
+    time_origin: float = 0.0
 
 
 def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
@@ -172,17 +182,23 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
     Lie-group generalized-alpha; its velocity coordinates are the local angular velocity). The
     input keeps ``NodeRigidBodyRxyz`` under every value: the drive (a coordinate connector) and
     the input angle of the results use its raw first angle (coordinate 3), which no other node
-    type has. Every node's reference rotation is the identity (node axes = global axes at input
-    angle 0). Rotation vectors are kept within ``|nu| <= pi`` between steps
-    (:func:`_wrap_rotation_vectors`). Measured at 35 deg, 200 steps per revolution: ``"RotVecLG"``
-    needs a spectral radius of 0.8 or less (at 0.9 and 0.95 the run with friction ends "ok"
-    with a mean efficiency off by 0.23 and 4.8, and at 0.95 the frictionless run fails).
+    type has; that coordinate is kept within ``[-pi, pi]`` between steps and
+    ``ExudynModel.input_turns`` gives back the continuous input angle. Every node's reference
+    rotation is the identity (node axes = global axes at input angle 0). Rotation vectors are kept
+    within ``|nu| <= pi`` between steps (:func:`_wrap_rotations`). Measured at 35 deg, 200 steps
+    per revolution: ``"RotVecLG"`` needs a spectral radius of 0.8 or less (at 0.9 and 0.95 the
+    run with friction ends "ok" with a mean efficiency off by 0.23 and 4.8, and at 0.95 the
+    frictionless run fails).
     """
     if node_type not in ROTATION_COORDINATES:
         raise ValueError(f"node_type must be one of {list(ROTATION_COORDINATES)}, got {node_type!r}")
+    # the model runs on a clock that starts at 0 (histories starting at t = 1e9 s included):
+    # model.scene is the scene on that clock, model.time_origin what was subtracted
+    scene, origin = run_clock(scene)
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    model = ExudynModel(scene=scene, system_container=sc, mbs=mbs, node_type=node_type)
+    model = ExudynModel(scene=scene, system_container=sc, mbs=mbs, node_type=node_type,
+                        time_origin=origin)
     ground = mbs.AddObject(eii.ObjectGround())
     _add_bodies(model)
     _add_pairs(model, ground)
@@ -195,7 +211,7 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
     mbs.Assemble()
     if model.friction is not None:
         model.friction.prepare()
-    _wrap_rotation_vectors(model)
+    _wrap_rotations(model)
     return model
 
 
@@ -219,6 +235,8 @@ def _add_bodies(model: ExudynModel) -> None:
         model.rotations[name] = rot
         a0 = state[name]["A"]
         p0 = rot.from_matrix(a0)
+        if name == "input":  # its angle coordinate starts within [-pi, pi]: the rest is whole turns
+            model.input_turns = WholeTurns(start=round((theta0 - p0[0]) / TWO_PI))
         w = state[name]["omega"]
         arm = a0 @ com
         pos0 = state[name]["origin"] + arm
@@ -261,47 +279,79 @@ def _add_pairs(model: ExudynModel, ground: int) -> None:
         ))
 
 
-def _wrap_rotation_vectors(model: ExudynModel) -> None:
-    """Keep the rotation vectors of ``NodeRigidBodyRotVecLG`` nodes within ``|nu| <= pi``.
+def _wrap_rotations(model: ExudynModel) -> None:
+    """After every step, keep the input's angle coordinate and the other Rxyz angles within
+    ``[-pi, pi]``, and the rotation vectors of ``NodeRigidBodyRotVecLG`` nodes within ``|nu| <= pi``.
 
-    Exudyn's Lie-group update keeps ``0 <= |nu| <= 2 pi`` and lets a body that turns whole
-    revolutions reach ``|nu| = 2 pi`` (the identity again) once every two revolutions, where the
-    exponential map is singular: measured at 35 deg, Newton needs 6 iterations in that step at
-    200 steps per revolution and fails at 100, and the reactions and drive torque spike. After
-    every step a post-step user function replaces a vector with ``|nu| > pi`` by the same rotation
-    ``nu (1 - 2 pi / |nu|)``. The velocity coordinates (local angular velocity) and the
-    integrator's accelerations do not depend on that choice, so the step sequence is otherwise
-    the same. Node axes turned away from the body (e.g. by a half-turn about z) would keep
-    ``|nu|`` away from ``2 pi`` too, but Exudyn 1.13.6 computes wrong initial accelerations and
-    Lagrange multipliers when a rotation vector is not zero at the start (measured: reactions off
-    by 3e3 N at 35 deg, decaying over about 30 steps; its initial-acceleration solve seems to
-    take the local angular velocity for the rate of ``nu`` in the ``(C_q q_t)_q q_t`` term).
-    The nodes therefore start at the identity, which holds for a drive starting at input angle
-    0; an angle drive starting elsewhere gets that start-up error with ``RotVecLG``.
+    Input angle: the input's first Rxyz angle is the input angle, unbounded. Left so, each step's
+    update rounds at the spacing of doubles at the angle (1.8e-12 rad after 2000 revolutions), so
+    the angle wanders from ``omega t`` (7e-8 rad after 2000 revolutions: the velocity-level drive
+    holds the speed, nothing holds the angle), and with ``"RotVecLG"`` nodes the run fails at
+    revolution 268: the spider passes the identity at every whole input revolution, where Exudyn's
+    ``CompositionRotationVector`` (``w = pi - 2 atan2(x, sqrt(|1 - x^2|))``, ``x = cos(w/2)``)
+    cannot give angles below about 3e-8 rad and returns zero, so the pair input-spider is
+    misaligned there by the input angle's wander, beyond Newton's tolerance once that exceeds 1e-9
+    rad. The hook removes whole revolutions (``ExudynModel.input_turns`` records them; exact in
+    floating point: ``q - 2 pi`` for ``pi < q < 4 pi``), so the update rounds at 4.4e-16 rad at
+    most. Nothing else depends on the choice: ``Rx`` is periodic, the speed drive acts on the
+    velocity, an angle drive's offset and a torque drive's stop subtract the same revolutions, the
+    friction coupling reads relative angles of rotation matrices, and the results' ``theta_in``
+    adds them back (:func:`cardan_exudyn.model.postprocess.body_states`). The angles of the
+    spider's and output's Rxyz nodes are wrapped the same way, unrecorded (only their rotation
+    matrices are read): the spider's first angle is the input angle too, and with it unbounded
+    against a wrapped input their roundings no longer cancel in the pair input-spider (measured
+    over 2000 revolutions with friction: misalignment up to 1.8e-12 rad and marker distance
+    1.5e-14 m, growing, against 1e-15 rad and 4e-17 m with both wrapped or both unbounded).
+
+    Rotation vectors: Exudyn's Lie-group update keeps ``0 <= |nu| <= 2 pi`` and lets a body that
+    turns whole revolutions reach ``|nu| = 2 pi`` (the identity again) once every two revolutions,
+    where the exponential map is singular: measured at 35 deg, Newton needs 6 iterations in that
+    step at 200 steps per revolution and fails at 100, and the reactions and drive torque spike.
+    A vector with ``|nu| > pi`` is replaced by the same rotation ``nu (1 - 2 pi / |nu|)``. The
+    velocity coordinates (local angular velocity) and the integrator's accelerations do not depend
+    on that choice, so the step sequence is otherwise the same. Node axes turned away from the body
+    (e.g. by a half-turn about z) would keep ``|nu|`` away from ``2 pi`` too, but Exudyn 1.13.6
+    computes wrong initial accelerations and Lagrange multipliers when a rotation vector is not
+    zero at the start (measured: reactions off by 3e3 N at 35 deg, decaying over about 30 steps;
+    its initial-acceleration solve seems to take the local angular velocity for the rate of ``nu``
+    in the ``(C_q q_t)_q q_t`` term). The nodes therefore start at the identity, which holds for a
+    drive starting at input angle 0; an angle drive starting elsewhere gets that start-up error
+    with ``RotVecLG``.
+
+    The hook runs before Exudyn stores the step's sensor values, and the next step starts from
+    the state it leaves.
     """
-    starts = [model.mbs.GetNodeODE2Index(node) + 3 for name, node in model.nodes.items()
-              if model.rotations[name].name == "RotVecLG"]
-    if not starts:
-        return
-    system_data = model.mbs.systemData
+    mbs = model.mbs
+    angle = mbs.GetNodeODE2Index(model.nodes["input"]) + 3
+    angles = [mbs.GetNodeODE2Index(node) + 3 + k for name, node in model.nodes.items()
+              if name != "input" and model.rotations[name].name == "Rxyz" for k in range(3)]
+    vectors = [mbs.GetNodeODE2Index(node) + 3 for name, node in model.nodes.items()
+               if model.rotations[name].name == "RotVecLG"]
+    system_data = mbs.systemData
     current = exu.ConfigurationType.Current
-    two_pi = 2.0 * math.pi
+    turns = model.input_turns
 
     def post_step(mbs_, t):
         q = system_data.GetODE2Coordinates(current)
-        changed = False
-        for i in starts:
+        changed = abs(q[angle]) > math.pi
+        if changed:
+            q[angle] = turns.remove(float(q[angle]), system_data.GetTime(current))
+        for i in angles:
+            if abs(q[i]) > math.pi:
+                q[i] -= TWO_PI * round(q[i] / TWO_PI)
+                changed = True
+        for i in vectors:
             x, y, z = q[i], q[i + 1], q[i + 2]
             phi = math.sqrt(x * x + y * y + z * z)
             if phi > math.pi:
-                q[i:i + 3] *= 1.0 - two_pi / phi
+                q[i:i + 3] *= 1.0 - TWO_PI / phi
                 changed = True
         if changed:
             system_data.SetODE2Coordinates(q, current)
         return True
 
     model.user_functions.append(post_step)
-    model.mbs.SetPostStepUserFunction(post_step)
+    mbs.SetPostStepUserFunction(post_step)
 
 
 def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
@@ -331,10 +381,11 @@ def _add_drive(model: ExudynModel, ground) -> None:
         connector = eii.ObjectConnectorCoordinate(markerNumbers=[m_ground, m_angle],
                                                   velocityLevel=True, offset=drive.speed)
     else:
-        spline = drive.spline()
+        angle = drive.evaluator()  # O(log n) per call in plain floats (reference.histories)
+        turns = model.input_turns  # the coordinate is the angle less these (_wrap_rotations)
 
         def angle_offset(mbs_, t, item, offset):
-            return float(spline(t))
+            return angle(t) - TWO_PI * turns.count
 
         model.user_functions.append(angle_offset)
         connector = eii.ObjectConnectorCoordinate(markerNumbers=[m_ground, m_angle],
@@ -346,10 +397,12 @@ def _add_loads(model: ExudynModel) -> None:
     mbs, scene = model.mbs, model.scene
     axis = model.pair_frames["output_frame"][:, 2]  # the output axis, fixed in the ground
     if not scene.load.constant:  # a measured history: interpolated at each instant
-        load = scene.load
+        torque = scene.load.evaluator()  # O(log n) per call in plain floats (reference.histories)
+        ax, ay, az = (-float(c) for c in axis)
 
         def load_history(mbs_, t, load_vector):
-            return list(-float(load.at(t)) * axis)
+            value = torque(t)
+            return [value * ax, value * ay, value * az]
 
         model.user_functions.append(load_history)
         m_out = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["output"]))

@@ -4,7 +4,12 @@ What is added to the model
 --------------------------
 For each pair with a non-zero friction coefficient (and only for those): a body-fixed
 ``LoadTorqueVector`` about the pair axis on each non-ground body of the pair, and for cylindrical
-pairs a body-fixed ``LoadForceVector`` along the axis, applied at the pair point of each body.
+pairs of a joint with mounting errors a body-fixed ``LoadForceVector`` along the axis, applied at
+the pair point of each body. The ideal joint's cylindrical pairs cannot slide (their axial friction
+is 0, as the reference engine computes it); the solver leaves their slide with noise at the Newton
+tolerance (1e-11..1e-10 m/s with a measured angle drive), which the sign ramp would turn into an
+axial force that changes with every solve: at 0 deg, where the true friction is only the weights',
+the fixed point could not converge below it and the run stopped as self-locking.
 Body ``b`` receives the friction (torque ``M_z``, force ``F_z``), body ``a`` the opposite. Both
 load vectors are fixed in their body because the pair axis is fixed in both bodies of the pair.
 
@@ -54,6 +59,7 @@ import exudyn.itemInterface as eii
 import numpy as np
 
 from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
+from reference.bands import sign_bands
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.schema import Status
 
@@ -106,7 +112,7 @@ class FrictionCoupling:
         self.model = model
         self.mbs = model.mbs
         self.settings = scene.friction
-        self.band = scene.friction.sign_band
+        self.bands = sign_bands(scene)  # per pair (rotation, sliding) [m/s], as every engine
         self.converged = scene.friction.coupling == "converged"
         self.pairs: list[_PairData] = []
         for name, pair in scene.joint.pairs.items():
@@ -124,7 +130,9 @@ class FrictionCoupling:
                     bodyNumber=model.bodies[body], localPosition=list(local)))
                 p.torque_loads.append((self.mbs.AddLoad(eii.LoadTorqueVector(
                     markerNumber=marker, loadVector=[0.0, 0.0, 0.0], bodyFixed=True)), role))
-                if p.kind == "cylindrical":
+                # the ideal joint's cylindrical pairs cannot slide: their axial friction is 0 (as
+                # the reference's); the law would turn the solver's noise in the slide into force
+                if p.kind == "cylindrical" and scene.joint.errors.any:
                     p.force_loads.append((self.mbs.AddLoad(eii.LoadForceVector(
                         markerNumber=marker, loadVector=[0.0, 0.0, 0.0], bodyFixed=True)), role))
             self.pairs.append(p)
@@ -146,7 +154,7 @@ class FrictionCoupling:
         self._weight = np.ones((self.n, 2))
         for k, p in enumerate(self.pairs):
             mask[k, 0] = True
-            mask[k, 1] = p.kind == "cylindrical"
+            mask[k, 1] = bool(p.force_loads)
             self._weight[k, 1] = 0.5 * p.law.d
         self._mask = mask.ravel()
         self.unconverged_steps = 0
@@ -291,8 +299,8 @@ class FrictionCoupling:
             tx, ty, _ = get(p.joint, torque_local)
             omega_rel, slide = speeds[k]
             # TorqueLocal's in-plane components are rotated by 90 deg; only the magnitude enters
-            loads = pair_loads(p.law, lx, ly, tx, ty, float(omega_rel), float(slide), self.band)
-            friction[k] = loads.torque, loads.force
+            loads = pair_loads(p.law, lx, ly, tx, ty, float(omega_rel), float(slide), *self.bands[p.name])
+            friction[k] = loads.torque, (loads.force if p.force_loads else 0.0)
             sliding = max(sliding, loads.sliding_scale)
         self.scale_floor = REST_FLOOR * sliding
         return friction, coords
@@ -437,10 +445,10 @@ class FrictionCoupling:
         self.apply(prediction)
 
     def _band_hint(self) -> str:
-        if self.band > 0.0:
+        if all(min(self.bands[p.name]) > 0.0 for p in self.pairs):
             return ""
-        return (" (with sign_band = 0 the exact sign of rounding-level relative speeds decides the "
-                "direction of friction in pairs that do not move; use a positive band)")
+        return (" (with a sign band of 0 the exact sign of rounding-level relative speeds decides "
+                "the direction of friction in pairs that do not move; use a positive band)")
 
     def _watch_growth(self, friction: np.ndarray) -> None:
         size = float(np.max(np.abs(friction)))
@@ -462,7 +470,7 @@ class FrictionCoupling:
         iterations = np.asarray(self.log.iterations, dtype=float)
         return {
             "coupling": self.settings.coupling,
-            "sign_band_m_s": self.band,
+            "sign_bands_m_s": {p.name: list(self.bands[p.name]) for p in self.pairs},
             "pairs_with_friction": [p.name for p in self.pairs],
             "tolerance": self.settings.tolerance if self.converged else None,
             "mean_iterations_per_step": float(iterations.mean()) if iterations.size else 0.0,

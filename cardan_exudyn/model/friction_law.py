@@ -17,8 +17,9 @@ and a cylindrical pair also resists sliding with the axial force magnitude (eq. 
 
 Body ``b`` of the pair receives ``-s(v_rot) T`` about the axis and ``-s(v_slide) A`` along it,
 body ``a`` the opposite, where ``s`` is the sign of the relative surface speed of ``b`` with
-respect to ``a``, regularised by a linear ramp of width ``band`` [m/s]; for the rotation the
-surface speed is ``omega_rel d / 2``.
+respect to ``a``, regularised by a linear ramp of width ``band`` [m/s] (the rotation's; the
+sliding has its own, ``slide_band``); for the rotation the surface speed is ``omega_rel d / 2``.
+The widths are scene data, the same for every engine (:func:`reference.bands.sign_bands`).
 
 References
 ----------
@@ -92,7 +93,8 @@ def ramp_sign(speed: float, band: float) -> float:
 
 
 def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, moment_y: float,
-               omega_rel: float, slide_rel: float, band: float) -> FrictionLoads:
+               omega_rel: float, slide_rel: float, band: float,
+               slide_band: float | None = None) -> FrictionLoads:
     """Friction of one pair from its reaction and relative motion (eqs. (1)-(5)).
 
     Parameters
@@ -107,7 +109,9 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
     slide_rel : float
         Sliding speed of ``b`` relative to ``a`` along the axis [m/s] (ignored for a revolute).
     band : float
-        Width of the sign ramp [m/s].
+        Width of the rotation's sign ramp, in relative surface speed [m/s] (0: the exact sign).
+    slide_band : float or None
+        Width of the sliding's sign ramp [m/s]; None: ``band``.
     """
     force_n = math.hypot(force_x, force_y)
     moment_n = math.hypot(moment_x, moment_y)
@@ -117,7 +121,7 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
     axial = 0.0
     if law.cylindrical:
         magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
-        axial = -ramp_sign(slide_rel, band) * magnitude
+        axial = -ramp_sign(slide_rel, band if slide_band is None else slide_band) * magnitude
         scale = max(scale, radius * magnitude)
     return FrictionLoads(-ramp_sign(radius * omega_rel, band) * torque, axial, scale)
 

@@ -19,6 +19,7 @@ import numpy as np
 from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
 from cardan_exudyn.model.projection import project_velocities
+from reference.bands import sign_bands
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.scene import AngleDrive
 from reference.schema import instantaneous_efficiency
@@ -45,7 +46,8 @@ def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
     """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity.
 
     ``psi`` holds the node's total rotation coordinates (reference included): the Rxyz angles
-    for the input (every node type; the first is the shaft angle), else those of
+    for the input (every node type; the first is the continuous shaft angle, the recorded
+    coordinate plus the whole revolutions ``model.input_turns`` took out of it), else those of
     ``model.rotations[name]``.
     """
     states = {}
@@ -57,7 +59,10 @@ def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
         rot = model.rotations[name]
         end = 4 + rot.size
         p = q[:, 4:end] if rot.zero_reference else q[:, 4:end] + np.asarray(rot.reference)
-        a, omega = rot.frame(p, q_t[:, 4:end])
+        a, omega = rot.frame(p, q_t[:, 4:end])  # from the coordinates the solver had
+        if name == "input":
+            p = p.copy()
+            p[:, 0] = model.input_turns.angle(q[:, 0], p[:, 0])
         states[name] = {
             "t": q[:, 0],
             "r": model.com_reference[name] + q[:, 1:4],
@@ -183,13 +188,14 @@ def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
     out = {p: (np.zeros(n), np.zeros(n)) for p in PAIR_NAMES}
     if not scene.has_friction:
         return out
+    bands = sign_bands(scene)
     for name, pair in scene.joint.pairs.items():
         if pair.friction_coefficient <= 0.0:
             continue
         law = PairLaw.of(PAIR_KIND[name], pair)
         rows = zip(*(cols[f"{name}_{s}"].tolist()
                      for s in ("fx", "fy", "mx", "my", "omega_rel", "slide_rel")), strict=True)
-        loads = [pair_loads(law, *row, scene.friction.sign_band) for row in rows]
+        loads = [pair_loads(law, *row, *bands[name]) for row in rows]
         out[name] = (np.array([x.torque for x in loads]), np.array([x.force for x in loads]))
     return out
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -248,6 +248,55 @@ class RotationCoordinates:
     @property
     def zero_reference(self) -> bool:
         return not any(self.reference)
+
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass
+class WholeTurns:
+    """Whole revolutions taken out of an unbounded angle coordinate, and when.
+
+    The input's first Rxyz angle is the input angle, unbounded; a post-step hook keeps the
+    coordinate within ``[-pi, pi]`` by :meth:`remove`, which records each change so that
+    :meth:`angle` gives back the continuous angle of every recorded state.
+
+    Attributes
+    ----------
+    start : int
+        Whole revolutions in the initial angle (the coordinate starts within ``[-pi, pi]``).
+    times : list of float
+        Times [s] of the states at which revolutions were removed.
+    counts : list of int
+        Whole revolutions removed in total at each of those times, ``start`` included.
+    """
+
+    start: int = 0
+    times: list[float] = field(default_factory=list)
+    counts: list[int] = field(default_factory=list)
+
+    @property
+    def count(self) -> int:
+        """Whole revolutions removed up to now."""
+        return self.counts[-1] if self.counts else self.start
+
+    def remove(self, coordinate: float, t: float) -> float:
+        """``coordinate`` [rad] less its nearest whole revolutions (recorded at time ``t`` [s])."""
+        k = round(coordinate / TWO_PI)
+        if k == 0:
+            return coordinate
+        self.times.append(t)
+        self.counts.append(self.count + k)
+        return coordinate - k * TWO_PI
+
+    def at(self, t: np.ndarray) -> np.ndarray:
+        """Whole revolutions removed from the states at times ``t`` [s] (recorded after the hook)."""
+        counts = np.asarray([self.start, *self.counts], dtype=float)
+        return counts[np.searchsorted(np.asarray(self.times, dtype=float), t, side="right")]
+
+    def angle(self, t: np.ndarray, coordinate: np.ndarray) -> np.ndarray:
+        """The continuous angle [rad] of states with coordinates ``coordinate`` at times ``t``."""
+        return coordinate + TWO_PI * self.at(t)
 
 
 ROTATION_COORDINATES = {

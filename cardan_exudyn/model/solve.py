@@ -13,13 +13,26 @@ from typing import Any
 import exudyn as exu
 import numpy as np
 
+from cardan_exudyn.interrupts import watch_signals
 from cardan_exudyn.model.build import ExudynModel, build_model
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.postprocess import constraint_violation, first_non_finite, postprocess
-from cardan_exudyn.model.stepsize import choose_step
+from cardan_exudyn.model.stepsize import (
+    MAX_STEPS_PER_REVOLUTION,
+    MIN_COMPANION_STEPS,
+    choose_step,
+    convergence_order,
+    efficiency_error,
+    kinematic_steps,
+    plan_steps,
+    refuse,
+    reversing_parts,
+    revolution_period,
+    richardson,
+)
 from reference.joint import PAIR_NAMES
 from reference.loop_closure import LoopClosureError
-from reference.scene import AngleDrive, Scene, scene_to_dict
+from reference.scene import AngleDrive, Scene, replace, scene_to_dict
 from reference.schema import (
     REACTION_SUFFIXES,
     Result,
@@ -106,7 +119,7 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene, options.node_type)
     model = build_model(scene, reactions=reactions, node_type=options.node_type)
-    t_end = end_time(scene, model.start_time)
+    t_end = end_time(model.scene, model.start_time)  # on the model's clock (build.run_clock)
     span = t_end - model.start_time
     check_steps(span / dt, f"{scene.revolutions:g} revolutions at dt = {dt:.3g} s")
     dt = span / steps_for_span(span, dt)  # whole steps end exactly at the span's end
@@ -120,18 +133,21 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
         tweak(model, settings)
     solver = exu.MainSolverImplicitSecondOrder()
     status, reason = Status.OK, ""
-    try:
-        if friction is None:
-            ok = solver.SolveSystem(model.mbs, settings)
-        else:
-            solver.InitializeSolver(model.mbs, settings)
-            friction.initialise(solver, settings)
-            ok = friction.status != Status.OK or solver.SolveSteps(model.mbs, settings)
-            solver.FinalizeSolver(model.mbs, settings)
-        if not ok:
-            status, reason = Status.INTEGRATION_FAILURE, solver.GetErrorString() or "solver failed"
-    except (RuntimeError, ValueError) as exc:  # how Exudyn reports a failed solve
-        status, reason = Status.INTEGRATION_FAILURE, str(exc).strip().splitlines()[0][:300]
+    # Ctrl-C / SIGTERM inside the solver comes back as a failed solve or a SystemError: the watch
+    # raises the interruption instead, so it is never recorded as an integration failure
+    with watch_signals():
+        try:
+            if friction is None:
+                ok = solver.SolveSystem(model.mbs, settings)
+            else:
+                solver.InitializeSolver(model.mbs, settings)
+                friction.initialise(solver, settings)
+                ok = friction.status != Status.OK or solver.SolveSteps(model.mbs, settings)
+                solver.FinalizeSolver(model.mbs, settings)
+            if not ok:
+                status, reason = Status.INTEGRATION_FAILURE, solver.GetErrorString() or "solver failed"
+        except (RuntimeError, ValueError) as exc:  # how Exudyn reports a failed solve
+            status, reason = Status.INTEGRATION_FAILURE, str(exc).strip().splitlines()[0][:300]
     if friction is not None and friction.error is not None:
         raise friction.error
     if friction is not None and friction.status != Status.OK:
@@ -140,8 +156,165 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
 
 
 def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
-    """Simulate ``scene`` with Exudyn and return its time table and summary."""
+    """Simulate ``scene`` with Exudyn and return its time table and summary, with the estimated
+    error of its mean efficiency (``docs/accuracy.md``).
+
+    With friction the main run has a companion at 2 to 3 times its step, and the Richardson
+    estimate from the two (:func:`_estimate`) is the run's ``summary.efficiency_error_estimate``
+    (``accuracy_met``, ``extras["accuracy"]``). A given ``numerics.dt`` has its companion at
+    twice the step; an automatic step is chosen by :func:`_automatic_runs`. Without friction the
+    mean efficiency is 1 exactly and nothing else runs.
+
+    Raises
+    ------
+    SceneError
+        ``numerics.accuracy`` needs more steps than allowed (the message gives the predicted
+        steps per revolution and run time).
+    """
     options = options or ExudynOptions()
+    wall_start = time.perf_counter()
+    if not scene.has_friction:
+        result = run_once(scene, options)
+        _report_accuracy(result, None, scene, options)
+        return result
+    if scene.numerics.dt is not None:
+        coarse = run_once(_companion(scene, 2.0 * scene.numerics.dt), options)
+        main = run_once(scene, options)
+        _report_accuracy(main, coarse, scene, options)
+    else:
+        main = _automatic_runs(scene, options)
+    main.summary.wall_time_s = time.perf_counter() - wall_start
+    return main
+
+
+def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
+    """The runs of an automatic step, the main run returned with its estimate.
+
+    A pilot at half the speed-ratio step (at least :data:`MIN_COMPANION_STEPS` per revolution)
+    runs first: its losses set the steps ``n`` that meet ``numerics.accuracy``
+    (:func:`cardan_exudyn.model.stepsize.plan_steps`). The pilot is the companion when ``n`` is
+    at most :data:`MAX_COMPANION_RATIO` times its steps, else a companion at ``n / 2`` runs. When
+    the estimate still exceeds the target, the main run becomes the companion of one more at
+    ``2 n`` (the step where the error changes order can make two levels read high)."""
+    period = revolution_period(scene)
+    pilot_steps = max(MIN_COMPANION_STEPS, math.ceil(0.5 * _kinematic_steps(scene, options)))
+    pilot = run_once(_companion(scene, period / pilot_steps), options)
+    cost = pilot.summary.wall_time_s / max(pilot.summary.steps or 1, 1)
+    steps, why = plan_steps(scene, loss_fraction(pilot), options.node_type, cost,
+                            reversing_fraction(scene, pilot))
+    coarse, steps = pilot, max(steps, 2 * pilot_steps)
+    if steps > MAX_COMPANION_RATIO * pilot_steps:  # the pilot is too coarse: a companion at half
+        coarse = run_once(_companion(scene, 2.0 * period / steps), options)
+    main = run_once(replace(scene, **{"numerics.dt": period / steps}), options)
+    _report_accuracy(main, coarse, scene, options)
+    if main.summary.accuracy_met is False and 2 * steps <= MAX_STEPS_PER_REVOLUTION:
+        first = main.summary.efficiency_error_estimate
+        coarse, steps = main, 2 * steps
+        main = run_once(replace(scene, **{"numerics.dt": period / steps}), options)
+        _report_accuracy(main, coarse, scene, options)
+        why += f"; refined to {steps} after an estimated error of {first:.2g} at {steps // 2}"
+    main.summary.scene, main.summary.dt_choice = scene_to_dict(scene), why
+    main.summary.extras.setdefault("accuracy", {})["pilot"] = {
+        "dt": pilot.summary.dt, "mean_efficiency": pilot.summary.mean_efficiency,
+        "wall_time_s": pilot.summary.wall_time_s, "is_companion": coarse is pilot}
+    return main
+
+
+def _kinematic_steps(scene: Scene, options: ExudynOptions) -> float:
+    """Steps per revolution for the speed ratio; refused (SceneError) beyond the limits."""
+    accuracy, beta = scene.numerics.accuracy, scene.joint.geometry.shaft_angle
+    steps = kinematic_steps(beta, accuracy, options.node_type)
+    refuse(scene, steps, f"a speed-ratio error of {accuracy:g} at {math.degrees(beta):g} deg")
+    return steps
+
+
+def _companion(scene: Scene, dt: float) -> Scene:
+    """The companion run's scene: ``scene`` at the step ``dt`` [s], no time table."""
+    return replace(scene, **{"numerics.dt": dt, "record.timeseries": False})
+
+
+def loss_fraction(result: Result) -> float:
+    """``1 - mean_efficiency`` of a run [-]; 1 (the most a joint can lose) without one."""
+    eta = result.summary.mean_efficiency
+    if not result.success or eta is None or not math.isfinite(eta):
+        return 1.0
+    return min(abs(1.0 - eta), 1.0)
+
+
+MAX_COMPANION_RATIO = 3.0
+"""The pilot run is the companion when the main step is at most this many times finer (else a
+companion at exactly twice the main step runs): Richardson from far coarser steps is unreliable
+(ratios up to 11.6 gave true/estimate 0.03-6)."""
+MODEL_FLOOR = 1.0 / 3.0
+"""At first order (unresolved sign ramps) the estimate is at least this share of the a-priori
+model: the error there is irregular in the step, and the two runs can agree by chance."""
+
+
+def reversing_fraction(scene: Scene, result: Result) -> float | None:
+    """Share [-] of the input work a run loses in the motions that may reverse
+    (:func:`cardan_exudyn.model.stepsize.reversing_parts`); None without per-pair losses."""
+    s = result.summary
+    if not result.success or not s.input_work or not s.pair_loss_work:
+        return None
+    sliding = s.pair_sliding_loss_work or {}
+    lost = 0.0
+    for pair, part in reversing_parts(scene):
+        part_loss = sliding.get(pair, 0.0)
+        lost += part_loss if part == "sliding" else s.pair_loss_work.get(pair, 0.0) - part_loss
+    return min(abs(lost / s.input_work), 1.0)
+
+
+def _report_accuracy(main: Result, coarse: Result | None, scene: Scene, options: ExudynOptions) -> None:
+    """The mean-efficiency error estimate of ``main`` into its summary (:func:`_estimate`; 0
+    without friction), ``accuracy_met`` and a warning when the estimate exceeds the target."""
+    s = main.summary
+    if not s.success or s.mean_efficiency is None or not math.isfinite(s.mean_efficiency):
+        return
+    target = scene.numerics.accuracy
+    info: dict = {"target": target}
+    if coarse is None:
+        estimate, info["method"] = 0.0, "no friction: nothing is lost, the efficiency is 1"
+    else:
+        estimate = _estimate(main, coarse, scene, options, info)
+    s.efficiency_error_estimate, s.accuracy_met = estimate, bool(estimate <= target)
+    s.extras["accuracy"] = info
+    if not s.accuracy_met:
+        s.warn(f"accuracy not met: estimated mean-efficiency error {estimate:.2g} > target {target:g} "
+               f"(refine --dt or --accuracy)")
+
+
+def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions, info: dict) -> float:
+    """Richardson from ``coarse`` (at first order at least :data:`MODEL_FLOOR` of the a-priori
+    model); the model when the companion failed or is too coarse. How, into ``info``."""
+    s = main.summary
+    steps, loss = revolution_period(scene) / s.dt, loss_fraction(main)
+    reversing = reversing_fraction(scene, main)
+    order = convergence_order(scene, steps)
+    model = efficiency_error(scene, steps, loss, options.node_type, reversing_fraction=reversing)
+    info.update(order=order, loss_fraction=loss, reversing_fraction=reversing,
+                steps_per_revolution=steps, model=model, companion_dt=coarse.summary.dt,
+                companion_status=str(coarse.summary.status),
+                companion_mean_efficiency=coarse.summary.mean_efficiency,
+                companion_wall_time_s=coarse.summary.wall_time_s)
+    eta_c = coarse.summary.mean_efficiency
+    if not (coarse.success and eta_c is not None and math.isfinite(eta_c)):
+        info["method"] = f"a-priori model (the companion run ended {coarse.summary.status})"
+        return model
+    ratio = coarse.summary.dt / s.dt
+    info["richardson"] = richardson(s.mean_efficiency, eta_c, ratio, order)
+    estimate = max(info["richardson"], MODEL_FLOOR * model if order == 1 else 0.0)
+    info["method"] = (f"Richardson, companion at {ratio:.3g} x the step, order {order}"
+                      + (f", at least {MODEL_FLOOR:.2g} x the a-priori model" if order == 1 else ""))
+    if steps / ratio < MIN_COMPANION_STEPS:  # too coarse for the asymptotic range
+        estimate = max(estimate, model)
+        info["method"] += (f"; the companion's {steps / ratio:.3g} steps per revolution are "
+                           f"too few to trust it: at least the a-priori model")
+    return estimate
+
+
+def run_once(scene: Scene, options: ExudynOptions) -> Result:
+    """One Exudyn run of ``scene`` at its own step (given, or :func:`choose_step`'s), without the
+    companion run and error estimate of :func:`run`."""
     wall_start = time.perf_counter()
     summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=engine_version(),
                       scene=scene_to_dict(scene),
@@ -170,6 +343,7 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
             summary.fail(Status.INTEGRATION_FAILURE, f"no usable output: {exc}")
         return Result(None, summary)
     _check_columns(scene, model, columns, summary, options)
+    columns["t"] = columns["t"] + model.time_origin  # the scene's own time (means taken before)
     table = result_table(columns, scene.record.every) if scene.record.timeseries else None
     return Result(table, summary)
 
@@ -212,7 +386,8 @@ def _set_pre_step(model: ExudynModel, target: float | None) -> None:
             return False
         if target is None:
             return True
-        angle = mbs_.GetNodeOutput(node, exu.OutputVariableType.Coordinates)[3]
+        angle = (mbs_.GetNodeOutput(node, exu.OutputVariableType.Coordinates)[3]
+                 + 2.0 * math.pi * model.input_turns.count)  # the continuous angle
         start.setdefault("angle", angle)
         return abs(angle - start["angle"]) < target - 1e-12
 

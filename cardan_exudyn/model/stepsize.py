@@ -1,6 +1,12 @@
-"""Choosing the time step from the scene.
+"""Choosing the time step from the scene, and the a-priori error of the mean efficiency.
 
-For a second-order integrator the error of the output/input speed ratio of a Cardan joint
+``numerics.accuracy`` is the target absolute error of the mean efficiency (the headline number)
+and of the relative speed-ratio error. The step meets both: the speed-ratio model below
+(:func:`steps_per_revolution`) and the mean-efficiency model (:func:`efficiency_error`), which
+needs the run's loss fraction ``1 - eta`` (the engine takes it from a companion run at a coarser
+step, :func:`cardan_exudyn.model.solve.run`). ``docs/accuracy.md`` has the measurements.
+
+Speed ratio. For a second-order integrator the error of the output/input speed ratio of a Cardan joint
 grows as ``K(beta) * h**2`` with ``h = omega * dt`` the input angle step. Measured with this
 model (generalized-alpha, spectral radius 0.6, Rxyz nodes; the ``exudyn default`` ladders of
 ``cardan bench`` re-measure it: 5.8e-6 at 10 deg and 200 steps per revolution, 8.8e-6 at 35 deg
@@ -21,7 +27,21 @@ from __future__ import annotations
 
 import math
 
-from reference.scene import Scene, SpeedDrive
+from reference.bands import characteristic_speeds, sign_bands
+from reference.joint import PAIR_NAMES
+from reference.loop_closure import LoopClosureError
+from reference.scene import AngleDrive, Scene, SpeedDrive
+from reference.validation import SceneError
+
+__all__ = ["ERROR_CONSTANT", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS_PER_REVOLUTION", "NODE_ERROR",
+           "EFFICIENCY_FIRST_ORDER", "EFFICIENCY_FIRST_ORDER_ERRORS", "EFFICIENCY_SECOND_ORDER",
+           "RAMP_STEPS", "SECONDS_PER_STEP",
+           "MIN_COMPANION_STEPS", "error_coefficient", "steps_per_revolution", "choose_step",
+           "reverses", "reversing_parts", "has_errors", "ramp_angle", "convergence_order",
+           "efficiency_error",
+           "efficiency_steps",
+           "plan_steps", "richardson", "revolution_period", "refuse", "kinematic_steps",
+           "predicted_error"]
 
 ERROR_CONSTANT = 0.19
 MIN_STEPS_PER_REVOLUTION = 100
@@ -64,3 +84,205 @@ def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
     if not isinstance(scene.drive, SpeedDrive):
         why += " (at the highest input speed of the drive)"
     return period / n, why
+
+
+EFFICIENCY_FIRST_ORDER = 0.6
+"""``C1`` [1/rad] of the mean-efficiency model while the friction sign ramps are not resolved:
+error <= ``C1 h r``, ``h`` the input angle per step [rad], ``r`` the share of the input work lost
+in reversing motions. Envelope of the measured ``error / (r h)`` without mounting errors:
+``paper-10deg`` 0.54 and 0.46 at 50 and 100 steps per revolution, the accuracy grid's cells at
+most 0.24 (``cardan accuracy --fit`` refits it)."""
+EFFICIENCY_FIRST_ORDER_ERRORS = 3.5
+"""``C1`` with mounting errors: their sliding reverses too, and its sign changes cost far more
+than its small loss (measured ``error / (r h)`` = 2.8-3.2 at 15 deg, 2000 rpm, f = 0.05, 100-800 steps per
+revolution)."""
+EFFICIENCY_SECOND_ORDER = 3.0
+"""``C2`` [1/rad^2]: the smooth part, error <= ``(C2 + K) (1 - eta) h^2`` (measured at 35 deg,
+``paper-35deg``: -7.5e-3, -3.1e-3 at 100, 150 steps per revolution, ``error / ((1 - eta) h^2)``
+= 2.5, 2.4 with ``K`` = 0.14 included; the grid's second-order cells at 0 deg: at most 0.04)."""
+RAMP_STEPS = 4
+"""Steps across a sign ramp for it to count as resolved (then the error is second order)."""
+SECONDS_PER_STEP = 3e-3
+"""Wall time of one Exudyn step with friction [s] on one core (measured 2.3 ms at 10 deg), for the
+predicted run time of a refused request before anything ran."""
+MIN_COMPANION_STEPS = 50
+"""Fewest steps per revolution of the companion run (half :data:`MIN_STEPS_PER_REVOLUTION`)."""
+
+
+def revolution_period(scene: Scene) -> float:
+    """Time of one input revolution at the drive's highest speed [s]: steps per revolution are
+    counted against it."""
+    return 2.0 * math.pi / scene.drive.max_speed()
+
+
+def reversing_parts(scene: Scene) -> list[tuple[str, str]]:
+    """The ``(pair, "rotation" | "sliding")`` motions with friction that may reverse: the spider
+    pairs' rotation at a shaft angle or with mounting errors, every pair's sliding with mounting
+    errors, the frame pairs' rotation under a drive that may turn back (an angle history that is
+    not monotonic; a torque drive, conservatively). Their friction changes sign inside steps: the
+    error is first order until the ramps are resolved."""
+    pairs = dict(scene.joint.pairs.items())
+    errors = has_errors(scene)
+    drive = scene.drive
+    turns_back = drive.kind == "torque" or (
+        isinstance(drive, AngleDrive) and not _monotonic(drive.angle))
+    parts = []
+    for p in PAIR_NAMES:
+        if pairs[p].friction_coefficient <= 0.0:
+            continue
+        spider = p in ("input_spider", "spider_output")
+        if (spider and (scene.joint.geometry.shaft_angle > 0.0 or errors)) or (not spider and turns_back):
+            parts.append((p, "rotation"))
+        if errors:
+            parts.append((p, "sliding"))
+    return parts
+
+
+def has_errors(scene: Scene) -> bool:
+    """Whether the joint has mounting errors."""
+    return any(getattr(scene.joint.errors, name) != 0.0 for name in scene.joint.errors.__dataclass_fields__)
+
+
+def _monotonic(values: tuple) -> bool:
+    steps = [b - a for a, b in zip(values[:-1], values[1:], strict=True)]
+    return all(d > 0 for d in steps) or all(d < 0 for d in steps)
+
+
+def reverses(scene: Scene) -> bool:
+    """Whether some motion with friction may reverse (:func:`reversing_parts`)."""
+    return bool(reversing_parts(scene))
+
+
+def ramp_angle(scene: Scene) -> float:
+    """Input angle [rad] over which the narrowest sign ramp of a reversing motion is crossed:
+    its band over its characteristic speed (``reference.bands``); inf without a ramp to cross."""
+    try:
+        bands, speeds = sign_bands(scene), characteristic_speeds(scene)
+    except LoopClosureError:  # the run itself reports the loop that does not close
+        return 0.0
+    widths = []
+    for p, part in reversing_parts(scene):
+        band, speed = getattr(bands[p], part), getattr(speeds[p], part)
+        if speed > 0.0:
+            widths.append(band / speed)
+    return min(widths, default=math.inf)
+
+
+def convergence_order(scene: Scene, steps: float) -> int:
+    """Order of convergence of the mean efficiency at ``steps`` per revolution: 1 with the
+    ``lagged`` coupling, or while a reversing pair's sign ramp spans fewer than
+    :data:`RAMP_STEPS` steps; else 2."""
+    if scene.has_friction and scene.friction.coupling == "lagged":
+        return 1
+    h = 2.0 * math.pi / steps
+    return 1 if reverses(scene) and h * RAMP_STEPS > ramp_angle(scene) else 2
+
+
+def efficiency_error(scene: Scene, steps: float, loss_fraction: float, node_type: str = "Rxyz",
+                     ramp: float | None = None, reversing_fraction: float | None = None) -> float:
+    """A-priori error [-] of the mean efficiency at ``steps`` per revolution, for a run losing
+    ``loss_fraction`` (``1 - eta``) of its input work, ``reversing_fraction`` of it in the motions
+    that reverse (:func:`reversing_parts`; default: all of the loss):
+    ``C1 h u r + (C2 + K) h^2 (1 - eta)`` with ``r`` the reversing fraction (all of the loss with
+    the ``lagged`` coupling), ``C1`` larger with mounting errors,
+    ``u = min(1, RAMP_STEPS h / ramp)`` (1 with the ``lagged`` coupling, 0 without reversing
+    friction) and ``K`` the speed-ratio coefficient (:func:`error_coefficient`).
+    ``ramp``: :func:`ramp_angle` when already known."""
+    if not scene.has_friction:
+        return 0.0
+    h = 2.0 * math.pi / steps
+    if scene.friction.coupling == "lagged":
+        unresolved = 1.0
+    elif not reverses(scene):
+        unresolved = 0.0
+    else:
+        ramp = ramp_angle(scene) if ramp is None else ramp
+        unresolved = 1.0 if ramp <= 0.0 else min(1.0, RAMP_STEPS * h / ramp)
+    reversing = abs(loss_fraction)
+    if reversing_fraction is not None and scene.friction.coupling != "lagged":
+        reversing = min(abs(reversing_fraction), reversing)
+    beta = scene.joint.geometry.shaft_angle
+    smooth = EFFICIENCY_SECOND_ORDER + error_coefficient(beta, node_type)
+    c1 = EFFICIENCY_FIRST_ORDER_ERRORS if has_errors(scene) else EFFICIENCY_FIRST_ORDER
+    return c1 * h * unresolved * reversing + smooth * h * h * abs(loss_fraction)
+
+
+def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_type: str = "Rxyz",
+                     reversing_fraction: float | None = None) -> int:
+    """Fewest steps per revolution whose :func:`efficiency_error` meets ``accuracy`` (may exceed
+    :data:`MAX_STEPS_PER_REVOLUTION`: the caller refuses)."""
+    ramp = ramp_angle(scene)
+
+    def meets(n: int) -> bool:
+        return efficiency_error(scene, n, loss_fraction, node_type, ramp, reversing_fraction) <= accuracy
+
+    low, high = 1, MIN_STEPS_PER_REVOLUTION
+    while not meets(high):
+        low, high = high, 2 * high
+        if high > 1e15:  # far beyond any limit: the caller refuses
+            return high
+    while high - low > 1:  # the error falls as the steps grow: bisect
+        middle = (low + high) // 2
+        low, high = (low, middle) if meets(middle) else (middle, high)
+    return high
+
+
+def refuse(scene: Scene, steps: float, why: str, seconds_per_step: float = SECONDS_PER_STEP) -> None:
+    """Raise :class:`SceneError` when ``steps`` per revolution exceed the limits: the predicted
+    steps and run time (at ``seconds_per_step`` [s]), in one line."""
+    if steps <= MAX_STEPS_PER_REVOLUTION:
+        return
+    total = steps * scene.revolutions * (4.0 if scene.drive.kind == "torque" else 1.0)
+    raise SceneError(f"{why} needs {steps:.3g} steps per input revolution (at most "
+                     f"{MAX_STEPS_PER_REVOLUTION:.0e}): {total:.3g} steps, about "
+                     f"{total * seconds_per_step:.3g} s; ask for a larger `accuracy`")
+
+
+def plan_steps(scene: Scene, loss_fraction: float, node_type: str = "Rxyz",
+               seconds_per_step: float = SECONDS_PER_STEP,
+               reversing_fraction: float | None = None) -> tuple[int, str]:
+    """Steps per revolution meeting ``numerics.accuracy`` on the speed ratio and, for a run
+    losing ``loss_fraction`` of its input work (``reversing_fraction`` of it in reversing motions,
+    :func:`efficiency_error`), on the mean efficiency; and why.
+
+    Raises :class:`SceneError` (:func:`refuse`) beyond :data:`MAX_STEPS_PER_REVOLUTION`."""
+    accuracy, beta = scene.numerics.accuracy, scene.joint.geometry.shaft_angle
+    kinematic = kinematic_steps(beta, accuracy, node_type)
+    refuse(scene, kinematic, f"a speed-ratio error of {accuracy:g} at {math.degrees(beta):g} deg",
+           seconds_per_step)
+    friction = (efficiency_steps(scene, accuracy, loss_fraction, node_type, reversing_fraction)
+                if scene.has_friction else 0)
+    refuse(scene, friction, f"a mean-efficiency error of {accuracy:g} (loss fraction "
+                            f"{loss_fraction:.3g}, order {convergence_order(scene, max(friction, 1))})",
+           seconds_per_step)
+    n = max(kinematic, friction, MIN_STEPS_PER_REVOLUTION)
+    n += n % 2  # even: the companion at twice the step
+    why = (f"auto: {n} steps per input revolution for errors <= {accuracy:g} of the speed ratio "
+           f"({kinematic}) and the mean efficiency ({friction} at loss fraction {loss_fraction:.3g})")
+    return n, why
+
+
+def kinematic_steps(shaft_angle: float, accuracy: float, node_type: str = "Rxyz") -> float:
+    """Steps per revolution for a speed-ratio error ``accuracy``, not capped (may be huge)."""
+    k = error_coefficient(shaft_angle, node_type)
+    if k == 0.0:
+        return MIN_STEPS_PER_REVOLUTION
+    return math.ceil(2.0 * math.pi / math.sqrt(accuracy / k))
+
+
+def richardson(fine: float, coarse: float, ratio: float, order: int) -> float:
+    """Richardson estimate [-] of the error of ``fine`` from ``coarse`` at ``ratio`` times its
+    step: ``|fine - coarse| / (ratio**order - 1)``."""
+    return abs(fine - coarse) / (ratio ** order - 1.0)
+
+
+def predicted_error(scene: Scene, node_type: str = "Rxyz") -> float | None:
+    """A-priori error [-] of a run at the scene's given ``numerics.dt``, before anything runs: the
+    larger of the speed-ratio model and the mean-efficiency model at the largest loss fraction
+    (1); None without a given step."""
+    if scene.numerics.dt is None:
+        return None
+    steps = revolution_period(scene) / scene.numerics.dt
+    h = 2.0 * math.pi / steps
+    kinematic = error_coefficient(scene.joint.geometry.shaft_angle, node_type) * h * h
+    return max(kinematic, efficiency_error(scene, steps, 1.0, node_type))

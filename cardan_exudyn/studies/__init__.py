@@ -10,7 +10,8 @@ package; library code never does.
 - ``compare``: the ``cardan compare`` report over :mod:`cardan_exudyn.comparison`;
 - ``tolerance``: mounting errors, the paper's case and Monte Carlo;
 - ``friction_numerics``: ``cardan study`` (friction coupling error against step, sign band);
-- ``bench``: run time against error; ``stress``: stability map and long runs.
+- ``bench``: run time against error; ``stress``: stability map and long runs;
+- ``accuracy_grid``: ``cardan accuracy``, the honesty of the mean-efficiency error estimate.
 """
 
 from __future__ import annotations
@@ -18,5 +19,5 @@ from __future__ import annotations
 __all__ = ["COMMANDS"]
 
 COMMANDS: tuple[str, ...] = ("reproduce", "bench", "stress", "friction_numerics", "calibrate",
-                             "compare", "tolerance")
+                             "compare", "tolerance", "accuracy_grid")
 """Modules of this package that register a subcommand, in the order ``cardan --help`` lists them."""

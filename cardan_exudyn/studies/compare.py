@@ -69,8 +69,12 @@ def handler(args: argparse.Namespace) -> int:
 
     out_folder(args.out)
     scene = scene_from_args(args)
+    engines = engine_names(args.engines)
+    if args.skip_revolutions >= scene.revolutions:
+        raise BadInput(f"--skip-revolutions {args.skip_revolutions:g} leaves nothing of the scene's "
+                       f"{scene.revolutions:g} revolutions to compare: give fewer, or more --revolutions")
     progress = None if args.json else _say
-    comparison = compare(scene, engine_names(args.engines), skip_revolutions=args.skip_revolutions,
+    comparison = compare(scene, engines, skip_revolutions=args.skip_revolutions,
                          progress=progress)
     if args.out:
         write_report(comparison, args.out)

@@ -89,7 +89,7 @@ import pandas as pd
 from cardan_exudyn.engines import run
 from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.options import ExudynOptions
-from cardan_exudyn.model.postprocess import body_states, mechanical_energy, postprocess
+from cardan_exudyn.model.postprocess import body_states, mechanical_energy, postprocess, stored
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.longrun_measures import (
     at_revolutions,
@@ -210,8 +210,10 @@ def drift_run(node_type: str, revolutions: int) -> tuple[pd.DataFrame, dict[str,
     rows = drift_rows(model, cols, node_type, summary["dt"])
     steps = len(cols["t"]) - 1
     turned = abs(cols["theta_in"][-1] - cols["theta_in"][0]) / (2.0 * math.pi)
+    coordinate = stored(model, "input_q")[:, 4]  # the input's angle coordinate, as the solver had it
     info.update(steps=steps, completed_revolutions=len(rows), ended_at_revolution=turned,
-                ended_at_s=float(cols["t"][-1]),
+                ended_at_s=float(cols["t"][-1]), input_turns_removed=model.input_turns.count,
+                input_coordinate_max_abs_rad=float(np.abs(coordinate).max()),
                 newton_iterations_per_step=summary["newton_iterations"] / steps,
                 friction_evaluations_per_step=summary["friction"]["mean_iterations_per_step"],
                 unconverged_friction_steps=summary["friction"]["unconverged_steps"])

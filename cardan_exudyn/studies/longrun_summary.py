@@ -86,7 +86,7 @@ def efficiency_figures(rows: pd.DataFrame, steady: pd.DataFrame, window: int) ->
 
 def drift_summary(rows: pd.DataFrame, info: dict[str, Any]) -> dict[str, Any]:
     """A drift run's figures: its ``info`` with the measures, the efficiency, and the spacing of
-    doubles at the final input angle [rad] (the resolution of the unbounded Rxyz input angle)."""
+    doubles at the largest input angle coordinate [rad] (the resolution of the Rxyz input angle)."""
     out: dict[str, Any] = dict(info)
     if len(rows) < STARTUP_REVOLUTIONS + 3:
         return out
@@ -94,8 +94,9 @@ def drift_summary(rows: pd.DataFrame, info: dict[str, Any]) -> dict[str, Any]:
     window = window_size(len(steady))
     out.update(revolutions=len(rows), window=window, measures=measure_figures(rows, steady, window),
                efficiency=efficiency_figures(rows, steady, window))
-    out["input_angle_spacing_rad"] = float(np.spacing(2.0 * math.pi * info.get("ended_at_revolution",
-                                                                                len(rows))))
+    # the largest input angle coordinate the solver had (kept within pi by the post-step wrap)
+    out["input_angle_spacing_rad"] = float(np.spacing(info.get("input_coordinate_max_abs_rad",
+                                                               2.0 * math.pi * len(rows))))
     return out
 
 

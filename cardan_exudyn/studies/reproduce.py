@@ -358,6 +358,10 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
         ``out`` is not a folder, ``out/runs`` holds another plan (e.g. ``--quick`` then not)
         or another invocation is running there (raised before anything runs); or, after the
         runs, a recorded case's files are missing (the records are kept; ``restart`` helps).
+    cardan_exudyn.sweep.executors.SweepInterrupted
+        Ctrl-C or SIGTERM (a :class:`KeyboardInterrupt`): the runs finished before it are
+        recorded in ``out/runs``, none as failed, the report folder is as it was; the same call
+        (command) runs only the missing runs (``docs/outputs.md``).
     """
     # pandas and matplotlib (about 1 s) load only to write a report: `cardan` imports this module
     # to register the command

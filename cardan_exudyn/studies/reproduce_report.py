@@ -220,7 +220,8 @@ def _head(runs: int, quick: bool, wall: float, reused: int, runs_dir: str) -> li
         "`used_in_fit`; the other cases are held out.\n",
         "**Definitions.** `mean_efficiency` = 1 - (loss work)/(input work) over whole input "
         "revolutions; `mean_instantaneous_efficiency` = time average of eq. (18), which is "
-        "unbounded where the input power changes sign (it does at large angles).\n",
+        "unbounded where the input power changes sign (it does at large angles): '-' where it "
+        "is not defined or leaves [0, 1].\n",
     ]
 
 

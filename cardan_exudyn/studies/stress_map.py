@@ -24,7 +24,8 @@ A cell is classified from its measurements alone (:func:`classify`):
     Exudyn stopped the run because its friction fixed point does not converge (the engine's
     detection, :mod:`cardan_exudyn.model.coupling`).
 ``integration_failure``
-    Newton or the integrator failed (or the run diverged, ended early).
+    Newton or the integrator failed (or the run diverged, ended early, or its means came out
+    impossible: status ``unphysical``, e.g. a mean efficiency outside [0, 1] at too coarse a step).
 ``error``
     The harness raised (a bug; the record keeps the traceback).
 
@@ -73,8 +74,10 @@ ORDER = {"converged": 2, "lagged": 1}  # convergence order of the mean efficienc
 REFERENCE_OPTIONS = ReferenceOptions(samples_per_revolution=72, quadrature_rtol=1e-8)
 
 CLASSES = ("converged", "drift", "self_locking", "integration_failure", "error")
+# statuses of a numerical failure; ``unphysical``: means no run can have (an efficiency outside
+# [0, 1] from too coarse a step), caught by the engine instead of reported as ``drift``
 EXUDYN_FAILURES = ("integration_failure", "diverged", "incomplete", "no_whole_revolution",
-                   "loop_does_not_close")
+                   "loop_does_not_close", "unphysical")
 X_LABELS = {"friction": "friction coefficient (all pairs)", "rpm": "input speed [rpm]",
             "steps": "steps per input revolution"}
 

@@ -31,13 +31,16 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.arguments import (
+    COUNT_LIMITS,
     EXIT_FAILED,
     EXIT_OK,
+    SCENE_OPTIONS,
     BadInput,
     add_scene_options,
     count,
     out_folder,
     path_value,
+    refuse_options,
     scene_from_args,
 )
 from cardan_exudyn.engines import ENGINES, run
@@ -437,12 +440,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                           "paper's tolerances, uniform with both signs), resumable.")
     p.add_argument("study", choices=("paper", "montecarlo"))
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    p.add_argument("--engines", default="reference,exudyn", help="paper: engines to compare")
-    p.add_argument("--engine", default="reference", help="montecarlo: engine (default reference)")
-    p.add_argument("--samples", type=count("--samples"), default=1000, help="montecarlo: N (1000)")
-    p.add_argument("--seed", type=count("--seed", minimum=0), default=1,
-                   help="montecarlo: seed of the draws (1)")
-    p.add_argument("--method", choices=("lhs", "random"), default="lhs",
+    p.add_argument("--engines", help="paper: engines to compare (default reference,exudyn)")
+    p.add_argument("--engine", help="montecarlo: engine (default reference)")
+    p.add_argument("--samples", type=count("--samples"),
+                   help=f"montecarlo: N (default 1000, at most {COUNT_LIMITS['--samples']})")
+    p.add_argument("--seed", type=count("--seed", minimum=0), help="montecarlo: seed of the draws (1)")
+    p.add_argument("--method", choices=("lhs", "random"),
                    help="montecarlo: Latin hypercube (default) or independent draws")
     p.add_argument("--error", action="append", metavar="PATH=DIST:...",
                    help="montecarlo: e.g. joint.errors.a1_mm=uniform:-0.5:0.5, "
@@ -454,7 +457,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--restart", action="store_true", help="montecarlo: discard earlier samples in --out")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     add_scene_options(p)
-    p.set_defaults(func=handler, name="rig-calibrated")
+    p.set_defaults(func=handler)
+
+
+#: Options of ``cardan tolerance montecarlo`` only (``paper`` runs its fixed cases), and defaults.
+MONTE_CARLO_ONLY = {"engine": "reference", "samples": 1000, "seed": 1, "method": "lhs", "error": None,
+                    "workers": None, "scheduler": None, "restart": False}
+PAPER_ONLY = {"engines": "reference,exudyn"}
 
 
 def error_distribution(text: str) -> tuple[str, dict[str, Any]]:
@@ -475,6 +484,16 @@ def error_distribution(text: str) -> tuple[str, dict[str, Any]]:
 
 def handler(args: argparse.Namespace) -> int:
     """``cardan tolerance``: exit 0 when every run ended ok, 3 otherwise."""
+    if args.study == "paper":
+        refuse_options(args, [*MONTE_CARLO_ONLY, *SCENE_OPTIONS],
+                       "to `cardan tolerance paper` (it runs the paper's rig case; use montecarlo)")
+    else:
+        refuse_options(args, list(PAPER_ONLY), "to `cardan tolerance montecarlo` (use --engine)")
+    for key, default in {**MONTE_CARLO_ONLY, **PAPER_ONLY}.items():
+        if getattr(args, key) is None or getattr(args, key) is False:
+            setattr(args, key, default)
+    if args.study == "montecarlo" and args.name is None and args.scene is None:
+        args.name = "rig-calibrated"
     out_folder(args.out, replace=args.study == "paper")
     if args.study == "paper":
         return paper_handler(args)

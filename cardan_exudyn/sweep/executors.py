@@ -4,21 +4,29 @@ Every executor calls :func:`run_case` where the case runs and hands each record 
 the driver as its case finishes; only the driver writes files. A worker process that dies is a
 record too (``WorkerCrash`` locally, ``KilledWorker`` on Dask), so one bad case never stops the
 others.
+
+An interruption (Ctrl-C, SIGTERM: a :class:`KeyboardInterrupt`) is never a record: it passes
+through :func:`run_case`; the executors then emit the cases already finished, cancel the others
+and stop the local workers at once (they ignore Ctrl-C themselves, so that the driver decides),
+and re-raise it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
+import signal
 import time
 import traceback
 import uuid
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
+from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.io import to_jsonable
 from cardan_exudyn.sweep.plan import Case
 from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, error_record
@@ -26,8 +34,8 @@ from cardan_exudyn.sweep.spec import DEFAULT_FUNCTION, CaseFunction, SweepError,
 from reference.scene import Scene, replace
 from reference.schema import Status
 
-__all__ = ["SweepIncomplete", "Emit", "default_workers", "run_case", "run_in_process", "run_pool",
-           "connect", "run_dask"]
+__all__ = ["SweepIncomplete", "SweepInterrupted", "Emit", "default_workers", "run_case", "run_in_process",
+           "run_pool", "ignore_interrupts", "connect", "run_dask"]
 
 Emit = Callable[[dict[str, Any]], None]
 """The driver's callback receiving each record as its case finishes."""
@@ -35,6 +43,18 @@ Emit = Callable[[dict[str, Any]], None]
 
 class SweepIncomplete(RuntimeError):
     """The sweep stopped before every case had a record (e.g. the Dask cluster went away)."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C or SIGTERM stopped the sweep: every case finished before is recorded, no case was
+    recorded as failed for it, and the same command resumes.
+
+    Attributes: ``done`` and ``total`` cases, ``out`` folder, ``signum`` (the signal)."""
+
+    def __init__(self, done: int, total: int, out: os.PathLike | str, signum: int = signal.SIGINT) -> None:
+        super().__init__(f"{done} of {total} cases done (records in {out}); rerun the same command "
+                         "to resume")
+        self.done, self.total, self.out, self.signum = done, total, out, signum
 
 
 def default_workers() -> int:
@@ -118,11 +138,43 @@ def run_pool(cases: Sequence[Case], base: Scene, function: CaseFunction, workers
         _run_one_at_a_time(deque(victims), base, function, context, emit)
 
 
+def ignore_interrupts() -> None:
+    """Pool worker initializer: Ctrl-C reaches the whole process group, and the driver alone
+    decides what an interruption stops (it terminates the workers)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def _pool(workers: int, context) -> Iterator[ProcessPoolExecutor]:
+    """A process pool; on any exception its workers are terminated instead of awaited (a running
+    case would otherwise hold the driver until it ends)."""
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=ignore_interrupts)
+    try:
+        yield pool
+    except BaseException:
+        # no public way to stop running tasks before Python 3.14's terminate_workers()
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            with contextlib.suppress(OSError, ValueError, AttributeError):
+                process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
+def _emit_finished(running: dict[Any, Case], emit: Emit) -> None:
+    """Emit the records of the futures in ``running`` that finished with one (at an interruption:
+    cases done meanwhile are kept)."""
+    for future in list(running):
+        if future.done() and not future.cancelled() and future.exception() is None:
+            emit(future.result())
+            running.pop(future)
+
+
 def _pool_round(queue: deque, base: Scene, function: CaseFunction, workers: int, context,
                 emit: Emit) -> list[Case]:
     """Run from ``queue`` until it is empty or the pool breaks; returns the cases in flight then."""
     running: dict[Any, Case] = {}
-    with ProcessPoolExecutor(workers, mp_context=context) as pool:
+    with _pool(workers, context) as pool:
         try:
             while queue or running:
                 while queue and len(running) < 2 * workers:
@@ -134,28 +186,32 @@ def _pool_round(queue: deque, base: Scene, function: CaseFunction, workers: int,
                     if isinstance(future.exception(), BrokenProcessPool):
                         broken = True
                         continue
-                    emit(future.result())
-                    running.pop(future)
+                    with deferred_signals():  # emitted and crossed off together
+                        emit(future.result())
+                        running.pop(future)
                 if broken:
                     return list(running.values())
-        except BaseException:
-            for future in running:
-                future.cancel()
+        except KeyboardInterrupt:
+            _emit_finished(running, emit)
             raise
     return []
 
 
 def _run_one_at_a_time(queue: deque, base: Scene, function: CaseFunction, context, emit: Emit) -> None:
     while queue:
-        with ProcessPoolExecutor(1, mp_context=context) as pool:
+        with _pool(1, context) as pool:
             while queue:
                 case = queue.popleft()
+                future = pool.submit(run_case, case, base, function)
                 try:
-                    record = pool.submit(run_case, case, base, function).result()
+                    record = future.result()
                 except BrokenProcessPool:
                     emit(error_record(case, "WorkerCrash", "the worker process died while running "
                                       "this case alone (a crash, os._exit, or killed, e.g. out of memory)"))
                     break
+                except KeyboardInterrupt:
+                    _emit_finished({future: case}, emit)
+                    raise
                 emit(record)
 
 
@@ -201,14 +257,22 @@ def run_dask(cases: Sequence[Case], base: Scene, function: CaseFunction, client,
     case_of = dict(zip(futures, cases, strict=True))
     try:
         for future, result in as_completed(futures, with_results=True, raise_errors=False):
-            case = case_of[future]
-            if future.status == "finished":
-                emit(result)
-                continue
-            error = future.exception() if future.status == "error" else future.status
-            if not isinstance(error, KilledWorker):
-                raise SweepIncomplete(f"the Dask cluster failed on case {case.id}: "
-                                      f"{type(error).__name__}: {error}; rerun to resume")
-            emit(error_record(case, "KilledWorker", str(error)))
+            with deferred_signals():  # emitted and crossed off together
+                _emit_dask(future, result, case_of.pop(future), emit, KilledWorker)
+    except KeyboardInterrupt:  # keep the cases finished meanwhile
+        for future in [f for f in case_of if f.status == "finished"]:
+            emit(future.result())
+        raise
     finally:
         client.cancel(futures)
+
+
+def _emit_dask(future, result, case: Case, emit: Emit, killed: type) -> None:
+    if future.status == "finished":
+        emit(result)
+        return
+    error = future.exception() if future.status == "error" else future.status
+    if not isinstance(error, killed):
+        raise SweepIncomplete(f"the Dask cluster failed on case {case.id}: "
+                              f"{type(error).__name__}: {error}; rerun to resume")
+    emit(error_record(case, "KilledWorker", str(error)))

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn import engines
+from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.io import atomic_write, to_jsonable
 from cardan_exudyn.sweep.plan import Case, Plan, plan_difference
 from cardan_exudyn.sweep.spec import SweepError
@@ -30,8 +31,8 @@ from reference.schema import Status, Summary
 
 __all__ = ["PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE", "SWEEP_FILES", "RECORD_KEYS",
            "RESERVED_OUTPUTS", "read_records", "RecordWriter", "existing_records", "locked",
-           "write_text", "error_record", "results_table", "statistics", "scalar_summary",
-           "summary_outputs"]
+           "write_text", "interrupted_record", "error_record", "results_table", "statistics",
+           "scalar_summary", "summary_outputs"]
 
 PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE = "plan.json", "cases.jsonl", "results.csv", "sweep.json"
 SWEEP_FILES = (PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE)
@@ -93,11 +94,14 @@ class RecordWriter:
         self._file = open(path, "ab")
 
     def write(self, record: Mapping[str, Any]) -> None:
-        """Append one record; it is on disk when this returns."""
+        """Append one record; it is on disk when this returns. Ctrl-C and SIGTERM wait until it
+        is (:func:`cardan_exudyn.interrupts.deferred_signals`): a finished case is never lost
+        to an interruption."""
         line = json.dumps(to_jsonable(record), allow_nan=False, separators=(",", ":")) + "\n"
-        self._file.write(line.encode("utf-8"))
-        self._file.flush()
-        os.fsync(self._file.fileno())
+        with deferred_signals():
+            self._file.write(line.encode("utf-8"))
+            self._file.flush()
+            os.fsync(self._file.fileno())
 
     def close(self) -> None:
         self._file.close()
@@ -146,6 +150,20 @@ def locked(out: Path) -> Iterator[None]:
         except OSError:
             raise SweepError(f"another sweep is running in {out}") from None
         yield
+
+
+# How Exudyn reported a Python exception escaping a user function: before the interruptions were
+# told apart (issue 18) that was Ctrl-C inside a run, recorded as a failure of the case
+_INTERRUPTED_REASON = "Error in Python USER FUNCTION"
+
+
+def interrupted_record(record: Mapping[str, Any]) -> bool:
+    """A record that earlier versions wrote for a case stopped by Ctrl-C (status
+    ``integration_failure``, Exudyn's user-function failure as reason): no result, to run again.
+    The friction update now keeps its own exceptions (recorded as ``error``), so only an
+    interruption ever produced that reason, and none is recorded any more."""
+    return (record.get("status") == Status.INTEGRATION_FAILURE
+            and _INTERRUPTED_REASON in str(record.get("reason") or ""))
 
 
 def error_record(case: Case, error_type: str, error: str) -> dict[str, Any]:
@@ -241,8 +259,9 @@ def scalar_summary(summary: Summary | Mapping[str, Any]) -> dict[str, Any]:
     """The scalar values of an engine summary.
 
     Numbers, strings, booleans and None at the top level, and those of nested tables
-    (``extras``, ``pair_loss_work``, ...) as ``table.key``; the scene, the schema version and
-    lists are dropped. Units are those of the summary's fields.
+    (``extras``, ``pair_loss_work``, ...) as ``table.key``; ``warnings`` as one text joined by
+    "; "; the scene, the schema version and other lists are dropped. Units are those of the
+    summary's fields.
     """
     out: dict[str, Any] = {}
     if isinstance(summary, Summary):
@@ -252,6 +271,8 @@ def scalar_summary(summary: Summary | Mapping[str, Any]) -> dict[str, Any]:
             continue
         if isinstance(value, Mapping):
             out.update({f"{key}.{k}": v for k, v in value.items() if _is_scalar(v)})
+        elif key == "warnings":
+            out[key] = "; ".join(value)
         elif _is_scalar(value):
             out[key] = value
     return to_jsonable(out)

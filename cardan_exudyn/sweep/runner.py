@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import sys
 import time
 from collections.abc import Mapping
@@ -34,9 +35,18 @@ from typing import Any
 
 import numpy as np
 
+from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.io import OutputError, check_output_folder, to_jsonable
 from cardan_exudyn.report.environment import environment
-from cardan_exudyn.sweep.executors import Emit, connect, default_workers, run_dask, run_in_process, run_pool
+from cardan_exudyn.sweep.executors import (
+    Emit,
+    SweepInterrupted,
+    connect,
+    default_workers,
+    run_dask,
+    run_in_process,
+    run_pool,
+)
 from cardan_exudyn.sweep.plan import Case, Plan, make_plan
 from cardan_exudyn.sweep.records import (
     CASES_FILE,
@@ -46,6 +56,7 @@ from cardan_exudyn.sweep.records import (
     SWEEP_FILES,
     RecordWriter,
     existing_records,
+    interrupted_record,
     locked,
     read_records,
     results_table,
@@ -93,6 +104,9 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
         Invalid spec or output folder; raised before anything is written.
     SweepIncomplete
         The Dask cluster failed; the records so far are kept, rerun to resume.
+    SweepInterrupted
+        Ctrl-C or SIGTERM (a :class:`KeyboardInterrupt`): the cases finished before it are
+        recorded, none is recorded as failed for it, the workers are stopped; rerun to resume.
     """
     start = time.perf_counter()
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
@@ -110,7 +124,7 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
         out.mkdir(parents=True, exist_ok=True)
         with locked(out):
             records = _prepare(out, plan, restart)
-            todo = [c for c in plan.cases if c.id not in records
+            todo = [c for c in plan.cases if c.id not in records or interrupted_record(records[c.id])
                     or (retry_failed and records[c.id].get("status") != Status.OK)]
             executor = _execute(plan, todo, records, out, workers, client, progress)
             return _finish(plan, records, out, len(todo), time.perf_counter() - start, executor)
@@ -143,12 +157,17 @@ def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, workers: in
     writer = RecordWriter(out / CASES_FILE)
 
     def emit(record: dict[str, Any]) -> None:
-        writer.write(record)
-        records[record["id"]] = record
+        with deferred_signals():  # an interruption now counts this record as done
+            writer.write(record)
+            records[record["id"]] = record
         bar.update(record.get("status") == Status.OK)
 
     try:
         return _dispatch(plan, todo, min(workers or default_workers(), max(len(todo), 1)), client, emit)
+    except KeyboardInterrupt as exc:
+        done = sum(c.id in records and not interrupted_record(records[c.id]) for c in plan.cases)
+        raise SweepInterrupted(done, len(plan.cases), out / CASES_FILE,
+                               getattr(exc, "signum", signal.SIGINT)) from None
     finally:
         writer.close()
         bar.close()

@@ -33,6 +33,9 @@ __all__ = ["SweepError", "Distribution", "RandomSpec", "SweepSpec", "CaseFunctio
 # the public face's name, not the defining module's: it survives moves inside the package
 DEFAULT_FUNCTION = "cardan_exudyn.sweep:summary_outputs"
 GRID_FORMS = ("linspace", "geomspace")
+MAX_CASES = 100_000
+"""Most cases one sweep may have (grid points times random samples): more would take weeks and a
+plan too large for memory."""
 SAMPLING_METHODS = ("random", "lhs")
 DISTRIBUTIONS = {"uniform": ("low", "high"), "loguniform": ("low", "high"),
                  "normal": ("mean", "std", "low", "high")}
@@ -181,8 +184,8 @@ class RandomSpec:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
                 raise SweepError(f"`random.{name}` must be an integer, got {value!r}")
-        if self.samples < 1:
-            raise SweepError(f"`random.samples` must be >= 1, got {self.samples!r}")
+        if not 1 <= self.samples <= MAX_CASES:
+            raise SweepError(f"`random.samples` must be in [1, {MAX_CASES}], got {self.samples!r}")
         if self.seed < 0:
             raise SweepError(f"`random.seed` must be >= 0, got {self.seed!r}")
         if self.method not in SAMPLING_METHODS:
@@ -285,6 +288,10 @@ class SweepSpec:
         if not (self.cases or self.grid or self.random):
             raise SweepError("nothing to sweep: give `grid`, `random` or `cases`")
         _check_disjoint(self)
+        total = math.prod(len(v) for v in self.grid.values()) * (self.random.samples if self.random else 1)
+        if max(total, len(self.cases)) > MAX_CASES:
+            raise SweepError(f"the sweep has {max(total, len(self.cases))} cases; at most {MAX_CASES} are "
+                             "allowed (fewer grid values or samples)")
         object.__setattr__(self, "function", function_name(self.function))
         object.__setattr__(self, "function_args", _function_args(self.function_args))
 
@@ -366,8 +373,8 @@ def _spaced_values(where: str, spec: Mapping) -> tuple:
         raise SweepError(f"{where}: {form} needs [start, stop, num], got {args!r}")
     start, stop = (finite_number(f"{where} {form} start/stop", v) for v in args[:2])
     num = args[2]
-    if isinstance(num, bool) or not isinstance(num, int) or num < 1:
-        raise SweepError(f"{where}: {form} num must be an integer >= 1, got {num!r}")
+    if isinstance(num, bool) or not isinstance(num, int) or not 1 <= num <= MAX_CASES:
+        raise SweepError(f"{where}: {form} num must be an integer >= 1 and at most {MAX_CASES}, got {num!r}")
     if form == "geomspace" and (start <= 0.0 or stop <= 0.0):
         raise SweepError(f"{where}: geomspace needs positive start and stop, got {args!r}")
     return tuple(float(v) for v in getattr(np, form)(start, stop, num))

@@ -6,7 +6,9 @@ runs' errors when two runs are compared). A tolerance the test gives (``rtol``, 
 when it is larger; when the estimate is larger it wins, with a :class:`CardanToleranceWarning`
 (the run cannot resolve what was asked). A check never passes by default without an estimate,
 nor with an estimate over :data:`MAX_RELATIVE_ERROR` of the value's scale: it fails and says so.
-A run that did not end ``ok`` fails the check with its status and reason.
+A run that did not end ``ok`` fails the check with its status and reason, and so does one whose
+efficiency is undefined (its warnings say why); engines that disagree on the direction of the
+power flow (``power_flow``) disagree.
 """
 
 from __future__ import annotations
@@ -226,6 +228,9 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
     if not result.success:
         raise AssertionError(f"{failed_runs({engine: result})}: no mean efficiency to compare "
                              f"with {expected!r}")
+    if result.mean_efficiency is None:
+        raise AssertionError(f"the {engine} run of scene {scene!r} has no mean efficiency to compare "
+                             f"with {expected!r}: {'; '.join(result.summary.warnings)}")
     estimate = estimate_of(result, run)
     if isinstance(estimate, str):
         raise AssertionError(estimate)
@@ -240,11 +245,21 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
 
 
 def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
-    """The scale of a mean value: a work's is the input work (a zero loss has a scale too), any
-    other's its magnitude (None)."""
+    """The scale of a mean value: a work's is the larger of the input and output works (the
+    source's, whichever way the power flows; a zero loss has a scale too), any other's its
+    magnitude (None)."""
     if name.endswith("_work") or name.startswith("loss_work_"):
-        return max(abs(values.get(name, 0.0)), abs(values.get("input_work", 0.0)))
+        return max(abs(values.get(name, 0.0)), abs(values.get("input_work", 0.0)),
+                   abs(values.get("output_work", 0.0)))
     return None
+
+
+def check_flow(base: Result, other: Result) -> list[Check]:
+    """A failed check when the two runs' power flows in different directions (empty otherwise)."""
+    flows = (base.summary.power_flow, other.summary.power_flow)
+    if flows[0] == flows[1]:
+        return []
+    return [Check("power_flow", flows, problem="the power flows a different way")]
 
 
 def check_means(names: Sequence[str], base: Result, other: Result,
@@ -350,7 +365,8 @@ def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "refe
     base, *others = engines
     for other in others:
         errors = (estimates[base], estimates[other])
-        checks = (check_means(means, results[base], results[other], errors, rtol, atol)
+        checks = (check_flow(results[base], results[other])
+                  + check_means(means, results[base], results[other], errors, rtol, atol)
                   + check_columns(table_columns, results[base], results[other], errors, rtol, atol,
                                   skip_revolutions))
         warn_widened(checks)

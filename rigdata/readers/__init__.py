@@ -27,9 +27,8 @@ Assumptions
 from __future__ import annotations
 
 import hashlib
-import math
 from collections.abc import Mapping
-from pathlib import Path
+from pathlib import Path, PurePath
 
 import numpy as np
 
@@ -69,8 +68,10 @@ def read_table(path: str | Path, format: str = "auto") -> RawTable:
         truncated, without a header line, with rows of the wrong number of fields, or that the
         format's library cannot parse.
     """
-    if format not in FORMAT_ALIASES:
-        raise ValueError(f"`format` must be 'auto' or one of {FORMATS}, got {format!r}")
+    if not isinstance(format, str) or format not in FORMAT_ALIASES:
+        raise ValueError(f"`format` must be 'auto' or one of {FORMATS}, got {format!r:.80}")
+    if not isinstance(path, (str, PurePath)) or not str(path).strip():
+        raise TypeError(f"`path` must be a str or pathlib.Path naming a rig file, got {path!r:.80}")
     path = Path(path)
     data = file_bytes(path)
     fmt = choose_format(path, format, data[:64])
@@ -123,10 +124,24 @@ def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | Non
     ValueError
         Bad arguments (``format``, ``mapping`` keys, ``sensitivity``, ``pulses_per_rev``).
     """
-    if not (isinstance(sensitivity, (int, float)) and math.isfinite(sensitivity) and sensitivity > 0):
-        raise ValueError(f"`sensitivity` must be a positive number of V/(N m), got {sensitivity!r}")
-    if not (isinstance(pulses_per_rev, (int, np.integer)) and pulses_per_rev > 0):
-        raise ValueError(f"`pulses_per_rev` must be a positive integer, got {pulses_per_rev!r}")
+    if isinstance(sensitivity, bool) or not (isinstance(sensitivity, (int, float))
+                                             and 1e-12 <= sensitivity <= 1e12):  # NaN fails too
+        raise ValueError(f"`sensitivity` must be a number of V/(N m) in [1e-12, 1e12], "
+                         f"got {sensitivity!r:.80}")
+    if isinstance(pulses_per_rev, bool) or not (isinstance(pulses_per_rev, (int, np.integer))
+                                                and 0 < pulses_per_rev <= 1_000_000):
+        raise ValueError(f"`pulses_per_rev` must be an integer in [1, 1000000], "
+                         f"got {pulses_per_rev!r:.80}")
+    for name, table in (("mapping", mapping), ("units", units)):
+        if table is None:
+            continue
+        if not isinstance(table, Mapping):
+            raise TypeError(f"`{name}` must be a mapping of channel names to strings, got {table!r:.80}")
+        wrong = [(k, v) for k, v in table.items()
+                 if not isinstance(k, str) or not (isinstance(v, str) or (v is None and name == "mapping"))]
+        if wrong:
+            raise TypeError(f"`{name}` must map names (str) to strings, "
+                            f"got {wrong[0][0]!r:.40}: {wrong[0][1]!r:.40}")
     raw = read_table(path, format)
     chosen = match_channels(raw, mapping)
     return to_record(raw, chosen, dict(units or {}), sensitivity, pulses_per_rev)

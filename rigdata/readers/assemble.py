@@ -17,7 +17,7 @@ import numpy as np
 from rigdata.readers.channels import MAP_HINT, channel_unit
 from rigdata.readers.table import RawTable
 from rigdata.record import RATE_TOLERANCE, ChannelSource, RigDataError, RigRecord
-from rigdata.units import normalise, parse_unit, split_header, to_si
+from rigdata.units import check_magnitudes, normalise, parse_unit, split_header, to_si
 
 __all__ = ["time_axis", "to_record"]
 
@@ -184,4 +184,6 @@ def to_record(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str]
     synthetic = _synthetic(raw.metadata)
     if synthetic is not None:
         provenance["synthetic"] = synthetic
-    return RigRecord(time, channels, sources, provenance)
+    record = RigRecord(time, channels, sources, provenance)  # its own checks first: NaN, time order
+    check_magnitudes(record.time, record.channels, file=raw.file)
+    return record

@@ -1,0 +1,130 @@
+"""Interruptions (Ctrl-C, SIGTERM) as exceptions that no layer mistakes for a failure.
+
+Ctrl-C raises :class:`KeyboardInterrupt`, and the ``cardan`` command makes SIGTERM raise
+:class:`Terminated`, a subclass: every ``except Exception`` lets both through, every cleanup
+written for one serves both, and the command exits ``128 + signal`` (130, 143).
+
+Exudyn calls Python user functions (friction, stop test) inside its solver and turns any
+exception they raise into a failed solve ("Python ... UserFunction failed"); an interruption
+between two of them can also come back as a ``SystemError``. :func:`watch_signals` records a
+signal arriving while foreign code runs, so the caller raises the interruption whatever that
+code made of it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import threading
+from collections.abc import Iterator
+from types import FrameType
+
+__all__ = ["Terminated", "SignalWatch", "interruption", "exit_status", "terminate_raises",
+           "watch_signals", "deferred_signals"]
+
+WATCHED = (signal.SIGINT, signal.SIGTERM)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived (the ``cardan`` command's handler, :func:`terminate_raises`)."""
+
+    signum = signal.SIGTERM
+
+
+def interruption(signum: int) -> KeyboardInterrupt:
+    """The exception that stands for signal ``signum``: :class:`Terminated` for SIGTERM."""
+    return Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def exit_status(exc: BaseException) -> int:
+    """``128 + signal`` for an interruption: 130 (SIGINT) unless the exception carries ``signum``."""
+    return 128 + int(getattr(exc, "signum", signal.SIGINT))
+
+
+def _main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+def _raise_terminated(signum: int, frame: FrameType | None) -> None:
+    raise Terminated()
+
+
+@contextlib.contextmanager
+def terminate_raises() -> Iterator[None]:
+    """Within the block SIGTERM raises :class:`Terminated` (in the main thread; a SIGTERM that
+    the process was told to ignore stays ignored)."""
+    if not _main_thread() or signal.getsignal(signal.SIGTERM) == signal.SIG_IGN:
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+class SignalWatch:
+    """The signal (SIGINT or SIGTERM) that arrived within :func:`watch_signals`, or ``None``."""
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+
+    def handler(self, previous):
+        def record(signum: int, frame: FrameType | None) -> None:
+            self.signum = signum
+            previous(signum, frame)
+
+        return record
+
+
+@contextlib.contextmanager
+def watch_signals() -> Iterator[SignalWatch]:
+    """Record SIGINT and SIGTERM arriving within the block; on leaving it after one arrived,
+    raise the interruption (:func:`interruption`), whatever the block raised or returned.
+
+    Only signals with a Python handler are watched (an ignored or default signal is left alone)
+    and only in the main thread, where Python runs handlers; the handler still runs, so an
+    interruption also stops the block as before.
+    """
+    watch = SignalWatch()
+    previous = {}
+    if _main_thread():
+        for signum in WATCHED:
+            handler = signal.getsignal(signum)
+            if callable(handler):
+                previous[signum] = signal.signal(signum, watch.handler(handler))
+    try:
+        yield watch
+    except BaseException as exc:
+        if watch.signum is not None and not isinstance(exc, KeyboardInterrupt):
+            raise interruption(watch.signum) from exc
+        raise
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+    if watch.signum is not None:
+        raise interruption(watch.signum)
+
+
+@contextlib.contextmanager
+def deferred_signals() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back within the block (a few lines that must not be cut in half,
+    such as one record's append and its bookkeeping); one that arrived meanwhile is handled when
+    the block ends. (A handler that only notes the signal, not a blocked signal mask: Python runs
+    handlers in the main thread, whichever thread the signal reached.)"""
+    if not _main_thread():
+        yield
+        return
+    pending: list[int] = []
+    previous = {}
+    for signum in WATCHED:
+        handler = signal.getsignal(signum)
+        if callable(handler):  # an ignored or default signal is left alone
+            previous[signum] = signal.signal(signum, lambda number, frame: pending.append(number))
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        if pending:
+            previous[pending[0]](pending[0], None)
