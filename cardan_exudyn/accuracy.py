@@ -14,8 +14,10 @@ from what the run knows about itself.
   the pytest plugin's checks for every mean value and column, is separate: step halving, the
   same scene and options run again at half the step, and the change of every mean value and
   column, times the Richardson factor ``2**p / (2**p - 1)`` of the order ``p`` in
-  :data:`STEP_ORDERS` (generalized-alpha: 2; the ``"lagged"`` friction coupling: 1), estimates
-  the error of the run at the full step.
+  :data:`STEP_ORDERS` (generalized-alpha: 2; 1 with the ``"lagged"`` friction coupling or while
+  friction sign ramps are unresolved, :func:`cardan_exudyn.model.stepsize.convergence_order`),
+  estimates the error of the run at the full step; for the mean efficiency the larger of that
+  and the run's own estimate is taken.
 - Other engines (MuJoCo) give no estimate (:func:`error_estimate` returns None).
 
 With friction that changes sign (a shaft angle, mounting errors) the mean efficiency converges
@@ -24,7 +26,8 @@ the relative sign band, ``docs/accuracy.md``), so order 2 under-reads here: at `
 automatic step (266 per revolution, accuracy 1e-3) the true error (against the reference engine,
 quadrature rtol 1e-11) was 7.5 times this step-halving estimate (5.0 times with ``p = 1``), and
 at ``paper-35deg``'s (376) 3.1 times; the run's own ``efficiency_error_estimate`` was within 1.1
-and 1.7 times of it. The 13-scene measurement of 0.14 to 3.4 behind :data:`SAFETY_FACTOR` (5)
+and 1.7 times of it: hence the order from ``convergence_order`` and, for the mean efficiency, the
+larger of the two estimates. The 13-scene measurement of 0.14 to 3.4 behind :data:`SAFETY_FACTOR` (5)
 was made with the old absolute sign band and no longer bounds the ratio; the factor is what a
 check multiplies an estimate by (the table is in ``docs/pytest.md``).
 """
@@ -39,6 +42,7 @@ import numpy as np
 
 from cardan_exudyn.engines import make_options, options_class
 from cardan_exudyn.engines import run as run_engine
+from cardan_exudyn.model.stepsize import convergence_order, revolution_period
 from cardan_exudyn.report.format import is_number
 from reference.scene import Scene, replace, scene_from_dict
 from reference.schema import MEAN_KEYS, Result, Summary, after_revolutions
@@ -147,10 +151,16 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
         return None
     scene = scene_of(result)
     order = STEP_ORDERS[summary.engine]
-    if scene.has_friction and scene.friction.coupling == "lagged":
-        order = 1  # the friction lags one step behind the reactions
-    return step_halving_estimate(result, scene, options_of(result), order, run or run_engine,
-                                 skip_revolutions)
+    if summary.dt:  # 1 with the lagged coupling or while friction sign ramps are unresolved
+        order = min(order, convergence_order(scene, revolution_period(scene) / summary.dt))
+    estimate = step_halving_estimate(result, scene, options_of(result), order, run or run_engine,
+                                     skip_revolutions)
+    own = summary.efficiency_error_estimate
+    if is_number(own) and own > estimate.means.get("mean_efficiency", 0.0):  # the run's own bound
+        means = {**estimate.means, "mean_efficiency": float(own)}
+        detail = estimate.detail + f"; mean efficiency: the run's own estimate ({own:.3g})"
+        estimate = ErrorEstimate(estimate.engine, estimate.method, means, estimate.columns, detail)
+    return estimate
 
 
 def ratio_error(numerator: float, denominator: float, numerator_error: float,

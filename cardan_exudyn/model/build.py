@@ -289,9 +289,9 @@ def _wrap_rotations(model: ExudynModel) -> None:
     holds the speed, nothing holds the angle), and with ``"RotVecLG"`` nodes the run fails at
     revolution 268: the spider passes the identity at every whole input revolution, where Exudyn's
     ``CompositionRotationVector`` (``w = pi - 2 atan2(x, sqrt(|1 - x^2|))``, ``x = cos(w/2)``)
-    cannot give angles below about 3e-8 rad and returns zero, so the pair input-spider is
-    misaligned there by the input angle's wander, beyond Newton's tolerance once that exceeds 1e-9
-    rad. The hook removes whole revolutions (``ExudynModel.input_turns`` records them; exact in
+    resolves angles near zero only in steps of about 3e-8 rad, so the pair input-spider is
+    misaligned there by the input angle's wander, which Newton could not accept by then (1.3e-9
+    rad). The hook removes whole revolutions (``ExudynModel.input_turns`` records them; exact in
     floating point: ``q - 2 pi`` for ``pi < q < 4 pi``), so the update rounds at 4.4e-16 rad at
     most. Nothing else depends on the choice: ``Rx`` is periodic, the speed drive acts on the
     velocity, an angle drive's offset and a torque drive's stop subtract the same revolutions, the
