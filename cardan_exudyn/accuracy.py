@@ -156,9 +156,14 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
     estimate = step_halving_estimate(result, scene, options_of(result), order, run or run_engine,
                                      skip_revolutions)
     own = summary.efficiency_error_estimate
-    if is_number(own) and own > estimate.means.get("mean_efficiency", 0.0):  # the run's own bound
-        means = {**estimate.means, "mean_efficiency": float(own)}
-        detail = estimate.detail + f"; mean efficiency: the run's own estimate ({own:.3g})"
+    halving = estimate.means.get("mean_efficiency", 0.0)
+    if is_number(own) and own > halving:  # the run's own estimate is larger: step halving under-reads
+        # every mean is integrated over the same unresolved sign ramps: scale them alike
+        factor = own / halving if halving > 0 else 1.0
+        means = {k: v * factor for k, v in estimate.means.items()}
+        means["mean_efficiency"] = float(own)
+        detail = (estimate.detail + f"; means scaled by {factor:.3g} to the run's own mean-efficiency "
+                  f"estimate ({own:.3g})")
         estimate = ErrorEstimate(estimate.engine, estimate.method, means, estimate.columns, detail)
     return estimate
 

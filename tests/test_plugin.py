@@ -138,7 +138,7 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
 
         @pytest.fixture(scope="module")
         def runs(cardan_scene, cardan_run):
-            scene = cardan_scene("rig", revolutions=1.0)
+            scene = cardan_scene("rig", revolutions=1.0, numerics__accuracy=3e-4)
             return cardan_run(scene), cardan_run(scene, "reference")
 
         def test_exudyn_agrees_with_the_reference_within_its_estimate(runs, cardan_run):
@@ -146,7 +146,7 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
             assert_efficiency(exudyn, reference.mean_efficiency, run=cardan_run)
 
         def test_an_explicit_tolerance(runs, cardan_run):
-            assert_efficiency(runs[0], runs[1].mean_efficiency, rtol=1e-3, run=cardan_run)
+            assert_efficiency(runs[0], runs[1].mean_efficiency, rtol=3e-3, run=cardan_run)
 
         def test_too_tight_a_tolerance_warns(runs, cardan_run):
             with pytest.warns(CardanToleranceWarning, match="cannot resolve"):
@@ -163,10 +163,10 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
     result.assert_outcomes(passed=3, failed=2)
     result.stdout.fnmatch_lines([
         ">*assert_efficiency(runs?0?, runs?0?.mean_efficiency + 0.01, run=cardan_run)",
-        "E*AssertionError: mean efficiency of scene 'rig' (exudyn) is not 0.2115*:",
+        "E*AssertionError: mean efficiency of scene 'rig*' (exudyn) is not 0.1963*:",
         "E*| quantity | expected | exudyn | difference | tolerance | from |",
-        "E*| mean_efficiency | 0.2115* | 0.2015* | -1.000e-02 | *e-0* | 5 x estimated error |",
-        "E*error estimates: exudyn: step halving: dt = * s and * s, order 2",
+        "E*| mean_efficiency | 0.1963* | 0.1863* | -1.000e-02 | *e-0* | 5 x estimated error |",
+        "E*error estimates: exudyn: step halving: dt = * s and * s, order 1*",
     ])
     result.stdout.fnmatch_lines([
         "E*AssertionError: the reference run of scene 'rig-errors' ended self_locking: friction "
@@ -204,7 +204,7 @@ def test_assert_engines_agree_passes_and_fails_with_a_table(pytester):
     result.stdout.fnmatch_lines([
         "E*AssertionError: engine reference disagrees with engine exudyn on scene 'paper-10deg*':",
         "E*| quantity | exudyn | reference | difference | tolerance | from |",
-        "E*| work_ratio | 0.9999* | 1.00* | +1.0*e-03 | *e-0* | 5 x estimated error |",
+        "E*| work_ratio | 0.999* | 1.00* | +1.*e-03 | *e-0* | 5 x estimated error |",
         "E*| omega_out (largest difference) | * | * | +2.1*e-01 | *e-0* | 5 x estimated error |",
         "E*error estimates: exudyn: step halving*; reference: quadrature*",
     ])
@@ -285,10 +285,13 @@ def summary_of(scene, engine: str, dt: float, efficiency: float) -> Summary:
                    input_work=10.0, loss_work=10.0 * (1.0 - efficiency), mean_efficiency=efficiency)
 
 
-@pytest.mark.parametrize(("coupling", "factor"), [("converged", 4.0 / 3.0), ("lagged", 2.0)])
-def test_step_halving_reruns_at_half_the_step(coupling, factor):
+@pytest.mark.parametrize(("coupling", "band", "factor"), [
+    ("converged", 0.5, 4.0 / 3.0),   # sign ramps resolved by the 0.06 rad step: second order
+    ("converged", None, 2.0),        # the default ramps (~2e-3 rad) are not: first order
+    ("lagged", 0.5, 2.0)])           # friction lags one step: first order
+def test_step_halving_reruns_at_half_the_step(coupling, band, factor):
     scene = make_scene("rig", revolutions=1.0, friction__coupling=coupling,
-                       record__timeseries=False)
+                       friction__sign_band_relative=band, record__timeseries=False)
     reruns = []
 
     def half_step(scene, engine, options):
