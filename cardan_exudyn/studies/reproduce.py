@@ -110,6 +110,8 @@ def run_numbers(result: Result) -> dict[str, Any]:
     friction = s.extras["friction"]
     out.update({
         "mean_efficiency": s.mean_efficiency,
+        "efficiency_error_estimate": s.efficiency_error_estimate,
+        "accuracy_met": s.accuracy_met,
         "mean_instantaneous_efficiency": s.mean_instantaneous_efficiency,
         "mean_torque_in": s.mean_torque_in,
         "input_work_J": s.input_work,

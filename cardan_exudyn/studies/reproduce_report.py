@@ -31,11 +31,13 @@ from reference.schema import Status
 __all__ = ["RUN_NUMBERS", "fit_case_keys", "case_row", "write_report", "draw_figures", "report_text"]
 
 # the numbers of a run, in the order of the report's results.csv (after difference_to_paper)
-RUN_NUMBERS = ("mean_torque_in", "input_work_J", "loss_work_J", "energy_balance_residual_J",
+RUN_NUMBERS = ("efficiency_error_estimate", "accuracy_met", "mean_torque_in", "input_work_J",
+               "loss_work_J", "energy_balance_residual_J",
                "loop_gain_estimate", "friction_evaluations_per_step", "steps", "wall_time_s",
                *(f"loss_share_{pair}" for pair in PAIR_NAMES))
 MAIN_COLUMNS = ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
-                "paper_mean_efficiency", "mean_efficiency", "difference_to_paper",
+                "paper_mean_efficiency", "mean_efficiency", "efficiency_error_estimate",
+                "accuracy_met", "difference_to_paper",
                 "mean_instantaneous_efficiency", "used_in_fit", "loop_gain_estimate"]
 FAILED_COLUMNS = ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status", "reason"]
 LOSS_COLUMNS = ["parameters", "shaft_angle_deg", "speed_rpm", *(f"loss_share_{p}" for p in PAIR_NAMES)]
@@ -219,7 +221,9 @@ def _head(runs: int, quick: bool, wall: float, reused: int, runs_dir: str) -> li
         "*Calibrated parameters* identified by `cardan calibrate` from the cases marked "
         "`used_in_fit`; the other cases are held out.\n",
         "**Definitions.** `mean_efficiency` = 1 - (loss work)/(input work) over whole input "
-        "revolutions; `mean_instantaneous_efficiency` = time average of eq. (18), which is "
+        "revolutions; `efficiency_error_estimate` = the run's own estimate of its error "
+        "(`docs/accuracy.md`), `accuracy_met` whether it is within the target "
+        "(`numerics.accuracy`); `mean_instantaneous_efficiency` = time average of eq. (18), which is "
         "unbounded where the input power changes sign (it does at large angles): '-' where it "
         "is not defined or leaves [0, 1].\n",
     ]
