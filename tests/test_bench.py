@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 
 import numpy as np
 import pandas as pd
@@ -114,9 +115,10 @@ def test_skip_audit_measures_each_item_side_by_side():
     # Exudyn's coordinates file written every step (text formatting, CPU work) is the one item
     # whose effect is far above timing noise at this size: with / without measured 1.21 to 1.64
     # (median 1.37) over 40 such audits on 2 loaded cores, while items of no effect ranged 0.95 to
-    # 1.16 (5-95 %). In wall time (the default clock) noise reached 0.6 to 2.0 there. The Python
-    # drive function, 1.66 when the angle history was a CubicSpline call (15 us), is 1.10 to 1.14
-    # since histories evaluate in plain floats (reference.histories, about 1 us): within the noise.
+    # 1.16 (5-95 %); in wall time (the default clock) they ranged 0.46 to 2.0 there. The Python
+    # drive function, 1.66 when the angle history was a CubicSpline call (15 us), measures 1.10 to
+    # 1.14 (medians) since histories evaluate in plain floats (reference.histories, about 1 us):
+    # within the noise.
     row = audit[audit["item"] == "solution file"].iloc[0]
     assert row["with_over_without"] > 1.1
 

@@ -33,7 +33,8 @@ from reference.paper import named_scene
 from reference.scene import Scene, replace
 from reference.schema import Status
 
-__all__ = ["AUDIT_SCENE", "Tweak", "Clock", "AuditItem", "run_wall", "solve_only", "audit_items", "skip_audit"]
+__all__ = ["AUDIT_SCENE", "Tweak", "Clock", "AuditItem", "run_wall", "solve_only", "audit_items",
+           "skip_audit"]
 
 AUDIT_SCENE = SCENES["frictionless-10deg"]
 Tweak = Callable[[ExudynModel, Any], None]

@@ -20,9 +20,10 @@ ENGINE, REFERENCE = "exudyn", "reference"
 DRIFT_SCENE = "paper-10deg-2000rpm"
 # The step of the drift runs, the same for every node type: the automatic step of the default
 # (Rxyz) nodes at 10 deg for a speed-ratio error of 1e-5 (the default accuracy until issue 18),
-# given, so that it stays the step the figures below were measured at. The automatic step for EP and
-# RotVecLG nodes at that accuracy is finer (480 and 220 steps per revolution, stepsize.NODE_ERROR); one common step
-# keeps the drift figures comparable and EP's run affordable (480 would triple its 2000 revolutions).
+# given, so that it stays the step the figures below were measured at. The automatic step for EP
+# and RotVecLG nodes at that accuracy is finer (480 and 220 steps per revolution,
+# stepsize.NODE_ERROR); one common step keeps the drift figures comparable and EP's run affordable
+# (480 would triple its 2000 revolutions).
 DRIFT_STEPS_PER_REVOLUTION = 156
 ENERGY_SPEED_RPM = 2000.0
 RHO_LADDER_STEPS = 200               # steps per revolution of the spectral-radius ladder
