@@ -10,12 +10,12 @@ import os
 import random
 import signal
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
 
 import pytest
+from processes import CLI, start, wait_for
 
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
@@ -26,26 +26,10 @@ from cardan_exudyn.sweep.records import RecordWriter
 from reference.paper import named_scene
 from reference.scene import replace
 
-CLI = [sys.executable, "-m", "cardan_exudyn.cli"]
 SIGNALS = [signal.SIGINT, signal.SIGTERM]
 STOP_WITHIN_S = 5.0  # "promptly": measured 0.1-1 s here, on 2 shared cores
 
 
-def start(argv: list[str], cwd: Path) -> subprocess.Popen:
-    """``cardan ARGV`` leading a session of its own, so that a signal to its process group
-    reaches it (and its workers) as a terminal's Ctrl-C would."""
-    return subprocess.Popen([*CLI, *argv], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
-
-
-def wait_for(condition, proc: subprocess.Popen, timeout: float = 90.0) -> None:
-    end = time.monotonic() + timeout
-    while not condition():
-        if proc.poll() is not None:
-            raise AssertionError(f"the command ended before the signal: {proc.communicate()}")
-        if time.monotonic() > end:
-            raise AssertionError("timed out")
-        time.sleep(0.01)
 
 
 def interrupt(proc: subprocess.Popen, signum: int, delay: float) -> tuple[str, float]:
@@ -95,7 +79,7 @@ def delay(seed: int, low: float, high: float) -> float:
 @pytest.fixture(scope="module")
 def rig_file(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("rig") / "rig.lvm"
-    assert main(["rig", "synthetic", "--format", "lvm", "--revolutions", "3", "--out", str(path)]) == 0
+    assert main(["rig", "synthetic", "--format", "lvm", "--revolutions", "12", "--out", str(path)]) == 0  # about 5 s to validate: the signal lands mid-run
     return path
 
 

@@ -265,7 +265,7 @@ def test_exudyn_and_reference_agree_on_each_errors_effect_on_efficiency(error, r
     estimate 7.4e-4). The offsets' effects (0.24..0.49) are more than 10x the bound, so for them
     the agreement is meaningful; the twists' effects (4e-7..5.7e-4) are below it and are compared
     tightly by ``test_twists_effect_on_efficiency_at_a_fine_accuracy`` (slow). Sliding work within
-    1 % of the reference's (measured 2.3e-3 at most).
+    1 % of the reference's (measured 2.2e-3 at most).
     """
     ref, exu = pair = _rig_pair(**{error: SINGLE[error]})
     effect_ref, effect_exu, bound = _effects_and_bound(pair, rig_ideal)
@@ -284,7 +284,7 @@ def test_twists_effect_on_efficiency_at_a_fine_accuracy(error):
     """At accuracy 3e-5 the twists' effects (-4.9e-4, +5.7e-4) agree within 3x the estimates.
 
     Bound about 6e-5, a ninth of the effect (measured difference 4.7e-7 and 4.4e-7); alpha1 and
-    alpha2 change the efficiency by less than 5e-6 and are left out. About 30 s (8700 steps per
+    alpha2 change the efficiency by less than 5e-6 and are left out. About 15 s each (8700 steps per
     revolution: the first-order constant with mounting errors).
     """
     effect_ref, effect_exu, bound = _effects_and_bound(_rig_pair(3e-5, **{error: SINGLE[error]}),

@@ -17,31 +17,17 @@ import time
 from pathlib import Path
 
 import pytest
+from processes import start, wait_for
 
 import cardan_exudyn.io as cio
 from cardan_exudyn.cli import main
 from cardan_exudyn.sweep import run_sweep
 
-CLI = [sys.executable, "-m", "cardan_exudyn.cli"]
 # the reference engine: a second of work, a 0.7 MB time table to write
 QUICK = ["run", "--name", "paper-35deg", "--engine", "reference", "--revolutions", "1"]
 LONG = ["run", "--name", "paper-35deg", "--engine", "reference", "--revolutions", "4"]
 
 
-def start(argv: list[str], cwd: Path, preexec_fn=None) -> subprocess.Popen:
-    """``cardan ARGV`` in a process of its own session (signals reach it and its children)."""
-    return subprocess.Popen([*CLI, *argv], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True, preexec_fn=preexec_fn)
-
-
-def wait_for(condition, proc: subprocess.Popen, timeout: float = 60.0) -> None:
-    end = time.monotonic() + timeout
-    while not condition():
-        if proc.poll() is not None:
-            raise AssertionError(f"the command ended first: {proc.communicate()}")
-        if time.monotonic() > end:
-            raise AssertionError("timed out")
-        time.sleep(0.01)
 
 
 def snapshot(folder: Path) -> dict[str, bytes]:
