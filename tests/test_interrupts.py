@@ -79,7 +79,8 @@ def delay(seed: int, low: float, high: float) -> float:
 @pytest.fixture(scope="module")
 def rig_file(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("rig") / "rig.lvm"
-    assert main(["rig", "synthetic", "--format", "lvm", "--revolutions", "12", "--out", str(path)]) == 0  # about 5 s to validate: the signal lands mid-run
+    # 12 revolutions: about 5 s to validate, so the signal lands mid-run
+    assert main(["rig", "synthetic", "--format", "lvm", "--revolutions", "12", "--out", str(path)]) == 0
     return path
 
 
