@@ -19,7 +19,13 @@ from cardan_exudyn.model.stepsize import (
     reversing_parts,
     richardson,
 )
-from cardan_exudyn.studies.accuracy_grid import REFERENCE_TIGHT, grid_cells, honesty, run_cell
+from cardan_exudyn.studies.accuracy_grid import (
+    REFERENCE_TIGHT,
+    grid_cells,
+    honesty,
+    run_cell,
+    run_cell_limited,
+)
 from reference.paper import named_scene
 from reference.scene import replace
 from reference.validation import SceneError
@@ -165,10 +171,24 @@ def test_reference_settings_are_tight():
     assert REFERENCE_TIGHT["quadrature_rtol"] <= 1e-10
 
 
+@pytest.fixture(scope="module")
+def full_grid() -> dict:
+    """The full grid (``cardan accuracy``, 384 cells; hours on 2 cores), each cell stopped after
+    10 minutes (torque drives starting at 1 rpm take longer in the reference engine)."""
+    return honesty([run_cell_limited(cell, 1e-3, timeout=600.0) for cell in grid_cells()])
+
+
 @pytest.mark.slow
-def test_accuracy_grid_is_honest():
-    """The full grid (``cardan accuracy``): within the target in >= 95 % of the cells compared,
-    the true error within 3 times the estimate in >= 95 %."""
-    verdict = honesty([run_cell(cell, 1e-3) for cell in grid_cells()])
-    assert verdict["within_target"] >= 0.95
-    assert verdict["true_within_3x_estimate"] >= 0.95
+def test_accuracy_grid_is_honest(full_grid):
+    """Within the target in >= 95 % of the cells compared, the true error within 3 times the
+    estimate in >= 95 %."""
+    assert full_grid["within_target"] >= 0.95
+    assert full_grid["true_within_3x_estimate"] >= 0.95
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue 18's target not reached: the estimate is within a "
+                   "factor 3 of the true error both ways in 58 % of the friction cells of a "
+                   "24-cell sample (it over-reads: the first-order model's floor, docs/accuracy.md)")
+def test_estimate_is_within_a_factor_3_both_ways(full_grid):
+    assert full_grid["estimate_within_3x"] >= 0.95
