@@ -272,8 +272,8 @@ def override_name(name: str, labels: list[tuple[str, str]], frictionless: bool |
     for key, text in labels:
         token = _TOKENS.get(key)
         where = [i for i, p in enumerate(parts) if token is not None and token.match(p)]
-        if len(where) == 1:
-            parts[where[0]] = text
+        if len(where) == 1:  # a negative value in brackets, not read as a separator
+            parts[where[0]] = f"({text})" if text.startswith("-") else text
         else:
             extra.append(text if token is not None else f"{key}={text}" if text else key)
     if frictionless is False and "frictionless" in parts:

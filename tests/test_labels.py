@@ -68,6 +68,10 @@ def test_scene_file_name_gets_the_overrides(tmp_path):
     assert scene.name == "my-joint+12.5deg+load=0.5Nm"
 
 
+def test_negative_speed_is_not_read_as_a_separator():
+    assert override_name("paper-10deg-2000rpm", [("rpm", "-2000rpm")]) == "paper-10deg-(-2000rpm)"
+
+
 def test_override_name_rules():
     """Token replaced when exactly one part gives it; appended otherwise; frictionless dropped only
     when the scene has friction."""
