@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import time
@@ -14,8 +15,15 @@ def start(argv: list[str], cwd: Path, preexec_fn=None) -> subprocess.Popen:
     """``cardan ARGV`` leading a session of its own, so that a signal to its process group
     reaches it (and its workers) as a terminal's Ctrl-C would; ``preexec_fn`` runs in the child
     (e.g. a file-size limit)."""
+    def child() -> None:
+        # a shell without job control starts background jobs (a CI runner's pytest, say) with
+        # SIGINT ignored, and children inherit that: give the command the default a terminal gives
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        if preexec_fn is not None:
+            preexec_fn()
+
     return subprocess.Popen([*CLI, *argv], cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True, preexec_fn=preexec_fn)
+                            text=True, start_new_session=True, preexec_fn=child)
 
 
 def wait_for(condition, proc: subprocess.Popen, timeout: float = 90.0) -> None:

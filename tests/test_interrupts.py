@@ -76,6 +76,15 @@ def delay(seed: int, low: float, high: float) -> float:
     return random.Random(seed).uniform(low, high)
 
 
+@pytest.fixture(autouse=True)
+def ctrl_c_raises():
+    """SIGINT raises KeyboardInterrupt in this process, as in an interactive session, even where
+    pytest was started with SIGINT ignored (a background job of a shell without job control)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 @pytest.fixture(scope="module")
 def rig_file(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("rig") / "rig.lvm"
