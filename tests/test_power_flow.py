@@ -357,3 +357,17 @@ def test_cli_prints_the_flow_and_exits_3_when_unphysical(capsys):
     assert main(["run", "--name", "paper", "--dt", "0.01"]) == 3
     out, err = capsys.readouterr()
     assert "status: unphysical" in err and "mean efficiency" not in out
+
+
+def test_uncoupled_friction_without_load_transmits_nothing():
+    """The defect pinned by a strict xfail before issue 18 (a falsifying example of the property
+    tests): uncoupled friction estimates the loss on the frictionless reactions, so without a load
+    the input work is rounding noise and 1 - W_loss / W_in was +-1e16 with status ok. Now nothing
+    is transmitted: flow ``none``, efficiency 0, in [0, 1]."""
+    scene = replace(named_scene("paper-20deg-1000rpm"), **{
+        "load.torque": 0.0, "gravity": (0.0, 0.0, 0.0), "friction.coupling": "uncoupled",
+        "joint.pairs.input_spider.friction_coefficient": 0.5,
+        "joint.pairs.spider_output.friction_coefficient": 0.5})
+    s = run_engine(scene, "reference").summary
+    assert s.status == Status.OK, s.reason
+    assert s.power_flow == "none" and s.mean_efficiency == 0.0, (s.power_flow, s.mean_efficiency)
