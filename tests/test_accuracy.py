@@ -21,6 +21,7 @@ from cardan_exudyn.model.stepsize import (
 )
 from cardan_exudyn.studies.accuracy_grid import (
     REFERENCE_TIGHT,
+    cell_scene,
     grid_cells,
     honesty,
     run_cell,
@@ -28,6 +29,7 @@ from cardan_exudyn.studies.accuracy_grid import (
 )
 from reference.paper import named_scene
 from reference.scene import replace
+from reference.schema import Status
 from reference.validation import SceneError
 
 ONE_REVOLUTION = {"revolutions": 1.0, "record.timeseries": False}
@@ -192,3 +194,13 @@ def test_accuracy_grid_is_honest(full_grid):
                    "24-cell sample (it over-reads: the first-order model's floor, docs/accuracy.md)")
 def test_estimate_is_within_a_factor_3_both_ways(full_grid):
     assert full_grid["estimate_within_3x"] >= 0.95
+
+
+def test_torque_drive_speeding_up_past_its_step_says_why():
+    """Known limitation (issue 18's note): a torque drive's step is sized for its initial speed;
+    starting at 1 rpm the joint speeds up past it and Exudyn fails (the reference runs). The
+    failure says so and what to give instead."""
+    scene = cell_scene(dict(angle_deg=15.0, rpm=1.0, friction=0.0, errors=False, drive="torque"), 1e-3)
+    s = run(scene, "exudyn").summary
+    assert s.status == Status.INTEGRATION_FAILURE
+    assert "sized for the torque drive's initial speed" in s.reason and "numerics.dt" in s.reason

@@ -152,6 +152,10 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
         raise friction.error
     if friction is not None and friction.status != Status.OK:
         status, reason = friction.status, friction.reason
+    if status == Status.INTEGRATION_FAILURE and scene.drive.kind == "torque" and scene.numerics.dt is None:
+        reason += (f" (the step was sized for the torque drive's initial speed, "
+                   f"{abs(scene.drive.initial_speed):.3g} rad/s; a joint that speeds up beyond it "
+                   f"needs `numerics.dt` for its top speed)")
     return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
 
 
