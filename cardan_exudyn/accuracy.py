@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from dataclasses import replace as replace_fields
 from typing import Any
 
 import numpy as np
@@ -218,6 +219,9 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
     s = result.summary
     if not is_number(s.dt) or s.dt <= 0:
         raise AccuracyError(f"the {s.engine} run reports no time step to halve")
+    if "error_estimate" in getattr(options, "__dataclass_fields__", {}):
+        options = replace_fields(options, error_estimate=False)  # no companion: it would be
+        # the run being halved
     try:
         finer = run(half_step_scene(scene, s.dt, result.table is not None), s.engine, options)
     except SceneError as exc:

@@ -204,3 +204,15 @@ def test_torque_drive_speeding_up_past_its_step_says_why():
     s = run(scene, "exudyn").summary
     assert s.status == Status.INTEGRATION_FAILURE
     assert "sized for the torque drive's initial speed" in s.reason and "numerics.dt" in s.reason
+
+
+def test_without_error_estimate_one_run_and_no_estimate():
+    """``ExudynOptions(error_estimate=False)`` (what step halving reruns with): the run at the
+    given step alone, the same numbers as the main run of the estimated one, no estimate."""
+    scene = replace(named_scene("paper-10deg"), revolutions=1.0, **{"numerics.dt": 2e-4})
+    full = run(scene, "exudyn")
+    alone = run(scene, "exudyn", error_estimate=False)
+    assert alone.summary.mean_efficiency == full.summary.mean_efficiency
+    assert alone.summary.efficiency_error_estimate is None and "accuracy" not in alone.summary.extras
+    assert full.summary.efficiency_error_estimate is not None
+    assert full.summary.extras["accuracy"]["companion_dt"] == 4e-4  # the companion the other skips

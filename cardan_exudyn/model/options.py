@@ -40,6 +40,11 @@ class ExudynOptions:
         Report velocities projected onto the velocity constraints at the computed positions
         (post-processing, :mod:`cardan_exudyn.model.projection`): exact speed ratio for a prescribed
         input; the drive torque, reactions and friction keep the integrator's error.
+    error_estimate : bool
+        With friction, run the pilot and companion that choose the step and estimate the mean
+        efficiency's error (:func:`cardan_exudyn.model.solve.run`). False: one run at the given
+        ``numerics.dt`` or at the speed-ratio step, no estimate (for a caller that estimates the
+        error itself, such as step halving, which would otherwise repeat the run it halves).
     """
 
     spectral_radius: float = 0.6
@@ -50,8 +55,12 @@ class ExudynOptions:
     node_type: str = "Rxyz"
     sensors: str = "auto"
     velocity_projection: bool = False
+    error_estimate: bool = True
 
     def __post_init__(self) -> None:
+        for name in ("modified_newton", "jacobian_every_step", "velocity_projection", "error_estimate"):
+            if not isinstance(getattr(self, name), bool):
+                raise OptionsError(f"`{name}` must be true or false, got {getattr(self, name)!r}")
         if not 0.0 <= self.spectral_radius < 1.0:
             raise OptionsError(f"`spectral_radius` must be in [0, 1), got {self.spectral_radius!r}")
         for name in ("newton_relative_tolerance", "newton_absolute_tolerance"):

@@ -181,6 +181,8 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
         result = run_once(scene, options)
         _report_accuracy(result, None, scene, options)
         return result
+    if not options.error_estimate:
+        return run_once(scene, options)
     if scene.numerics.dt is not None:
         coarse = run_once(_companion(scene, 2.0 * scene.numerics.dt), options)
         main = run_once(scene, options)
