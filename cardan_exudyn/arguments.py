@@ -39,7 +39,9 @@ EXIT_OK, EXIT_BAD_INPUT, EXIT_FAILED = 0, 2, 3
 EXIT_INCOMPLETE = 4
 EXIT_INACCURATE = 5
 EXIT_INTERRUPTED = 130
-DEFAULT_SCENE = "paper-10deg-frictionless"
+DEFAULT_SCENE = "paper-10deg-2000rpm"
+"""The scene of ``cardan run`` without ``--name`` or ``--scene``: the paper's joint with friction
+under the default (physical) parameter set."""
 
 
 class BadInput(Exception):
@@ -129,7 +131,8 @@ def path_value(option: str, text: str, form: str) -> tuple[str, str]:
 
 
 SCENE_OPTIONS = ("scene", "name", "angle", "rpm", "load_torque", "friction_spider", "friction_frame",
-                 "coupling", "sign_band", "no_gravity", "dt", "accuracy", "revolutions")
+                 "coupling", "friction_law", "sign_band", "sign_band_relative", "no_gravity", "dt",
+                 "accuracy", "revolutions")
 """Destinations of :func:`add_scene_options` (None or False when not given)."""
 
 
@@ -146,7 +149,8 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument("--scene", metavar="FILE", help="scene TOML file")
     src.add_argument("--name", metavar="NAME",
-                     help=f"named scene, e.g. paper-10deg-2000rpm, rig (default {DEFAULT_SCENE})")
+                     help=f"named scene, e.g. paper-35deg, paper-literal-10deg-500rpm, rig-errors (parameter "
+                          f"sets physical, literal, matched; default {DEFAULT_SCENE}, physical set)")
     p.add_argument("--angle", metavar="DEG", type=number("deg"), help="shaft angle [deg]")
     p.add_argument("--rpm", metavar="RPM", type=number("rpm"),
                    help="constant input speed [rpm] (makes the drive a constant-speed drive)")
@@ -159,6 +163,10 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--coupling", choices=("converged", "lagged"),
                    help="friction coupling: converged per step (default) or lagged one step "
                         "(the paper's)")
+    p.add_argument("--friction-law", choices=("paper", "resultant"),
+                   help="friction of a pair that rotates and slides: the paper's eqs. (3), (5), "
+                        "a full Coulomb load in each direction (default), or one Coulomb force "
+                        "against the resultant slip velocity")
     band = p.add_mutually_exclusive_group()
     band.add_argument("--sign-band", metavar="M_S", type=number("m/s", non_negative=True),
                       help="one absolute surface speed [m/s] below which sign() of eqs. (3), (5) "
@@ -184,7 +192,7 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     if args.scene is not None:
         scene = load_scene(args.scene)
     else:
-        scene = named_scene(DEFAULT_SCENE if args.name is None else args.name)
+        scene = _named(DEFAULT_SCENE if args.name is None else args.name, args)
     changes, labels = _overrides(args)
     if not changes:
         return scene
@@ -198,6 +206,21 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     described = ", ".join(f"{k}={v}" if v else k for k, v in labels)
     description = f"{scene.description}; command-line overrides: {described}".lstrip("; ")
     return dataclasses.replace(changed, name=name, description=description)
+
+
+def _named(name: str, args: argparse.Namespace) -> Scene:
+    """The named scene, built at the ``--angle`` and ``--rpm`` asked for when it is one of the
+    paper's (so that its parameter set's choices, such as the load that gives the case's mean input
+    torque, are made for that angle and speed; the override then changes nothing)."""
+    scene = named_scene(name)
+    labels = [(k, f"{v:g}{k.replace('angle', 'deg')}") for k, v in (("angle", args.angle), ("rpm", args.rpm))
+              if v is not None and v >= 0.0]
+    if not scene.parameter_set or not labels:
+        return scene
+    try:
+        return named_scene(override_name(scene.name, labels))
+    except SceneError:
+        return scene  # not a name the paper's scenes take (e.g. 92 deg): the override will say why
 
 
 def _overrides(args: argparse.Namespace) -> tuple[dict[str, Any], list[tuple[str, str]]]:
@@ -221,7 +244,10 @@ def _overrides(args: argparse.Namespace) -> tuple[dict[str, Any], list[tuple[str
             for pair in pairs:
                 changes[f"joint.pairs.{pair}.friction_coefficient"] = value
     for option, key, label, unit in (("coupling", "friction.coupling", "coupling", ""),
+                                     ("friction_law", "friction.law", "friction_law", ""),
                                      ("sign_band", "friction.sign_band", "sign_band", ""),
+                                     ("sign_band_relative", "friction.sign_band_relative",
+                                      "sign_band_relative", ""),
                                      ("dt", "numerics.dt", "dt", "s"),
                                      ("accuracy", "numerics.accuracy", "accuracy", ""),
                                      ("revolutions", "revolutions", "revolutions", "")):

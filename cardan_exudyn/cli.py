@@ -125,11 +125,20 @@ def _error_text(s: Summary) -> str:
     return f" +- {s.efficiency_error_estimate:.2g} (estimated, {met})"
 
 
+def _set_text(s: Summary) -> str:
+    """`` (physical parameter set)`` after the scene name: which of the paper's parameter sets
+    the numbers come from (nothing for a scene that is not the paper's)."""
+    label = s.scene.get("parameter_set", "")
+    if not label:
+        return ""
+    return " (custom parameter values)" if label == "custom" else f" ({label} parameter set)"
+
+
 def _print_summary(s: Summary, out: str | None, files: list[str]) -> None:
     if s.status != Status.OK:
         print(f"status: {s.status}: {s.reason}", file=sys.stderr)
         return
-    print(f"scene {s.scene['name']} with {s.engine} {s.engine_version}: "
+    print(f"scene {s.scene['name']}{_set_text(s)} with {s.engine} {s.engine_version}: "
           f"mean efficiency {number(s.mean_efficiency, '.6f', _no_work(s))}{_error_text(s)}{_flow(s)} "
           f"(time average of eq. (18): {number(s.mean_instantaneous_efficiency, '.6f', 'undefined')}) "
           f"over {s.revolutions} revolutions; dt {number(s.dt, '.3g')} s, "

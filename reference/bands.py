@@ -27,6 +27,12 @@ at every speed").
 ``FrictionSettings.sign_band`` [m/s], when given, is one absolute band for every pair (0: the
 exact sign), as before.
 
+Under the resultant-slip law (``FrictionSettings.law = "resultant"``) one Coulomb force opposes
+the pair's slip velocity ``v = (omega_rel d / 2, v_slide)`` and is regularised as a vector,
+``v / max(|v|, band)``: its band (``PairBands.resultant``) is ``sign_band_relative *
+max(hypot(v_char rotation, v_char sliding), floor)``, or the absolute ``sign_band``. For a pair
+that does not slide it is the rotation's band, so the two laws then coincide even inside it.
+
 Every engine takes its bands from :func:`sign_bands`, so they regularise identically.
 """
 
@@ -68,6 +74,8 @@ class PairBands(NamedTuple):
     """For the friction torque, in relative surface speed."""
     sliding: float
     """For the axial friction force, in sliding speed."""
+    resultant: float
+    """For the resultant slip speed ``hypot(omega_rel d / 2, v_slide)`` (``law = "resultant"``)."""
 
 
 def nominal_speed(scene: Scene) -> float:
@@ -118,7 +126,8 @@ def sign_bands(scene: Scene) -> dict[str, PairBands]:
 
     ``FrictionSettings.sign_band`` given: that band for every ramp. Otherwise
     ``sign_band_relative * max(v_char, SPEED_FLOOR * max(v_char over the scene))`` per ramp, with
-    ``v_char`` from :func:`characteristic_speeds`.
+    ``v_char`` from :func:`characteristic_speeds` (for the resultant slip, ``v_char`` is the
+    hypotenuse of the pair's rotation and sliding ``v_char``).
 
     Raises
     ------
@@ -133,11 +142,13 @@ def _bands(scene: Scene) -> tuple[PairBands, ...]:
     # cached per scene (frozen, hashable): engines ask for the bands at every evaluation
     settings = scene.friction
     if settings.sign_band is not None:
-        return tuple(PairBands(settings.sign_band, settings.sign_band) for _ in PAIR_NAMES)
+        return tuple(PairBands(settings.sign_band, settings.sign_band, settings.sign_band)
+                     for _ in PAIR_NAMES)
     relative = settings.relative_band
     if relative == 0.0:
-        return tuple(PairBands(0.0, 0.0) for _ in PAIR_NAMES)
+        return tuple(PairBands(0.0, 0.0, 0.0) for _ in PAIR_NAMES)
     speeds = characteristic_speeds(scene)
     floor = SPEED_FLOOR * max(max(s) for s in speeds.values())
     return tuple(PairBands(relative * max(speeds[p].rotation, floor),
-                           relative * max(speeds[p].sliding, floor)) for p in PAIR_NAMES)
+                           relative * max(speeds[p].sliding, floor),
+                           relative * max(math.hypot(*speeds[p]), floor)) for p in PAIR_NAMES)

@@ -231,9 +231,10 @@ class FrictionLaw:
         self.index = np.array([[position[(pair, c)] for c in ("fx", "fy", "mx", "my")]
                                for pair, _ in slots], dtype=int).reshape(len(slots), 4)
         coefficients = []
+        pairs = dict(scene.joint.friction_pairs())
         for pair, kind in slots:
             which = 0 if kind == "torque" else 1  # eq. (3) torque or eq. (5) axial force
-            data = getattr(scene.joint.pairs, pair)
+            data = pairs[pair]
             coefficients.append((float(friction_magnitudes(data, 1.0, 0.0)[which]),
                                  float(friction_magnitudes(data, 0.0, 1.0)[which])))
         self.k_force, self.k_moment = np.array(coefficients, float).reshape(len(slots), 2).T
@@ -246,7 +247,9 @@ class FrictionLaw:
         x : ndarray, shape (n, 18)
             Reactions (and the drive unknown, unused), ordered as :func:`unknowns`.
         signs : ndarray, shape (n, K)
-            Regularised sign of the relative motion for each slot (fixed by the kinematics).
+            Regularised sign of the relative motion for each slot, or under the resultant-slip
+            law the slot's component of the regularised unit slip vector (:func:`slot_signs`;
+            fixed by the kinematics).
 
         Returns
         -------
@@ -286,10 +289,60 @@ def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str,
 
 
 def slot_bands(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
-    """Width of each slot's sign ramp [m/s] (:func:`reference.bands.sign_bands`), shape (K,)."""
+    """Width of each slot's sign ramp [m/s] (:func:`reference.bands.sign_bands`), shape (K,).
+
+    Under the resultant-slip law (``scene.friction.law``) both slots of a pair share the ramp of
+    its resultant slip speed.
+    """
     bands = sign_bands(scene)
+    if scene.friction.law == "resultant":
+        return np.array([bands[pair].resultant for pair, _ in slots], dtype=float)
     return np.array([bands[pair].rotation if kind == "torque" else bands[pair].sliding
                      for pair, kind in slots], dtype=float)
+
+
+def slip_speeds(slots: list[tuple[str, str]], speeds: np.ndarray) -> np.ndarray:
+    """Per slot, the resultant slip speed of its pair [m/s]: the hypotenuse of the pair's slot
+    speeds (:func:`slot_speeds`, shape (..., K)), shape (..., K)."""
+    out = np.empty_like(speeds)
+    for pair in dict.fromkeys(pair for pair, _ in slots):
+        mine = [j for j, (p, _) in enumerate(slots) if p == pair]
+        out[..., mine] = np.sqrt(np.sum(np.square(speeds[..., mine]), -1))[..., None]
+    return out
+
+
+def slot_signs(scene: Scene, slots: list[tuple[str, str]], speeds: np.ndarray,
+               bands: np.ndarray) -> np.ndarray:
+    """The factor of each slot's Coulomb magnitude, in [-1, 1], shape (..., K).
+
+    ``speeds`` from :func:`slot_speeds`, ``bands`` from :func:`slot_bands`. The paper's law: the
+    regularised sign of each slot's speed (:func:`reference.friction.regularised_sign`). The
+    resultant-slip law: the slot's component of its pair's regularised unit slip vector
+    ``v / max(|v|, band)`` (:mod:`reference.friction`).
+    """
+    if scene.friction.law != "resultant":
+        return regularised_sign(speeds, bands)
+    size = np.maximum(slip_speeds(slots, speeds), bands)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(size > 0.0, speeds / size, 0.0)
+
+
+def ramp_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
+                slide_rel: dict[str, np.ndarray]) -> np.ndarray:
+    """Speeds [m/s] whose crossings of ``+-`` :func:`ramp_bands` are the kinks of the friction
+    factors (:func:`slot_signs`), shape (..., K'): the slot speeds (:func:`slot_speeds`), and under
+    the resultant-slip law also the pairs' slip speeds (the slot speeds' zero crossings stay: with
+    a zero band the factor jumps there when the pair does not slide)."""
+    speeds = slot_speeds(scene, slots, omega_rel, slide_rel)
+    if scene.friction.law != "resultant":
+        return speeds
+    return np.concatenate([speeds, slip_speeds(slots, speeds)], -1)
+
+
+def ramp_bands(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
+    """Ramp widths [m/s] of :func:`ramp_speeds`, shape (K',)."""
+    bands = slot_bands(scene, slots)
+    return np.concatenate([bands, bands]) if scene.friction.law == "resultant" else bands
 
 
 @dataclass
@@ -429,7 +482,7 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     both = np.linalg.solve(matrix, np.concatenate([rhs[..., None], wrenches], -1))
     if bands is None:
         bands = slot_bands(scene, slots)
-    signs = (regularised_sign(slot_speeds(scene, slots, omega_rel, slide_rel), bands)
+    signs = (slot_signs(scene, slots, slot_speeds(scene, slots, omega_rel, slide_rel), bands)
              if slots else np.zeros(theta.shape + (0,)))
     law = FrictionLaw(scene, slots)
     if scene.friction.coupling == "uncoupled":  # evaluated on the frictionless reactions only

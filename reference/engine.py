@@ -31,8 +31,9 @@ from reference.bands import sign_bands
 from reference.dynamics import (
     dynamics_columns,
     friction_slots,
+    ramp_bands,
+    ramp_speeds,
     slot_bands,
-    slot_speeds,
     solve_dynamics,
 )
 from reference.histories import run_clock
@@ -257,13 +258,13 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     def speeds(t: np.ndarray) -> np.ndarray:
         theta, theta_t, _ = motion.state(t)
         kin = joint_motion(scene.joint, theta, theta_t, 0.0)  # speeds do not need accelerations
-        return slot_speeds(scene, slots, kin.omega_rel, kin.slide_rel)
+        return ramp_speeds(scene, slots, kin.omega_rel, kin.slide_rel)  # resultant law: slip speeds too
 
     theta_a, theta_b = motion.angle(t_a), motion.angle(t_b)
     n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
     grid = np.linspace(t_a, t_b, n + 1)
     values = speeds(grid)
-    bands = slot_bands(scene, slots)
+    bands = ramp_bands(scene, slots)
     brackets = []
     for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
         g = values - levels

@@ -23,6 +23,15 @@ rotation the surface speed is ``omega_rel d / 2``. With ``band = 0`` it is the e
 for the rotation and for the sliding (:func:`reference.bands.sign_bands`: by default relative to
 the pair's characteristic speed, so the same at every input speed in relative terms).
 
+Resultant-slip law (``FrictionSettings.law = "resultant"``): eqs. (3), (5) as written apply the
+full Coulomb load in each direction of a pair that both rotates and slides. Both magnitudes come
+from one normal load ``N = |F| + 2 |M| / L`` (the torque is ``(d / 2) f N``, the force ``f N``), so
+physically one Coulomb force ``f N`` opposes the contact's resultant slip velocity
+``v = (v_c, v_a) = (omega_rel d / 2, v_slide)``: ``M_z = -(d / 2) f N u_c``, ``F_z = -f N u_a`` with
+``u = v / max(|v|, band)`` (linear below the band, the unit slip direction above it; ``band = 0``:
+``v / |v|``, 0 at rest). A revolute pair (``v_a = 0``) or a pair that does not slide gets the
+paper's law exactly outside the band.
+
 The power dissipated in a pair is ``-(M_z omega_rel + F_z v_slide) >= 0``.
 """
 
@@ -68,42 +77,69 @@ def friction_magnitudes(pair: Pair, force_normal: Any, moment_normal: Any) -> tu
     return torque, force
 
 
+def slip_direction(surface_speed: Any, slide_speed: Any, band: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Regularised unit slip vector ``v / max(|v|, band)`` of ``v = (surface_speed, slide_speed)``.
+
+    ``surface_speed`` (``omega_rel d / 2``) and ``slide_speed`` [m/s] broadcast together;
+    ``band`` [m/s] broadcasts with them (0: ``v / |v|``, and 0 where ``v = 0``). Returns the
+    circumferential and axial components [-], each in [-1, 1], their hypotenuse at most 1.
+    """
+    surface = np.asarray(surface_speed, dtype=float)
+    slide = np.asarray(slide_speed, dtype=float)
+    size = np.maximum(np.hypot(surface, slide), np.asarray(band, dtype=float))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (np.where(size > 0.0, surface / size, 0.0), np.where(size > 0.0, slide / size, 0.0))
+
+
 def pair_friction(pair: Pair, kind: str, fx: Any, fy: Any, mx: Any, my: Any, omega_rel: Any,
-                  slide_rel: Any, sign_band: float,
-                  slide_band: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+                  slide_rel: Any, sign_band: float, slide_band: float | None = None,
+                  resultant_band: float | None = None,
+                  law: str = "paper") -> tuple[np.ndarray, np.ndarray]:
     """Friction torque about and force along the pair axis, acting on body ``b`` of the pair.
 
     Parameters are arrays over time samples (or scalars): the reaction components normal to the
     axis in any frame whose z is the pair axis, and the relative angular and sliding speed of
     ``b`` with respect to ``a``; the ramp widths [m/s] of the rotation's sign (``sign_band``, in
-    surface speed) and of the sliding's (``slide_band``; None: ``sign_band``). A revolute pair
-    gets no axial force (its sliding is constrained). A pair with zero coefficient gets zeros.
+    surface speed), of the sliding's (``slide_band``; None: ``sign_band``) and of the resultant
+    slip (``resultant_band``; None: ``sign_band``); ``law`` ``"paper"`` (eqs. (3), (5), one sign
+    per direction) or ``"resultant"`` (one Coulomb force against the resultant slip, see the
+    module doc). A revolute pair gets no axial force (its sliding is constrained) and does not
+    slide. A pair with zero coefficient gets zeros.
     """
     if kind not in ("revolute", "cylindrical"):
         raise ValueError(f"unknown pair kind {kind!r}")
+    if law not in ("paper", "resultant"):
+        raise ValueError(f"`law` must be 'paper' or 'resultant', got {law!r}")
     force_normal = np.hypot(fx, fy)
     moment_normal = np.hypot(mx, my)
     torque_mag, force_mag = friction_magnitudes(pair, force_normal, moment_normal)
-    torque = -regularised_sign(0.5 * pair.journal_diameter * np.asarray(omega_rel, float),
-                               sign_band) * torque_mag
-    if kind == "revolute":
-        force = np.zeros_like(torque)
+    surface = 0.5 * pair.journal_diameter * np.asarray(omega_rel, float)
+    slide = np.zeros_like(surface) if kind == "revolute" else np.asarray(slide_rel, float)
+    if law == "resultant":
+        u_c, u_a = slip_direction(surface, slide, sign_band if resultant_band is None else resultant_band)
     else:
-        force = -regularised_sign(slide_rel, sign_band if slide_band is None else slide_band) * force_mag
+        u_c = regularised_sign(surface, sign_band)
+        u_a = regularised_sign(slide, sign_band if slide_band is None else slide_band)
+    torque = -u_c * torque_mag
+    force = np.zeros_like(torque) if kind == "revolute" else -u_a * force_mag
     return torque, force
 
 
 def friction_from_columns(scene: Scene,
                           columns: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Friction torque and force of every pair from result-schema columns (reactions, speeds),
-    with the scene's sign bands (:func:`reference.bands.sign_bands`)."""
+    with the scene's sign bands (:func:`reference.bands.sign_bands`) and friction law
+    (``scene.friction.law``)."""
     out = {}
     bands = sign_bands(scene)
-    for name, pair in scene.joint.pairs.items():
+    for name, pair in scene.joint.friction_pairs():
         c = {s: np.asarray(columns[f"{name}_{s}"], dtype=float)
              for s in ("fx", "fy", "mx", "my", "omega_rel", "slide_rel")}
+        band = bands[name]
         out[name] = pair_friction(pair, PAIR_KIND[name], c["fx"], c["fy"], c["mx"], c["my"],
-                                  c["omega_rel"], c["slide_rel"], *bands[name])
+                                  c["omega_rel"], c["slide_rel"], sign_band=band.rotation,
+                                  slide_band=band.sliding, resultant_band=band.resultant,
+                                  law=scene.friction.law)
     return out
 
 
@@ -113,4 +149,4 @@ def pair_power_loss(torque: Any, force: Any, omega_rel: Any, slide_rel: Any) -> 
 
 
 __all__ = ["friction_from_columns", "friction_magnitudes", "pair_friction",
-           "pair_power_loss", "regularised_sign"]
+           "pair_power_loss", "regularised_sign", "slip_direction"]

@@ -27,6 +27,7 @@ Pairs, in chain order, each between a body ``a`` and a body ``b``:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -127,6 +128,10 @@ class Body:
         return self.mass, com, rotate_inertia(self.centroidal_inertia_local(), r)
 
 
+GEOMETRY_LEVER = "geometry"
+"""``Pair.moment_lever`` value meaning: derived from the joint's geometry (:meth:`Joint.lever`)."""
+
+
 @dataclass(frozen=True)
 class Pair:
     """Friction data of one kinematic pair (eqs. (1)-(5)).
@@ -137,19 +142,29 @@ class Pair:
         Coulomb coefficient f [-], >= 0; zero means the pair is frictionless.
     journal_diameter : float
         Journal diameter d [m] of eqs. (2), (3).
-    moment_lever : float
-        Lever L [m] that turns a bending moment into a couple of forces, eq. (1).
+    moment_lever : float or "geometry"
+        Lever L [m] that turns a bending moment into a couple of forces, eq. (1); ``"geometry"``
+        (None is read as it): derived from the joint's geometry (:meth:`Joint.lever`): a spider
+        pair stands for two trunnion
+        bearings on opposite arms, which carry a bending moment as a couple over their spacing,
+        ``2 * arm_radius``; a frame pair for a shaft's two support bearings, ``support_spacing``.
     """
 
     friction_coefficient: float = 0.0
     journal_diameter: float = 0.02
-    moment_lever: float = 0.01
+    moment_lever: float | str = 0.01
 
     def __post_init__(self) -> None:
         set_field(self, "friction_coefficient",
                   non_negative("friction_coefficient", self.friction_coefficient))
         set_field(self, "journal_diameter", positive("journal_diameter", self.journal_diameter))
-        set_field(self, "moment_lever", positive("moment_lever", self.moment_lever))
+        if self.moment_lever is None or self.moment_lever == GEOMETRY_LEVER:
+            set_field(self, "moment_lever", GEOMETRY_LEVER)
+        elif isinstance(self.moment_lever, str):
+            raise SceneError(f"`moment_lever` must be a number [m] or {GEOMETRY_LEVER!r} (derived from "
+                             f"the joint's geometry), got {self.moment_lever!r:.80}")
+        else:
+            set_field(self, "moment_lever", positive("moment_lever", self.moment_lever))
 
 
 @dataclass(frozen=True)
@@ -183,13 +198,18 @@ class Geometry:
     output_bearing : float
         Distance from the joint centre to the output-frame bearing along the output axis [m].
     arm_radius : float
-        Spider arm radius: joint centre to the middle of each trunnion bearing [m].
+        Spider arm radius: joint centre to the middle of each trunnion bearing [m]. The moment
+        lever of a spider pair whose ``moment_lever`` is ``"geometry"`` is ``2 * arm_radius``.
+    support_spacing : float
+        Distance between the two support bearings of each shaft [m], the frame pair's lumped
+        bearings; the moment lever of a frame pair whose ``moment_lever`` is ``"geometry"``.
     """
 
     shaft_angle: float = 0.0
     input_bearing: float = 0.1
     output_bearing: float = 0.1
     arm_radius: float = 0.012
+    support_spacing: float = 0.1
 
     def __post_init__(self) -> None:
         beta = finite("shaft_angle", self.shaft_angle)
@@ -201,6 +221,7 @@ class Geometry:
         set_field(self, "input_bearing", positive("input_bearing", self.input_bearing))
         set_field(self, "output_bearing", positive("output_bearing", self.output_bearing))
         set_field(self, "arm_radius", positive("arm_radius", self.arm_radius))
+        set_field(self, "support_spacing", positive("support_spacing", self.support_spacing))
 
     def output_axis(self) -> np.ndarray:
         """Unit vector of the output shaft axis in the global frame."""
@@ -278,6 +299,24 @@ class Joint:
         if not abs(twist) < 0.5 * math.pi:
             raise SceneError(f"`errors.alpha4` minus the shaft angle (the frame's twist) must be in "
                              f"(-90, 90) deg, got {twist / DEG!r} deg")
+
+    def lever(self, name: str) -> float:
+        """Moment lever of pair ``name`` [m]: its ``moment_lever``, or when that is ``"geometry"``
+        the one the joint's geometry gives (``2 * arm_radius`` for a spider pair,
+        ``support_spacing`` for a frame
+        pair; see :class:`Pair`)."""
+        pair = getattr(self.pairs, name)
+        if pair.moment_lever != GEOMETRY_LEVER:
+            return pair.moment_lever
+        if name in ("input_spider", "spider_output"):
+            return 2.0 * self.geometry.arm_radius
+        return self.geometry.support_spacing
+
+    def friction_pairs(self) -> list[tuple[str, Pair]]:
+        """``(name, pair)`` in chain order with every moment lever resolved (:meth:`lever`): the
+        pairs as the friction law sees them."""
+        return [(name, dataclasses.replace(pair, moment_lever=self.lever(name)))
+                for name, pair in self.pairs.items()]
 
     def bodies(self) -> list[tuple[str, Body]]:
         """``(name, body)`` of the three moving bodies, :data:`BODY_NAMES`."""

@@ -264,6 +264,7 @@ class Numerics:
 
 
 COUPLINGS = ("converged", "lagged", "uncoupled")
+FRICTION_LAWS = ("paper", "resultant")
 DEFAULT_SIGN_BAND_RELATIVE = 1e-3
 """Default ``FrictionSettings.sign_band_relative`` [-] (``docs/paper.md``, "Friction at every speed")."""
 
@@ -301,6 +302,16 @@ class FrictionSettings:
         torque they make at the journal radius, ``F d / 2``).
     max_iterations : int
         Converged coupling: friction updates per step before the step is declared not converged.
+    law : str
+        Direction of the friction of a pair that rotates and slides (a cylindrical pair of a joint
+        with mounting errors). ``"paper"`` (default): eqs. (3), (5) as written, a Coulomb torque
+        ``-s(omega_rel d/2) f (d/2) N`` about the axis and, independently, a Coulomb force
+        ``-s(v_slide) f N`` along it, ``N = |F| + 2 |M| / L`` (the full load in both directions at
+        once). ``"resultant"``: one Coulomb force ``f N`` opposing the resultant slip velocity
+        ``v = (omega_rel d/2, v_slide)`` of the contact, regularised as a vector,
+        ``-f N v / max(|v|, band)``: torque ``(d/2)`` times its circumferential, axial force its
+        axial component (:func:`reference.bands.sign_bands`, ``resultant`` band). Both laws agree
+        for a revolute pair and a pair that does not slide (``docs/scenes.md``, "Friction law").
     """
 
     coupling: str = "converged"
@@ -308,10 +319,13 @@ class FrictionSettings:
     sign_band_relative: float | None = None
     tolerance: float = 1e-6
     max_iterations: int = 20
+    law: str = "paper"
 
     def __post_init__(self) -> None:
         if not isinstance(self.coupling, str) or self.coupling not in COUPLINGS:
             raise SceneError(f"`coupling` must be one of {list(COUPLINGS)}, got {self.coupling!r}")
+        if not isinstance(self.law, str) or self.law not in FRICTION_LAWS:
+            raise SceneError(f"`law` must be one of {list(FRICTION_LAWS)}, got {self.law!r:.80}")
         if self.sign_band is not None and self.sign_band_relative is not None:
             raise SceneError(
                 f"give either `sign_band` (absolute, m/s) or `sign_band_relative` (fraction of each "
@@ -375,6 +389,10 @@ class Scene:
         least one whole revolution is averaged).
     gravity : tuple, shape (3,)
         Gravitational acceleration in the global frame [m/s^2].
+    parameter_set : str
+        The paper's parameter set the scene was built with (:data:`reference.paper.PARAMETER_SETS`,
+        ``"custom"`` for values given by hand), or ``""`` for a scene that is not the paper's;
+        every result carries it, and ``cardan run`` prints it.
     """
 
     joint: Joint
@@ -387,6 +405,7 @@ class Scene:
     record: Record = field(default_factory=Record)
     name: str = "scene"
     description: str = ""
+    parameter_set: str = ""
 
     def __post_init__(self) -> None:
         require_instance("joint", self.joint, Joint, "a Joint")
@@ -395,7 +414,7 @@ class Scene:
         for name, cls in (("load", Load), ("numerics", Numerics), ("friction", FrictionSettings),
                           ("record", Record)):
             require_instance(name, getattr(self, name), cls, f"a {cls.__name__}")
-        for name in ("name", "description"):
+        for name in ("name", "description", "parameter_set"):
             if not isinstance(getattr(self, name), str):
                 raise SceneError(f"`{name}` must be a string, got {getattr(self, name)!r}")
         set_field(self, "gravity", vector("gravity", self.gravity, (3,)))

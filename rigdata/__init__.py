@@ -6,7 +6,7 @@ The public face::
 
     record = rigdata.read("rig.lvm")                    # file -> RigRecord (SI units)
     m = rigdata.measure(record, shaft_angle_deg=15)     # measured efficiency +- u
-    v = rigdata.validate("rig.lvm", "rig-calibrated")   # measured against computed, per engine
+    v = rigdata.validate("rig.lvm", "rig")   # measured against computed, per engine
     rigdata.write_report(v, "out/rig")                  # report.md, figure10.png, ...
     used = rigdata.synthetic.write("rig.csv", "csv", rigdata.RigSettings(revolutions=5))
 

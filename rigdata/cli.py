@@ -263,10 +263,10 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
 
 def _validate_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
-    p.add_argument("--scene", default="rig-calibrated", metavar="NAME|FILE",
+    p.add_argument("--scene", default="rig", metavar="NAME|FILE",
                    help="the joint: a named scene or a scene TOML file (your own joint; may start "
-                        "from base = \"rig-calibrated\"); its drive and load are replaced by the "
-                        "measurement's (default rig-calibrated)")
+                        "from base = \"rig\"); its drive and load are replaced by the "
+                        "measurement's (default rig: the physical parameter set)")
     p.add_argument("--friction", type=arguments.number("-", non_negative=True),
                    help="friction coefficient of every pair (default: the scene's, 0.42 for the rig)")
     p.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")

@@ -1,7 +1,7 @@
 """A synthetic rig: the model's joint measured by a model of the paper's transducers.
 
 The truth is the reference engine (numpy, no time steps) running the rig case (15 deg,
-f = 0.42, calibrated parameter set by default) driven by a motor whose speed ripples with the
+f = 0.42, physical parameter set by default) driven by a motor whose speed ripples with the
 input angle (so every revolution repeats and the kinetic energy returns each revolution: the
 true efficiency over any whole revolutions is the engine's mean efficiency) and loaded by a
 constant brake torque chosen for a mean input torque of 0.2 N m. The transducer model adds
@@ -76,7 +76,7 @@ class RigSettings:
     seed : int
     """
 
-    scene: str = "rig-calibrated"
+    scene: str = "rig"
     shaft_angle_deg: float | None = None
     speed: float = 6.0
     ripple: tuple = (0.01, 0.005)

@@ -277,7 +277,7 @@ def _ok_efficiency(computed: Mapping[str, Any] | None) -> float | None:
     return float(computed["mean_efficiency"])
 
 
-def validate(source: Source, scene: Scene | str | os.PathLike = "rig-calibrated",
+def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
              engines: tuple[str, ...] = MODEL_ENGINES, *, conditioning: Conditioning | None = None,
              transducers: Transducer | tuple[Transducer, Transducer] | None = None,
              monte_carlo: int = 2000, seed: int = 0, progress: Callable[[str], None] | None = None,

@@ -112,8 +112,8 @@ class Case:
 
 # Inputs
 
-_PAPER = 'base = "paper"\n'
-_PAPER_FRICTIONLESS = 'base = "paper-frictionless"\n'
+_PAPER = 'base = "paper-literal"\n'
+_PAPER_FRICTIONLESS = 'base = "paper-literal-frictionless"\n'
 RIG_HEADER = "time [s],torque_in [N m],torque_out [N m],speed_in [rad/s],speed_out [rad/s]\n"
 
 
@@ -156,12 +156,12 @@ def _api_empty_dict(d: Path) -> Any:
 
 def _api_replace_nan(d: Path) -> Any:
     """replace(scene, **{"joint.geometry.shaft_angle": nan})"""
-    return replace(named_scene("paper"), **{"joint.geometry.shaft_angle": math.nan})
+    return replace(named_scene("paper-literal"), **{"joint.geometry.shaft_angle": math.nan})
 
 
 def _api_replace_unknown(d: Path) -> Any:
     """replace(scene, **{"joint.nope.x": 1})"""
-    return replace(named_scene("paper"), **{"joint.nope.x": 1})
+    return replace(named_scene("paper-literal"), **{"joint.nope.x": 1})
 
 
 def _api_body_unphysical(d: Path) -> Any:
@@ -186,22 +186,22 @@ def _api_engine_unknown(d: Path) -> Any:
 
 def _api_tiny_step(d: Path) -> Any:
     """cardan_exudyn.engines.run(paper-frictionless with numerics.dt = 1e-12, "reference")"""
-    return run(replace(named_scene("paper-frictionless"), **{"numerics.dt": 1e-12}), "reference")
+    return run(replace(named_scene("paper-literal-frictionless"), **{"numerics.dt": 1e-12}), "reference")
 
 
 def _api_compare_unknown(d: Path) -> Any:
     """compare(scene, ["exudyn", "warp"]): refused before any engine runs"""
-    return compare(named_scene("paper-frictionless"), ["exudyn", "warp"])
+    return compare(named_scene("paper-literal-frictionless"), ["exudyn", "warp"])
 
 
 def _api_spec_empty_grid(d: Path) -> Any:
-    """spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})"""
-    return spec_from_mapping({"scene": "paper", "grid": {"revolutions": []}})
+    """spec_from_mapping({"scene": "paper-literal", "grid": {"revolutions": []}})"""
+    return spec_from_mapping({"scene": "paper-literal", "grid": {"revolutions": []}})
 
 
 def _api_sweep_out_of_range(d: Path) -> Any:
-    """run_sweep({"scene": "paper", "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, OUT)"""
-    return run_sweep({"scene": "paper", "engine": "reference",
+    """run_sweep({"scene": "paper-literal", "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, OUT)"""
+    return run_sweep({"scene": "paper-literal", "engine": "reference",
                       "grid": {"joint.geometry.shaft_angle_deg": [10, 95]}}, d / "out", workers=1)
 
 
@@ -253,18 +253,18 @@ def _api_run_none(d: Path) -> Any:
 
 
 def _api_run_scene_name(d: Path) -> Any:
-    """cardan_exudyn.engines.run("paper", "reference"): a name where a Scene is expected"""
-    return run("paper", "reference")
+    """cardan_exudyn.engines.run("paper-literal", "reference"): a name where a Scene is expected"""
+    return run("paper-literal", "reference")
 
 
 def _api_run_engine_list(d: Path) -> Any:
     """cardan_exudyn.engines.run(scene, ["reference"]): a list where an engine name is expected"""
-    return run(named_scene("paper-frictionless"), ["reference"])
+    return run(named_scene("paper-literal-frictionless"), ["reference"])
 
 
 def _api_compare_string(d: Path) -> Any:
     """compare(scene, "exudyn,reference"): one string, not a list of engines"""
-    return compare(named_scene("paper-frictionless"), "exudyn,reference")
+    return compare(named_scene("paper-literal-frictionless"), "exudyn,reference")
 
 
 def _api_compare_none(d: Path) -> Any:
@@ -274,7 +274,8 @@ def _api_compare_none(d: Path) -> Any:
 
 def _api_compare_skip_all(d: Path) -> Any:
     """compare(one-revolution scene, skip_revolutions=5): nothing left to compare"""
-    return compare(replace(named_scene("paper-frictionless"), revolutions=1.0), ["reference", "exudyn"],
+    return compare(replace(named_scene("paper-literal-frictionless"), revolutions=1.0), ["reference",
+                                                                                         "exudyn"],
                    skip_revolutions=5.0)
 
 
@@ -285,13 +286,13 @@ def _api_replace_none(d: Path) -> Any:
 
 def _api_scene_load_type(d: Path) -> Any:
     """Scene(joint, drive, load=5): a number where a Load is expected"""
-    scene = named_scene("paper")
+    scene = named_scene("paper-literal")
     return Scene(scene.joint, scene.drive, load=5)
 
 
 def _api_named_scene_list(d: Path) -> Any:
-    """reference.paper.named_scene(["paper"])"""
-    return named_scene(["paper"])
+    """reference.paper.named_scene(["paper-literal"])"""
+    return named_scene(["paper-literal"])
 
 
 def _api_load_scene_none(d: Path) -> Any:
@@ -315,8 +316,8 @@ def _api_rig_transducer_class(d: Path) -> Any:
 
 
 def _api_rig_validate_string(d: Path) -> Any:
-    """rigdata.validate("rig.csv", "rig", "reference,exudyn"): one string, not a tuple of engines"""
-    return validate(d / "rig.csv", "rig", "reference,exudyn", monte_carlo=0)
+    """rigdata.validate("rig.csv", "rig-literal", "reference,exudyn"): one string, not a tuple of engines"""
+    return validate(d / "rig.csv", "rig-literal", "reference,exudyn", monte_carlo=0)
 
 
 def _api_rig_conditioning_phase(d: Path) -> Any:
@@ -425,7 +426,7 @@ CASES: tuple[Case, ...] = (
          ("compare", "--engines", "reference,exudyn", "--revolutions", "1", "--skip-revolutions", "5",
           "--out", "{out}"), out="folder", match="leaves nothing"),
     Case("sweep-workers-huge", "cli", "1e12 workers",
-         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--workers", "1000000000000",
+         ("sweep", "--scene", "paper-literal", "--grid", "revolutions=1", "--workers", "1000000000000",
           "--out", "{out}"),
          out="folder", match="at most 1024"),
     Case("bench-repeats-huge", "cli", "1e12 timed repeats", ("bench", "--repeats", "1e12"),
@@ -451,11 +452,12 @@ CASES: tuple[Case, ...] = (
     Case("run-engine-unknown", "cli", "unknown engine", ("run", "--engine", "warp", "--out", "{out}"),
          out="folder", match="must be one of"),
     Case("run-engine-friction", "cli", "MuJoCo asked for a scene with friction",
-         ("run", "--name", "paper", "--engine", "mujoco"), match="cannot"),
+         ("run", "--name", "paper-literal", "--engine", "mujoco"), match="cannot"),
     Case("run-name-unknown", "cli", "unknown named scene", ("run", "--name", "nope"),
          match="unknown scene name"),
     Case("run-scene-and-name", "cli", "--scene and --name together",
-         ("run", "--scene", "{d}/x.toml", "--name", "paper"), match="not allowed with argument --scene"),
+         ("run", "--scene", "{d}/x.toml", "--name", "paper-literal"),
+             match="not allowed with argument --scene"),
     Case("run-revolutions-short", "cli", "half a revolution (no whole revolution to average)",
          ("run", "--revolutions", "0.5"), match="`revolutions` must be at least"),
     Case("run-tiny-step", "cli", "--dt 1e-12 (6e10 steps)", ("run", "--dt", "1e-12", "--out", "{out}"),
@@ -479,15 +481,16 @@ CASES: tuple[Case, ...] = (
     Case("sweep-no-scene", "cli", "no spec and no --scene", ("sweep", "--out", "{out}"), out="folder",
          match="`scene` is required"),
     Case("sweep-grid-syntax", "cli", "--grid without `=`",
-         ("sweep", "--scene", "paper", "--grid", "revolutions", "--out", "{out}"), out="folder",
+         ("sweep", "--scene", "paper-literal", "--grid", "revolutions", "--out", "{out}"), out="folder",
          match="must look like PATH=V1,V2"),
     Case("sweep-out-empty", "cli", "an empty --out (would be the current folder)",
-         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--out", ""), match="--out is empty"),
+         ("sweep", "--scene", "paper-literal", "--grid", "revolutions=1", "--out", ""),
+             match="--out is empty"),
     Case("sweep-workers-scheduler", "cli", "--workers and --scheduler together",
-         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--workers", "2", "--scheduler",
+         ("sweep", "--scene", "paper-literal", "--grid", "revolutions=1", "--workers", "2", "--scheduler",
           "tcp://127.0.0.1:1", "--out", "{out}"), match="not allowed with"),
     Case("sweep-workers-zero", "cli", "zero workers",
-         ("sweep", "--scene", "paper", "--grid", "revolutions=1", "--workers", "0", "--out", "{out}"),
+         ("sweep", "--scene", "paper-literal", "--grid", "revolutions=1", "--workers", "0", "--out", "{out}"),
          match="must be >= 1"),
     Case("tolerance-samples-zero", "cli", "zero Monte Carlo samples",
          ("tolerance", "montecarlo", "--samples", "0", "--out", "{out}"), match="must be >= 1"),
@@ -501,7 +504,8 @@ CASES: tuple[Case, ...] = (
          ("tolerance", "montecarlo", "--seed", "-1", "--samples", "2", "--out", "{out}"), out="folder",
          match="seed"),
     Case("tolerance-engines-unknown", "cli", "unknown engine in the paper case",
-         ("tolerance", "paper", "--engines", "warp", "--out", "{out}"), out="folder", match="--engines"),
+         ("tolerance", "paper", "--engines", "warp", "--out", "{out}"), out="folder",
+             match="--engines"),
     Case("reproduce-workers-zero", "cli", "zero workers", ("reproduce", "--workers", "0", "--out", "{out}"),
          match="must be >= 1"),
     Case("reproduce-out-is-file", "cli", "--out names an existing file", ("reproduce", "--out", "{out}"),
@@ -511,10 +515,10 @@ CASES: tuple[Case, ...] = (
          match="must be among"),
     Case("bench-out-is-file", "cli", "--out names an existing file (refused before the benchmark runs)",
          ("bench", "--quick", "--out", "{out}"), out="file", match="not a folder"),
-    Case("calibrate-unknown", "cli", "unknown parameter", ("calibrate", "--parameters", "foo"),
-         match="unknown"),
-    Case("calibrate-empty", "cli", "an empty parameter list", ("calibrate", "--parameters", ","),
-         match="--parameters"),
+    Case("calibrate-unknown", "cli", "unknown parameter set", ("calibrate", "--set", "foo"),
+         match="--set must be one of"),
+    Case("calibrate-engine", "cli", "an engine a fit cannot use", ("calibrate", "--engine", "mujoco"),
+         match="--engine must be one of"),
     Case("study-unknown", "cli", "unknown study", ("study", "warp"), match="invalid choice"),
     Case("study-out-parent-file", "cli", "--out inside an existing file (refused before the study runs)",
          ("study", "coupling", "--quick", "--out", "{out}/sub"), out="file", match="not a folder"),
@@ -690,81 +694,87 @@ CASES: tuple[Case, ...] = (
          match="channel 'time'"),
     # sweep specifications
     Case("spec-samples-huge", "sweep spec", "[random] samples = 1000000000 (out of memory)", _SWEEP,
-         files=_spec('scene = "paper"\n[random]\nsamples = 1000000000\nseed = 1\n'
+         files=_spec('scene = "paper-literal"\n[random]\nsamples = 1000000000\nseed = 1\n'
                      '[random.parameters.revolutions]\ndist = "uniform"\nlow = 1\nhigh = 2\n'),
          out="folder", match="`random.samples` must be in [1, 100000]"),
     Case("spec-samples-float", "sweep spec", "[random] samples = 1e9 (a float)", _SWEEP,
-         files=_spec('scene = "paper"\n[random]\nsamples = 1e9\nseed = 1\n'
+         files=_spec('scene = "paper-literal"\n[random]\nsamples = 1e9\nseed = 1\n'
                      '[random.parameters.revolutions]\ndist = "uniform"\nlow = 1\nhigh = 2\n'),
          out="folder", match="`random.samples` must be an integer"),
     Case("spec-grid-huge", "sweep spec", "a grid of 1e5 x 1e5 points", _SWEEP,
-         files=_spec('scene = "paper"\n[grid]\nrevolutions = {linspace = [1, 2, 100000]}\n'
+         files=_spec('scene = "paper-literal"\n[grid]\nrevolutions = {linspace = [1, 2, 100000]}\n'
                      '"load.torque" = {linspace = [1, 2, 100000]}\n'), out="folder", match="at most 100000"),
     Case("spec-unknown-parameter", "sweep spec", "grid over a scene field that does not exist", _SWEEP,
-         files=_spec('scene = "paper"\nengine = "reference"\n[grid]\n"joint.geometry.nope" = [1, 2]\n'),
+         files=_spec('scene = "paper-literal"\nengine = "reference"\n[grid]\n'
+                     '"joint.geometry.nope" = [1, 2]\n'),
          out="folder", match="unknown key(s) ['nope']"),
     Case("spec-empty-grid", "sweep spec", "a grid parameter with no values", _SWEEP,
-         files=_spec('scene = "paper"\n[grid]\nrevolutions = []\n'), out="folder", match="empty list"),
+         files=_spec('scene = "paper-literal"\n[grid]\nrevolutions = []\n'), out="folder",
+             match="empty list"),
     Case("spec-bad-distribution", "sweep spec", "distribution `cauchy`", _SWEEP,
-         files=_spec('scene = "paper"\n[random]\nsamples = 3\nseed = 1\n'
+         files=_spec('scene = "paper-literal"\n[random]\nsamples = 3\nseed = 1\n'
                      '[random.parameters."joint.errors.a1_mm"]\ndist = "cauchy"\nlow = 0\nhigh = 1\n'),
          out="folder", match="`dist` must be one of"),
     Case("spec-toml-syntax", "sweep spec", "unclosed table header", _SWEEP,
-         files=_spec('scene = "paper"\n[grid\n'), out="folder", match="not valid TOML"),
+         files=_spec('scene = "paper-literal"\n[grid\n'), out="folder", match="not valid TOML"),
     Case("spec-unknown-key", "sweep spec", "a top-level key no spec has", _SWEEP,
-         files=_spec('scene = "paper"\nfoo = 1\n[grid]\nrevolutions = [1]\n'), out="folder",
+         files=_spec('scene = "paper-literal"\nfoo = 1\n[grid]\nrevolutions = [1]\n'), out="folder",
          match="unknown key(s) ['foo']"),
     Case("spec-no-seed", "sweep spec", "random samples without a seed", _SWEEP,
-         files=_spec('scene = "paper"\n[random]\nsamples = 3\n'
+         files=_spec('scene = "paper-literal"\n[random]\nsamples = 3\n'
                      '[random.parameters.revolutions]\ndist = "uniform"\nlow = 1\nhigh = 2\n'),
          out="folder", match="`seed` is required"),
     Case("spec-cases-and-grid", "sweep spec", "explicit cases and a grid", _SWEEP,
-         files=_spec('scene = "paper"\ncases = [{revolutions = 1}]\n[grid]\nrevolutions = [1]\n'),
+         files=_spec('scene = "paper-literal"\ncases = [{revolutions = 1}]\n[grid]\nrevolutions = [1]\n'),
          out="folder",
          match="not both"),
     Case("spec-linspace-zero", "sweep spec", "linspace with zero points", _SWEEP,
-         files=_spec('scene = "paper"\n[grid]\nrevolutions = {linspace = [1, 2, 0]}\n'), out="folder",
+         files=_spec('scene = "paper-literal"\n[grid]\nrevolutions = {linspace = [1, 2, 0]}\n'), out="folder",
          match="num must be an integer >= 1"),
     Case("spec-grid-out-of-range", "sweep spec", "a grid value outside the scene's range", _SWEEP,
-         files=_spec('scene = "paper"\n[grid]\n"joint.geometry.shaft_angle_deg" = [10, 95]\n'), out="folder",
+         files=_spec('scene = "paper-literal"\n[grid]\n"joint.geometry.shaft_angle_deg" = [10, 95]\n'),
+             out="folder",
          match="[0, 90) deg"),
     Case("spec-binary", "sweep spec", "binary junk instead of TOML", _SWEEP,
          files={"spec.toml": b"\xff\xfe\x00junk"}, out="folder", match="not UTF-8 text"),
     Case("spec-directory", "sweep spec", "a folder where the spec should be", _SWEEP,
          files={"spec.toml": DIRECTORY}, out="folder", match="is a directory"),
     Case("spec-duplicate-id", "sweep spec", "two cases with one id", _SWEEP,
-         files=_spec('scene = "paper"\ncases = [{id = "a", revolutions = 1}, {id = "a", revolutions = 2}]\n'),
+         files=_spec('scene = "paper-literal"\n'
+                     'cases = [{id = "a", revolutions = 1}, {id = "a", revolutions = 2}]\n'),
          out="folder", match="used twice"),
     Case("spec-missing", "sweep spec", "the spec file does not exist",
          ("sweep", "{d}/missing.toml", "--out", "{out}"), out="folder", match="cannot read sweep spec"),
     Case("spec-nothing", "sweep spec", "a scene and nothing to sweep", _SWEEP,
-         files=_spec('scene = "paper"\n'), out="folder", match="nothing to sweep"),
+         files=_spec('scene = "paper-literal"\n'), out="folder", match="nothing to sweep"),
     Case("spec-engine-fixed", "sweep spec", "engine among the fixed overrides", _SWEEP,
-         files=_spec('scene = "paper"\n[fixed]\nengine = "reference"\n[grid]\nrevolutions = [1]\n'),
+         files=_spec('scene = "paper-literal"\n[fixed]\nengine = "reference"\n[grid]\nrevolutions = [1]\n'),
          out="folder", match="`engine` can be set"),
     Case("spec-scene-missing", "sweep spec", "the spec's scene file does not exist", _SWEEP,
          files=_spec('scene = "nope.toml"\n[grid]\nrevolutions = [1]\n'), out="folder",
          match="cannot read scene file"),
     # failures inside a run
     Case("fail-run-reference", "run failure", "self-locking at 50 deg, reference engine",
-         ("run", "--name", "paper-50deg", "--engine", "reference", "--revolutions", "1"), expect=3,
+         ("run", "--name", "paper-literal-50deg", "--engine", "reference", "--revolutions", "1"), expect=3,
          match="status: self_locking"),
     Case("fail-run-exudyn", "run failure", "self-locking at 50 deg, Exudyn",
-         ("run", "--name", "paper-50deg", "--revolutions", "1"), expect=3, match="status: self_locking"),
+         ("run", "--name", "paper-literal-50deg", "--revolutions", "1"), expect=3,
+             match="status: self_locking"),
     Case("fail-run-json", "run failure", "self-locking with --json: strict JSON, no efficiency",
-         ("run", "--name", "paper-50deg", "--engine", "reference", "--revolutions", "1", "--json"), expect=3,
+         ("run", "--name", "paper-literal-50deg", "--engine", "reference", "--revolutions", "1", "--json"),
+             expect=3,
          match='"status": "self_locking"'),
     Case("free-spin", "run failure", "a joint spinning free: no input work, the efficiency is 0/0",
          ("run", "--scene", "{d}/scene.toml"), expect=0, match="mean efficiency undefined",
-         files=_scene_toml('base = "paper-frictionless"\nrevolutions = 1\n[load]\ntorque = 0.0\n'
+         files=_scene_toml('base = "paper-literal-frictionless"\nrevolutions = 1\n[load]\ntorque = 0.0\n'
                            '[drive]\nkind = "torque"\ntorque = 0.0\ninitial_speed = 209.4\n')),
     Case("fail-compare", "run failure", "compare where both engines self-lock",
-         ("compare", "--name", "paper-50deg", "--engines", "reference,exudyn", "--revolutions", "1"),
+         ("compare", "--name", "paper-literal-50deg", "--engines", "reference,exudyn", "--revolutions", "1"),
          expect=3, match="self_locking"),
     Case("fail-sweep", "run failure", "a sweep whose case self-locks",
-         ("sweep", "--scene", "paper-50deg", "--engine", "reference", "--grid", "revolutions=1",
+         ("sweep", "--scene", "paper-literal-50deg", "--engine", "reference", "--grid", "revolutions=1",
           "--workers", "1", "--out", "{d}/sweep"), expect=3, match="1 self_locking"),
     Case("fail-tolerance", "run failure", "Monte Carlo on a self-locking scene",
-         ("tolerance", "montecarlo", "--name", "paper-50deg", "--revolutions", "1", "--samples", "2",
+         ("tolerance", "montecarlo", "--name", "paper-literal-50deg", "--revolutions", "1", "--samples", "2",
           "--workers", "1", "--out", "{d}/mc"), expect=3, match="self_locking"),
 )

@@ -41,7 +41,7 @@ def balanced_scene(shaft_angle_deg: float = 0.0, rpm: float = 600.0, load: float
 
 @pytest.fixture
 def paper_10deg_frictionless() -> Scene:
-    return named_scene("paper-10deg-frictionless")
+    return named_scene("paper-literal-10deg-frictionless")
 
 
 __all__ = ["balanced_scene", "balanced_joint", "Pair"]

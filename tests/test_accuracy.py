@@ -43,11 +43,11 @@ def test_richardson_formula():
 
 def test_efficiency_model_falls_with_the_step_and_scales_with_the_loss():
     """The a-priori error falls as the steps grow and is proportional to the loss fraction."""
-    scene = named_scene("paper-10deg")
+    scene = named_scene("paper-literal-10deg")
     errors = [efficiency_error(scene, n, 0.5) for n in (100, 200, 400, 800)]
     assert errors == sorted(errors, reverse=True)
     assert efficiency_error(scene, 200, 0.25) == pytest.approx(0.5 * efficiency_error(scene, 200, 0.5))
-    assert efficiency_error(named_scene("paper-10deg-frictionless"), 100, 0.5) == 0.0
+    assert efficiency_error(named_scene("paper-literal-10deg-frictionless"), 100, 0.5) == 0.0
     n = efficiency_steps(scene, 1e-3, 0.5)
     assert efficiency_error(scene, n, 0.5) <= 1e-3 < efficiency_error(scene, n - 1, 0.5)
 
@@ -55,17 +55,17 @@ def test_efficiency_model_falls_with_the_step_and_scales_with_the_loss():
 def test_order_is_one_while_the_sign_ramps_are_not_resolved():
     """Reversing friction with unresolved sign ramps converges at first order; at 0 deg (no
     reversal) and with ramps resolved, at second order; the lagged coupling at first order."""
-    scene = named_scene("paper-10deg")
+    scene = named_scene("paper-literal-10deg")
     assert convergence_order(scene, 400) == 1
     assert convergence_order(scene, 10_000_000) == 2
-    assert convergence_order(named_scene("paper-0deg"), 400) == 2
+    assert convergence_order(named_scene("paper-literal-0deg"), 400) == 2
     assert convergence_order(replace(scene, **{"friction.coupling": "lagged"}), 10_000_000) == 1
 
 
 @pytest.mark.parametrize("accuracy, angle", [(1e-300, 10.0), (1e-3, 89.9)], ids=["tiny-accuracy", "89.9deg"])
 def test_unreachable_accuracy_is_refused_before_running(accuracy, angle):
     """A request needing more steps than allowed is refused with the predicted steps and time."""
-    scene = replace(named_scene("paper-10deg"), **{"numerics.accuracy": accuracy,
+    scene = replace(named_scene("paper-literal-10deg"), **{"numerics.accuracy": accuracy,
                                                    "joint.geometry.shaft_angle": math.radians(angle)})
     with pytest.raises(SceneError, match=r"steps per input revolution .* about .* s"):
         plan_steps(scene, 0.5)
@@ -77,8 +77,8 @@ def test_reversing_parts_follow_angle_errors_and_drive():
     """Only motions that can turn back feed the first-order term: none at 0 deg under a speed
     drive, the spider rotations at a shaft angle, sliding with mounting errors, the frame pairs
     under a torque drive but not under a monotonic angle history."""
-    assert reversing_parts(named_scene("paper-0deg")) == []
-    ten = named_scene("paper-10deg")
+    assert reversing_parts(named_scene("paper-literal-0deg")) == []
+    ten = named_scene("paper-literal-10deg")
     assert set(reversing_parts(ten)) == {("input_spider", "rotation"), ("spider_output", "rotation")}
     errors = replace(ten, **{"joint.errors.a2": 2e-4})
     assert ("input_spider", "sliding") in reversing_parts(errors)
@@ -93,7 +93,7 @@ def test_reversing_parts_follow_angle_errors_and_drive():
 
 def test_only_the_reversing_loss_is_first_order():
     """The first-order term scales with the loss in reversing motions, the second with all."""
-    scene = named_scene("paper-10deg")
+    scene = named_scene("paper-literal-10deg")
     full, part, none = (efficiency_error(scene, 400, 0.5, reversing_fraction=r) for r in (0.5, 0.1, 0.0))
     assert none < part < full
     assert full - none == pytest.approx(5.0 * (part - none))
@@ -105,7 +105,7 @@ def test_companion_is_two_to_three_times_the_step():
     """The estimate comes from a companion at 2-3 times the main step (never the far coarser
     steps whose Richardson estimates were off by up to 30x), and it bounds the true error
     within a factor 3 on ``paper-10deg``."""
-    scene = replace(named_scene("paper-10deg"), **ONE_REVOLUTION)
+    scene = replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION)
     s = run(scene).summary
     info = s.extras["accuracy"]
     assert 2.0 - 1e-9 <= info["companion_dt"] / s.dt <= 3.0 + 1e-9
@@ -118,7 +118,7 @@ def test_companion_is_two_to_three_times_the_step():
 def test_paper_35deg_is_not_flagged_wrongly():
     """``paper-35deg`` at the default accuracy is not flagged (it was: 3.3e-3 estimated against a
     true 1.7e-4, from a companion 11.6 times coarser) and its estimate is within 3x of the truth."""
-    scene = replace(named_scene("paper-35deg"), **{"record.timeseries": False})
+    scene = replace(named_scene("paper-literal-35deg"), **{"record.timeseries": False})
     s = run(scene).summary
     true = abs(s.mean_efficiency - run(scene, "reference", **REFERENCE_TIGHT).summary.mean_efficiency)
     assert s.accuracy_met is True and true <= scene.numerics.accuracy
@@ -127,7 +127,7 @@ def test_paper_35deg_is_not_flagged_wrongly():
 
 def test_frictionless_run_reports_zero_error_without_a_companion():
     """Without friction nothing is lost: the estimate is 0 and no companion runs."""
-    result = run(replace(named_scene("paper-10deg-frictionless"), **ONE_REVOLUTION))
+    result = run(replace(named_scene("paper-literal-10deg-frictionless"), **ONE_REVOLUTION))
     assert result.summary.efficiency_error_estimate == 0.0
     assert result.summary.accuracy_met is True
     assert "companion_dt" not in result.summary.extras["accuracy"]
@@ -135,7 +135,7 @@ def test_frictionless_run_reports_zero_error_without_a_companion():
 
 def test_reference_reports_its_quadrature_estimate():
     """The reference engine reports its quadrature's estimate in the same field."""
-    s = run(replace(named_scene("paper-10deg"), **ONE_REVOLUTION), "reference").summary
+    s = run(replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION), "reference").summary
     assert 0.0 <= s.efficiency_error_estimate < 1e-6  # rtol 1e-9 of works of ~25 J
     assert s.accuracy_met is True
 
@@ -143,7 +143,7 @@ def test_reference_reports_its_quadrature_estimate():
 def test_given_coarse_step_is_flagged(capsys):
     """The issue's ``--dt 0.005`` (0.175 against 0.4749): warned before running, the estimate
     exceeds the target, ``accuracy_met`` is false and ``cardan run`` exits 5."""
-    status = main(["run", "--name", "paper-10deg", "--dt", "0.005", "--revolutions", "1"])
+    status = main(["run", "--name", "paper-literal-10deg", "--dt", "0.005", "--revolutions", "1"])
     err = capsys.readouterr().err
     assert status == EXIT_INACCURATE
     assert "may miss the accuracy" in err and "accuracy not met" in err
@@ -209,7 +209,7 @@ def test_torque_drive_speeding_up_past_its_step_says_why():
 def test_without_error_estimate_one_run_and_no_estimate():
     """``ExudynOptions(error_estimate=False)`` (what step halving reruns with): the run at the
     given step alone, the same numbers as the main run of the estimated one, no estimate."""
-    scene = replace(named_scene("paper-10deg"), revolutions=1.0, **{"numerics.dt": 2e-4})
+    scene = replace(named_scene("paper-literal-10deg"), revolutions=1.0, **{"numerics.dt": 2e-4})
     full = run(scene, "exudyn")
     alone = run(scene, "exudyn", error_estimate=False)
     assert alone.summary.mean_efficiency == full.summary.mean_efficiency

@@ -91,7 +91,9 @@ def _product_sources() -> list[tuple[str, str]]:
 
 
 def test_engine_runs_go_through_the_dispatch():
-    """No engine-string dispatch and no engine's run function imported outside engines.py."""
+    """No engine-string dispatch and no engine's run function imported outside engines.py; the
+    reference package, which cannot import cardan_exudyn, may run its own engine (the paper's
+    data solve a load with it: reference.paper.mean_input_load)."""
     dispatch = re.compile(r"""(==|!=)\s*["'](exudyn|reference|mujoco)["']|"""
                           r"""in\s*\(\s*["'](exudyn|reference|mujoco)["']""")
     offenders = []
@@ -100,7 +102,8 @@ def test_engine_runs_go_through_the_dispatch():
             continue
         offenders += [f"{module}: {m.group(0)}" for m in dispatch.finditer(text)]
         for node in ast.walk(ast.parse(text)):
-            if isinstance(node, ast.ImportFrom) and node.module in ENGINE_RUN_MODULES:
+            if isinstance(node, ast.ImportFrom) and node.module in ENGINE_RUN_MODULES \
+                    and not (module.startswith("reference.") and node.module == "reference.engine"):
                 offenders += [f"{module}: from {node.module} import run"
                               for a in node.names if a.name == "run"]
     assert offenders == []

@@ -30,7 +30,7 @@ def test_run_errors_follow_the_integrators_order():
     """Halving Exudyn's step divides the speed-ratio and drive-torque errors (after the start-up
     revolution) by about four: the errors are measured against the exact reference, not against
     a run of the same engine."""
-    scene = named_scene("paper-35deg-frictionless")
+    scene = named_scene("paper-literal-35deg-frictionless")
     yard = yardstick(scene)
     errs = []
     for n in (100, 200):
@@ -45,7 +45,7 @@ def test_run_errors_follow_the_integrators_order():
 
 
 def test_run_errors_of_a_failed_run_are_nan():
-    scene = named_scene("paper-10deg-frictionless")
+    scene = named_scene("paper-literal-10deg-frictionless")
     failed = Result(None, Summary(Status.INTEGRATION_FAILURE, "solver failed"))
     errs = run_errors(scene, failed, yardstick(scene))
     assert all(math.isnan(v) for v in errs.values())
@@ -127,7 +127,7 @@ def test_solve_only_is_the_engine_solve_with_the_tweak(tmp_path):
     """The audit's build-and-solve runs are the engine's one solve sequence (the same step as a
     full run), with the tweak applied once before the solver starts: the solution-file item
     really writes Exudyn's coordinates file."""
-    scene = replace(named_scene("paper-10deg-frictionless"),
+    scene = replace(named_scene("paper-literal-10deg-frictionless"),
                     **{"numerics.dt": 2 * math.pi / 209.44 / 100, "revolutions": 1,
                        "record.timeseries": False})
     steps = []
@@ -177,13 +177,13 @@ def test_configurations_cover_the_issue_dimensions():
     assert not any(c.engine == "mujoco" for c in full)  # MuJoCo has no reaction friction
     free = configurations("frictionless-35deg", quick=False)
     assert any("projection" in c.label for c in free)
-    scene = free[0].scene(named_scene("paper-35deg-frictionless"))
+    scene = free[0].scene(named_scene("paper-literal-35deg-frictionless"))
     assert scene.numerics.dt == pytest.approx(2 * math.pi / scene.drive.speed / free[0].steps)
     lagged = next(c for c in full if c.coupling == "lagged")
-    assert lagged.scene(named_scene("paper-35deg")).friction.coupling == "lagged"
+    assert lagged.scene(named_scene("paper-literal-35deg")).friction.coupling == "lagged"
     # the reference engine's resolution is its table samples, in its options, not a time step
     reference = [c for c in full if c.engine == "reference"]
-    base = named_scene("paper-35deg")
+    base = named_scene("paper-literal-35deg")
     assert all(c.options.samples_per_revolution == c.steps for c in reference)
     assert all(c.scene(base).numerics.dt == base.numerics.dt for c in reference)
 
@@ -191,7 +191,7 @@ def test_configurations_cover_the_issue_dimensions():
 def test_exudyn_tuned_options_do_not_change_the_answer():
     """Modified Newton with one Jacobian per step and tolerance 1e-8: same mean efficiency as the
     defaults to 1e-7 on a friction scene (the bench's 'tuned' is a cost change only)."""
-    scene = replace(named_scene("paper-10deg"), **{"numerics.dt": 2 * math.pi / 209.44 / 200,
+    scene = replace(named_scene("paper-literal-10deg"), **{"numerics.dt": 2 * math.pi / 209.44 / 200,
                                                     "revolutions": 1})
     a = engines.run(scene, "exudyn")
     b = engines.run(scene, "exudyn", EXUDYN_TUNED)

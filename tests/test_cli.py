@@ -71,7 +71,7 @@ def test_bad_cli_input(args, message):
 
 def test_scene_command_prints_toml():
     """`cardan scene` prints the resolved scene, which loads back."""
-    proc = cardan("scene", "--name", "paper-frictionless", "--angle", "12")
+    proc = cardan("scene", "--name", "paper-literal-frictionless", "--angle", "12")
     assert proc.returncode == 0
     assert "shaft_angle = 0.2094" in proc.stdout
 
@@ -80,8 +80,8 @@ def test_reproduce_quick(tmp_path):
     """`cardan reproduce --quick` writes the report folder with its table and plots."""
     out = tmp_path / "rep"
     assert main(["reproduce", "--quick", "--out", str(out)]) == 0
-    for name in ("report.md", "results.csv", "assumptions.csv", "table2_plain.png",
-                 "fig4_efficiency_10deg_plain.png", "fig5_pair_losses_plain.png",
+    for name in ("report.md", "results.csv", "assumptions.csv", "table2.png",
+                 "fig4_efficiency_10deg_physical.png", "fig5_pair_losses_physical.png",
                  "summaries.json"):
         assert (out / name).is_file(), name
     report = (out / "report.md").read_text()
@@ -91,7 +91,7 @@ def test_reproduce_quick(tmp_path):
 
 def test_self_locking_exits_3():
     """A self-locking run prints its status and reason, not a number, and exits 3."""
-    proc = cardan("run", "--name", "paper-50deg", "--revolutions", "1")
+    proc = cardan("run", "--name", "paper-literal-50deg", "--revolutions", "1")
     assert proc.returncode == 3
     assert "self_locking" in proc.stderr and "loop gain" in proc.stderr
     assert "mean efficiency" not in proc.stdout
@@ -100,7 +100,7 @@ def test_self_locking_exits_3():
 def test_reader_that_goes_away_ends_quietly():
     """`cardan run --json | head -1`: no BrokenPipeError traceback, exit 141 (128 + SIGPIPE)."""
     proc = subprocess.Popen([sys.executable, "-m", "cardan_exudyn.cli", "run", "--name",
-                             "paper-10deg-frictionless", "--revolutions", "1", "--json"],
+                             "paper-literal-10deg-frictionless", "--revolutions", "1", "--json"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     proc.stdout.close()  # the reader is gone before the command writes
     err = proc.stderr.read().decode()

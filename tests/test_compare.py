@@ -36,7 +36,7 @@ from reference.schema import OptionsError, Status
 
 SKIP = 0.25  # revolutions left out of the steady statistics
 RAMP_RELATIVE = 0.1  # sign ramp resolved by the step (see the module docstring)
-SCENES = ["paper-30deg-frictionless", "paper-10deg", "paper-calibrated-30deg"]
+SCENES = ["paper-literal-30deg-frictionless", "paper-literal-10deg", "paper-matched-30deg"]
 
 
 def kind_scales(table) -> dict[str, float]:
@@ -82,7 +82,7 @@ def ladder():
     return {(name, spr): run_pair(name, spr) for name in SCENES for spr in (200, 400)}
 
 
-@pytest.mark.parametrize("name", ["paper-30deg-frictionless"])
+@pytest.mark.parametrize("name", ["paper-literal-30deg-frictionless"])
 def test_richardson_extrapolated_exudyn_predicts_the_reference(ladder, name):
     """Every checked column (kinematics, each pair's reactions and friction, input torque,
     per-pair loss): Exudyn's error is its leading second-order term. Extrapolating Exudyn's own
@@ -146,7 +146,7 @@ def test_differences_shrink_with_the_step(ladder, name):
 def test_join_interpolates_when_rows_differ():
     """Different sampling: the spline join reproduces a smooth column far below the differences
     the comparison measures (reference sampled at two resolutions against itself)."""
-    scene = replace(named_scene("paper-20deg-frictionless"), revolutions=1)
+    scene = replace(named_scene("paper-literal-20deg-frictionless"), revolutions=1)
     a = run(scene, "reference", ReferenceOptions(samples_per_revolution=720)).table
     b = run(scene, "reference", ReferenceOptions(samples_per_revolution=360)).table
     joined, how = join_on_input_angle(a, b)
@@ -159,7 +159,7 @@ def test_join_interpolates_when_rows_differ():
 
 def test_cli_compare_json_and_report(tmp_path, capsys):
     out = tmp_path / "cmp"
-    code = main(["compare", "--name", "paper-10deg-frictionless", "--revolutions", "1",
+    code = main(["compare", "--name", "paper-literal-10deg-frictionless", "--revolutions", "1",
                  "--engines", "exudyn,reference", "--skip-revolutions", "0.25", "--json",
                  "--out", str(out)])
     assert code == 0
@@ -180,7 +180,7 @@ def test_cli_compare_json_and_report(tmp_path, capsys):
 ])
 def test_cli_compare_bad_engines(tmp_path, capsys, engines, message):
     out = tmp_path / "cmp"
-    code = main(["compare", "--name", "paper-10deg", "--revolutions", "1", "--engines", engines,
+    code = main(["compare", "--name", "paper-literal-10deg", "--revolutions", "1", "--engines", engines,
                  "--out", str(out)])
     assert code == 2
     assert message in capsys.readouterr().err
@@ -190,7 +190,7 @@ def test_cli_compare_bad_engines(tmp_path, capsys, engines, message):
 def test_comparison_api(ladder):
     """The typed comparison: statistics per column as a DataFrame, the JSON shape of the report,
     and the differing columns as a text table."""
-    comparison, _ = ladder[("paper-30deg-frictionless", 200)]
+    comparison, _ = ladder[("paper-literal-30deg-frictionless", 200)]
     assert comparison.base == "exudyn" and comparison.success
     d = comparison.differences["reference"]
     assert d.against == "exudyn" and d.join == "same rows"
@@ -214,7 +214,7 @@ def test_comparison_api(ladder):
 
 
 def test_compare_passes_each_engine_its_options():
-    scene = replace(named_scene("paper-10deg-frictionless"), revolutions=1)
+    scene = replace(named_scene("paper-literal-10deg-frictionless"), revolutions=1)
     options = {"reference": ReferenceOptions(gauss_nodes=6)}
     comparison = compare(scene, ("exudyn", "reference"), options=options)
     assert comparison.results["reference"].summary.options["gauss_nodes"] == 6
@@ -226,7 +226,7 @@ def test_compare_passes_each_engine_its_options():
     ({"reference": ExudynOptions()}, "not the options of engine 'reference'"),
 ])
 def test_compare_refuses_wrong_options_before_running(options, message):
-    scene = named_scene("paper-10deg-frictionless")
+    scene = named_scene("paper-literal-10deg-frictionless")
     with pytest.raises(OptionsError, match=message):
         compare(scene, ("exudyn", "reference"), options=options)
 

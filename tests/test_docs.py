@@ -70,7 +70,7 @@ RUN = (
     "cardan run --angle 15 --revolutions 1 --json",
     "cardan run --scene my_joint.toml",
     "cardan run --scene my_joint.toml --engine reference --out out/my_joint",
-    "cardan scene --name paper-calibrated",
+    "cardan scene --name paper-10deg",
     "cardan rig synthetic --format lvm --out rig.lvm",
 )
 """Commands (as written in the documents, comments left out) that run, not only parse: each

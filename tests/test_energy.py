@@ -23,7 +23,7 @@ def balance_residual(result) -> tuple[float, float]:
     return s.input_work - s.output_work - s.loss_work - (e1 - e0), s.input_work
 
 
-@pytest.mark.parametrize("name", ["paper-10deg-frictionless", "paper-35deg-frictionless"])
+@pytest.mark.parametrize("name", ["paper-literal-10deg-frictionless", "paper-literal-35deg-frictionless"])
 def test_energy_balance_converges_at_second_order(name):
     """The balance residual of the paper's scene falls as dt^2."""
     scene = named_scene(name)

@@ -19,7 +19,7 @@ SHORT = {"revolutions": 1.0}
 
 @pytest.fixture(scope="module")
 def frictionless():
-    return replace(named_scene("paper-10deg-frictionless"), **SHORT)
+    return replace(named_scene("paper-literal-10deg-frictionless"), **SHORT)
 
 
 @pytest.mark.parametrize("engine", ["exudyn", "reference", "mujoco"])
@@ -74,7 +74,7 @@ def test_option_errors_have_one_type():
 def test_mujoco_refuses_friction():
     """An engine that cannot express a scene says so (EngineUnavailable), no result."""
     with pytest.raises(engines.EngineUnavailable, match="friction"):
-        cardan_exudyn.run(replace(named_scene("paper-10deg"), **SHORT), "mujoco")
+        cardan_exudyn.run(replace(named_scene("paper-literal-10deg"), **SHORT), "mujoco")
 
 
 def test_summary_round_trips_through_json(frictionless):
@@ -88,7 +88,7 @@ def test_summary_round_trips_through_json(frictionless):
 
 def test_a_failed_run_has_no_means():
     """A self-locking run (the reference's 50 deg case) carries its reason and no efficiency."""
-    result = cardan_exudyn.run(replace(named_scene("paper-50deg"), **SHORT), "reference")
+    result = cardan_exudyn.run(replace(named_scene("paper-literal-50deg"), **SHORT), "reference")
     assert result.status is Status.SELF_LOCKING and not result.success
     assert result.message and result.mean_efficiency is None
     assert result.summary.to_dict()["mean_efficiency"] is None
@@ -108,14 +108,14 @@ def test_a_bug_in_the_friction_update_is_raised(monkeypatch):
 
     monkeypatch.setattr(coupling.FrictionCoupling, "evaluate", evaluate)
     with pytest.raises(TypeError, match="a bug in the friction update"):
-        cardan_exudyn.run(replace(named_scene("paper-10deg"), **SHORT))
+        cardan_exudyn.run(replace(named_scene("paper-literal-10deg"), **SHORT))
 
 
 def test_uncoupled_friction_without_the_table():
     """``uncoupled`` friction is evaluated on the recorded reactions afterwards, so a
     summary-only run records them too and gives the same efficiency as a run with the table
     (it ended 'diverged' on NaN reactions before)."""
-    scene = replace(named_scene("paper-10deg"), revolutions=1.0, **{"friction.coupling": "uncoupled"})
+    scene = replace(named_scene("paper-literal-10deg"), revolutions=1.0, **{"friction.coupling": "uncoupled"})
     with_table = cardan_exudyn.run(scene)
     summary_only = cardan_exudyn.run(replace(scene, **{"record.timeseries": False}))
     assert with_table.success and summary_only.success, summary_only.message

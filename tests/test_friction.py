@@ -1,7 +1,7 @@
 """Friction of eqs. (1)-(5): the numpy law, the loads Exudyn applied, energy, dissipation, locking.
 
-The paper-10deg scene (f1 = 0.42, f2 = 0.20, 2000 rpm, 2 N m) over one revolution is the workhorse:
-its friction loses about half of the input power under the plain reading, so every check below
+The paper-literal-10deg scene (f1 = 0.42, f2 = 0.20, 2000 rpm, 2 N m) over one revolution is the workhorse:
+its friction loses about half of the input power under the literal set, so every check below
 is made where friction matters.
 """
 
@@ -22,7 +22,7 @@ from reference.scene import replace
 
 
 def _scene(coupling: str, **changes):
-    return replace(named_scene("paper-10deg"),
+    return replace(named_scene("paper-literal-10deg"),
                    **{"friction.coupling": coupling, "revolutions": 1, **changes})
 
 
@@ -199,8 +199,8 @@ def test_friction_machinery_only_for_pairs_with_friction():
 
 @pytest.mark.parametrize("coupling", ["lagged", "converged"])
 def test_self_locking_is_a_status_not_a_number(coupling):
-    """At 50 deg and 2000 rpm the plain reading's friction loop gain exceeds one."""
-    result = run(replace(named_scene("paper-50deg"),
+    """At 50 deg and 2000 rpm the literal set's friction loop gain exceeds one."""
+    result = run(replace(named_scene("paper-literal-50deg"),
                          **{"friction.coupling": coupling, "revolutions": 1}))
     assert result.summary.status == "self_locking"
     assert "loop gain" in result.summary.reason

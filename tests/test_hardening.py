@@ -181,7 +181,8 @@ def test_grading_flags_misbehaviour(tmp_path):
     expects_3 = Case("expects-3", "cli", "a bad option expected to fail as a run", ("run", "--angle", "x"),
                      expect=3, match="anything")
     touches = Case("touches-output", "cli", "a run that writes the output it was given",
-                   ("run", "--name", "rig-frictionless", "--engine", "reference", "--revolutions", "1",
+                   ("run", "--name", "rig-literal-frictionless", "--engine", "reference", "--revolutions",
+                    "1",
                     "--out", "{out}"), out="folder", expect=0)
     assert "exit status 2, expected 3" in case_problems(expects_3, tmp_path / "a")
     problems = case_problems(touches, tmp_path / "b")
@@ -205,7 +206,7 @@ def _intact(folder: Path) -> None:
     assert [p.name for p in folder.parent.iterdir() if p.name.startswith(f".{folder.name}")] == []
 
 
-RUN = ["run", "--name", "rig-frictionless", "--engine", "reference", "--revolutions", "1"]
+RUN = ["run", "--name", "rig-literal-frictionless", "--engine", "reference", "--revolutions", "1"]
 
 
 @pytest.mark.parametrize("stop", [KeyboardInterrupt, RuntimeError])
@@ -243,7 +244,7 @@ def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(compare, "overlay_plots", plots)
-    status = main(["compare", "--name", "rig-frictionless", "--engines", "reference,exudyn",
+    status = main(["compare", "--name", "rig-literal-frictionless", "--engines", "reference,exudyn",
                    "--revolutions", "1", "--out", str(out)])
     assert status == 130
     _intact(out)
@@ -276,7 +277,7 @@ def test_tolerance_out_failure_keeps_previous_study(tmp_path, monkeypatch):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(tolerance, "_plots", plots)
-    status = main(["tolerance", "montecarlo", "--name", "rig-calibrated", "--engine", "reference",
+    status = main(["tolerance", "montecarlo", "--name", "rig-matched", "--engine", "reference",
                    "--revolutions", "1", "--samples", "3", "--workers", "1", "--out", str(out)])
     assert status == 130
     _intact(out / "study")
@@ -388,7 +389,7 @@ def test_zero_input_work_prints_undefined(monkeypatch, capsys):
 
 def test_absurd_friction_self_locks_exit_3(capsys):
     """A real failure: friction coefficient 1e6 self-locks Exudyn's run at its start."""
-    status = main(["run", "--name", "paper", "--friction-spider", "1e6", "--revolutions", "1"])
+    status = main(["run", "--name", "paper-literal", "--friction-spider", "1e6", "--revolutions", "1"])
     out, err = capsys.readouterr()
     assert status == 3
     assert "status: self_locking" in err
@@ -397,7 +398,8 @@ def test_absurd_friction_self_locks_exit_3(capsys):
 
 def test_compare_with_failed_engines_prints_no_number(capsys):
     """`cardan compare` where both engines lock: statuses in the table, '-' for the numbers."""
-    status = main(["compare", "--name", "paper-50deg", "--engines", "reference,exudyn", "--revolutions", "1"])
+    status = main(["compare", "--name", "paper-literal-50deg", "--engines", "reference,exudyn",
+                   "--revolutions", "1"])
     out, err = capsys.readouterr()
     assert status == 3
     assert out.count("self_locking") >= 2
@@ -414,9 +416,10 @@ def test_calibrate_failed_case_prints_status(monkeypatch, capsys):
              "difference": -0.01, "status": "ok", "reason": ""},
             {"case": "table2:45:2000", "used_in_fit": False, "paper": 0.9, "model": math.nan,
              "difference": math.nan, "status": "self_locking", "reason": "loop gain >= 1"}]
-    result = {"parameters": {"spider_lever": 0.06}, "rows": rows, "fit_rms": 0.01,
-              "held_out_rms": math.nan, "held_out_max_abs": math.nan, "function_evaluations": 3,
-              "wall_time_s": 1.0}
+    result = {"set": "matched", "engine": "reference", "fit_cases": ["table2:0:2000"], "method": "-",
+              "parameters": {"spider_lever": 0.06}, "values": {"spider_lever": 0.06},
+              "combinations": [], "rows": rows, "fit_rms": 0.01, "fit_max_abs": 0.01,
+              "held_out_rms": math.nan, "held_out_max_abs": math.nan, "runs": 3, "wall_time_s": 1.0}
     monkeypatch.setattr(calibrate, "calibrate", lambda *a, **k: result)
     assert main(["calibrate"]) == 3
     out, err = capsys.readouterr()
@@ -433,7 +436,7 @@ def test_reference_zero_input_work_finishes():
     from reference.scene import replace
 
     for angle in (0.0, 10.0):
-        scene = replace(named_scene("paper-frictionless"), revolutions=1, gravity=[0.0, 0.0, 0.0],
+        scene = replace(named_scene("paper-literal-frictionless"), revolutions=1, gravity=[0.0, 0.0, 0.0],
                         **{"load.torque": 0.0, "joint.geometry.shaft_angle_deg": angle})
         s = run(scene, "reference").summary
         assert s.status == Status.OK and s.mean_efficiency is None and s.power_flow == "none"
@@ -446,7 +449,7 @@ def test_scene_file_switches_drive_kind(tmp_path):
     from reference.scene_files import load_scene
 
     path = tmp_path / "s.toml"
-    path.write_text('base = "paper-frictionless"\n[drive]\nkind = "angle"\n'
+    path.write_text('base = "paper-literal-frictionless"\n[drive]\nkind = "angle"\n'
                     "time = [0.0, 0.1, 0.2, 0.3]\nangle = [0.0, 7.0, 14.0, 21.0]\n")
     scene = load_scene(path)
     assert scene.drive.kind == "angle" and scene.drive.angle[-1] == 21.0

@@ -130,7 +130,7 @@ def test_deferred_signals_wait_for_the_block():
 def test_ctrl_c_inside_exudyn_is_an_interruption_not_a_failure():
     """SIGINT while Exudyn integrates a scene with friction (Python user functions inside its
     loop) raises KeyboardInterrupt; before issue 18 it came back as integration_failure."""
-    scene = replace(named_scene("paper-35deg"), revolutions=5.0)
+    scene = replace(named_scene("paper-literal-35deg"), revolutions=5.0)
     timer = threading.Timer(0.8, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     try:
@@ -149,10 +149,10 @@ def test_ctrl_c_inside_exudyn_is_an_interruption_not_a_failure():
 def test_run_interrupted_keeps_previous_output(tmp_path, signum, seed):
     """`cardan run --out` (Exudyn, friction) stopped at a random instant of its run."""
     out = tmp_path / "out"
-    assert main(["run", "--name", "paper-10deg", "--engine", "reference", "--revolutions", "1",
+    assert main(["run", "--name", "paper-literal-10deg", "--engine", "reference", "--revolutions", "1",
                  "--out", str(out)]) == 0
     before = snapshot(out)
-    proc = start(["run", "--name", "paper-35deg", "--revolutions", "5", "--out", str(out)], tmp_path)
+    proc = start(["run", "--name", "paper-literal-35deg", "--revolutions", "5", "--out", str(out)], tmp_path)
     wait_for(lambda: (tmp_path / ".out.lock").exists(), proc)  # the command has started
     stderr, took = interrupt(proc, signum, delay(seed, 0.0, 1.5))
     assert_stopped(proc, signum, stderr, took)
@@ -165,7 +165,8 @@ def test_compare_interrupted_keeps_previous_output(tmp_path, signum):
     out = tmp_path / "cmp"
     out.mkdir()
     (out / "report.md").write_text("previous\n")
-    proc = start(["compare", "--name", "paper-35deg", "--engines", "reference,exudyn", "--revolutions", "3",
+    proc = start(["compare", "--name", "paper-literal-35deg", "--engines", "reference,exudyn",
+                  "--revolutions", "3",
                   "--out", str(out)], tmp_path)
     wait_for(lambda: (tmp_path / ".cmp.lock").exists(), proc)
     stderr, took = interrupt(proc, signum, delay(signum, 0.0, 1.5))
@@ -187,7 +188,7 @@ def test_rig_validate_interrupted_keeps_previous_output(tmp_path, rig_file, sign
 
 
 SPEC = """
-scene = "paper-10deg"
+scene = "paper-literal-10deg"
 engine = "exudyn"
 [fixed]
 revolutions = 2
@@ -246,7 +247,7 @@ def test_sweep_api_raises_sweep_interrupted(tmp_path, monkeypatch):
 
     monkeypatch.setattr(RecordWriter, "write", write_then_stop)
     with pytest.raises(SweepInterrupted, match="2 of 3 cases done") as info:
-        run_sweep({"scene": "paper-35deg", "engine": "reference", "fixed": {"revolutions": 1},
+        run_sweep({"scene": "paper-literal-35deg", "engine": "reference", "fixed": {"revolutions": 1},
                    "grid": {"load.torque": [1, 2, 3]}}, out, workers=1, progress=False)
     assert (info.value.done, info.value.total, info.value.signum) == (2, 3, signal.SIGINT)
     assert len(records(out)) == 2
@@ -256,7 +257,7 @@ def test_records_of_interrupted_cases_from_earlier_versions_run_again(tmp_path):
     """A case that an earlier version recorded as integration_failure because of Ctrl-C (Exudyn's
     user-function failure as reason) runs again on resume; a real failure stays."""
     out = tmp_path / "sw"
-    spec = {"scene": "paper-35deg", "engine": "reference", "fixed": {"revolutions": 1},
+    spec = {"scene": "paper-literal-35deg", "engine": "reference", "fixed": {"revolutions": 1},
             "grid": {"load.torque": [1, 2, 3]}}
     run_sweep(spec, out, workers=1, progress=False)
     lines = (out / "cases.jsonl").read_text().splitlines()

@@ -19,19 +19,20 @@ def _scene(*argv: str):
 
 
 def test_issue_example_angle_and_friction():
-    """`--angle 45 --friction-spider 0.42` on the default frictionless scene: the name gives the new
-    angle and both friction coefficients, and no longer 10 deg or frictionless."""
-    scene = _scene("--angle", "45", "--friction-spider", "0.42")
-    assert scene.name == "paper-45deg-2000rpm+f_spider=0.42+f_frame=0"
+    """`--angle 45 --friction-spider 0.42` on the frictionless paper scene (the default scene until
+    issue 21): the name gives the new angle and both friction coefficients, and no longer 10 deg or
+    frictionless."""
+    scene = _scene("--name", "paper-10deg-frictionless", "--angle", "45", "--friction-spider", "0.42")
+    assert scene.name == "paper-physical-45deg-2000rpm+f_spider=0.42+f_frame=0"
     assert "angle=45deg, f_spider=0.42, f_frame=0" in scene.description
 
 
 def test_replaced_token_names_the_named_scene():
     """An angle or speed that replaces the part of a paper name gives that named scene's name, and
     the scene is that named scene."""
-    scene = _scene("--name", "paper-10deg-frictionless", "--angle", "35", "--rpm", "1000")
-    assert scene.name == "paper-35deg-1000rpm-frictionless"
-    named = named_scene("paper-35deg-1000rpm-frictionless")
+    scene = _scene("--name", "paper-literal-10deg-frictionless", "--angle", "35", "--rpm", "1000")
+    assert scene.name == "paper-literal-35deg-1000rpm-frictionless"
+    named = named_scene("paper-literal-35deg-1000rpm-frictionless")
     assert scene.joint == named.joint and scene.drive == named.drive
 
 
@@ -39,8 +40,8 @@ def test_replaced_token_names_the_named_scene():
     (("--angle", "20"), "20deg"),
     (("--rpm", "500"), "500rpm"),
     (("--load-torque", "3"), "+load=3Nm"),
-    (("--friction-spider", "0.1"), "+f_spider=0.1+f_frame=0"),
-    (("--friction-frame", "0.2"), "+f_spider=0+f_frame=0.2"),
+    (("--friction-spider", "0.1"), "+f_spider=0.1+f_frame=0.2"),
+    (("--friction-frame", "0.3"), "+f_spider=0.42+f_frame=0.3"),
     (("--coupling", "lagged"), "+coupling=lagged"),
     (("--sign-band", "0.01"), "+sign_band=0.01"),
     (("--no-gravity",), "+no_gravity"),
@@ -51,19 +52,19 @@ def test_replaced_token_names_the_named_scene():
 def test_every_scene_option_shows_in_the_name(argv, label):
     """Each command-line scene option changes the name (from the default scene's) and shows its value."""
     scene = _scene(*argv)
-    assert scene.name != "paper-10deg-2000rpm-frictionless"
+    assert scene.name != "paper-physical-10deg-2000rpm"
     assert label in scene.name
 
 
 def test_no_override_keeps_the_name():
     """Without overrides the scene is the named or loaded one, name included."""
-    assert _scene("--name", "rig").name == "rig"
+    assert _scene("--name", "rig-literal").name == "rig-literal"
 
 
 def test_scene_file_name_gets_the_overrides(tmp_path):
     """A scene file's own name (no angle part) gets the overrides appended."""
     path = tmp_path / "s.toml"
-    path.write_text('base = "paper"\nname = "my-joint"\n')
+    path.write_text('base = "paper-literal"\nname = "my-joint"\n')
     scene = _scene("--scene", str(path), "--angle", "12.5", "--load-torque", "0.5")
     assert scene.name == "my-joint+12.5deg+load=0.5Nm"
 
@@ -85,18 +86,18 @@ def test_override_name_rules():
 def test_run_summary_carries_the_override_name(capsys):
     """`cardan run --load-torque` (reference engine, one revolution): the summary's scene name and the
     printed line say the load was overridden."""
-    status = main(["run", "--name", "rig-frictionless", "--engine", "reference", "--revolutions", "1",
+    status = main(["run", "--name", "rig-literal-frictionless", "--engine", "reference", "--revolutions", "1",
                    "--load-torque", "0.3", "--json"])
     out = capsys.readouterr().out
     assert status == 0
-    assert json.loads(out)["scene"]["name"] == "rig-frictionless+load=0.3Nm+revolutions=1"
+    assert json.loads(out)["scene"]["name"] == "rig-literal-frictionless+load=0.3Nm+revolutions=1"
 
 
 def test_drive_typo_lists_every_allowed_key():
     """A misspelt drive key: the message lists `kind` and the unit-suffixed alias, not `speed` alone."""
     with pytest.raises(SceneError, match=r"allowed: \['kind', 'speed', 'speed_rpm'\]"):
-        scene_from_mapping({"base": "paper", "drive": {"sped": 100}})
+        scene_from_mapping({"base": "paper-literal", "drive": {"sped": 100}})
     with pytest.raises(SceneError, match=r"allowed: \['initial_speed', 'initial_speed_rpm', 'kind', "
                                          r"'torque'\]"):
-        scene_from_mapping({"base": "paper", "drive": {"kind": "torque", "torque": 1.0,
+        scene_from_mapping({"base": "paper-literal", "drive": {"kind": "torque", "torque": 1.0,
                                                         "initial_speed": 1.0, "tork": 1}})

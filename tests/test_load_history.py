@@ -21,7 +21,7 @@ def driven(load: Load, revolutions: float = 2.0):
     """The rig case driven by a fluctuating input angle (a motor's 2x ripple), ``load`` on it."""
     t = np.linspace(0.0, SPAN, 400)
     angle = SPEED * t + 0.03 * np.sin(2 * SPEED * t)
-    return replace(named_scene("rig-calibrated"), drive=AngleDrive(tuple(t), tuple(angle)), load=load,
+    return replace(named_scene("rig-matched"), drive=AngleDrive(tuple(t), tuple(angle)), load=load,
                    revolutions=revolutions)
 
 
@@ -102,7 +102,7 @@ def test_mujoco_refuses_load_history():
     pytest.importorskip("mujoco")
     from cardan_exudyn.engines import EngineUnavailable
 
-    scene = replace(named_scene("rig-frictionless"), load=Load((0.2, 0.2), (0.0, 10.0)))
+    scene = replace(named_scene("rig-literal-frictionless"), load=Load((0.2, 0.2), (0.0, 10.0)))
     with pytest.raises(EngineUnavailable, match="load history"):
         run(scene, "mujoco")
 
@@ -118,7 +118,7 @@ def rippled(t0: float, n: int = 300, step: float = 2.0 ** -8):
     t = tuple((t0 + tau).tolist())
     angle = SPEED * tau + 0.03 * np.sin(2 * SPEED * tau)
     torque = 0.2 + 0.03 * np.sin(3.0 * SPEED * tau)
-    return replace(named_scene("rig-calibrated"), drive=AngleDrive(t, tuple(angle)),
+    return replace(named_scene("rig-matched"), drive=AngleDrive(t, tuple(angle)),
                    load=Load(tuple(torque), t), revolutions=1.0)
 
 
@@ -202,7 +202,7 @@ def test_load_history_alone_starts_the_clock():
     history starting at 0 does (the run starts at its first sample)."""
     def scene(t0):
         tau = np.arange(400) * 2.0 ** -10
-        return replace(named_scene("rig-calibrated"), revolutions=1.0,
+        return replace(named_scene("rig-matched"), revolutions=1.0,
                        load=Load(tuple(0.2 + 0.05 * np.sin(5 * tau)), tuple((t0 + tau).tolist())))
     a, b = run(scene(0.0), "reference"), run(scene(1e9), "reference")
     assert b.summary.mean_efficiency == pytest.approx(a.summary.mean_efficiency, rel=0, abs=1e-12)
@@ -215,7 +215,7 @@ def test_long_load_history_costs_about_a_constant_load():
     history (minutes). Measured in one run on 2 shared cores: ratio 1.38; bound 3."""
     import time
 
-    base = named_scene("rig-calibrated")
+    base = named_scene("rig-matched")
     span = 2 * np.pi * base.revolutions / base.drive.speed
     t = np.linspace(0.0, 1.05 * span, 30_000)
     flat = replace(base, load=Load(tuple(np.full(t.size, base.load.torque)), tuple(t)))

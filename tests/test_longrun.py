@@ -198,7 +198,7 @@ def test_harness_errors_are_reported():
 def test_shape_and_settings(runs):
     s = runs.summary
     st = s["settings"]
-    assert st["drift_scene"] == "paper-10deg-2000rpm"
+    assert st["drift_scene"] == "paper-literal-10deg-2000rpm"
     assert st["drift_steps_per_revolution"] == 156  # given: the automatic step at 10 deg for 1e-5
     assert st["spectral_radius"] == DEFAULT_RHO
     assert set(runs.drift["node_type"]) == set(st["drift_node_types"])

@@ -42,13 +42,13 @@ def one_revolution(name: str, **changes) -> object:
 
 
 def test_errors_accept_units_and_round_trip():
-    scene = scene_from_dict({**scene_to_dict(named_scene("rig")),
-                             "joint": {**scene_to_dict(named_scene("rig"))["joint"],
+    scene = scene_from_dict({**scene_to_dict(named_scene("rig-literal")),
+                             "joint": {**scene_to_dict(named_scene("rig-literal"))["joint"],
                                        "errors": {"a1_mm": 0.5, "alpha2_deg": 0.006, "s1_mm": -1.0}}})
     e = scene.joint.errors
     assert (e.a1, e.alpha2, e.s1) == (pytest.approx(5e-4), pytest.approx(math.radians(0.006)),
                                       pytest.approx(-1e-3))
-    assert e.any and not named_scene("rig").joint.errors.any
+    assert e.any and not named_scene("rig-literal").joint.errors.any
     assert scene_from_dict(scene_to_dict(scene)) == scene
 
 
@@ -61,11 +61,11 @@ def test_errors_accept_units_and_round_trip():
 ])
 def test_bad_errors_are_rejected_by_name(field, value, message):
     with pytest.raises(SceneError, match=message):
-        replace(named_scene("rig"), **{field: value})
+        replace(named_scene("rig-literal"), **{field: value})
 
 
 def test_paper_errors_are_the_section_4_2_tolerances():
-    scene = named_scene("rig-errors")
+    scene = named_scene("rig-literal-errors")
     e = scene.joint.errors
     assert [getattr(e, f"a{k}") for k in (1, 2, 3, 4)] == [5e-4, 5e-4, 5e-4, 0.0]
     assert [math.degrees(getattr(e, f"alpha{k}")) for k in (1, 2, 3, 4)] == \
@@ -78,7 +78,7 @@ def test_paper_errors_are_the_section_4_2_tolerances():
 
 
 def test_pair_frames_of_the_ideal_loop_are_the_closed_form_ones():
-    scene = named_scene("paper-30deg")
+    scene = named_scene("paper-literal-30deg")
     params = rccc.DHParameters.of_joint(scene.joint)
     theta = np.linspace(0.0, 2 * math.pi, 13)
     loop = rccc.pair_frames(params, rccc.solve_positions(params, theta),
@@ -92,7 +92,7 @@ def test_pair_frames_of_the_ideal_loop_are_the_closed_form_ones():
                                    atol=1e-15)
 
 
-@pytest.mark.parametrize("name", ["paper-30deg", "rig-calibrated", "paper-calibrated-35deg"])
+@pytest.mark.parametrize("name", ["paper-literal-30deg", "rig-matched", "paper-matched-35deg"])
 def test_loop_dynamics_equal_the_closed_form_on_the_ideal_joint(name):
     """Every column, friction included, from the dual-number loop and from the closed form."""
     scene = named_scene(name)
@@ -107,14 +107,14 @@ def test_loop_dynamics_equal_the_closed_form_on_the_ideal_joint(name):
 
 
 def test_closed_form_refuses_a_joint_with_errors():
-    scene = named_scene("rig-errors")
+    scene = named_scene("rig-literal-errors")
     with pytest.raises(ValueError, match="ideal joint only"):
         joint_motion(scene.joint, 0.0, 1.0, 0.0, method="closed_form")
 
 
 ERROR_SCENES = {
-    "rig-calibrated-errors": {},
-    "paper-calibrated-30deg+a1,a4,s1": {"joint.errors.a1": 5e-4, "joint.errors.a4": -3e-4,
+    "rig-matched-errors": {},
+    "paper-matched-30deg+a1,a4,s1": {"joint.errors.a1": 5e-4, "joint.errors.a4": -3e-4,
                                         "joint.errors.s1": 1e-3, "joint.errors.alpha3": 0.01},
 }
 
@@ -154,7 +154,7 @@ def test_friction_is_the_law_of_the_reported_reactions_and_slides(key):
 
 
 def test_ideal_joint_has_no_sliding_work():
-    summary = cardan_exudyn.run(one_revolution("rig-calibrated"), "reference").summary
+    summary = cardan_exudyn.run(one_revolution("rig-matched"), "reference").summary
     assert all(summary.pair_sliding_loss_work[p] == 0.0 for p in CYLINDRICAL)
 
 
@@ -164,7 +164,7 @@ def test_ideal_joint_has_no_sliding_work():
     ({"alpha1_deg": -70.0}, "not a Cardan joint's double crank"),  # input twist 20 < shaft 30 deg
 ])
 def test_loop_that_cannot_close_is_a_status_not_a_crash(engine, twists, message):
-    scene = replace(named_scene("paper-30deg-frictionless"),
+    scene = replace(named_scene("paper-literal-30deg-frictionless"),
                     **{f"joint.errors.{k}": v for k, v in twists.items()})
     result = cardan_exudyn.run(scene, engine)
     assert result.summary.status == "loop_does_not_close" and result.table is None
@@ -185,7 +185,7 @@ KINEMATIC_ACCURACY = {"numerics.accuracy": 1e-5}
 
 @pytest.fixture(scope="module")
 def frictionless_ideal():
-    scene = one_revolution("paper-30deg-frictionless", **KINEMATIC_ACCURACY)
+    scene = one_revolution("paper-literal-30deg-frictionless", **KINEMATIC_ACCURACY)
     return cardan_exudyn.run(scene, "reference").table, cardan_exudyn.run(scene, "exudyn").table
 
 
@@ -202,7 +202,7 @@ def test_exudyn_kinematics_and_sliding_agree_with_reference(error, frictionless_
     part holds only twists and angles): zero effect in the reference, below Exudyn's step error
     in Exudyn. The pairs that must not slide stay below 1e-9 m/s.
     """
-    scene = one_revolution("paper-30deg-frictionless", **KINEMATIC_ACCURACY,
+    scene = one_revolution("paper-literal-30deg-frictionless", **KINEMATIC_ACCURACY,
                            **{f"joint.errors.{error}": SINGLE[error]})
     ref, exu = cardan_exudyn.run(scene, "reference").table, cardan_exudyn.run(scene, "exudyn").table
     ref0, exu0 = frictionless_ideal
@@ -229,7 +229,7 @@ def test_exudyn_kinematics_and_sliding_agree_with_reference(error, frictionless_
 def _rig_pair(accuracy: float | None = None, **errors) -> tuple:
     """Summaries (reference, exudyn) of one revolution of the rig case with ``errors``."""
     pinned = {} if accuracy is None else {"numerics.accuracy": accuracy}
-    scene = one_revolution("rig-calibrated", **{"record.timeseries": False}, **pinned,
+    scene = one_revolution("rig-matched", **{"record.timeseries": False}, **pinned,
                            **{f"joint.errors.{k}": v for k, v in errors.items()})
     return cardan_exudyn.run(scene, "reference").summary, cardan_exudyn.run(scene, "exudyn").summary
 

@@ -140,21 +140,21 @@ def test_friction_scene_is_refused():
     """MuJoCo cannot model friction proportional to reactions: the engine raises
     NotImplementedError, which the dispatch reports as the engine being unavailable."""
     with pytest.raises(NotImplementedError, match="friction"):
-        mujoco_engine.run(named_scene("paper-10deg"))
+        mujoco_engine.run(named_scene("paper-literal-10deg"))
     with pytest.raises(engines.EngineUnavailable, match="friction"):
-        run(named_scene("paper-10deg"))
+        run(named_scene("paper-literal-10deg"))
 
 
 def test_mujoco_defaults_are_flagged():
     """MuJoCo's own defaults (Euler, 2 ms, solref 0.02) open the loop: the run is flagged."""
-    result = run(named_scene("paper-30deg-frictionless"), MUJOCO_DEFAULTS)
+    result = run(named_scene("paper-literal-30deg-frictionless"), MUJOCO_DEFAULTS)
     assert result.status == Status.CONSTRAINT_VIOLATED
     assert result.summary.max_constraint_violation_rad > 0.1
 
 
 def test_automatic_step_meets_the_accuracy():
     """Without a step, the engine picks one that meets ``numerics.accuracy`` on the speed ratio."""
-    scene = replace(named_scene("paper-30deg-frictionless"), **{"numerics.accuracy": 1e-7})
+    scene = replace(named_scene("paper-literal-30deg-frictionless"), **{"numerics.accuracy": 1e-7})
     result = run(scene)
     assert result.summary.dt_choice.startswith("auto")
     assert accuracy(scene, result)["speed_ratio_error"] <= 1e-7
@@ -162,7 +162,7 @@ def test_automatic_step_meets_the_accuracy():
 
 def test_torque_drive_balances_energy():
     """Torque drive: input work = output work + change of mechanical energy (measured 1e-6)."""
-    base = named_scene("paper-30deg-frictionless")
+    base = named_scene("paper-literal-30deg-frictionless")
     scene = Scene(joint=base.joint, drive=TorqueDrive(torque=3.0, initial_speed=100.0),
                   load=base.load, gravity=base.gravity, revolutions=2.0, numerics=Numerics(dt=DT))
     result = run(scene)
@@ -197,6 +197,6 @@ def test_invalid_settings_are_rejected(kwargs, match):
 def test_settings_study_table():
     """The study returns one row per scene and case with every error measure."""
     cases = study_cases((DT,))[:3]
-    table = settings_study(scenes=("paper-10deg-frictionless",), cases=cases, repeats=1)
+    table = settings_study(scenes=("paper-literal-10deg-frictionless",), cases=cases, repeats=1)
     assert list(table["case"]) == [label for label, _ in cases]
     assert {"speed_ratio_error", "torque_in_error", "bearing_drift_m", "wall_time_s"} <= set(table)

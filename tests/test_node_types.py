@@ -104,7 +104,7 @@ def test_rotation_coordinates_round_trip(node_type):
 
 def test_unknown_node_type_is_refused():
     with pytest.raises(ValueError, match="node_type"):
-        build_model(named_scene("paper-10deg-frictionless"), node_type="Rzyx")
+        build_model(named_scene("paper-literal-10deg-frictionless"), node_type="Rzyx")
 
 
 # ------------------------------------------------------------------ readers against Exudyn
@@ -115,7 +115,7 @@ def test_readers_equal_exudyn_node_outputs(node_type, built):
     """After a run with friction: the recorded-state reader (``body_states``) and the friction
     update's reader of the current coordinates give Exudyn's own rotation matrix and angular
     velocity of every node."""
-    _, model = _run(_scene("paper-35deg", 100, revolutions=1), node_type, built)
+    _, model = _run(_scene("paper-literal-35deg", 100, revolutions=1), node_type, built)
     states = body_states(model)
     current = model.friction._body_states()
     out = exu.OutputVariableType
@@ -139,7 +139,7 @@ def test_speed_ratio_is_second_order(node_type, built):
     Exudyn's Newton fails at 100 steps per revolution where |nu| reaches 2 pi)."""
     errors = []
     for steps in (100, 200):
-        scene = _scene("paper-35deg-frictionless", steps, revolutions=1)
+        scene = _scene("paper-literal-35deg-frictionless", steps, revolutions=1)
         result, model = _run(scene, node_type, built)
         table = result.table
         hooke = speed_ratio(table["theta_in"].to_numpy(), scene.joint.geometry.shaft_angle)
@@ -157,7 +157,7 @@ def test_speed_ratio_is_second_order(node_type, built):
 
 @pytest.fixture(scope="module")
 def reference_summary():
-    return run(_scene("paper-10deg", 200), "reference").summary
+    return run(_scene("paper-literal-10deg", 200), "reference").summary
 
 
 @pytest.mark.parametrize("node_type", NODE_TYPES)
@@ -166,7 +166,7 @@ def test_mean_efficiency_with_friction(node_type, built, reference_summary):
     sum of both engines' error estimates of the reference engine's (Exudyn's true error within 3x
     its estimate over the accuracy grid, docs/accuracy.md; measured difference 1.01e-3..1.07e-3,
     1.03..1.16x Exudyn's estimate), and friction really costs power."""
-    summary = _run(_scene("paper-10deg", 200), node_type, built)[0].summary
+    summary = _run(_scene("paper-literal-10deg", 200), node_type, built)[0].summary
     eta, eta_ref = summary.mean_efficiency, reference_summary.mean_efficiency
     assert eta < 0.6
     assert summary.efficiency_error_estimate is not None and summary.efficiency_error_estimate > 0
@@ -182,7 +182,7 @@ def test_input_angle_coordinate_is_kept_within_pi(node_type, built):
     """Constant speed, 3 revolutions: the coordinate the solver integrates stays within
     [-pi, pi], three whole revolutions were taken out of it, and ``theta_in`` is the continuous
     angle, ``omega t`` to rounding (the velocity-level drive holds the speed exactly)."""
-    scene = _scene("paper-10deg-frictionless", 100, revolutions=3)
+    scene = _scene("paper-literal-10deg-frictionless", 100, revolutions=3)
     result, model = _run(scene, node_type, built)
     coordinate = stored(model, "input_q")[:, 4]
     assert np.abs(coordinate).max() <= math.pi * (1.0 + 1e-15)
@@ -199,7 +199,7 @@ def test_angle_drive_starting_whole_revolutions_in(node_type, built):
     the node coordinates start at the identity either way, and the results' input angle carries
     the 16 revolutions (the drive's offset subtracts what the coordinate lacks; before the
     wrap the coordinate started at 0 against an offset of 100.5 rad, and Newton failed)."""
-    scene = _scene("paper-35deg-frictionless", 100, revolutions=1)
+    scene = _scene("paper-literal-35deg-frictionless", 100, revolutions=1)
     w = scene.drive.speed
     t = np.linspace(0.0, 1.3 * 2.0 * math.pi / w, 60)
     tables = []

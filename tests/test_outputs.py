@@ -24,8 +24,8 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.sweep import run_sweep
 
 # the reference engine: a second of work, a 0.7 MB time table to write
-QUICK = ["run", "--name", "paper-35deg", "--engine", "reference", "--revolutions", "1"]
-LONG = ["run", "--name", "paper-35deg", "--engine", "reference", "--revolutions", "4"]
+QUICK = ["run", "--name", "paper-literal-35deg", "--engine", "reference", "--revolutions", "1"]
+LONG = ["run", "--name", "paper-literal-35deg", "--engine", "reference", "--revolutions", "4"]
 
 
 
@@ -203,7 +203,7 @@ def test_second_writer_is_refused_while_the_first_runs(tmp_path, capsys, previou
 def test_second_sweep_is_refused(tmp_path, capsys):
     """Two sweeps into one folder: the second is refused while the first holds it."""
     out = tmp_path / "sw"
-    argv = ["sweep", "--scene", "paper-35deg", "--engine", "reference", "--set", "revolutions=2",
+    argv = ["sweep", "--scene", "paper-literal-35deg", "--engine", "reference", "--set", "revolutions=2",
             "--grid", "load.torque=1,2,3,4,5,6", "--workers", "1", "--quiet", "--out", str(out)]
     proc = start(argv, tmp_path)
     wait_for(lambda: (tmp_path / ".sw.lock").exists(), proc)
@@ -262,7 +262,7 @@ def test_no_space_left_in_process_is_one_line(tmp_path, monkeypatch, capsys, pre
 def test_sweep_full_disk_is_one_line(tmp_path):
     """A sweep whose records no longer fit: one line, exit 2, the records written are kept."""
     out = tmp_path / "sw"
-    argv = ["sweep", "--scene", "paper-35deg", "--engine", "reference", "--set", "revolutions=1",
+    argv = ["sweep", "--scene", "paper-literal-35deg", "--engine", "reference", "--set", "revolutions=1",
             "--grid", "load.torque=1,2,3,4", "--workers", "1", "--quiet", "--out", str(out)]
     proc = start(argv, tmp_path, preexec_fn=_file_size_limit(8_000))
     _, stderr = proc.communicate(timeout=120)
@@ -288,7 +288,7 @@ def test_folder_and_files_follow_the_umask(tmp_path, umask):
 def test_summary_claims_only_files_written(tmp_path, capsys):
     """With record.timeseries = false the run writes and names summary.json only."""
     scene = tmp_path / "scene.toml"
-    scene.write_text('base = "paper-35deg"\nrevolutions = 1\n[record]\ntimeseries = false\n')
+    scene.write_text('base = "paper-literal-35deg"\nrevolutions = 1\n[record]\ntimeseries = false\n')
     out = tmp_path / "out"
     capsys.readouterr()
     assert main(["run", "--scene", str(scene), "--engine", "reference", "--out", str(out)]) == 0
@@ -323,7 +323,7 @@ def test_sweep_keeps_other_files_in_its_folder(tmp_path):
     out = tmp_path / "sw"
     out.mkdir()
     (out / "notes.txt").write_text("mine")
-    summary = run_sweep({"scene": "paper-35deg", "engine": "reference", "fixed": {"revolutions": 1},
+    summary = run_sweep({"scene": "paper-literal-35deg", "engine": "reference", "fixed": {"revolutions": 1},
                          "grid": {"load.torque": [1, 2]}}, out, workers=1, progress=False)
     assert summary["ok"] == 2 and (out / "notes.txt").read_text() == "mine"
     assert siblings(out) == []

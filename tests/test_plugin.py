@@ -29,7 +29,7 @@ pytest_plugins = ["pytester"]
 get_engine("exudyn"), get_engine("reference")
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "pytest.md"
-SMALL = "paper-10deg-frictionless"
+SMALL = "paper-literal-10deg-frictionless"
 
 
 def run_project(pytester: pytest.Pytester, source: str, *args: str) -> pytest.RunResult:
@@ -123,7 +123,8 @@ def test_cardan_run_computes_each_run_once_and_hands_out_copies(pytester):
     result = run_project(pytester, source, "--cardan-runs")
     result.assert_outcomes(passed=2)
     result.stdout.fnmatch_lines(["*cardan-exudyn engine runs*",
-                                 "| paper-10deg-*-frictionless | 1 | reference |*| ok | 1.000000 |*| 2 |",
+                                 "| paper-literal-10deg-*-frictionless | 1 | reference |*| ok "
+                                 "| 1.000000 |*| 2 |",
                                  "1 engine run(s), 2 result(s) reused from the cache"])
     result = run_project(pytester, source.replace("runs == 1 and cardan_run.reused == 2",
                                                   "runs == 3 and cardan_run.reused == 0"),
@@ -138,7 +139,7 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
 
         @pytest.fixture(scope="module")
         def runs(cardan_scene, cardan_run):
-            scene = cardan_scene("rig", revolutions=1.0, numerics__accuracy=3e-4)
+            scene = cardan_scene("rig-literal", revolutions=1.0, numerics__accuracy=3e-4)
             return cardan_run(scene), cardan_run(scene, "reference")
 
         def test_exudyn_agrees_with_the_reference_within_its_estimate(runs, cardan_run):
@@ -156,7 +157,7 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
             assert_efficiency(runs[0], runs[0].mean_efficiency + 0.01, run=cardan_run)
 
         def test_failed_run(cardan_scene, cardan_run):
-            result = cardan_run(cardan_scene("rig-errors", revolutions=1.0), "reference")
+            result = cardan_run(cardan_scene("rig-literal-errors", revolutions=1.0), "reference")
             assert_efficiency(result, 0.2)
     """
     result = run_project(pytester, source)
@@ -169,7 +170,7 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
         "E*error estimates: exudyn: step halving: dt = * s and * s, order 1*",
     ])
     result.stdout.fnmatch_lines([
-        "E*AssertionError: the reference run of scene 'rig-errors' ended self_locking: friction "
+        "E*AssertionError: the reference run of scene 'rig-literal-errors' ended self_locking: friction "
         "self-locks*: no mean efficiency to compare with 0.2"])
     assert "make_scene" not in result.stdout.str() and "def tolerance" not in result.stdout.str()
 
@@ -196,21 +197,21 @@ def test_assert_engines_agree_passes_and_fails_with_a_table(pytester):
                                  run=doctored)
 
         def test_failed_run(cardan_scene, cardan_run):
-            scene = cardan_scene("rig-errors", revolutions=1.0)
+            scene = cardan_scene("rig-literal-errors", revolutions=1.0)
             assert_engines_agree(scene, run=cardan_run)
     """
     result = run_project(pytester, source)
     result.assert_outcomes(passed=1, failed=2)
     result.stdout.fnmatch_lines([
-        "E*AssertionError: engine reference disagrees with engine exudyn on scene 'paper-10deg*':",
+        "E*AssertionError: engine reference disagrees with engine exudyn on scene 'paper-literal-10deg*':",
         "E*| quantity | exudyn | reference | difference | tolerance | from |",
         "E*| work_ratio | 0.999* | 1.00* | +1.*e-03 | *e-0* | 5 x estimated error |",
         "E*| omega_out (largest difference) | * | * | +2.1*e-01 | *e-0* | 5 x estimated error |",
         "E*error estimates: exudyn: step halving*; reference: quadrature*",
     ])
     assert "| mean_efficiency |" not in result.stdout.str()  # agrees: not in the table
-    result.stdout.fnmatch_lines(["E*AssertionError: the exudyn run of scene 'rig-errors' ended "
-                                 "self_locking*", "E*the reference run of scene 'rig-errors' "
+    result.stdout.fnmatch_lines(["E*AssertionError: the exudyn run of scene 'rig-literal-errors' ended "
+                                 "self_locking*", "E*the reference run of scene 'rig-literal-errors' "
                                                   "ended self_locking*"])
 
 
@@ -261,7 +262,7 @@ def test_bad_calls_raise_and_are_not_cached():
     runner = CachingRunner(counting)
     scene = make_scene(SMALL, revolutions=1.0)
     with pytest.raises(TypeError, match="must be a reference.scene.Scene"):
-        runner("paper-10deg")
+        runner("paper-literal-10deg")
     with pytest.raises(ValueError, match="not both"):
         runner(scene, options=make_options("exudyn"), node_type="EP")
     with pytest.raises(ValueError, match="not the options of engine 'reference'"):
@@ -276,8 +277,8 @@ def test_make_scene_names_the_source_in_errors(tmp_path):
         make_scene("nope.toml", root=tmp_path)
     with pytest.raises(SceneError, match="the source must be a scene name"):
         make_scene(3)
-    with pytest.raises(SceneError, match=r"^scene 'rig': .*unknown scene field"):
-        make_scene("rig", no__such=1)
+    with pytest.raises(SceneError, match=r"^scene 'rig-literal': .*unknown scene field"):
+        make_scene("rig-literal", no__such=1)
 
 
 def summary_of(scene, engine: str, dt: float, efficiency: float) -> Summary:
@@ -290,7 +291,7 @@ def summary_of(scene, engine: str, dt: float, efficiency: float) -> Summary:
     ("converged", None, 2.0),        # the default ramps (~2e-3 rad) are not: first order
     ("lagged", 0.5, 2.0)])           # friction lags one step: first order
 def test_step_halving_reruns_at_half_the_step(coupling, band, factor):
-    scene = make_scene("rig", revolutions=1.0, friction__coupling=coupling,
+    scene = make_scene("rig-literal", revolutions=1.0, friction__coupling=coupling,
                        friction__sign_band_relative=band, record__timeseries=False)
     reruns = []
 
@@ -310,7 +311,7 @@ def test_step_halving_reruns_at_half_the_step(coupling, band, factor):
 
 
 def test_a_failed_half_step_run_is_no_estimate():
-    scene = make_scene("rig", revolutions=1.0)
+    scene = make_scene("rig-literal", revolutions=1.0)
 
     def locking(scene, engine, options):
         summary = summary_of(scene, engine, scene.numerics.dt, 0.9)
@@ -328,7 +329,7 @@ def test_an_engine_without_an_estimate():
 
 @pytest.fixture(scope="module")
 def reference_rig() -> Result:
-    return CachingRunner()(make_scene("rig", revolutions=1.0), "reference")
+    return CachingRunner()(make_scene("rig-literal", revolutions=1.0), "reference")
 
 
 def test_the_reference_engine_reports_its_own_error(reference_rig):

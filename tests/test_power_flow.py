@@ -118,7 +118,7 @@ def cell_scene(cell: dict):
         changes[f"joint.pairs.{pair}.friction_coefficient"] = cell["f_frame"]
     if cell.get("steps"):
         changes["numerics.dt"] = 2 * math.pi / w / cell["steps"]
-    scene = replace(named_scene("paper"), **changes)
+    scene = replace(named_scene("paper-literal"), **changes)
     if not cell["history"]:
         return scene
     t = np.linspace(0.0, 1.2 * 2 * math.pi / w, 30)
@@ -190,7 +190,7 @@ def test_reversed_mirrored_scene_has_the_same_efficiency(engine, cell):
 def test_symmetric_joint_reversed_gravity_off(engine):
     """Bodies symmetric about the plane of the shafts, gravity off: the reversed scene itself
     (no mirror needed) gives the forward efficiency."""
-    scene = symmetric_joint(replace(named_scene("paper"), gravity=(0.0, 0.0, 0.0), revolutions=1.0,
+    scene = symmetric_joint(replace(named_scene("paper-literal"), gravity=(0.0, 0.0, 0.0), revolutions=1.0,
                                     **{"record.skip_revolutions": 0.0, "record.timeseries": False}))
     forward = run_engine(scene, engine).summary
     backward = run_engine(reversed_scene(scene, mirror=False), engine).summary
@@ -205,7 +205,7 @@ def test_symmetric_joint_reversed_gravity_off(engine):
 def test_reversed_torque_drive(engine):
     """A torque drive reversed with its load, mirrored: the same efficiency (the reference
     integrates the drive's ODE, about 30 s with friction: slow; Exudyn steps it)."""
-    scene = replace(named_scene("paper"), gravity=(0.0, 0.0, 0.0), revolutions=1.0,
+    scene = replace(named_scene("paper-literal"), gravity=(0.0, 0.0, 0.0), revolutions=1.0,
                     drive={"kind": "torque", "torque": 6.0, "initial_speed": 2000 * RPM},
                     **{"record.skip_revolutions": 0.0, "record.timeseries": False,
                        "joint.pairs.frame_input.friction_coefficient": 0.0,
@@ -223,7 +223,7 @@ def test_aiding_load_makes_the_output_the_source(engine):
     """The issue's `--rpm -2000` (the load aids the motion, the drive brakes): power flows from
     the output to the input, and its efficiency is 1 - W_loss / (-W_out), in [0, 1] (was 4.34);
     the mirror image (the forward speed with the load reversed) flows the same way."""
-    scene = replace(named_scene("paper"), revolutions=1.0, gravity=(0.0, 0.0, 0.0),
+    scene = replace(named_scene("paper-literal"), revolutions=1.0, gravity=(0.0, 0.0, 0.0),
                     **{"record.skip_revolutions": 0.0})
     aiding = run_engine(replace(scene, **{"drive.speed": -scene.drive.speed}), engine)
     s = aiding.summary
@@ -238,7 +238,7 @@ def test_aiding_load_makes_the_output_the_source(engine):
 def test_mujoco_frictionless_either_way():
     """MuJoCo (optional, frictionless): an ideal joint transmits everything either way."""
     pytest.importorskip("mujoco")
-    scene = replace(named_scene("paper-frictionless"), revolutions=1.0, gravity=(0.0, 0.0, 0.0),
+    scene = replace(named_scene("paper-literal-frictionless"), revolutions=1.0, gravity=(0.0, 0.0, 0.0),
                     **{"record.skip_revolutions": 0.0, "record.timeseries": False})
     for changes, flow in (({}, "input_to_output"), ({"load.torque": -scene.load.torque}, "output_to_input")):
         s = run_engine(replace(scene, **changes), "mujoco").summary
@@ -252,9 +252,9 @@ def test_mujoco_frictionless_either_way():
 def test_zero_work_edge(engine):
     """Frictionless and unloaded: undefined (None with a warning, was NaN or 1); with friction
     and no load: 0 (nothing transmitted); frictionless with a load: exactly 1."""
-    base = replace(named_scene("paper"), revolutions=1.0, **{"record.skip_revolutions": 0.0,
+    base = replace(named_scene("paper-literal"), revolutions=1.0, **{"record.skip_revolutions": 0.0,
                                                             "record.timeseries": False})
-    free = replace(named_scene("paper-frictionless"), revolutions=1.0,
+    free = replace(named_scene("paper-literal-frictionless"), revolutions=1.0,
                    **{"record.skip_revolutions": 0.0, "record.timeseries": False})
     s = run_engine(replace(free, **{"load.torque": 0.0}), engine).summary
     assert s.success and s.mean_efficiency is None and s.power_flow == "none"
@@ -268,7 +268,7 @@ def test_zero_work_edge(engine):
 def test_coarse_step_is_unphysical():
     """The issue's `--dt 0.01` (7 steps for 2 revolutions, efficiency 27.4 with status ok):
     status unphysical with the values and the likely cause."""
-    s = run_engine(replace(named_scene("paper"), **{"numerics.dt": 0.01}), "exudyn").summary
+    s = run_engine(replace(named_scene("paper-literal"), **{"numerics.dt": 0.01}), "exudyn").summary
     assert s.status is Status.UNPHYSICAL and s.mean_efficiency is None
     assert "too coarse" in s.reason
 
@@ -276,7 +276,7 @@ def test_coarse_step_is_unphysical():
 def test_time_average_of_eq18_not_reported_where_undefined():
     """At 35 deg eq. (18) averages -0.83 while the mean efficiency is 0.25: not reported (None)
     with the value in a warning; the mean efficiency stays."""
-    scene = replace(named_scene("paper-35deg"), revolutions=1.0,
+    scene = replace(named_scene("paper-literal-35deg"), revolutions=1.0,
                     **{"record.skip_revolutions": 0.0, "record.timeseries": False})
     s = run_engine(scene, "reference").summary
     assert s.success and 0.0 < s.mean_efficiency < 1.0
@@ -312,7 +312,7 @@ def test_impossible_works_are_problems(works, match):
 def test_schema_3_round_trip_and_older_versions_upgraded():
     """Version 3 writes the flow and the warnings and reads them back; a version-2 summary with a
     reversed flow (efficiency 4.3 with status ok) is read by version 3's rules."""
-    s = run_engine(replace(named_scene("paper"), revolutions=1.0,
+    s = run_engine(replace(named_scene("paper-literal"), revolutions=1.0,
                            **{"record.skip_revolutions": 0.0, "record.timeseries": False,
                               "drive.speed": -2000 * RPM}), "reference").summary
     data = json.loads(json.dumps(s.to_dict()))
@@ -348,13 +348,13 @@ def test_consumers_of_unphysical():
 def test_cli_prints_the_flow_and_exits_3_when_unphysical(capsys):
     """`cardan run --rpm -2000`: exit 0, the efficiency in [0, 1] and the flow's direction
     printed; a 7-step run: exit 3 with status unphysical."""
-    assert main(["run", "--name", "paper", "--rpm", "-2000", "--engine", "reference",
+    assert main(["run", "--name", "paper-literal", "--rpm", "-2000", "--engine", "reference",
                  "--revolutions", "1"]) == 0
     out, err = capsys.readouterr()
     eta = float(re.search(r"mean efficiency ([0-9.]+)", out).group(1))
     assert 0.0 <= eta <= 1.0 and "power flow output_to_input" in out
     assert "warning: power flows from the output to the input" in err
-    assert main(["run", "--name", "paper", "--dt", "0.01"]) == 3
+    assert main(["run", "--name", "paper-literal", "--dt", "0.01"]) == 3
     out, err = capsys.readouterr()
     assert "status: unphysical" in err and "mean efficiency" not in out
 
@@ -364,7 +364,7 @@ def test_uncoupled_friction_without_load_transmits_nothing():
     tests): uncoupled friction estimates the loss on the frictionless reactions, so without a load
     the input work is rounding noise and 1 - W_loss / W_in was +-1e16 with status ok. Now nothing
     is transmitted: flow ``none``, efficiency 0, in [0, 1]."""
-    scene = replace(named_scene("paper-20deg-1000rpm"), **{
+    scene = replace(named_scene("paper-literal-20deg-1000rpm"), **{
         "load.torque": 0.0, "gravity": (0.0, 0.0, 0.0), "friction.coupling": "uncoupled",
         "joint.pairs.input_spider.friction_coefficient": 0.5,
         "joint.pairs.spider_output.friction_coefficient": 0.5})

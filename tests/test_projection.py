@@ -50,7 +50,7 @@ def test_projection_with_mounting_errors_matches_the_reference_engine():
     """With offsets the cylindrical pairs slide (the rows carry the axis rotation term): the
     projected output speed and pair slide speeds equal the reference engine's at the same
     instants."""
-    scene = replace(named_scene("rig-calibrated-errors-frictionless"),
+    scene = replace(named_scene("rig-matched-errors-frictionless"),
                     **{"revolutions": 1, "numerics.dt": 2 * math.pi / 6.0 / 60})
     ex = run(scene, options=ExudynOptions(velocity_projection=True))
     plain = run(scene)
@@ -75,7 +75,7 @@ def test_torque_drive_projection_satisfies_the_constraints_and_is_idempotent():
     from cardan_exudyn.model.projection import constraint_jacobian, project_velocities
     from cardan_exudyn.model.solve import solve
 
-    scene = replace(named_scene("paper-20deg-frictionless"),
+    scene = replace(named_scene("paper-literal-20deg-frictionless"),
                     drive={"kind": "torque", "torque": 2.0, "initial_speed": 100.0},
                     load={"torque": 0.0}, revolutions=1, **{"numerics.dt": 2e-4})
     result = run(scene, options=ExudynOptions(velocity_projection=True))

@@ -158,7 +158,7 @@ def cells(max_angle: float = 80.0, min_rpm: float = 1.0, max_rpm: float = 3000.0
           gravity=(True, False), errors: bool = True) -> st.SearchStrategy[dict]:
     """Scene parameters inside the scene's validation (beta in [0, 90) deg, non-zero speed)."""
     return st.fixed_dictionaries({
-        "base": st.sampled_from(("paper", "paper-calibrated")),
+        "base": st.sampled_from(("paper-literal", "paper-matched")),
         "shaft_angle_deg": _maybe_zero(max_angle),
         "speed_rpm": st.floats(min_rpm, max_rpm),
         "direction": st.sampled_from((1, -1)),
@@ -441,14 +441,15 @@ def test_reference_invariants_many(cell):
 
 #: found by hypothesis: the largest balance constant, 0.102 (second order: 0.1009 / 0.1017 /
 #: 0.1022 / 0.1024 at 100 / 200 / 400 / 800 steps), spider friction 1 near locking (loop gain 0.92)
-STRONG_SPIDER_FRICTION = {"base": "paper", "shaft_angle_deg": 30.0, "speed_rpm": 14.0, "direction": 1,
+STRONG_SPIDER_FRICTION = {"base": "paper-literal", "shaft_angle_deg": 30.0, "speed_rpm": 14.0, "direction": 1,
                           "load": 1.0, "f_spider": 1.0, "f_frame": 0.0, "coupling": "converged",
                           "gravity": True, "errors": None}
 #: found by hypothesis: Exudyn reported self_locking at 0 deg (spider pairs at rest, their friction
 #: rounding noise that the relative fixed-point tolerance could never meet); fixed in
 #: cardan_exudyn/model/coupling.py (REST_FLOOR); lagged, the growth of that noise out of rounding was
 #: taken for the geometric growth of a locking loop
-SPIDER_AT_REST = {"base": "paper", "shaft_angle_deg": 0.0, "speed_rpm": 1.0, "direction": 1, "load": 0.0,
+SPIDER_AT_REST = {"base": "paper-literal", "shaft_angle_deg": 0.0, "speed_rpm": 1.0, "direction": 1,
+                  "load": 0.0,
                   "f_spider": 0.5, "f_frame": 0.0, "coupling": "converged", "gravity": True,
                   "errors": None}
 SPIDER_AT_REST_LAGGED = {**SPIDER_AT_REST, "coupling": "lagged"}
@@ -561,7 +562,7 @@ def test_engines_agree_inside_ok_region_many(cell):
 def check_locking_between_samples(angle_deg: float, samples: int) -> None:
     """Status contract of the reference engine where friction locks over narrow arcs only, with
     a coarse table: the locking is then found at quadrature nodes between the samples."""
-    cell = {"base": "paper", "shaft_angle_deg": angle_deg, "speed_rpm": 2000.0, "direction": 1,
+    cell = {"base": "paper-literal", "shaft_angle_deg": angle_deg, "speed_rpm": 2000.0, "direction": 1,
             "load": 2.0, "f_spider": 0.42, "f_frame": 0.2, "coupling": "converged", "gravity": True,
             "errors": None}
     scene = scene_of(cell)
@@ -583,7 +584,7 @@ def test_reference_locking_between_samples_presents_no_efficiency(angle_deg, sam
 def test_statuses_seen_include_locking_and_ok():
     """Both sides of the self-locking boundary: the plain set locks at 50 deg, runs at 10 deg
     (README)."""
-    base = {"base": "paper", "speed_rpm": 2000.0, "direction": 1, "load": 2.0, "f_spider": 0.42,
+    base = {"base": "paper-literal", "speed_rpm": 2000.0, "direction": 1, "load": 2.0, "f_spider": 0.42,
             "f_frame": 0.2, "coupling": "converged", "gravity": True, "errors": None}
     locked = check_invariants({**base, "shaft_angle_deg": 50.0}, "reference")[1]
     assert locked.summary.status == "self_locking"
@@ -595,7 +596,7 @@ def test_instantaneous_efficiency_is_not_bounded():
     ok) inertia drives the input over part of each revolution, the input power changes sign and
     the time average of eq. (18) is negative (-0.41), while the mean efficiency is in [0, 1]; that
     average is not reported (None, with a warning; issue 18)."""
-    cell = {"base": "paper", "shaft_angle_deg": 45.0, "speed_rpm": 2000.0, "direction": 1,
+    cell = {"base": "paper-literal", "shaft_angle_deg": 45.0, "speed_rpm": 2000.0, "direction": 1,
             "load": 2.0, "f_spider": 0.42, "f_frame": 0.2, "coupling": "converged",
             "gravity": True, "errors": None}
     _, result = check_invariants(cell, "reference")
@@ -611,7 +612,7 @@ def test_uncoupled_without_load_has_no_efficiency():
     the frictionless reactions, so the input work pays no loss; without load it is zero up to
     rounding and the quotient was noise (measured 7e15; the column overflows to inf at 1 rpm).
     Fixed (issue 18): no shaft takes net work, the efficiency is 0 (nothing is transmitted)."""
-    cell = {"base": "paper", "shaft_angle_deg": 20.0, "speed_rpm": 1000.0, "direction": 1,
+    cell = {"base": "paper-literal", "shaft_angle_deg": 20.0, "speed_rpm": 1000.0, "direction": 1,
             "load": 0.0, "f_spider": 0.5, "f_frame": 0.2, "coupling": "uncoupled",
             "gravity": False, "errors": None}
     s = run_engine(scene_of(cell), "reference").summary

@@ -25,7 +25,7 @@ TIMES = np.linspace(0.0, 6.5, 1301)  # the input below turns a little over two r
 PAPER_ERRORS = {"a": (0.5e-3,) * 3 + (0.0,), "alpha": (6e-3 * DEG,) * 3 + (0.0,)}
 LARGE_ERRORS = {"a": (5e-3, -3e-3, 4e-3, 2e-3), "alpha": (1 * DEG, -1 * DEG, 0.5 * DEG, 1 * DEG),
                 "s1": 2e-3}
-ERROR_SETS = {"paper": PAPER_ERRORS, "large": LARGE_ERRORS}
+ERROR_SETS = {"paper-literal": PAPER_ERRORS, "large": LARGE_ERRORS}
 H = 5e-4  # difference step [s]: truncation ~1e-11 and rounding ~1e-10 of rates of a few rad/s
 
 

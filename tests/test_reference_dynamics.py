@@ -154,7 +154,7 @@ def test_power_balance_at_every_sample(beta_deg):
 
 def test_result_follows_the_schema():
     """Columns, sampling, zero friction columns and the summary match the common schema."""
-    scene = replace(named_scene("paper-10deg-frictionless"), **{"record.every": 2})
+    scene = replace(named_scene("paper-literal-10deg-frictionless"), **{"record.every": 2})
     result = run(scene, samples_per_revolution=36)
     table, s = result.table, result.summary
     assert list(table.columns) == table_columns() + list(engine.EXTRA_COLUMNS)

@@ -19,7 +19,7 @@ from reference.paper import named_scene, paper_scene
 from reference.scene import AngleDrive, Scene, TorqueDrive, replace
 from reference.schema import Status, table_columns
 
-FRICTION_SCENES = ["paper-10deg", "paper-35deg", "paper-calibrated-20deg"]
+FRICTION_SCENES = ["paper-literal-10deg", "paper-literal-35deg", "paper-matched-20deg"]
 
 
 def one_revolution(name: str, **changes) -> Scene:
@@ -61,7 +61,7 @@ def test_power_balance_with_friction_at_every_sample(name):
     assert np.all(table["power_loss"] >= 0.0)
 
 
-@pytest.mark.parametrize("name", ["paper-10deg", "paper-35deg"])
+@pytest.mark.parametrize("name", ["paper-literal-10deg", "paper-literal-35deg"])
 def test_momentum_balance_with_friction(name):
     """Ground reactions, their friction torques, drive, load and gravity change the momenta."""
     scene = one_revolution(name)
@@ -86,7 +86,7 @@ def test_work_quadrature_closes_the_energy_balance(name):
                                              "output_frame")), rel=1e-13)
 
 
-@pytest.mark.parametrize("name", ["paper-10deg", "paper-35deg", "paper-calibrated-20deg"])
+@pytest.mark.parametrize("name", ["paper-literal-10deg", "paper-literal-35deg", "paper-matched-20deg"])
 def test_mean_efficiency_self_converges_to_1e_8(name):
     """Refining the quadrature and the table sampling moves the mean efficiency by < 1e-8."""
     scene = one_revolution(name)
@@ -103,7 +103,7 @@ def test_table_trapezoid_agrees_with_the_quadrature():
     sign ramps are 1 mm/s wide (the absolute band, 1.5e-2 of the spider pairs' RMS speed: about
     30 rows; the default relative band, 1e-3, spans fewer than 2 and the bound below would see
     the ramps as jumps)."""
-    scene = one_revolution("paper-10deg", **{"friction.sign_band": 1e-3})
+    scene = one_revolution("paper-literal-10deg", **{"friction.sign_band": 1e-3})
     r = run(scene, ReferenceOptions(samples_per_revolution=8000))
     t, f = r.table["t"].to_numpy(), r.table["power_loss"].to_numpy()
     h = t[1] - t[0]
@@ -116,7 +116,7 @@ def test_table_trapezoid_agrees_with_the_quadrature():
 def test_self_locking_is_reported_per_sample():
     """Plain reading at 50 deg: the friction loop gain exceeds 1 over part of the revolution;
     those samples (and only those) are flagged, the run reports self_locking and no means."""
-    scene = replace(paper_scene(50.0), revolutions=1)
+    scene = replace(paper_scene(50.0, parameters="literal"), revolutions=1)
     r = run(scene, ReferenceOptions(samples_per_revolution=180))
     table = r.table
     locked = table["self_locking"].to_numpy()
@@ -131,14 +131,15 @@ def test_self_locking_is_reported_per_sample():
 
 def test_no_self_locking_below_the_threshold():
     """At 40 deg (plain reading) every sample has a loop gain below 1: no locking."""
-    r = run(replace(paper_scene(40.0), revolutions=1), ReferenceOptions(samples_per_revolution=180))
+    r = run(replace(paper_scene(40.0, parameters="literal"), revolutions=1),
+            ReferenceOptions(samples_per_revolution=180))
     assert r.summary.status is Status.OK
     assert 0.5 < r.summary.max_friction_loop_gain < 1.0
 
 
 def test_angle_history_of_a_constant_speed_equals_the_speed_drive():
     """A linear angle history (its cubic spline is exact) reproduces the constant-speed drive."""
-    scene = one_revolution("paper-20deg")
+    scene = one_revolution("paper-literal-20deg")
     w = scene.drive.speed
     t = np.linspace(0.0, 1.2 * 2 * math.pi / w, 13)
     angle_scene = dataclasses.replace(scene, drive=AngleDrive(tuple(t), tuple(w * t)))
@@ -148,14 +149,14 @@ def test_angle_history_of_a_constant_speed_equals_the_speed_drive():
     assert b.input_work == pytest.approx(a.input_work, rel=1e-11)
 
 
-def torque_scene(torque: float, speed: float, name="paper-10deg") -> Scene:
+def torque_scene(torque: float, speed: float, name="paper-literal-10deg") -> Scene:
     return dataclasses.replace(named_scene(name), drive=TorqueDrive(torque, speed), revolutions=1)
 
 
 def test_torque_drive_without_friction_conserves_energy():
     """Frictionless torque drive: W_in - W_out equals the change of mechanical energy, to the
     integrator's tolerance, and the run stops after the requested revolution."""
-    r = run(torque_scene(8.0, 60.0, name="paper-10deg-frictionless"),
+    r = run(torque_scene(8.0, 60.0, name="paper-literal-10deg-frictionless"),
             ReferenceOptions(ode_rtol=1e-10, ode_atol=1e-10))
     s, table = r.summary, r.table
     assert s.status is Status.OK
@@ -170,7 +171,7 @@ def test_torque_drive_without_friction_conserves_energy():
 def test_torque_drive_reverses_and_stops_after_the_turn():
     """A drive weaker than the load: the joint slows, reverses, and the run stops when the input
     has turned the requested angle either way (as the Exudyn engine stops)."""
-    r = run(torque_scene(0.5, 20.0, name="paper-10deg-frictionless"),
+    r = run(torque_scene(0.5, 20.0, name="paper-literal-10deg-frictionless"),
             ReferenceOptions(ode_rtol=1e-8, ode_atol=1e-8))
     table = r.table
     assert table["omega_in"].iloc[-1] < 0 and table["theta_in"].iloc[-1] == pytest.approx(-2 * math.pi)
@@ -190,7 +191,7 @@ def test_torque_drive_with_friction_converges_with_the_tolerance():
 
 
 def test_extra_columns_and_schema():
-    table = run(one_revolution("paper-10deg"), ReferenceOptions(samples_per_revolution=36)).table
+    table = run(one_revolution("paper-literal-10deg"), ReferenceOptions(samples_per_revolution=36)).table
     assert list(table.columns) == table_columns() + list(EXTRA_COLUMNS)
     assert np.all(table["input_acceleration"] == 0.0)
 

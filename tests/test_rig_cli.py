@@ -76,7 +76,7 @@ def test_validate_takes_the_users_joint_as_a_scene_file(lvm, tmp_path):
 
     path, _ = lvm
     joint = tmp_path / "my_joint.toml"
-    joint.write_text('base = "rig-calibrated"\n[joint.geometry]\nshaft_angle_deg = 15.0\n'
+    joint.write_text('base = "rig-matched"\n[joint.geometry]\nshaft_angle_deg = 15.0\n'
                      '[joint.pairs.frame_input]\nfriction_coefficient = 0.1\n')
     out = tmp_path / "report"
     proc = cardan("validate", str(path), "--scene", str(joint), "--engines", "reference", "--mc", "0",
@@ -87,7 +87,7 @@ def test_validate_takes_the_users_joint_as_a_scene_file(lvm, tmp_path):
     assert api.scene.joint.pairs.frame_input.friction_coefficient == 0.1
     assert s["computed"]["reference"]["mean_efficiency"] == pytest.approx(
         api.computed_efficiency["reference"], rel=0, abs=1e-12)
-    named = rigdata.validate(str(path), "rig-calibrated", engines=("reference",), monte_carlo=0)
+    named = rigdata.validate(str(path), "rig-matched", engines=("reference",), monte_carlo=0)
     assert abs(named.computed_efficiency["reference"] - api.computed_efficiency["reference"]) > 1e-4
 
 
@@ -111,7 +111,7 @@ def test_bad_input_one_line_exit_2_nothing_written(lvm, tmp_path, args, match):
     short = tmp_path / "short.csv"
     short.write_text(CSV_ONE_REV)
     bad_scene = tmp_path / "bad.toml"
-    bad_scene.write_text('base = "rig-calibrated"\n[joint.pairs.frame_input]\nfrictoin = 0.2\n')
+    bad_scene.write_text('base = "rig-matched"\n[joint.pairs.frame_input]\nfrictoin = 0.2\n')
     out = tmp_path / "out"
     values = {"missing": str(tmp_path / "no-such.csv"), "lvm": str(path), "out": str(out),
               "short": str(short), "missing_scene": str(tmp_path / "no-such.toml"),

@@ -134,7 +134,8 @@ def test_model_driven_by_measurement_recovers_true_efficiency(truth, engine, tol
     efficiency: reference within 2e-5 (measured 4e-7), Exudyn within 3e-5 (measured 3e-6)."""
     rec, _ = perfect(truth)
     c = condition(rec, BETA)
-    comp = computed_efficiency(run(measured_scene(c, named_scene("rig-calibrated")), engine))
+    model = named_scene(synthetic.RigSettings().scene)  # the scene the synthetic truth comes from
+    comp = computed_efficiency(run(measured_scene(c, model), engine))
     assert comp["status"] == Status.OK
     assert comp["mean_efficiency"] == pytest.approx(truth.efficiency, abs=tol)
 
@@ -145,7 +146,7 @@ def test_validate_report_and_atomic_replacement(truth, tmp_path, monkeypatch):
     import rigdata.report as report
 
     rec, _ = synthetic.record(synthetic.RigSettings(), truth=truth)
-    v = validate(rec, named_scene("rig-calibrated"), engines=("reference",), monte_carlo=200)
+    v = validate(rec, named_scene(synthetic.RigSettings().scene), engines=("reference",), monte_carlo=200)
     assert isinstance(v, Validation) and v.success
     assert not list(tmp_path.iterdir())  # validate writes nothing
     out = tmp_path / "rep"
@@ -261,7 +262,8 @@ def rig_validation(rpm: float, torque: float, angle: float):
                                      input_torque=float(torque), revolutions=3.0,
                                      rate=max(1000.0, 50.0 * rpm))
     record, _ = synthetic.record(settings)
-    scene = replace_field(named_scene("rig-calibrated"), **{"joint.geometry.shaft_angle_deg": angle})
+    scene = replace_field(named_scene(synthetic.RigSettings().scene),
+                          **{"joint.geometry.shaft_angle_deg": angle})
     return validate(record, scene, monte_carlo=0)
 
 

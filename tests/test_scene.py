@@ -48,21 +48,21 @@ def test_bad_input_api(build, match):
 
 
 BAD_TOML = [
-    ("unknown top-level key", 'base = "paper"\nspeeed = 3\n', r"unknown key\(s\) \['speeed'\]"),
-    ("unknown geometry key", 'base = "paper"\n[joint.geometry]\nshaft_angel_deg = 10\n',
+    ("unknown top-level key", 'base = "paper-literal"\nspeeed = 3\n', r"unknown key\(s\) \['speeed'\]"),
+    ("unknown geometry key", 'base = "paper-literal"\n[joint.geometry]\nshaft_angel_deg = 10\n',
      r"\[joint.geometry\] unknown key\(s\) \['shaft_angel_deg'\]"),
-    ("angle out of range", 'base = "paper"\n[joint.geometry]\nshaft_angle_deg = 95\n',
+    ("angle out of range", 'base = "paper-literal"\n[joint.geometry]\nshaft_angle_deg = 95\n',
      r"\[joint.geometry\] `shaft_angle` must be in \[0, 90\) deg, got 95"),
-    ("negative mass", 'base = "paper"\n[joint.input]\nmass = -0.9\n',
+    ("negative mass", 'base = "paper-literal"\n[joint.input]\nmass = -0.9\n',
      r"\[joint.input\] `mass` must be positive, got -0.9"),
-    ("zero speed", 'base = "paper"\n[drive]\nkind = "speed"\nspeed_rpm = 0\n',
+    ("zero speed", 'base = "paper-literal"\n[drive]\nkind = "speed"\nspeed_rpm = 0\n',
      r"\[drive\] `speed` of a constant-speed drive must be non-zero"),
-    ("unknown drive", 'base = "paper"\n[drive]\nkind = "pedal"\n', r"`kind` must be one of"),
-    ("both units", 'base = "paper"\n[joint.geometry]\nshaft_angle = 0.1\nshaft_angle_deg = 5\n',
+    ("unknown drive", 'base = "paper-literal"\n[drive]\nkind = "pedal"\n', r"`kind` must be one of"),
+    ("both units", 'base = "paper-literal"\n[joint.geometry]\nshaft_angle = 0.1\nshaft_angle_deg = 5\n',
      r"give either `shaft_angle` or `shaft_angle_deg`"),
-    ("too few revolutions", 'base = "paper"\nrevolutions = 0.5\n', r"`revolutions` must be at least"),
+    ("too few revolutions", 'base = "paper-literal"\nrevolutions = 0.5\n', r"`revolutions` must be at least"),
     ("unknown base", 'base = "papr"\n', r"unknown scene name 'papr'"),
-    ("negative friction", 'base = "paper"\n[joint.pairs.frame_input]\nfriction_coefficient = -0.2\n',
+    ("negative friction", 'base = "paper-literal"\n[joint.pairs.frame_input]\nfriction_coefficient = -0.2\n',
      r"\[joint.pairs.frame_input\] `friction_coefficient` must be >= 0"),
     ("not TOML", 'base = "paper\n', r"is not valid TOML"),
 ]
@@ -86,7 +86,7 @@ def test_missing_scene_file(tmp_path):
 
 def test_toml_round_trip(tmp_path):
     """A resolved scene dumped to TOML loads back to an equal scene."""
-    scene = named_scene("paper-25deg-1000rpm-frictionless")
+    scene = named_scene("paper-literal-25deg-1000rpm-frictionless")
     path = tmp_path / "s.toml"
     path.write_text(tomli_w.dumps(scene_to_dict(scene)))
     assert load_scene(path) == scene
@@ -95,7 +95,7 @@ def test_toml_round_trip(tmp_path):
 def test_toml_base_and_units(tmp_path):
     """A file can start from a named scene and use unit-suffixed keys."""
     path = tmp_path / "s.toml"
-    path.write_text('base = "paper-frictionless"\n[joint.geometry]\nshaft_angle_deg = 20\n'
+    path.write_text('base = "paper-literal-frictionless"\n[joint.geometry]\nshaft_angle_deg = 20\n'
                     '[drive]\nspeed_rpm = 1500\n')
     scene = load_scene(path)
     assert scene.joint.geometry.shaft_angle == pytest.approx(math.radians(20))
@@ -105,7 +105,7 @@ def test_toml_base_and_units(tmp_path):
 
 def test_replace_validates():
     """replace() rebuilds and validates the scene."""
-    scene = named_scene("paper")
+    scene = named_scene("paper-literal")
     with pytest.raises(SceneError, match="shaft_angle"):
         replace(scene, **{"joint.geometry.shaft_angle": 2.0})
     with pytest.raises(SceneError, match=r"unknown key\(s\) \['mas'\]"):

@@ -33,7 +33,7 @@ from reference.validation import SceneError
 
 TESTS = Path(__file__).parent
 # the reference engine at one revolution without a time table: ~0.05 s per case
-BASE = {"scene": "paper-10deg", "engine": "reference",
+BASE = {"scene": "paper-literal-10deg", "engine": "reference",
         "fixed": {"revolutions": 1, "record.timeseries": False}}
 TIMING = ["case_wall_s", "wall_time_s"]
 
@@ -229,7 +229,7 @@ def test_reference_sweep_records_the_summary_and_writes_the_table(tmp_path):
     assert list(t.columns[:4]) == ["id", "engine", "joint.geometry.shaft_angle_deg", "status"]
     assert t["joint.geometry.shaft_angle_deg"].tolist() == angles
     assert "scene" not in t and "quadrature.evaluations" in t
-    direct = engines.run(replace(named_scene("paper-10deg"), revolutions=1,
+    direct = engines.run(replace(named_scene("paper-literal-10deg"), revolutions=1,
                                  **{"record.timeseries": False, "joint.geometry.shaft_angle_deg": 20}),
                          "reference").summary
     assert t["mean_efficiency"].iloc[2] == direct.mean_efficiency
@@ -290,7 +290,7 @@ def test_resume_after_kill_runs_only_the_missing_cases(tmp_path):
     """SIGKILL the driver and its two workers after three records; the same command resumes,
     runs only the missing cases, and the table equals an uninterrupted run's."""
     spec = write_spec(tmp_path / "spec.toml", """
-scene = "paper-10deg"
+scene = "paper-literal-10deg"
 engine = "reference"
 function = "test_sweep:dying_case"
 [fixed]
@@ -325,7 +325,7 @@ def test_resume_after_the_driver_dies_mid_case(tmp_path):
     """In-process, the process dies (os._exit) during the fourth case: exactly three records
     survive, and the rerun runs the other cases only."""
     spec = write_spec(tmp_path / "spec.toml", """
-scene = "paper-10deg"
+scene = "paper-literal-10deg"
 engine = "reference"
 function = "test_sweep:dying_case"
 fixed = { revolutions = 1 }
@@ -414,7 +414,7 @@ def test_cli_exit_codes_and_json(tmp_path, capsys):
     """Exit 0 when every case is ok, 3 when some failed (files still written); --json prints
     sweep.json on stdout and nothing else."""
     spec = write_spec(tmp_path / "spec.toml", """
-scene = "paper-10deg"
+scene = "paper-literal-10deg"
 engine = "reference"
 function = "test_sweep:cheap_case"
 [grid]
@@ -433,9 +433,9 @@ function = "test_sweep:cheap_case"
 
 
 BAD_CLI = [
-    (["--scene", "paper-10deg", "--grid", "joint.geometry.shaft_angel_deg=1,2"], "unknown key(s)"),
-    (["--scene", "paper-10deg", "--grid", "load.torque"], "--grid must look like PATH=V1,V2"),
-    (["--scene", "paper-10deg"], "nothing to sweep"),
+    (["--scene", "paper-literal-10deg", "--grid", "joint.geometry.shaft_angel_deg=1,2"], "unknown key(s)"),
+    (["--scene", "paper-literal-10deg", "--grid", "load.torque"], "--grid must look like PATH=V1,V2"),
+    (["--scene", "paper-literal-10deg"], "nothing to sweep"),
     (["--grid", "load.torque=1"], "`scene` is required"),
     (["/nonexistent.toml"], "cannot read sweep spec"),
 ]
@@ -487,7 +487,7 @@ def test_summary_outputs_are_scalars():
     from reference.paper import named_scene
     from reference.scene import replace
 
-    out = summary_outputs(replace(named_scene("paper-10deg"), revolutions=1), "reference")
+    out = summary_outputs(replace(named_scene("paper-literal-10deg"), revolutions=1), "reference")
     assert "scene" not in out and out["status"] == "ok"
     assert all(v is None or isinstance(v, (str, bool, int, float)) for v in out.values())
     assert math.isfinite(out["mean_efficiency"]) and "quadrature.evaluations" in out
@@ -497,7 +497,7 @@ def test_sweep_spec_object_and_scene_object(tmp_path):
     """Programmatic use: a SweepSpec with a Scene and explicit cases."""
     from reference.paper import named_scene
 
-    spec = SweepSpec(scene=named_scene("rig"), engine="reference", function=cheap_case,
+    spec = SweepSpec(scene=named_scene("rig-literal"), engine="reference", function=cheap_case,
                      cases=({"id": "x", "load.torque": 2.0}, {"id": "y", "load.torque": 13.0}))
     summary = run_sweep(spec, tmp_path, workers=1)
     assert summary["failed_ids"] == ["y"] and summary["spec"]["function"] == "test_sweep:cheap_case"

@@ -112,14 +112,14 @@ class FrictionCoupling:
         self.model = model
         self.mbs = model.mbs
         self.settings = scene.friction
-        self.bands = sign_bands(scene)  # per pair (rotation, sliding) [m/s], as every engine
+        self.bands = sign_bands(scene)  # per pair (rotation, sliding, resultant) [m/s], as every engine
         self.converged = scene.friction.coupling == "converged"
         self.pairs: list[_PairData] = []
-        for name, pair in scene.joint.pairs.items():
+        for name, pair in scene.joint.friction_pairs():
             if pair.friction_coefficient <= 0.0:
                 continue
             frame = model.pair_frames[name]
-            law = PairLaw.of(PAIR_KIND[name], pair)
+            law = PairLaw.of(PAIR_KIND[name], pair, scene.friction.law)
             p = _PairData(name=name, kind=PAIR_KIND[name], law=law, joint=model.joints[name],
                           bodies=PAIR_BODIES[name], local=model.marker_local[name],
                           axis_local=frame[:, 2].copy())
@@ -298,8 +298,13 @@ class FrictionCoupling:
             lx, ly, _ = get(p.joint, force_local)
             tx, ty, _ = get(p.joint, torque_local)
             omega_rel, slide = speeds[k]
+            # a pair that cannot slide (no axial load: the ideal joint) has solver noise as its
+            # slide; under the resultant law it would enter the slip direction
+            slide = float(slide) if p.force_loads else 0.0
+            band = self.bands[p.name]
             # TorqueLocal's in-plane components are rotated by 90 deg; only the magnitude enters
-            loads = pair_loads(p.law, lx, ly, tx, ty, float(omega_rel), float(slide), *self.bands[p.name])
+            loads = pair_loads(p.law, lx, ly, tx, ty, float(omega_rel), slide, band.rotation,
+                               band.sliding, band.resultant)
             friction[k] = loads.torque, (loads.force if p.force_loads else 0.0)
             sliding = max(sliding, loads.sliding_scale)
         self.scale_floor = REST_FLOOR * sliding

@@ -21,6 +21,13 @@ respect to ``a``, regularised by a linear ramp of width ``band`` [m/s] (the rota
 sliding has its own, ``slide_band``); for the rotation the surface speed is ``omega_rel d / 2``.
 The widths are scene data, the same for every engine (:func:`reference.bands.sign_bands`).
 
+That is the paper's law (``FrictionSettings.law = "paper"``). Since ``T = (d / 2) A``, both are
+one Coulomb force ``A`` at the journal surface; the resultant-slip law (``"resultant"``) lets that
+one force oppose the contact's slip velocity ``(v_c, v_a) = (omega_rel d / 2, v_slide)`` instead of
+acting in full in each direction: body ``b`` receives ``-(d / 2) A v_c / m`` about the axis and
+``-A v_a / m`` along it, ``m = max(sqrt(v_c^2 + v_a^2), resultant_band)`` (the unit slip direction
+outside the band, linear inside). A revolute pair has ``v_a = 0``.
+
 References
 ----------
 Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
@@ -50,19 +57,26 @@ class PairLaw:
         Journal diameter [m].
     lever : float
         Moment lever ``L`` of eqs. (1)-(2) [m].
+    resultant : bool
+        True: one Coulomb force against the resultant slip (``FrictionSettings.law ==
+        "resultant"``); False: the paper's eqs. (3), (5), one sign per direction.
     """
 
     cylindrical: bool
     f: float
     d: float
     lever: float
+    resultant: bool = False
 
     @classmethod
-    def of(cls, kind: str, pair: Any) -> PairLaw:
-        """The law of a scene's pair (:class:`reference.joint.Pair`) of ``kind`` ("revolute" or
-        "cylindrical")."""
+    def of(cls, kind: str, pair: Any, law: str = "paper") -> PairLaw:
+        """The law of a scene's pair (:class:`reference.joint.Pair`, its ``moment_lever``
+        resolved to a number) of ``kind`` ("revolute" or "cylindrical") under the friction
+        ``law`` ("paper" or "resultant", ``FrictionSettings.law``)."""
+        if law not in ("paper", "resultant"):
+            raise ValueError(f"`law` must be 'paper' or 'resultant', got {law!r}")
         return cls(kind == "cylindrical", pair.friction_coefficient, pair.journal_diameter,
-                   pair.moment_lever)
+                   float(pair.moment_lever), law == "resultant")
 
 
 class FrictionLoads(NamedTuple):
@@ -94,7 +108,8 @@ def ramp_sign(speed: float, band: float) -> float:
 
 def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, moment_y: float,
                omega_rel: float, slide_rel: float, band: float,
-               slide_band: float | None = None) -> FrictionLoads:
+               slide_band: float | None = None,
+               resultant_band: float | None = None) -> FrictionLoads:
     """Friction of one pair from its reaction and relative motion (eqs. (1)-(5)).
 
     Parameters
@@ -112,18 +127,29 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
         Width of the rotation's sign ramp, in relative surface speed [m/s] (0: the exact sign).
     slide_band : float or None
         Width of the sliding's sign ramp [m/s]; None: ``band``.
+    resultant_band : float or None
+        Resultant-slip law: width of the ramp of the slip speed ``hypot(omega_rel d / 2,
+        slide_rel)`` [m/s]; None: ``band``.
     """
     force_n = math.hypot(force_x, force_y)
     moment_n = math.hypot(moment_x, moment_y)
     radius = 0.5 * law.d
     torque = law.f * law.d * moment_n / law.lever + law.f * radius * force_n
-    scale = torque
+    magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
+    scale = max(torque, radius * magnitude) if law.cylindrical else torque
+    surface = radius * omega_rel
+    if law.resultant:
+        slide = slide_rel if law.cylindrical else 0.0
+        width = band if resultant_band is None else resultant_band
+        slip = max(math.hypot(surface, slide), width)
+        if slip <= 0.0:
+            return FrictionLoads(0.0, 0.0, scale)
+        return FrictionLoads(-torque * surface / slip,
+                             -magnitude * slide / slip if law.cylindrical else 0.0, scale)
     axial = 0.0
     if law.cylindrical:
-        magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
         axial = -ramp_sign(slide_rel, band if slide_band is None else slide_band) * magnitude
-        scale = max(scale, radius * magnitude)
-    return FrictionLoads(-ramp_sign(radius * omega_rel, band) * torque, axial, scale)
+    return FrictionLoads(-ramp_sign(surface, band) * torque, axial, scale)
 
 
 def bdf2_weights(h1: float, h2: float) -> tuple[float, float]:

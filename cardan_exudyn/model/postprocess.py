@@ -189,13 +189,14 @@ def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
     if not scene.has_friction:
         return out
     bands = sign_bands(scene)
-    for name, pair in scene.joint.pairs.items():
+    for name, pair in scene.joint.friction_pairs():
         if pair.friction_coefficient <= 0.0:
             continue
-        law = PairLaw.of(PAIR_KIND[name], pair)
+        law = PairLaw.of(PAIR_KIND[name], pair, scene.friction.law)
+        band = bands[name]
         rows = zip(*(cols[f"{name}_{s}"].tolist()
                      for s in ("fx", "fy", "mx", "my", "omega_rel", "slide_rel")), strict=True)
-        loads = [pair_loads(law, *row, *bands[name]) for row in rows]
+        loads = [pair_loads(law, *row, band.rotation, band.sliding, band.resultant) for row in rows]
         out[name] = (np.array([x.torque for x in loads]), np.array([x.force for x in loads]))
     return out
 

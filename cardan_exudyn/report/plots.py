@@ -36,18 +36,57 @@ def speed_ratio(tables: dict[str, object], ax=None):
                                 "omega_out / omega_in [-]", ax)
 
 
-def efficiency_history(tables: dict[str, object], title: str = "", ax=None, ylim=(0.0, 1.05)):
-    """Instantaneous efficiency of eq. (18) against time (Figures 4, 6, 7 of the paper).
+def data_limits(values, margin: float = 0.08, min_span: float = 2e-3,
+                clip: tuple[float, float] | None = None) -> tuple[float, float]:
+    """Axis limits that show the variation of ``values``: their finite range widened by
+    ``margin`` of its span on each side (a span of at least ``min_span``, centred, so that a
+    constant reads as one), then cut to ``clip`` when given. No finite value: ``clip`` or (0, 1).
 
-    Where the input power changes sign eq. (18) is unbounded; the axis is clipped to ``ylim``.
+    Parameters
+    ----------
+    values : array_like
+        Every value the axis must show (NaN and infinities are ignored).
+    margin : float
+        Fraction of the span added below and above [-].
+    min_span : float
+        Smallest span of the limits, in the values' unit.
+    clip : tuple of float, optional
+        Limits never exceeded (for a quantity that is unbounded somewhere, eq. (18)).
+    """
+    x = np.asarray(values, dtype=float).ravel()
+    x = x[np.isfinite(x)]
+    if clip is not None:
+        x = x[(x >= clip[0]) & (x <= clip[1])]
+    if x.size == 0:
+        return tuple(clip) if clip is not None else (0.0, 1.0)
+    lo, hi = float(x.min()), float(x.max())
+    if hi - lo < min_span:
+        mid = 0.5 * (lo + hi)
+        lo, hi = mid - 0.5 * min_span, mid + 0.5 * min_span
+    pad = margin * (hi - lo)
+    lo, hi = lo - pad, hi + pad
+    if clip is not None:
+        lo, hi = max(lo, clip[0]), min(hi, clip[1])
+    return lo, hi
+
+
+def efficiency_against_input_angle(curves: dict[str, tuple], title: str = "", ax=None,
+                                   clip: tuple[float, float] = (-0.5, 1.05)):
+    """Instantaneous efficiency of eq. (18) against the input angle (Figures 4, 6, 7 of the paper).
+
+    ``curves``: label -> (input angle [deg], efficiency [-]), one revolution each, so that runs at
+    different speeds are comparable. The y limits follow the data (:func:`data_limits`); eq. (18)
+    is unbounded where the input power changes sign, so they never leave ``clip``.
     """
     fig, ax = _axes(ax)
-    for label, t in tables.items():
-        ax.plot(t["t"], t["efficiency"], lw=0.9, label=label)
-    ax.set_xlabel("time [s]")
+    for label, (angle, eta) in curves.items():
+        ax.plot(angle, eta, lw=0.9, label=label)
+    ax.set_xlabel("input angle [deg]")
     ax.set_ylabel("instantaneous efficiency, eq. (18) [-]")
-    if ylim is not None:
-        ax.set_ylim(*ylim)
+    ax.set_xlim(0, 360)
+    ax.set_xticks(range(0, 361, 45))
+    ax.set_ylim(*data_limits(np.concatenate([np.asarray(e, float) for _, e in curves.values()]),
+                             clip=clip))
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     if title:
@@ -55,38 +94,52 @@ def efficiency_history(tables: dict[str, object], title: str = "", ax=None, ylim
     return fig
 
 
-def pair_losses(table, title: str = ""):
-    """Power loss of the spider pairs (left) and of the shaft-frame pairs (right), Figure 5."""
+def pair_losses(angle, losses: dict[str, object], title: str = ""):
+    """Power loss of the spider pairs (left) and of the shaft-frame pairs (right) against the
+    input angle [deg], Figure 5; ``losses``: pair name -> power loss [W]. Each panel's y limits
+    follow its data."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
     for ax, pairs in zip(axes, (("input_spider", "spider_output"), ("frame_input", "output_frame")),
                          strict=True):
         for pair in pairs:
-            ax.plot(table["t"], table[f"power_loss_{pair}"], lw=0.9, label=pair)
-        ax.set_xlabel("time [s]")
+            ax.plot(angle, losses[pair], lw=0.9, label=pair)
+        ax.set_xlabel("input angle [deg]")
         ax.set_ylabel("power loss [W]")
+        ax.set_xlim(0, 360)
+        ax.set_xticks(range(0, 361, 90))
+        ax.set_ylim(*data_limits(np.concatenate([np.asarray(losses[p], float) for p in pairs]),
+                                 min_span=1e-2))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(title, fontsize=9)
     return fig
 
 
-def efficiency_against_paper(rows, x: str, xlabel: str, ax=None):
-    """Mean efficiency (both definitions, each parameter set) against the paper's values."""
-    fig, ax = _axes(ax)
-    first = True
-    for label, df in rows.items():
-        ax.plot(df[x], df["mean_efficiency"], "o-", label=f"{label}: 1 - W_loss / W_in")
-        ax.plot(df[x], df["mean_instantaneous_efficiency"].clip(-0.1, 1.1), "x:",
-                label=f"{label}: time average of eq. (18)")
-        if first:
-            ax.plot(df[x], df["paper_mean_efficiency"], "ks", mfc="none", label="paper")
-            first = False
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("mean efficiency [-]")
-    ax.set_ylim(-0.1, 1.1)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+def efficiency_against_paper(panels: dict[str, object], x: str, xlabel: str):
+    """Mean efficiency against the paper, one panel per parameter set, each with its own y limits
+    from its data (:func:`data_limits`): the set's two mean efficiencies as lines (``o-``: one
+    minus lost over input work; ``x:``: the time average of eq. (18), where defined) and the
+    paper's values as markers at the same abscissae. ``panels``: set -> DataFrame with ``x``,
+    ``mean_efficiency``, ``mean_instantaneous_efficiency``, ``paper_mean_efficiency``, and
+    ``used_in_fit`` (fitted cases filled, held-out ones open)."""
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 4), squeeze=False,
+                             constrained_layout=True)
+    for ax, (label, df) in zip(axes[0], panels.items(), strict=True):
+        ax.plot(df[x], df["mean_efficiency"], "o-", ms=4, label="model: 1 - W_loss / W_in")
+        ax.plot(df[x], df["mean_instantaneous_efficiency"], "x:", label="model: time average of eq. (18)")
+        fit = df["used_in_fit"].astype(bool)
+        ax.plot(df[x][fit], df["paper_mean_efficiency"][fit], "ks", ms=6, label="paper (fitted)")
+        ax.plot(df[x][~fit], df["paper_mean_efficiency"][~fit], "ks", mfc="none", ms=6,
+                label="paper (held out)")
+        ax.set_ylim(*data_limits(np.concatenate([df[c].to_numpy(float) for c in (
+            "mean_efficiency", "mean_instantaneous_efficiency", "paper_mean_efficiency")]),
+            clip=(-0.05, 1.05)))
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("mean efficiency [-]")
+        ax.set_title(label, fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=6)
     return fig
 
 

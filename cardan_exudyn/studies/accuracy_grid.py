@@ -83,7 +83,7 @@ def cell_scene(cell: dict[str, Any], accuracy: float) -> Scene:
     else:  # torque: twice the load, starting at the cell's speed
         changes["drive"] = {"kind": "torque", "torque": 4.0, "initial_speed": speed}
         changes["record.skip_revolutions"] = 0.5
-    return replace(named_scene("paper-10deg"), **changes)
+    return replace(named_scene("paper-literal-10deg"), **changes)
 
 
 def run_cell(cell: dict[str, Any], accuracy: float) -> dict[str, Any]:

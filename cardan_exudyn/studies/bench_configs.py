@@ -27,10 +27,10 @@ __all__ = ["SCENES", "ENGINE_NAMES", "EXUDYN_DEFAULT", "EXUDYN_TUNED", "FULL_LAD
            "configurations", "simulated_time"]
 
 SCENES = {
-    "frictionless-10deg": "paper-10deg-frictionless",
-    "frictionless-35deg": "paper-35deg-frictionless",
-    "friction-10deg": "paper-10deg",
-    "friction-35deg": "paper-35deg",
+    "frictionless-10deg": "paper-literal-10deg-frictionless",
+    "frictionless-35deg": "paper-literal-35deg-frictionless",
+    "friction-10deg": "paper-literal-10deg",
+    "friction-35deg": "paper-literal-35deg",
 }
 """The fixed scene set: key -> named scene (all at 2000 rpm, the paper's masses, load and gravity)."""
 

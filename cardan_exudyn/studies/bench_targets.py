@@ -187,7 +187,7 @@ def evaluate_targets(rows: pd.DataFrame, paper: dict[str, Any] | None) -> list[d
     return out
 
 
-def paper_scenes(parameters: str = "plain") -> list[Scene]:
+def paper_scenes(parameters: str = "literal") -> list[Scene]:
     """The paper's eleven scenes with friction (Table 2 and the speed study), summary only."""
     return [replace(paper_scene(c["shaft_angle_deg"], c["speed_rpm"], parameters=parameters),
                     **{"record.timeseries": False}) for c in paper_cases()]

@@ -1,24 +1,16 @@
-"""``cardan calibrate``: identify the paper's open parameters from a subset of its own results.
+"""``cardan calibrate``: identify a parameter set's open values from a subset of the paper's own
+results, and (``--envelope``) bound what the plausible box can give for each of the paper's
+numbers (:mod:`cardan_exudyn.studies.envelope`).
 
-The paper leaves several values open (see the assumption register). This module fits the
-fewest physically interpretable ones to a subset of the paper's eleven mean efficiencies
-(default: 0, 10, 20, 30 deg at 2000 rpm and 10 deg at 1000 rpm) by least squares
-(``scipy.optimize.least_squares``, parameters on a log scale within physical bounds), then
-reports the error on the cases not used in the fit. The values it prints are what
-``reference/data/paper.toml`` stores under ``[calibrated]``; ``tests/test_calibration.py``
-(slow) re-runs the fit and checks that they still agree.
-
-The parameters (each applied by :func:`reference.paper.apply_parameters`):
-
-- ``spider_lever`` [m]: moment lever of eq. (1) in the two spider pairs. Literal reading: the
-  trunnion bearing length L = 6 mm. A lumped pair stands for two trunnion bearings on opposite
-  arms, which carry a bending moment as a couple with the lever *between the bearings*,
-  2 x arm radius.
-- ``frame_lever`` [m]: the same for the two shaft-frame pairs. Literal: L = 10 mm. Physical: the
-  spacing of the two support bearings of a shaft.
-- ``input_eccentricity`` [m]: distance of the input shaft's centre of mass from its axis.
-  Table 1 under the register's reading: 8.6 mm (a 352 N rotating load at 2000 rpm). The paper
-  mentions the eccentricity; its size is what makes the 0 deg loss.
+``--set physical`` (default) fits the physical set's ``fitted`` values (arm radius, support
+spacing, input eccentricity, spider centre-of-mass offset) inside the plausible box
+(``[plausible]`` of ``reference/data/paper.toml``) to the set's ``fit_cases`` by bounded least
+squares (``scipy.optimize.least_squares``, trust-region reflective), once for every combination
+of the box's discrete options (gravity, reading of the 2 N m), and keeps the combination with
+the smallest RMS. ``--set matched`` refits the matched set's levers and eccentricity within wide
+bounds (:data:`cardan_exudyn.studies.fitting.MATCHED_BOUNDS`, log scale), its choices held. The
+other cases are held out: their errors are reported next to the fitted ones.
+``tests/test_calibration.py`` (slow) re-runs both and checks the stored values.
 """
 
 from __future__ import annotations
@@ -32,212 +24,179 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput
-from cardan_exudyn.engines import run
-from cardan_exudyn.io import dumps
+from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, out_folder
+from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
-from reference.paper import CALIBRATION_PARAMETERS, paper_cases, paper_scene
-from reference.scene import replace
-from reference.schema import Status
+from cardan_exudyn.studies.envelope import envelope_study, envelope_text
+from cardan_exudyn.studies.fitting import (
+    FIT_ENGINES,
+    CaseModel,
+    Space,
+    cases_named,
+    in_fit,
+    set_space,
+)
+from reference.paper import case_key, paper_cases, parameter_set
 
-DEFAULT_FIT = ("table2:0:2000", "table2:10:2000", "table2:20:2000", "table2:30:2000",
-               "speed:10:1000")
-DEFAULT_PARAMETERS = ("spider_lever", "frame_lever", "input_eccentricity")
+FIT_SETS = ("physical", "matched")
 CASE_COLUMNS = ["case", "used in fit", "paper", "model", "difference"]
 CASE_FORMATS = {"paper": ".3f", "model": ".4f", "difference": "+.4f"}
+XTOL = 1e-8
+"""``least_squares`` step tolerance in the unit box: 1e-8 of a parameter's range."""
+
+__all__ = ["FIT_SETS", "calibrate", "fit", "fit_statistics", "in_fit", "register"]
 
 
-def case_key(case: Mapping[str, Any]) -> str:
-    """``study:angle:rpm``, the name of one of :func:`reference.paper.paper_cases`."""
-    return f"{case['study']}:{case['shaft_angle_deg']:g}:{case['speed_rpm']:g}"
-
-
-def in_fit(case: Mapping[str, Any], fit: Sequence[str]) -> bool:
-    """Whether ``case`` is one of the fit cases or the same scene (angle and speed) as one:
-    the speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case."""
-    scene = (case["shaft_angle_deg"], case["speed_rpm"])
-    return any((float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
-
-
-def efficiency(case: Mapping[str, Any], values: Mapping[str, float], accuracy: float,
-               revolutions: float) -> float:
-    """Mean efficiency [-] of ``case`` with the parameter ``values``; NaN when the run failed."""
-    return run_case(case, values, accuracy, revolutions)[0]
-
-
-def run_case(case: Mapping[str, Any], values: Mapping[str, float], accuracy: float,
-             revolutions: float) -> tuple[float, Status, str]:
-    """Mean efficiency [-] (NaN when the run failed), status and reason of ``case`` run by Exudyn.
-
-    Parameters
-    ----------
-    case : mapping
-        One of :func:`reference.paper.paper_cases`.
-    values : mapping
-        Calibration parameter -> value (units of :data:`reference.paper.CALIBRATION_PARAMETERS`).
-    accuracy : float
-        ``numerics.accuracy`` of the run [-].
-    revolutions : float
-        Input revolutions to simulate [-].
-    """
-    scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=dict(values))
-    scene = replace(scene, **{"numerics.accuracy": accuracy, "revolutions": revolutions,
-                              "record.timeseries": False})
-    result = run(scene, "exudyn")
-    if not result.success:
-        return float("nan"), result.status, result.message
-    return float(result.mean_efficiency), Status.OK, ""
-
-
-def check_parameters(names: Sequence[str]) -> None:
-    """Refuse a parameter :data:`reference.paper.CALIBRATION_PARAMETERS` does not know."""
-    unknown = [n for n in names if n not in CALIBRATION_PARAMETERS]
-    if unknown:
-        raise ValueError(f"unknown parameter(s) {unknown}; choose from {list(CALIBRATION_PARAMETERS)}")
-
-
-def fit_cases(fit: Sequence[str]) -> list[dict[str, Any]]:
-    """The paper's cases named by ``fit`` (:func:`case_key`), in that order."""
-    by_key = {case_key(c): c for c in paper_cases()}
-    missing = [k for k in fit if k not in by_key]
-    if missing:
-        raise ValueError(f"unknown fit case(s) {missing}; cases are {list(by_key)}")
-    return [by_key[k] for k in fit]
-
-
-def residuals(cases: Sequence[Mapping[str, Any]], values: Mapping[str, float], accuracy: float,
-              revolutions: float) -> np.ndarray:
+def residuals(model: CaseModel, cases: Sequence[Mapping[str, Any]], values: Mapping[str, Any]) -> np.ndarray:
     """Model minus paper mean efficiency [-] per case; a failed (self-locking) case counts as
     efficiency 0: a large, finite residual."""
-    out = []
-    for case in cases:
-        eta = efficiency(case, values, accuracy, revolutions)
-        out.append((eta if math.isfinite(eta) else 0.0) - case["paper_mean_efficiency"])
-    return np.asarray(out)
+    etas = [model.efficiency(c, values) for c in cases]
+    return np.asarray([(e if math.isfinite(e) else 0.0) - c["paper_mean_efficiency"]
+                       for e, c in zip(etas, cases, strict=True)])
 
 
-def fit_parameters(names: Sequence[str], cases: Sequence[Mapping[str, Any]], accuracy: float,
-                   revolutions: float,
-                   progress: Callable[[str], None] | None = None) -> tuple[dict[str, float], int]:
-    """Least-squares values of ``names`` (on a log scale, within their physical bounds) for
-    ``cases``, and the number of function evaluations."""
+def fit(model: CaseModel, space: Space, combinations: Sequence[Mapping[str, Any]],
+        start: Sequence[float], cases: Sequence[Mapping[str, Any]],
+        progress: Callable[[str], None] | None = None) -> list[dict[str, Any]]:
+    """Bounded least-squares fit of ``space``'s numbers to ``cases``, once per combination of
+    discrete choices, from ``start`` (unit box).
+
+    Returns
+    -------
+    list of dict
+        Per combination, best first: ``choices``, ``values`` (every parameter), ``rms`` [-]
+        (RMS residual on ``cases``), ``evaluations``, ``status`` (the optimiser's message).
+    """
     from scipy.optimize import least_squares  # import cost: this module registers a CLI command
 
-    spec = [CALIBRATION_PARAMETERS[n] for n in names]
-    lo, hi = np.log([s["bounds"][0] for s in spec]), np.log([s["bounds"][1] for s in spec])
-    x0 = np.clip(np.log([s["start"] for s in spec]), lo, hi)
-    evaluations = 0
+    out = []
+    for choices in combinations:
+        count = 0
 
-    def values_of(x: np.ndarray) -> dict[str, float]:
-        return {n: float(math.exp(v)) for n, v in zip(names, x, strict=True)}
+        def fun(u: np.ndarray, choices: Mapping[str, Any] = choices) -> np.ndarray:
+            nonlocal count
+            count += 1
+            return residuals(model, cases, {**choices, **space.values(u)})
 
-    def fun(x: np.ndarray) -> np.ndarray:
-        nonlocal evaluations
-        values = values_of(x)
-        out = residuals(cases, values, accuracy, revolutions)
-        evaluations += 1
+        # diff_step: 1e-6 of a range; the reference's quadrature (1e-9 of the input work) keeps
+        # the difference quotient's error near 1e-3 of the derivative
+        solution = least_squares(fun, np.asarray(start, dtype=float), bounds=(0.0, 1.0), method="trf",
+                                 diff_step=1e-6, xtol=XTOL, ftol=1e-12, gtol=1e-12, max_nfev=200)
+        values = {**choices, **space.values(solution.x)}
+        rms = float(np.sqrt(np.mean(np.square(solution.fun))))
+        out.append({"choices": dict(choices), "values": values, "rms": rms, "evaluations": count,
+                    "status": solution.message})
         if progress:
-            progress(f"evaluation {evaluations}: "
-                     + ", ".join(f"{n} = {v:.5g}" for n, v in values.items())
-                     + f"; RMS residual {np.sqrt(np.mean(np.square(out))):.5f}")
-        return out
-
-    solution = least_squares(fun, x0, bounds=(lo, hi), diff_step=1e-3, xtol=1e-6, ftol=1e-8)
-    return values_of(solution.x), evaluations
+            progress(f"{_label(choices)}: fit RMS {rms:.5f} after {count} evaluations")
+    return sorted(out, key=lambda r: r["rms"])
 
 
-def case_rows(values: Mapping[str, float], fit: Sequence[str], accuracy: float,
-              revolutions: float) -> list[dict[str, Any]]:
-    """Every paper case with the fitted ``values``: paper and model mean efficiency [-], their
-    difference, whether it was used in the fit, status and reason."""
+def _label(choices: Mapping[str, Any]) -> str:
+    return ", ".join(f"{k} = {v}" for k, v in choices.items()) or "held choices"
+
+
+def case_rows(model: CaseModel, values: Mapping[str, Any], fit_keys: Sequence[str]) -> list[dict[str, Any]]:
+    """Every paper case under ``values``: paper and model mean efficiency [-], their difference,
+    whether it was used in the fit (:func:`in_fit`), status and reason."""
     rows = []
     for case in paper_cases():
-        eta, status, reason = run_case(case, values, accuracy, revolutions)
-        rows.append({"case": case_key(case), "used_in_fit": in_fit(case, fit),
+        eta, status, reason = model.run_case(case, values)
+        rows.append({"case": case_key(case), "used_in_fit": in_fit(case, fit_keys),
                      "paper": case["paper_mean_efficiency"], "model": eta,
-                     "difference": eta - case["paper_mean_efficiency"], "status": status.value,
+                     "difference": eta - case["paper_mean_efficiency"], "status": status,
                      "reason": reason})
     return rows
 
 
 def fit_statistics(rows: Sequence[Mapping[str, Any]]) -> dict[str, float]:
-    """RMS difference of the fit cases, RMS and largest magnitude of the held-out ones [-]."""
-    held = [r["difference"] for r in rows if not r["used_in_fit"]]
-    fitted = [r["difference"] for r in rows if r["used_in_fit"]]
-    return {"fit_rms": float(np.sqrt(np.nanmean(np.square(fitted)))),
-            "held_out_rms": float(np.sqrt(np.nanmean(np.square(held)))) if held else float("nan"),
-            "held_out_max_abs": float(np.nanmax(np.abs(held))) if held else float("nan")}
+    """RMS and largest magnitude of the difference [-], fit cases and held-out cases apart."""
+    out = {}
+    for group, used in (("fit", True), ("held_out", False)):
+        d = np.asarray([r["difference"] for r in rows if r["used_in_fit"] == used], dtype=float)
+        out[f"{group}_rms"] = float(np.sqrt(np.nanmean(np.square(d)))) if d.size else float("nan")
+        out[f"{group}_max_abs"] = float(np.nanmax(np.abs(d))) if d.size else float("nan")
+    return out
 
 
-def calibrate(names: Sequence[str] = DEFAULT_PARAMETERS, fit: Sequence[str] = DEFAULT_FIT,
-              accuracy: float = 1e-4, revolutions: float = 1.0,
+def calibrate(name: str = "physical", engine: str = "reference",
               progress: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Least-squares fit of ``names`` to the ``fit`` cases; the held-out errors of the others.
+    """Refit parameter set ``name``'s fitted values on its fit cases; the errors on all eleven.
 
     Parameters
     ----------
-    names : sequence of str
-        Keys of :data:`reference.paper.CALIBRATION_PARAMETERS`.
-    fit : sequence of str
-        Paper cases to fit (:func:`case_key`).
-    accuracy : float
-        ``numerics.accuracy`` of every run [-].
-    revolutions : float
-        Input revolutions per run [-].
+    name : {"physical", "matched"}
+        The set (``[sets.<name>]`` of the data file).
+    engine : {"reference", "exudyn"}
+        Engine of every run.
     progress : callable, optional
-        Called with one line of text after every function evaluation.
+        Called with a line of text as the fit proceeds.
 
     Returns
     -------
     dict
-        ``parameters`` (name -> fitted value, units of the parameter), ``fit_cases``, ``rows``
-        (:func:`case_rows`), the statistics of :func:`fit_statistics`,
-        ``function_evaluations``, ``accuracy``, ``revolutions`` and ``wall_time_s`` [s].
+        ``set``, ``engine``, ``fit_cases``, ``parameters`` (fitted name -> value [m]),
+        ``values`` (every value of the set), ``combinations`` (:func:`fit`, best first),
+        ``rows`` (:func:`case_rows`), the statistics of :func:`fit_statistics`, ``runs``,
+        ``method`` and ``wall_time_s`` [s].
     """
-    check_parameters(names)
-    cases = fit_cases(fit)
-    start = time.perf_counter()
-    values, evaluations = fit_parameters(names, cases, accuracy, revolutions, progress)
-    rows = case_rows(values, fit, accuracy, revolutions)
-    return {"parameters": values, "fit_cases": list(fit), "rows": rows, **fit_statistics(rows),
-            "function_evaluations": evaluations, "accuracy": accuracy, "revolutions": revolutions,
-            "wall_time_s": time.perf_counter() - start}
+    if not isinstance(name, str) or name not in FIT_SETS:
+        raise ValueError(f"`name` must be one of {list(FIT_SETS)}, got {name!r:.80}")
+    start_time = time.perf_counter()
+    model = CaseModel(engine, progress)
+    space, combinations, start = set_space(name)
+    start_text = [round(float(x), 6) for x in start]
+    fit_keys = parameter_set(name)["fit_cases"]
+    combos = fit(model, space, combinations, start, cases_named(fit_keys), progress)
+    best = combos[0]["values"]
+    rows = case_rows(model, best, fit_keys)
+    return {"set": name, "engine": engine, "fit_cases": list(fit_keys),
+            "parameters": {k: best[k] for k in space.names}, "values": best,
+            "combinations": combos, "rows": rows, **fit_statistics(rows), "runs": model.runs,
+            "method": ("scipy.optimize.least_squares (trf, bounded), unit-box variables "
+                       f"({'log' if any(space.log) else 'linear'} scale), start {start_text}, "
+                       f"xtol {XTOL:g}; every combination of discrete choices"),
+            "wall_time_s": time.perf_counter() - start_time}
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``cardan calibrate`` to the ``cardan`` subcommands."""
-    p = subparsers.add_parser("calibrate",
-                              help="fit the paper's open parameters to a subset of its results")
-    p.add_argument("--parameters", metavar="A,B",
-                   help="parameters to fit (default spider_lever,frame_lever,input_eccentricity)")
-    p.add_argument("--json", action="store_true", help="print the fit as JSON on stdout")
+    p = subparsers.add_parser("calibrate", help="fit a parameter set to a subset of the paper's results, "
+                                                "or bound the paper's numbers over the plausible box")
+    p.add_argument("--set", dest="parameter_set", default="physical", metavar="NAME",
+                   help=f"parameter set to refit: {', '.join(FIT_SETS)} (default physical)")
+    p.add_argument("--engine", default="reference", metavar="NAME",
+                   help=f"engine of every run: {', '.join(FIT_ENGINES)} (default reference)")
+    p.add_argument("--envelope", action="store_true",
+                   help="instead of a fit: the lowest and highest value of each of the paper's "
+                        "numbers over the plausible box")
+    p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+    p.add_argument("--out", metavar="DIR", help="write the result (JSON) and the report (markdown) here")
     p.set_defaults(func=handler)
-
-
-def parameter_names(text: str | None) -> tuple[str, ...]:
-    """The parameters of ``--parameters A,B`` (the default set when not given)."""
-    if text is None:
-        return DEFAULT_PARAMETERS
-    names = [n.strip() for n in text.split(",") if n.strip()]
-    if not names:
-        raise BadInput(f"--parameters names no parameter, got {text!r}; choose from "
-                       f"{list(CALIBRATION_PARAMETERS)}")
-    unknown = [n for n in names if n not in CALIBRATION_PARAMETERS]
-    if unknown:
-        raise BadInput(f"--parameters: unknown {unknown}; choose from {list(CALIBRATION_PARAMETERS)}")
-    return tuple(names)
 
 
 def handler(args: argparse.Namespace) -> int:
     """``cardan calibrate``: exit 0 when every case ran to status ok, 3 otherwise."""
-    result = calibrate(parameter_names(args.parameters), progress=_say)
-    failed = [r for r in result["rows"] if r.get("status", Status.OK) != Status.OK]
-    if args.json:
-        print(dumps(result))
-        return EXIT_FAILED if failed else EXIT_OK
-    print_fit(result)
-    for r in failed:
-        print(f"status: {r['case']}: {r['status']}: {r['reason']}", file=sys.stderr)
+    if args.parameter_set not in FIT_SETS:
+        hint = " (the literal set has nothing fitted)" if args.parameter_set == "literal" else ""
+        raise BadInput(f"--set must be one of {list(FIT_SETS)}, got {args.parameter_set!r}{hint}")
+    if args.engine not in FIT_ENGINES:
+        raise BadInput(f"--engine must be one of {list(FIT_ENGINES)}, got {args.engine!r}")
+    out_folder(args.out)
+    if args.envelope:
+        result = envelope_study(args.engine, progress=_say)
+        text, failed = envelope_text(result), result["failed_runs"]
+    else:
+        result = calibrate(args.parameter_set, args.engine, progress=_say)
+        text = fit_text(result)
+        failed = [r for r in result["rows"] if r.get("status", "ok") != "ok"]
+        for r in failed:
+            print(f"status: {r['case']}: {r['status']}: {r['reason']}", file=sys.stderr)
+    if args.out:
+        with atomic_directory(args.out) as tmp:
+            (tmp / ("envelope.json" if args.envelope else "calibrate.json")).write_text(dumps(result))
+            (tmp / "report.md").write_text(text)
+        _say(f"wrote {args.out}")
+    print(dumps(result) if args.json else text, end="" if not args.json else "\n")
     return EXIT_FAILED if failed else EXIT_OK
 
 
@@ -245,19 +204,41 @@ def _say(message: str) -> None:
     print(f"  {message}", file=sys.stderr, flush=True)
 
 
-def print_fit(result: Mapping[str, Any]) -> None:
-    """The fitted values, the table of every case and the fit statistics, on stdout."""
-    print("fitted parameters (paste into reference/data/paper.toml [calibrated.parameters]):")
-    for n, v in result["parameters"].items():
-        print(f"  {n} = {v:.6g} {CALIBRATION_PARAMETERS[n]['unit']}")
-    rows = []
-    for r in result["rows"]:
-        ok = r.get("status", Status.OK) == Status.OK  # a failed run has no efficiency: its status
-        rows.append({"case": r["case"], "used in fit": "yes" if r["used_in_fit"] else "no",
-                     "paper": r["paper"], "model": r["model"] if ok else r["status"],
-                     "difference": r["difference"]})
-    print("\n" + markdown_table(rows, CASE_COLUMNS, CASE_FORMATS), end="")
-    print(f"\nfit RMS {number(result['fit_rms'], '.4f')}; "
-          f"held-out RMS {number(result['held_out_rms'], '.4f')}, "
-          f"max |difference| {number(result['held_out_max_abs'], '.4f')}; "
-          f"{result['function_evaluations']} evaluations, {number(result['wall_time_s'], '.0f')} s")
+def _toml_value(v: Any) -> str:
+    return f'"{v}"' if isinstance(v, str) else f"{v:.6g}"
+
+
+def fit_text(result: Mapping[str, Any]) -> str:
+    """The report of :func:`calibrate`: what to paste into the data file, every combination's
+    RMS, the table of the eleven cases and the statistics."""
+    stored = parameter_set(result["set"])["values"]
+    lines = [f"parameter set {result['set']}, engine {result['engine']}; fit cases "
+             f"{', '.join(result['fit_cases'])}", f"method: {result['method']}", "",
+             f"paste into reference/data/paper.toml [sets.{result['set']}.values] (reasons as stored):"]
+    for k, v in result["values"].items():
+        entry = dict(stored.get(k, {}), value=v)
+        lines.append(f"{k} = {{ " + ", ".join(f"{f} = {_toml_value(x) if f == 'value' else _toml_raw(x)}"
+                                             for f, x in entry.items()) + " }")
+    lines += ["", "every combination of discrete choices (best first):"]
+    for c in result["combinations"]:
+        numbers = ", ".join(f"{k} = {c['values'][k]:.6g}" for k in result["parameters"])
+        lines.append(f"  {_label(c['choices'])}: fit RMS {c['rms']:.5f} ({numbers}; "
+                     f"{c['evaluations']} evaluations)")
+    rows = [{"case": r["case"], "used in fit": "yes" if r["used_in_fit"] else "no", "paper": r["paper"],
+             "model": r["model"] if r.get("status", "ok") == "ok" else r["status"],
+             "difference": r["difference"]} for r in result["rows"]]
+    lines += ["", markdown_table(rows, CASE_COLUMNS, CASE_FORMATS).rstrip("\n"), ""]
+    lines.append(f"fitted: RMS {number(result['fit_rms'], '.4f')}, largest "
+                 f"{number(result['fit_max_abs'], '.4f')}; held out: RMS "
+                 f"{number(result['held_out_rms'], '.4f')}, "
+                 f"largest {number(result['held_out_max_abs'], '.4f')}")
+    lines.append(f"{result.get('runs', '-')} engine runs, {number(result['wall_time_s'], '.0f')} s")
+    return "\n".join(lines) + "\n"
+
+
+def _toml_raw(x: Any) -> str:
+    if isinstance(x, bool):
+        return "true" if x else "false"
+    if isinstance(x, str):
+        return '"' + x.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return _toml_value(x)

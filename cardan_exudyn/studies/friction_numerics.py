@@ -32,11 +32,12 @@ from reference.schema import Status
 
 Progress = Callable[[str], None]
 
-COUPLING_DEFAULT = {"names": ["paper-10deg", "paper-30deg"], "ladder": [100, 200, 400, 800, 1600]}
-COUPLING_QUICK = {"names": ["paper-10deg"], "ladder": [100, 200, 400]}
-BAND_DEFAULT = {"names": ["paper-0deg", "paper-10deg"],
+COUPLING_DEFAULT = {"names": ["paper-literal-10deg", "paper-literal-30deg"], "ladder": [100, 200, 400, 800,
+                                                                                        1600]}
+COUPLING_QUICK = {"names": ["paper-literal-10deg"], "ladder": [100, 200, 400]}
+BAND_DEFAULT = {"names": ["paper-literal-0deg", "paper-literal-10deg"],
                 "bands": [0.0, 1e-9, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 3e-3, 1e-2, 3e-2, 1e-1]}
-BAND_QUICK = {"names": ["paper-0deg"], "bands": [0.0, 1e-6, 1e-3, 1e-1]}
+BAND_QUICK = {"names": ["paper-literal-0deg"], "bands": [0.0, 1e-6, 1e-3, 1e-1]}
 
 # columns of the printed table and of the markdown file, per study
 PRINTED = {"coupling": ["scene", "coupling", "steps_per_revolution", "mean_efficiency", "error",

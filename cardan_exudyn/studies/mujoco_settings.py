@@ -38,7 +38,7 @@ MUJOCO_DEFAULT_TIMESTEP = 0.002
 MUJOCO_DEFAULTS = MujocoOptions(integrator="Euler", timestep=MUJOCO_DEFAULT_TIMESTEP,
                                 solref=MUJOCO_DEFAULT_SOLREF, solimp=MUJOCO_DEFAULT_SOLIMP)
 """MuJoCo's own defaults as they come (Euler, 2 ms, ``solref``, ``solimp``): table A."""
-STUDY_SCENES = ("paper-10deg-frictionless", "paper-30deg-frictionless")
+STUDY_SCENES = ("paper-literal-10deg-frictionless", "paper-literal-30deg-frictionless")
 STUDY_TIMESTEPS = (1e-4, 5e-5, 2e-5, 1e-5)  # [s]
 ACCURACY_KEYS = ("speed_ratio_error", "torque_in_error", "mean_torque_in_error",
                  "axis_misalignment_rad", "bearing_drift_m", "drive_error_rad")

@@ -1,32 +1,38 @@
-"""``cardan reproduce``: the paper's results with friction, under two parameter sets, as a report.
+"""``cardan reproduce``: the paper's results with friction, under its three parameter sets, as a
+report.
 
-For each parameter set (``plain``: the paper read literally, with the assumption register for
-what it does not state; ``calibrated``: the few free parameters identified by ``cardan
-calibrate`` from a subset of the paper's numbers) the report has
+For each parameter set of :data:`reference.paper.PARAMETER_SETS` (``physical``, the default:
+every open value a dimension or physical quantity inside its plausible range; ``literal``: the
+paper read literally, kept as evidence; ``matched``: fitted to the paper's numbers with values
+that are not plausible dimensions) the report has
 
 - Table 2 (0 to 35 deg at 2000 rpm) and the speed study (500, 1000, 2000 rpm at 10 deg) next to
   the paper, with both mean-efficiency definitions (one minus lost over input energy over whole
-  revolutions, and the time average of eq. (18)); for the calibrated set the cases used in the
-  fit are marked and the error on the held-out cases is summarised;
+  revolutions, and the time average of eq. (18)), each number with its engine, engine version,
+  step and estimated error; the cases the set was fitted to are marked, and its errors against
+  the paper (RMS and largest) are summarised for the fitted and the held-out cases apart;
+- the set's parameter table (value, plausible range, inside it or not, fitted or not, reason),
+  and the envelope of each paper number over the plausible box when it is stored;
 - the per-pair loss breakdown (share of the input work lost in each pair);
 - the time histories of Figures 4 (efficiency at 10 deg), 5 (power loss per pair at 10 deg),
-  6 (efficiency at several angles) and 7 (efficiency at several speeds);
+  6 (efficiency at several angles) and 7 (efficiency at several speeds, against the input angle);
 - the energy balance residual of every run, and the assumption register.
 
 This module runs the cases and registers the command; :mod:`.reproduce_report` writes the report.
 
 How the runs are made
 ---------------------
-The runs (the eleven cases under each parameter set: 22; 6 with ``--quick``) are one sweep of
+The runs (the eleven cases under each parameter set: 33; 9 with ``--quick``) are one sweep of
 :mod:`cardan_exudyn.sweep` with an explicit case list, in ``OUT/runs/``. The base scene is
-``paper_scene(10 deg, 2000 rpm)``; each case's overrides are the leaf-by-leaf difference between
-its own scene (:func:`reference.paper.paper_scene`, either parameter set) and the base, and
-:func:`paper_runs` checks that the runner rebuilds exactly that scene. Case ids read like
-``calibrated-table2-35deg-2000rpm``. So the cases can run in worker processes (``workers``), a
-rerun of an interrupted ``cardan reproduce`` runs only the cases without a record (a rerun of a
-finished one redraws the report from the records; ``restart`` runs everything again), a case
-that fails or raises is recorded with its status and reason while the report is written from
-the others, and progress is the sweep runner's bar.
+``paper_scene(10 deg, 2000 rpm)`` of the ``physical`` set; each case's overrides are the
+leaf-by-leaf difference between its own scene (:func:`reference.paper.paper_scene`, any parameter
+set) and the base, and :func:`paper_runs` checks that the runner rebuilds exactly that scene
+(the ``physical`` set's output load, solved per case for a mean input torque of 2 N m, is one
+such leaf). Case ids read like ``matched-table2-35deg-2000rpm``. So the cases can run in worker
+processes (``workers``), a rerun of an interrupted ``cardan reproduce`` runs only the cases
+without a record (a rerun of a finished one redraws the report from the records; ``restart``
+runs everything again), a case that fails or raises is recorded with its status and reason
+while the report is written from the others, and progress is the sweep runner's bar.
 
 Besides each run's numbers (the record: a few scalars, :func:`run_numbers`), the report needs the
 engine's full summary (``summaries.json``) and, for Figures 4-7, time histories. The case function
@@ -35,7 +41,7 @@ name>-<random token>/`` (``summary.json`` and ``history.npz`` with the columns o
 :data:`HISTORY_COLUMNS`, each written to a temporary name, fsync'ed and renamed), and returns that
 folder's name in its record (``files``). Why this way:
 
-- records stay small (about 1.4 kB each): the histories are about 12,700 rows x 6 columns for the
+- records stay small (about 1.4 kB each): the histories were about 12,700 rows x 6 columns for
   22 runs, which in the records would be about 1.6 MB of JSON in ``cases.jsonl`` and a text cell
   of up to 180 kB per case in the sweep's ``results.csv`` (as ``.npz`` files: 0.9 MB);
   recomputing them after the sweep would run 14 of the 22 scenes twice;
@@ -75,7 +81,7 @@ from cardan_exudyn.io import atomic_directory, atomic_write, dumps
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
 from reference.joint import PAIR_NAMES
-from reference.paper import PARAMETER_SETS, calibrated_parameters, paper_cases, paper_scene
+from reference.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
 from reference.scene import Scene, replace, scene_to_dict
 from reference.schema import Result, Status
 
@@ -86,7 +92,7 @@ __all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_O
 
 RUNS_DIR, FILES_DIR = "runs", "files"
 CASE_FUNCTION = "cardan_exudyn.studies.reproduce:paper_case_outputs"
-HISTORY_COLUMNS = ("t", "efficiency", *(f"power_loss_{pair}" for pair in PAIR_NAMES))
+HISTORY_COLUMNS = ("t", "theta_in", "efficiency", "power_in", *(f"power_loss_{pair}" for pair in PAIR_NAMES))
 QUICK_OVERRIDES = {"numerics.accuracy": 1e-4, "revolutions": 1.0}
 HISTORY_ANGLES = (0.0, 10.0, 20.0, 35.0)
 BASE_ANGLE_DEG, BASE_SPEED_RPM = 10.0, 2000.0
@@ -97,8 +103,11 @@ def run_numbers(result: Result) -> dict[str, Any]:
 
     Works in J (``input_work_J``, ``loss_work_J``, ``energy_balance_residual_J``: input minus
     output minus friction loss work minus the change of mechanical energy, trapezoidal over the
-    run), ``mean_torque_in`` in N m, ``wall_time_s`` in s; efficiencies, loop gain and loss shares
-    are dimensionless.
+    run), ``mean_torque_in`` and ``output_load_N_m`` (the scene's constant load) in N m,
+    ``dt_s`` (the step the run was made with), ``accuracy_target`` (the scene's
+    ``numerics.accuracy``) and ``wall_time_s`` in s, ``steps_per_revolution``
+    (at the mean input speed); ``engine`` and ``engine_version`` name what computed them;
+    efficiencies, loop gain and loss shares are dimensionless.
     """
     s = result.summary
     out: dict[str, Any] = {"status": s.status, "reason": s.reason}
@@ -108,9 +117,16 @@ def run_numbers(result: Result) -> dict[str, Any]:
     energy = t["energy_kinetic"] + t["energy_potential"]
     work = {c: float(np.trapezoid(t[c], t["t"])) for c in ("power_in", "power_out", "power_loss")}
     friction = s.extras["friction"]
+    speed = s.mean_speed_in
     out.update({
+        "engine": s.engine,
+        "engine_version": s.engine_version,
+        "dt_s": s.dt,
+        "steps_per_revolution": (2 * np.pi / (abs(speed) * s.dt) if s.dt and speed else None),
+        "output_load_N_m": s.scene.get("load", {}).get("torque"),
         "mean_efficiency": s.mean_efficiency,
         "efficiency_error_estimate": s.efficiency_error_estimate,
+        "accuracy_target": s.scene.get("numerics", {}).get("accuracy"),
         "accuracy_met": s.accuracy_met,
         "mean_instantaneous_efficiency": s.mean_instantaneous_efficiency,
         "mean_torque_in": s.mean_torque_in,
@@ -175,8 +191,8 @@ def selected_cases(quick: bool = False) -> list[dict[str, Any]]:
 
 
 def base_scene() -> Scene:
-    """The sweep's base scene: the plain set at 10 deg, 2000 rpm."""
-    return paper_scene(BASE_ANGLE_DEG, BASE_SPEED_RPM, parameters="plain")
+    """The sweep's base scene: the default (``physical``) set at 10 deg, 2000 rpm."""
+    return paper_scene(BASE_ANGLE_DEG, BASE_SPEED_RPM, parameters=DEFAULT_PARAMETER_SET)
 
 
 def paper_runs(quick: bool = False) -> list[PaperRun]:
@@ -190,9 +206,8 @@ def paper_runs(quick: bool = False) -> list[PaperRun]:
     fixed = QUICK_OVERRIDES if quick else {}
     built_base = replace(base, **fixed) if fixed else base
     base_leaves = flatten_paths(scene_to_dict(base))
-    sets = [p for p in PARAMETER_SETS if p == "plain" or calibrated_parameters()]
     runs = []
-    for parameters in sets:
+    for parameters in PARAMETER_SETS:
         for case in selected_cases(quick):
             scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=parameters)
             overrides = _overrides(scene, base_leaves)
@@ -329,7 +344,7 @@ class Reproduction:
 def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
               restart: bool = False, retry_failed: bool = False,
               progress: bool | None = None) -> Reproduction:
-    """Run the paper's cases under both parameter sets through the sweep runner and write the
+    """Run the paper's cases under every parameter set through the sweep runner and write the
     report into ``out``.
 
     Parameters
@@ -339,7 +354,7 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
         records, per-run files) lives in ``out/runs/`` and is kept, so that a rerun of an
         interrupted invocation runs only the cases without a record.
     quick : bool
-        Three cases per set, accuracy 1e-4, one revolution.
+        Three cases per set (0 and 10 deg at 2000 rpm, 500 rpm), accuracy 1e-4, one revolution.
     workers : int, optional
         Local worker processes (default: the sweep runner's, every available core); 1 runs the
         cases in this process.

@@ -16,49 +16,68 @@ import pandas as pd
 
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
-from cardan_exudyn.studies.calibrate import in_fit
 from reference.joint import PAIR_NAMES
 from reference.paper import (
+    DEFAULT_PARAMETER_SET,
     PARAMETER_SETS,
     assumption_register,
-    calibrated_choices,
-    calibrated_parameters,
-    paper_data,
+    case_key,
+    envelope,
+    parameter_set,
+    parameter_table,
+    plausible_box,
     stated_values,
 )
 from reference.schema import Status
 
-__all__ = ["RUN_NUMBERS", "fit_case_keys", "case_row", "write_report", "draw_figures", "report_text"]
+__all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "fitted", "case_row", "write_report",
+           "draw_figures", "report_text", "error_summary", "parameter_rows", "steady_revolution"]
 
 # the numbers of a run, in the order of the report's results.csv (after difference_to_paper)
-RUN_NUMBERS = ("efficiency_error_estimate", "accuracy_met", "mean_torque_in", "input_work_J",
-               "loss_work_J", "energy_balance_residual_J",
+RUN_NUMBERS = ("efficiency_error_estimate", "accuracy_met", "accuracy_target", "engine",
+               "engine_version", "dt_s", "steps_per_revolution", "output_load_N_m", "mean_torque_in",
+               "input_work_J", "loss_work_J", "energy_balance_residual_J",
                "loop_gain_estimate", "friction_evaluations_per_step", "steps", "wall_time_s",
                *(f"loss_share_{pair}" for pair in PAIR_NAMES))
-MAIN_COLUMNS = ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status",
-                "paper_mean_efficiency", "mean_efficiency", "efficiency_error_estimate",
-                "accuracy_met", "difference_to_paper",
-                "mean_instantaneous_efficiency", "used_in_fit", "loop_gain_estimate"]
+MAIN_COLUMNS = ["study", "shaft_angle_deg", "speed_rpm", "fit", "paper_mean_efficiency",
+                "mean_efficiency", "difference_to_paper", "efficiency_error_estimate", "accuracy_met",
+                "mean_instantaneous_efficiency", "engine", "engine_version", "dt_s",
+                "steps_per_revolution"]
+MAIN_FORMATS = {"dt_s": ".3g", "steps_per_revolution": ".0f", "efficiency_error_estimate": ".1e",
+                "difference_to_paper": "+.4f"}
 FAILED_COLUMNS = ["parameters", "study", "shaft_angle_deg", "speed_rpm", "status", "reason"]
 LOSS_COLUMNS = ["parameters", "shaft_angle_deg", "speed_rpm", *(f"loss_share_{p}" for p in PAIR_NAMES)]
-CHECK_COLUMNS = ["parameters", "shaft_angle_deg", "speed_rpm", "input_work_J", "loss_work_J",
-                 "energy_balance_residual_J", "friction_evaluations_per_step", "steps", "wall_time_s"]
-# the mean-efficiency figures: study, x column, x label, file name stem
-MEAN_FIGURES = (("table2", "shaft_angle_deg", "shaft angle [deg]", "table2"),
-                ("speed", "speed_rpm", "input speed [rpm]", "speed"))
-LEVERS_READING = (
-    "\n**Reading.** The fitted levers are not plausible dimensions for a joint this "
-    "size (a 60 mm spider lever is a 30 mm arm radius on a 45.6 g spider; a 0.59 m "
-    "frame lever is a bearing spacing far beyond shafts whose centres of mass sit "
-    "0.13 m and 0.09 m from the joint). They act as correction factors: the paper's "
-    "numbers need the moment term of eqs. (1)-(2) about 10 times weaker in the "
-    "spider pairs and about 60 times weaker in the frame pairs than the stated "
-    "bearing lengths give.\n")
+CHECK_COLUMNS = ["parameters", "shaft_angle_deg", "speed_rpm", "output_load_N_m", "input_work_J",
+                 "loss_work_J", "energy_balance_residual_J", "loop_gain_estimate",
+                 "friction_evaluations_per_step", "steps", "wall_time_s"]
+PARAMETER_COLUMNS = ["name", "value", "unit", "plausible", "inside", "fitted", "reason"]
+ENVELOPE_COLUMNS = ["case", "paper", "lowest", "highest", "reachable", "closest"]
+# the mean-efficiency figures: study, x column, x label, file name
+MEAN_FIGURES = (("table2", "shaft_angle_deg", "shaft angle [deg]", "table2.png"),
+                ("speed", "speed_rpm", "input speed [rpm]", "speed.png"))
+START_UP_STEPS = 40
+"""Steps at the start of a run left out of the time-history figures: the generalized-alpha
+integrator starts with its acceleration-like variables equal to the consistent accelerations,
+which excites a period-two oscillation of the reactions (and of every pair's friction, which
+follows them) that decays by a factor of about 0.8 per step at spectral radius 0.6 (0.6 at 0.3,
+gone after three steps at 0): the reactions at the same input angle one revolution later are
+smooth. After 40 steps it is below 1e-3 of its first amplitude."""
+# a set's moment levers as the dimension they stand for under the lumped-pair reading
+# (docs/paper.md): spider lever = 2 x arm radius, frame lever = support spacing
+LEVER_DIMENSIONS = {"spider_lever": ("arm_radius", 2.0), "frame_lever": ("support_spacing", 1.0)}
 
 
-def fit_case_keys() -> list[str]:
-    """The cases the calibrated set was fitted to, as ``study:angle:rpm`` keys."""
-    return list(paper_data().get("calibrated", {}).get("fit_cases", []))
+def fit_case_keys(parameters: str) -> list[str]:
+    """The cases a parameter set was fitted to, as ``study:angle:rpm`` keys (none: not fitted)."""
+    return list(parameter_set(parameters).get("fit_cases", []))
+
+
+def fitted(case: Mapping[str, Any], fit: Sequence[str]) -> bool:
+    """Whether ``case`` is one of the fit cases ``fit`` or the same scene (angle and speed) as
+    one: the speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case."""
+    scene = (float(case["shaft_angle_deg"]), float(case["speed_rpm"]))
+    return case_key(case) in fit or any(
+        (float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
 
 
 def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]) -> dict[str, Any]:
@@ -69,16 +88,18 @@ def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]
     case : mapping
         A paper case (``study``, ``shaft_angle_deg``, ``speed_rpm``, ``paper_mean_efficiency``).
     parameters : str
-        The parameter set, ``plain`` or ``calibrated``.
+        The parameter set, one of :data:`reference.paper.PARAMETER_SETS`.
     record : mapping
         The run's sweep record (:func:`cardan_exudyn.studies.reproduce.run_numbers` and status).
 
     Returns
     -------
     dict
-        The case, the paper's value and, for a run that is ``ok``, its numbers (works in J,
-        torque in N m, wall time in s, efficiencies and shares dimensionless).
+        The case, the paper's value, whether the set was fitted to it (``used_in_fit``) and, for
+        a run that is ``ok``, its numbers (works in J, torques in N m, step and wall time in s,
+        efficiencies and shares dimensionless).
     """
+    used = fitted(case, fit_case_keys(parameters))
     row: dict[str, Any] = {
         "parameters": parameters,
         "study": case["study"],
@@ -87,7 +108,8 @@ def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]
         "paper_mean_efficiency": case["paper_mean_efficiency"],
         "status": record["status"],
         "reason": record.get("reason") or "",
-        "used_in_fit": parameters == "calibrated" and in_fit(case, fit_case_keys()),
+        "used_in_fit": used,
+        "fit": "fitted" if used else "held out",
     }
     if record["status"] != Status.OK:
         return row
@@ -116,8 +138,9 @@ def write_report(folder: Path, rows: Sequence[Mapping[str, Any]] | pd.DataFrame,
     rows : sequence of dict or DataFrame
         One :func:`case_row` per run, in report order.
     histories : mapping
-        Parameter set -> label -> time history (columns ``t`` [s], ``efficiency`` [-],
-        ``power_loss_<pair>`` [W]); labels ``10deg``, ``angle <a> deg``, ``speed <n> rpm``.
+        Parameter set -> label -> time history (columns ``t`` [s], ``theta_in`` [rad],
+        ``efficiency`` [-], ``power_in``, ``power_loss_<pair>`` [W]); labels ``10deg``,
+        ``angle <a> deg``, ``speed <n> rpm``.
     quick : bool
         The runs were ``--quick`` ones (said in the report's head).
     wall : float
@@ -137,141 +160,263 @@ def write_report(folder: Path, rows: Sequence[Mapping[str, Any]] | pd.DataFrame,
     (folder / "report.md").write_text(text, encoding="utf-8")
 
 
+
+
+def steady_revolution(history: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of a history the figures show: its last whole input revolution, without the
+    first :data:`START_UP_STEPS` steps of the run where they fall in it (a run of one revolution).
+
+    Returns
+    -------
+    angle : ndarray
+        Input angle of the selected rows within the revolution [deg], from 0 to 360.
+    rows : ndarray of bool
+        The selected rows.
+    """
+    theta = np.asarray(history["theta_in"], dtype=float)
+    start = theta[-1] - 2 * np.pi
+    rows = theta >= start - 1e-9
+    rows[:START_UP_STEPS] = False
+    offset = 2 * np.pi * np.floor(start / (2 * np.pi) + 1e-9)
+    return np.degrees(theta[rows] - offset), rows
+
+
+def start_up_effect(history: Mapping[str, Any]) -> float | None:
+    """Mean efficiency of the run's first input revolution minus that of its last [-] (None with
+    fewer than two): at constant input speed the motion repeats every revolution, so this is the
+    start-up oscillation's whole effect on the first revolution's number."""
+    theta = np.asarray(history["theta_in"], dtype=float)
+    if theta[-1] < 4 * np.pi - 1e-9:
+        return None
+    t, power_in = np.asarray(history["t"], float), np.asarray(history["power_in"], float)
+    loss = sum(np.asarray(history[f"power_loss_{p}"], float) for p in PAIR_NAMES)
+
+    def efficiency(rows: np.ndarray) -> float:
+        return 1.0 - np.trapezoid(loss[rows], t[rows]) / np.trapezoid(power_in[rows], t[rows])
+
+    return efficiency(theta <= 2 * np.pi + 1e-9) - efficiency(theta >= theta[-1] - 2 * np.pi - 1e-9)
+
+
 def draw_figures(folder: Path, rows: pd.DataFrame,
-                 histories: Mapping[str, Mapping[str, Any]]) -> list[str]:
-    """Save every figure of the report into ``folder``; returns their file names in order."""
-    figures: list[str] = []
+                 histories: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, str]]:
+    """Save every figure of the report into ``folder``; returns (file name, caption) in order."""
+    ok = rows[rows.status == Status.OK]
+    figures = _mean_figures(folder, ok)
     for parameters in PARAMETER_SETS:
-        sel = rows[(rows.parameters == parameters) & (rows.status == Status.OK)]
-        if sel.empty:
-            continue
-        figures += _mean_figures(folder, parameters, sel)
         figures += _history_figures(folder, parameters, histories.get(parameters, {}))
     return figures
 
 
-def _mean_figures(folder: Path, parameters: str, sel: pd.DataFrame) -> list[str]:
-    """Mean efficiency against the paper over Table 2's angles and over the speeds."""
-    names = []
-    for study, x, xlabel, stem in MEAN_FIGURES:
-        part = sel[sel.study == study].sort_values(x)
-        if not part.empty:
-            names.append(_save(folder, f"{stem}_{parameters}.png",
-                               plots.efficiency_against_paper({parameters: part}, x, xlabel)))
-    return names
+def _mean_figures(folder: Path, ok: pd.DataFrame) -> list[tuple[str, str]]:
+    """Mean efficiency against the paper over Table 2's angles and over the speeds, one panel per
+    parameter set."""
+    figures = []
+    for study, x, xlabel, name in MEAN_FIGURES:
+        part = ok[ok.study == study]
+        panels = {p: part[part.parameters == p].sort_values(x) for p in PARAMETER_SETS
+                  if (part.parameters == p).any()}
+        if panels:
+            plots.save(plots.efficiency_against_paper(panels, x, xlabel), folder / name)
+            figures.append((name, f"{'Table 2' if study == 'table2' else 'The speed study'}: mean "
+                            "efficiency of each parameter set (lines) and the paper's values "
+                            "(squares: filled where the set was fitted to it, open where held "
+                            "out); each panel's axis spans its own data."))
+    return figures
 
 
-def _history_figures(folder: Path, parameters: str, hist: Mapping[str, Any]) -> list[str]:
-    """Figures 4 and 5 (10 deg, 2000 rpm), 6 (several angles) and 7 (several speeds)."""
-    names = []
+def _history_figures(folder: Path, parameters: str, hist: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """Figures 4 and 5 (10 deg, 2000 rpm), 6 (several angles) and 7 (several speeds), against the
+    input angle over one revolution (:func:`steady_revolution`)."""
+    figures = []
+    window = (f"the run's last input revolution (the first {START_UP_STEPS} steps of the run, "
+              "where they fall in it, left out: see 'The start-up oscillation' below)")
     if "10deg" in hist:
-        names.append(_save(folder, f"fig4_efficiency_10deg_{parameters}.png",
-                           plots.efficiency_history({"10 deg, 2000 rpm": hist["10deg"]},
-                                                    f"Figure 4 ({parameters})")))
-        names.append(_save(folder, f"fig5_pair_losses_{parameters}.png",
-                           plots.pair_losses(hist["10deg"], f"Figure 5 ({parameters}): power loss, "
-                                                            "10 deg, 2000 rpm")))
-    angles = {k: v for k, v in hist.items() if k.startswith("angle ")}
-    if angles:
-        names.append(_save(folder, f"fig6_angles_{parameters}.png",
-                           plots.efficiency_history(angles, f"Figure 6 ({parameters})",
-                                                    ylim=(-0.5, 1.05))))
-    speeds = {k: v for k, v in hist.items() if k.startswith("speed ")}
-    if speeds:
-        names.append(_save(folder, f"fig7_speeds_{parameters}.png",
-                           plots.efficiency_history(speeds, f"Figure 7 ({parameters})")))
-    return names
+        name = f"fig4_efficiency_10deg_{parameters}.png"
+        plots.save(plots.efficiency_against_input_angle(_curves({"10 deg, 2000 rpm": hist["10deg"]}),
+                                                        f"Figure 4 ({parameters})"), folder / name)
+        figures.append((name, f"Figure 4 ({parameters}): eq. (18) at 10 deg, 2000 rpm, over {window}."))
+        angle, sel = steady_revolution(hist["10deg"])
+        name = f"fig5_pair_losses_{parameters}.png"
+        losses = {p: np.asarray(hist["10deg"][f"power_loss_{p}"])[sel] for p in PAIR_NAMES}
+        plots.save(plots.pair_losses(angle, losses, f"Figure 5 ({parameters}): power loss, 10 deg, "
+                                                    "2000 rpm"), folder / name)
+        effect = start_up_effect(hist["10deg"])
+        said = ("" if effect is None else " The first revolution's mean efficiency differs from "
+                f"the last's by {number(effect, '+.1e')} (the motion repeats every revolution: this is "
+                "the start-up's whole effect on it).")
+        figures.append((name, f"Figure 5 ({parameters}): power loss per pair over {window}.{said}"))
+    for key, figure, what in (("angle ", 6, "several shaft angles at 2000 rpm"),
+                              ("speed ", 7, "10 deg at several input speeds")):
+        chosen = {k: v for k, v in hist.items() if k.startswith(key)}
+        if chosen:
+            name = f"fig{figure}_{'angles' if figure == 6 else 'speeds'}_{parameters}.png"
+            plots.save(plots.efficiency_against_input_angle(_curves(chosen), f"Figure {figure} "
+                                                            f"({parameters})"), folder / name)
+            figures.append((name, f"Figure {figure} ({parameters}): eq. (18), {what}, against the "
+                                  f"input angle over {window}."))
+    return figures
 
 
-def _save(folder: Path, name: str, fig: Any) -> str:
-    plots.save(fig, folder / name)
-    return name
+def _curves(histories: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Label -> (input angle [deg], eq. (18) [-]) over each history's steady revolution."""
+    out = {}
+    for label, history in histories.items():
+        angle, rows = steady_revolution(history)
+        out[label] = (angle, np.asarray(history["efficiency"], dtype=float)[rows])
+    return out
 
 
-def report_text(rows: pd.DataFrame, register: pd.DataFrame, figures: Sequence[str], *,
+def report_text(rows: pd.DataFrame, register: pd.DataFrame, figures: Sequence[tuple[str, str]], *,
                 quick: bool, wall: float, reused: int, runs_dir: str) -> str:
     """The markdown of ``report.md`` (arguments as for :func:`write_report`)."""
     ok = rows[rows.status == Status.OK]
-    md = (_head(len(rows), quick, wall, reused, runs_dir) + _results(rows, ok)
-          + _calibration() + _losses_and_checks(ok) + _appendix(figures, register))
+    md = (_head(rows, quick, wall, reused, runs_dir) + _parameter_sets() + _results(rows, ok)
+          + _envelope() + _losses_and_checks(ok) + _plots(figures) + _appendix(register))
     return "\n".join(md)
 
 
-def _table(frame: pd.DataFrame, columns: Sequence[str], spec: str = ".4f") -> str:
+def _table(frame: pd.DataFrame | Sequence[Mapping[str, Any]], columns: Sequence[str],
+           spec: str = ".4f", formats: Mapping[str, str] | None = None) -> str:
     """A markdown table of ``columns``: numbers in float columns with ``spec`` (angles and speeds
-    with ``g``), integers, booleans and text as they are, an undefined number as an empty cell."""
-    formats = {c: "g" if c.endswith(("_deg", "_rpm")) else spec
-               for c in columns if c in frame and frame[c].dtype.kind == "f"}
-    return markdown_table(frame, columns, formats, missing="")
+    with ``g``) unless ``formats`` says otherwise, integers, booleans and text as they are, an
+    undefined number as an empty cell."""
+    frame = pd.DataFrame(frame)
+    chosen = {c: "g" if c.endswith(("_deg", "_rpm")) else spec
+              for c in columns if c in frame and frame[c].dtype.kind == "f"}
+    chosen.update({c: f for c, f in (formats or {}).items() if c in frame and frame[c].dtype.kind == "f"})
+    return markdown_table(frame, columns, chosen, missing="")
 
 
-def _head(runs: int, quick: bool, wall: float, reused: int, runs_dir: str) -> list[str]:
-    earlier = (f" ({reused} of the {runs} runs from the records of an earlier invocation in "
+def _head(rows: pd.DataFrame, quick: bool, wall: float, reused: int, runs_dir: str) -> list[str]:
+    earlier = (f" ({reused} of the {len(rows)} runs from the records of an earlier invocation in "
                f"`{runs_dir}/`)" if reused else "")
+    ok = rows[rows.status == Status.OK]
+    engines = sorted({f"{e} {v}" for e, v in zip(ok.get("engine", []), ok.get("engine_version", []),
+                                                   strict=True)})
     return [
-        "# The paper's results with friction: plain reading and calibrated set\n",
+        "# The paper's results with friction under three parameter sets: physical (default), "
+        "literal, matched\n",
         f"Generated by `cardan reproduce{' --quick' if quick else ''}` in {number(wall, '.1f')} s"
-        + earlier + ". Every "
-        "number and plot here was computed by the code in this repository from "
+        + earlier + ". Every number and plot here was computed by the code in this repository from "
         "`reference/data/paper.toml`; nothing is copied from the paper except the column "
-        "`paper_mean_efficiency`.\n",
-        "**Parameter sets.** `plain`: every value the paper states, read literally (moment "
-        "lever of eq. (1) = bearing length L), and the assumption register below for what it "
-        "does not state. `calibrated`: the plain reading with the parameters listed under "
-        "*Calibrated parameters* identified by `cardan calibrate` from the cases marked "
-        "`used_in_fit`; the other cases are held out.\n",
+        "`paper_mean_efficiency` (and the envelope's `paper`).\n",
+        "**Parameter sets.** `physical` (the default of every scene, the CLI and the API): every "
+        "open value a dimension or physical quantity inside its plausible range. `literal`: the "
+        "paper read literally, kept as evidence. `matched`: fitted to the paper's numbers with "
+        "values that are not plausible dimensions. Each set's values, ranges and reasons are under "
+        "*Parameter sets*; every row below names its set.\n",
+        f"**How every number was computed.** Engine: {', '.join(engines) or '-'} (the tables give "
+        "engine and version per row), generalized-alpha with the step `dt_s` that the run's "
+        "accuracy control chose (`steps_per_revolution` at the input speed), accuracy target "
+        f"{_targets(ok)} on the mean efficiency. `efficiency_error_estimate` is the "
+        "run's own estimate of its error (Richardson from a companion run at a coarser step, "
+        "`docs/accuracy.md`), `accuracy_met` whether it is within the target.\n",
         "**Definitions.** `mean_efficiency` = 1 - (loss work)/(input work) over whole input "
-        "revolutions; `efficiency_error_estimate` = the run's own estimate of its error "
-        "(`docs/accuracy.md`), `accuracy_met` whether it is within the target "
-        "(`numerics.accuracy`); `mean_instantaneous_efficiency` = time average of eq. (18), which is "
-        "unbounded where the input power changes sign (it does at large angles): '-' where it "
-        "is not defined or leaves [0, 1].\n",
+        "revolutions; `mean_instantaneous_efficiency` = time average of eq. (18), which is "
+        "unbounded where the input power changes sign (it does at large angles): empty where it "
+        "is not defined or leaves [0, 1]. `fit`: `fitted` where the set's fitted values were "
+        "identified from that case (or the same scene), `held out` otherwise; a set fitted to "
+        "nothing has every case held out.\n",
     ]
 
 
+def _targets(ok: pd.DataFrame) -> str:
+    """The runs' accuracy targets (``numerics.accuracy``), as text."""
+    values = sorted(set(ok["accuracy_target"].dropna())) if "accuracy_target" in ok else []
+    return " / ".join(number(v, "g") for v in values) or "-"
+
+
+def parameter_rows(parameters: str) -> list[dict[str, Any]]:
+    """A set's parameter table (:func:`reference.paper.parameter_table`) for the report: the
+    plausible range as text and ``inside`` as ``yes``, ``**NO**`` (outside: not a plausible
+    dimension) or ``-`` (no range). A moment lever is checked as the dimension it stands for
+    under the lumped-pair reading (:data:`LEVER_DIMENSIONS`: spider lever = 2 x arm radius, frame
+    lever = the support spacing)."""
+    box = plausible_box()
+    out = []
+    for row in parameter_table(parameters):
+        plausible, inside = row["plausible"], row["plausible_value"]
+        if plausible is None and row["name"] in LEVER_DIMENSIONS:
+            dimension, factor = LEVER_DIMENSIONS[row["name"]]
+            lo, hi = (factor * v for v in box[dimension]["range"])
+            plausible = [lo, hi]
+            inside = lo <= row["value"] <= hi
+            row = {**row, "reason": f"{row['reason']} (as {'2 x ' if factor != 1 else ''}"
+                                    f"{dimension}: {number(row['value'] / factor, 'g')} m)"}
+        text = ("-" if plausible is None else
+                f"{number(plausible[0], 'g')} to {number(plausible[1], 'g')}"
+                if all(isinstance(v, (int, float)) for v in plausible) else ", ".join(plausible))
+        out.append({**row, "value": str(row["value"]), "plausible": text,
+                    "inside": "-" if inside is None else "yes" if inside else "**NO**",
+                    "fitted": "fitted" if row["fitted"] else "no"})
+    return out
+
+
+def _parameter_sets() -> list[str]:
+    md = ["## Parameter sets\n"]
+    for parameters in PARAMETER_SETS:
+        spec = parameter_set(parameters)
+        fit = spec.get("fit_cases", [])
+        rows = parameter_rows(parameters)
+        outside = [r["name"] for r in rows if r["inside"] == "**NO**"]
+        md += [f"\n### {parameters}{' (default)' if parameters == DEFAULT_PARAMETER_SET else ''}\n",
+               spec["description"] + "\n",
+               (f"Fitted to {', '.join(f'`{k}`' for k in fit)} (study:angle:rpm); the other "
+                "cases are held out.\n" if fit else "Fitted to nothing: every case is held out.\n"),
+               _table(rows, PARAMETER_COLUMNS, ".5g"),
+               (f"\n**Outside the plausible range:** {', '.join(f'`{n}`' for n in outside)}.\n"
+                if outside else "\nEvery value with a range is inside it.\n")]
+    return md
+
+
+def error_summary(rows: pd.DataFrame) -> list[dict[str, Any]]:
+    """Per parameter set, the fitted and the held-out cases apart: the number of cases, the RMS
+    and the largest difference to the paper [-] (signed, with its case)."""
+    ok = rows[rows.status == Status.OK]
+    out = []
+    for parameters in PARAMETER_SETS:
+        sel = ok[ok.parameters == parameters]
+        for group, part in (("fitted", sel[sel.used_in_fit.astype(bool)]),
+                            ("held out", sel[~sel.used_in_fit.astype(bool)])):
+            if part.empty:
+                continue
+            diff = part["difference_to_paper"].astype(float)
+            worst = part.loc[diff.abs().idxmax()]
+            out.append({"parameters": parameters, "cases": group, "count": len(part),
+                        "rms": float(np.sqrt((diff ** 2).mean())),
+                        "largest": float(worst["difference_to_paper"]),
+                        "largest_at": f"{worst['study']}:{worst['shaft_angle_deg']:g}:"
+                                      f"{worst['speed_rpm']:g}"})
+    return out
+
+
 def _results(rows: pd.DataFrame, ok: pd.DataFrame) -> list[str]:
-    md = ["## Mean efficiency against the paper\n",
-          _table(ok, MAIN_COLUMNS),
-          "\n### Summary of differences to the paper\n",
-          held_out_summary(rows)]
+    md = ["\n## Mean efficiency against the paper\n"]
+    for parameters in PARAMETER_SETS:
+        sel = ok[ok.parameters == parameters]
+        if not sel.empty:
+            md += [f"\n### {parameters}\n", _table(sel, MAIN_COLUMNS, formats=MAIN_FORMATS)]
+    md += ["\n### Errors against the paper, fitted and held out\n",
+           "Difference = model - paper, mean efficiency [-]; `largest` is the signed difference "
+           "of largest magnitude, at `largest_at`.\n\n",
+           _table(error_summary(rows), ["parameters", "cases", "count", "rms", "largest",
+                                        "largest_at"], formats={"largest": "+.4f"})]
     failed = rows[rows.status != Status.OK]
     if not failed.empty:
         md += ["\n### Cases without a result\n", _table(failed, FAILED_COLUMNS)]
     return md
 
 
-def held_out_summary(rows: pd.DataFrame) -> str:
-    """Largest and RMS difference to the paper of the fitted, the held-out and the plain cases."""
-    cal = rows[(rows.parameters == "calibrated") & (rows.status == Status.OK)]
-    if cal.empty:
-        return ""
-    groups = [("fitted", cal[cal.used_in_fit]), ("held out", cal[~cal.used_in_fit])]
-    plain = rows[(rows.parameters == "plain") & (rows.status == Status.OK)]
-    if not plain.empty:
-        groups.append(("plain reading", plain))
-    out = []
-    for label, sel in groups:
-        if sel.empty:
-            continue
-        err = sel["difference_to_paper"].abs()
-        out.append(f"- {label} ({len(sel)} cases): max |difference| {number(err.max(), '.4f')}, "
-                   f"RMS {number(np.sqrt((err ** 2).mean()), '.4f')}")
-    return "\n".join(out) + "\n"
-
-
-def _calibration() -> list[str]:
-    calibrated = pd.DataFrame(calibrated_parameters())
-    if calibrated.empty:
-        return []
-    cal = calibrated.assign(plain_value=calibrated["plain_value"].astype(str))
-    choices = pd.DataFrame([{"name": k, **v} for k, v in calibrated_choices().items()])
-    return ["\n## Calibrated parameters\n",
-            f"Fitted by `cardan calibrate` to {', '.join(fit_case_keys())} "
-            "(study:angle:rpm):\n\n",
-            _table(cal, ["name", "value", "unit", "plain_value", "meaning"], ".5g"),
-            "\nDiscrete choices of the calibrated set (not fitted):\n\n",
-            _table(choices.assign(value=choices["value"].astype(str)), ["name", "value", "reason"]),
-            LEVERS_READING]
+def _envelope() -> list[str]:
+    rows = envelope()
+    md = ["\n## What plausible physics can reach: the envelope\n"]
+    if not rows:
+        return md + ["Not computed: no envelope is stored in `reference/data/paper.toml` "
+                     "(`cardan calibrate --envelope` stores it).\n"]
+    out = [{**r, "reachable": "yes" if r["reachable"] else "**NO**"} for r in rows]
+    return md + ["Lowest and highest mean efficiency the model gives for each paper number over "
+                 "the plausible box (the ranges of *Parameter sets*), and the closest plausible "
+                 "value to the paper's.\n\n", _table(out, ENVELOPE_COLUMNS)]
 
 
 def _losses_and_checks(ok: pd.DataFrame) -> list[str]:
@@ -279,21 +424,40 @@ def _losses_and_checks(ok: pd.DataFrame) -> list[str]:
         "\n## Where the power goes: share of the input work lost in each pair\n",
         _table(ok, LOSS_COLUMNS),
         "\n## Checks: energy balance and cost\n",
+        "`output_load_N_m` = the constant output load (the `physical` set reads the paper's "
+        "2 N m as the mean input torque, so its load is solved per case); "
         "`energy_balance_residual_J` = input work - output work - friction loss work - change "
         "of mechanical energy over the run (trapezoidal, zero up to the integration error).\n\n",
         _table(ok, CHECK_COLUMNS, ".4g"),
     ]
 
 
-def _appendix(figures: Sequence[str], register: pd.DataFrame) -> list[str]:
+def _plots(figures: Sequence[tuple[str, str]]) -> list[str]:
+    return [
+        "\n## Plots\n",
+        "\n".join(f"![{name}]({name})\n\n*{caption}*\n" for name, caption in figures),
+        "\n### The start-up oscillation\n",
+        "The time histories leave out the first steps of a run. Every run starts from a "
+        "consistent state (the first row equals the row one revolution later to about 1e-3 W, "
+        "friction iterated to consistency before the first step), but the generalized-alpha "
+        "integrator starts its acceleration-like variables at the consistent accelerations, and "
+        "its index-3 reactions then oscillate from step to step for a few dozen steps (also "
+        "without friction, in the drive torque); every pair's friction follows its reactions, "
+        "most visibly the output-frame pair's moment term. The oscillation decays faster at a "
+        "lower spectral radius, and is absent one revolution later at the same input angle: an "
+        "artefact of the integrator's start, not of the joint. The figures show the last whole "
+        f"revolution (with one revolution, from step {START_UP_STEPS} on); the means keep every "
+        "step (Figure 5's caption gives the start-up's effect on the first revolution's mean).\n",
+    ]
+
+
+def _appendix(register: pd.DataFrame) -> list[str]:
     stated = pd.DataFrame(stated_values())
     stated["value"] = stated["value"].astype(str)
     return [
-        "\n## Plots\n",
-        "\n".join(f"![{f}]({f})\n" for f in figures),
         "\n## Assumption register\n",
         "Every value the paper does not state, the value used, and why (also "
-        "`assumptions.csv`).\n\n",
+        "`assumptions.csv`); a parameter set's values replace these where it has them.\n\n",
         _table(register.assign(value=register["value"].astype(str)),
                ["name", "value", "unit", "assumption", "reason"]),
         "\n## Values taken from the paper\n",

@@ -60,7 +60,7 @@ from reference.validation import DEG, RPM
 
 #: The engine the map tests, and the one it is tested against.
 ENGINE, REFERENCE = "exudyn", "reference"
-BASE_SCENE = "paper-10deg-2000rpm"
+BASE_SCENE = "paper-literal-10deg-2000rpm"
 REVOLUTIONS = 1.0
 DEFAULT_STEPS = 200          # steps per input revolution of the panels that do not vary it
 DEFAULT_RPM = 2000.0

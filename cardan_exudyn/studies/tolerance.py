@@ -3,10 +3,9 @@
 The paper's case (sections 4.2 and 5): the rig scene (15 deg, 6 rad/s, f = 0.42, 0.2 N m) with
 and without ``a_i = 0.5 mm`` and twist errors of 6e-3 deg (i = 1, 2, 3); the paper reports that
 such errors change the efficiency by about 0.15 %. :func:`paper_case` computes the change with
-every engine asked for, under both parameter sets (plain, calibrated) and two friction
-couplings: ``converged`` (friction applied to the dynamics, the model of this project) and
-``uncoupled`` (eqs. (3), (5) evaluated on the frictionless reactions, a first-order estimate),
-with the per-pair breakdown of where the change comes from and the sliding work of eq. (5).
+every engine, parameter set, friction law (``friction.law``) and coupling: ``converged`` (friction
+fed back into the dynamics) or ``uncoupled`` (eqs. (3), (5) on the frictionless reactions), with
+the per-pair breakdown and the sliding work of eq. (5); :func:`law_verdicts` says which matches.
 
 Monte Carlo (:func:`monte_carlo`): each error drawn from a stated distribution
 (:class:`cardan_exudyn.sweep.Distribution`), N samples reproducible from a seed, run through the
@@ -48,13 +47,15 @@ from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep
 from reference.joint import ERROR_NAMES, PAIR_NAMES
-from reference.paper import paper_errors, rig_scene, value
-from reference.scene import Scene, replace
+from reference.paper import PARAMETER_SETS, paper_errors, rig_scene, value
+from reference.scene import FRICTION_LAWS, Scene, replace
 from reference.schema import Status, Summary
 
 CYLINDRICAL = PAIR_NAMES[1:]
-PARAMETER_SETS = ("plain", "calibrated")
 COUPLINGS = ("converged", "uncoupled")
+LAWS = FRICTION_LAWS
+MATCH_FACTOR = 2.0  # a change matches the paper's "about 0.15 %" within this factor of its magnitude:
+# one rounded number for a sign combination the paper does not state (the signs alone move it more)
 LEVELS = (1, 5, 25, 50, 75, 95, 99)  # percentiles reported [%]
 
 
@@ -85,13 +86,13 @@ def case_numbers(summary: Summary) -> dict[str, float]:
     return out
 
 
-def paper_row(parameters: str, coupling: str, engine: str) -> dict[str, Any]:
-    """The rig case of one parameter set and coupling run by ``engine`` without and with the
-    stated errors: statuses, efficiencies [-], their change and per-pair loss changes [-]."""
-    ideal = replace(rig_scene(parameters=parameters), **{"friction.coupling": coupling})
+def paper_row(parameters: str, coupling: str, engine: str, law: str = "paper") -> dict[str, Any]:
+    """The rig case of one parameter set, friction law and coupling run by ``engine`` without and
+    with the stated errors: statuses, efficiencies [-], their change and per-pair loss changes [-]."""
+    ideal = replace(rig_scene(parameters=parameters), **{"friction.coupling": coupling, "friction.law": law})
     with_errors = replace(ideal, **paper_errors())
     r0, r1 = run(ideal, engine).summary, run(with_errors, engine).summary
-    row: dict[str, Any] = {"parameters": parameters, "coupling": coupling, "engine": engine,
+    row: dict[str, Any] = {"parameters": parameters, "law": law, "coupling": coupling, "engine": engine,
                            "status_ideal": r0.status.value, "status_errors": r1.status.value,
                            "reason": r1.reason if not r1.success else ""}
     a, b = case_numbers(r0), case_numbers(r1)
@@ -107,21 +108,22 @@ def paper_row(parameters: str, coupling: str, engine: str) -> dict[str, Any]:
 def paper_case(engines: Sequence[str] = ("reference", "exudyn"),
                parameter_sets: Sequence[str] = PARAMETER_SETS,
                couplings: Sequence[str] = COUPLINGS,
-               progress: Callable[[dict[str, Any]], None] | None = None):
-    """The rig case with and without the stated errors, per engine, parameter set and coupling.
+               progress: Callable[[dict[str, Any]], None] | None = None,
+               laws: Sequence[str] = LAWS):
+    """The rig case with and without the stated errors, per engine, parameter set, law and coupling.
 
     Parameters
     ----------
-    engines, parameter_sets, couplings : sequence of str
+    engines, parameter_sets, couplings, laws : sequence of str
         Keys of :data:`cardan_exudyn.engines.ENGINES`, parameter sets of
-        :func:`reference.paper.rig_scene` and ``friction.coupling`` values.
+        :func:`reference.paper.rig_scene`, ``friction.coupling`` and ``friction.law`` values.
     progress : callable, optional
         Called with each row as it is computed.
 
     Returns
     -------
     pandas.DataFrame
-        One row per (parameters, coupling, engine): statuses, ``eta_ideal``, ``eta_errors``,
+        One row per (parameters, law, coupling, engine): statuses, ``eta_ideal``, ``eta_errors``,
         ``change`` (absolute) and ``relative_change``, ``sliding_share`` (sliding work over input
         work, with errors) and per pair ``d_loss_<pair>``: the change of that pair's loss as a
         share of the input work (they add up to minus the change of efficiency, up to the change
@@ -130,14 +132,38 @@ def paper_case(engines: Sequence[str] = ("reference", "exudyn"),
     import pandas as pd  # import cost: this module registers a CLI command
 
     rows = []
-    for parameters, coupling, engine in itertools.product(parameter_sets, couplings, engines):
-        rows.append(paper_row(parameters, coupling, engine))
+    for parameters, law, coupling, engine in itertools.product(parameter_sets, laws, couplings, engines):
+        rows.append(paper_row(parameters, coupling, engine, law))
         if progress:
             progress(rows[-1])
     return pd.DataFrame(rows)
 
 
-def sign_envelope(parameters: str = "calibrated", coupling: str = "converged",
+def law_verdicts(rows, paper: float) -> list[dict[str, Any]]:
+    """Per parameter set and engine of :func:`paper_case` rows: the relative change (or status) of each
+    (law, coupling), the closest to ``paper`` [-] in magnitude ratio, whether it is within MATCH_FACTOR."""
+    out = []
+    for (parameters, engine), group in rows.groupby(["parameters", "engine"], sort=False):
+        cells = {}
+        for r in group.itertuples():  # a failed run: its status
+            bad = r.status_errors if r.status_ideal == Status.OK else r.status_ideal
+            cells[f"{r.law}/{r.coupling}"] = float(r.relative_change) if bad == Status.OK else str(bad)
+        ratio = {k: abs(v) / paper for k, v in cells.items() if isinstance(v, float) and v != 0.0}
+        best = min(ratio, key=lambda k: abs(math.log(ratio[k])), default=None)  # None: nothing ran ok
+        out.append({"parameters": parameters, "engine": engine, "cells": cells, "closest": best,
+                    "matches": None if best is None else 1.0 / MATCH_FACTOR <= ratio[best] <= MATCH_FACTOR})
+    return out
+
+
+def verdict_line(v: Mapping[str, Any], paper: float) -> str:
+    """One sentence: which law/coupling of a parameter set and engine matches the paper's change."""
+    said = "matches" if v["matches"] else f"is the closest, but outside a factor {MATCH_FACTOR:g} of"
+    return (f"{v['parameters']}, {v['engine']}: no combination ran ok" if v["closest"] is None else
+            f"{v['parameters']}, {v['engine']}: {v['closest']} ({number(v['cells'][v['closest']], '+.3%')}) "
+            f"{said} the paper's {number(paper, '.2%')}")
+
+
+def sign_envelope(parameters: str = "matched", coupling: str = "converged",
                   engine: str = "reference") -> dict[str, Any]:
     """Range of the efficiency change [-] over the 64 sign combinations of the stated errors.
 
@@ -364,12 +390,14 @@ def paper_report(out: str | Path, engines: Sequence[str] = ("reference", "exudyn
     rows = paper_case(engines, progress=progress)
     envelope = [sign_envelope(p, c) for p in PARAMETER_SETS for c in COUPLINGS]
     paper = value("case.rig.tolerance_effect")
-    summary = {"paper_change": paper, "cases": rows.to_dict(orient="records"), "sign_envelope": envelope}
+    verdicts = law_verdicts(rows, paper)
+    summary = {"paper_change": paper, "cases": rows.to_dict(orient="records"), "sign_envelope": envelope,
+               "verdicts": verdicts}
     with atomic_directory(Path(out)) as tmp:
         rows.to_csv(tmp / "paper_case.csv", index=False)
         (tmp / "paper_case.json").write_text(dumps(summary), encoding="utf-8")
         _breakdown_plot(tmp / "paper_case_breakdown.png", rows)
-        (tmp / "report.md").write_text(_paper_markdown(rows, envelope, paper), encoding="utf-8")
+        (tmp / "report.md").write_text(_paper_markdown(rows, envelope, paper, verdicts), encoding="utf-8")
     return summary
 
 
@@ -381,8 +409,8 @@ def _breakdown_plot(path: Path, rows) -> None:
     ok = rows[(rows.status_errors == Status.OK) & (rows.status_ideal == Status.OK)]
     if ok.empty:
         return
-    fig, ax = plt.subplots(figsize=(8, 4))
-    labels = [f"{r.parameters}\n{r.coupling}\n{r.engine}" for r in ok.itertuples()]
+    fig, ax = plt.subplots(figsize=(max(8, 0.6 * len(ok)), 4))
+    labels = [f"{r.parameters}\n{r.law}\n{r.coupling}\n{r.engine}" for r in ok.itertuples()]
     bottom_pos, bottom_neg = np.zeros(len(ok)), np.zeros(len(ok))
     for k, pair in enumerate(PAIR_NAMES):
         v = ok[f"d_loss_{pair}"].to_numpy(float)
@@ -398,22 +426,31 @@ def _breakdown_plot(path: Path, rows) -> None:
     save(fig, path, dpi=120)
 
 
-PAPER_COLUMNS = ["parameters", "coupling", "engine", "eta_ideal", "eta_errors", "change", "relative_change",
-                 "sliding_share", *(f"d_loss_{p}" for p in PAIR_NAMES)]
-PAPER_HEADERS = ["parameters", "coupling", "engine", "eta ideal", "eta with errors", "change", "relative",
+PAPER_COLUMNS = ["parameters", "law", "coupling", "engine", "eta_ideal", "eta_errors", "change",
+                 "relative_change", "sliding_share", *(f"d_loss_{p}" for p in PAIR_NAMES)]
+PAPER_HEADERS = ["parameters", "law", "coupling", "engine", "eta ideal", "eta errors", "change", "relative",
                  "sliding work / W_in", *(f"d loss {p}" if k == 0 else p for k, p in enumerate(PAIR_NAMES))]
 PAPER_FORMATS = {"eta_ideal": ".6f", "eta_errors": ".6f", "change": "+.2e", "relative_change": "+.3%",
                  "sliding_share": ".2e", **{f"d_loss_{p}": "+.2e" for p in PAIR_NAMES}}
 ENVELOPE_COLUMNS = ["parameters", "coupling", "combinations ok", "change min", "change max"]
 
 
-def _paper_markdown(rows, envelope: Sequence[Mapping[str, Any]], paper: float) -> str:
-    """``report.md`` of the paper's case: the table of cases and the sign envelope."""
+def _law_tables(verdicts: Sequence[Mapping[str, Any]], paper: float) -> str:
+    """Per parameter set and engine: the 2x2 table of relative changes (coupling x law), the verdict."""
+    return "".join(f"`{v['parameters']}`, {v['engine']}:\n\n" + markdown_table(
+        [{"coupling": c, **{law: v["cells"].get(f"{law}/{c}", "-") for law in LAWS}} for c in COUPLINGS],
+        ["coupling", *LAWS], {law: "+.3%" for law in LAWS}) + f"\n{verdict_line(v, paper)}.\n\n"
+        for v in verdicts)
+
+
+def _paper_markdown(rows, envelope: Sequence[Mapping[str, Any]], paper: float,
+                    verdicts: Sequence[Mapping[str, Any]] = ()) -> str:
+    """``report.md`` of the paper's case: law x coupling tables, the cases, the sign envelope."""
     cases = []
     for r in rows.to_dict(orient="records"):
         if r["status_errors"] != Status.OK or r["status_ideal"] != Status.OK:
             # a failed run has no numbers: its status in place of the efficiency with errors
-            r = {**{c: None for c in PAPER_COLUMNS}, **{c: r[c] for c in PAPER_COLUMNS[:4]},
+            r = {**{c: None for c in PAPER_COLUMNS}, **{c: r[c] for c in PAPER_COLUMNS[:5]},
                  "eta_errors": r["status_errors"]}
         cases.append(r)
     envelope_rows = [{"parameters": e["parameters"], "coupling": e["coupling"],
@@ -422,10 +459,14 @@ def _paper_markdown(rows, envelope: Sequence[Mapping[str, Any]], paper: float) -
     return ("# The paper's tolerance case (sections 4.2, 5)\n\n"
             "Rig scene (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m) without and with "
             "a1 = a2 = a3 = 0.5 mm and alpha1..3 errors of 6e-3 deg (all positive; the paper gives "
-            f"magnitudes). The paper: efficiency change about {number(paper, '.2%')}.\n\n"
+            f"magnitudes). The paper: efficiency change about {number(paper, '.2%')}. Relative change "
+            "of the mean efficiency, fed back (`converged`) or not (`uncoupled`), under the paper's "
+            "friction law (eqs. (3), (5) as written) and the resultant-slip law (`friction.law`; a "
+            f"match: within a factor {MATCH_FACTOR:g} of the paper's):\n\n"
+            + _law_tables(verdicts, paper)
             + markdown_table(cases, PAPER_COLUMNS, PAPER_FORMATS, PAPER_HEADERS)
             + "\nRange of the change over the 64 sign combinations of the six errors (reference "
-              "engine):\n\n"
+              "engine, the paper's friction law):\n\n"
             + markdown_table(envelope_rows, ENVELOPE_COLUMNS, {"change min": "+.2e", "change max": "+.2e"})
             + "\nPlot: `paper_case_breakdown.png` (change of each pair's loss, share of the input "
               "work).\n")
@@ -435,7 +476,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``cardan tolerance`` to the ``cardan`` subcommands."""
     p = subparsers.add_parser("tolerance", help="mounting-error studies: the paper's case, Monte Carlo",
                               description="`paper`: the rig case with and without the paper's tolerances "
-                                          "(both parameter sets and couplings, per-pair breakdown). "
+                                          "(every parameter set, friction law and coupling). "
                                           "`montecarlo`: errors drawn from distributions (default: the "
                                           "paper's tolerances, uniform with both signs), resumable.")
     p.add_argument("study", choices=("paper", "montecarlo"))
@@ -493,7 +534,7 @@ def handler(args: argparse.Namespace) -> int:
         if getattr(args, key) is None or getattr(args, key) is False:
             setattr(args, key, default)
     if args.study == "montecarlo" and args.name is None and args.scene is None:
-        args.name = "rig-calibrated"
+        args.name = "rig-matched"
     out_folder(args.out, replace=args.study == "paper")
     if args.study == "paper":
         return paper_handler(args)
@@ -510,6 +551,8 @@ def paper_handler(args: argparse.Namespace) -> int:
     if args.json:
         print(dumps(summary))
     else:
+        for v in summary["verdicts"]:
+            print(verdict_line(v, summary["paper_change"]), file=sys.stderr)
         print(f"wrote {args.out}/report.md", file=sys.stderr)
     failed = [c for c in summary["cases"]
               if c["status_ideal"] != Status.OK or c["status_errors"] != Status.OK]
@@ -517,7 +560,7 @@ def paper_handler(args: argparse.Namespace) -> int:
 
 
 def _show_row(row: Mapping[str, Any]) -> None:
-    print(f"  {row['parameters']:10s} {row['coupling']:9s} {row['engine']:9s} "
+    print(f"  {row['parameters']:10s} {row['law']:9s} {row['coupling']:9s} {row['engine']:9s} "
           f"{row['status_errors']:12s} change {number(row['relative_change'], '+.3%')}",
           file=sys.stderr)
 
@@ -552,5 +595,6 @@ def monte_carlo_line(summary: Mapping[str, Any], out: str) -> str:
             f"{number(m.get('p95'), '.6f')}; wrote {out}/study/report.md")
 
 
-__all__ = ["correlation_ratio", "default_distributions", "error_distribution", "monte_carlo",
-           "paper_case", "paper_report", "register", "handler", "sensitivities", "sign_envelope"]
+__all__ = ["correlation_ratio", "default_distributions", "error_distribution", "law_verdicts", "monte_carlo",
+           "paper_case", "paper_report", "register", "handler", "sensitivities", "sign_envelope",
+           "verdict_line"]
