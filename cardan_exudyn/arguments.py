@@ -189,11 +189,11 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     """The scene named or loaded by the options, with the command-line overrides applied and
     named after them (:func:`override_name`): ``--angle 45`` on ``paper-10deg-2000rpm`` is
     ``paper-45deg-2000rpm``, ``--load-torque 3`` adds ``+load=3Nm``."""
+    changes, labels = _overrides(args)
     if args.scene is not None:
         scene = load_scene(args.scene)
     else:
-        scene = _named(DEFAULT_SCENE if args.name is None else args.name, args)
-    changes, labels = _overrides(args)
+        scene = _named(DEFAULT_SCENE if args.name is None else args.name, labels)
     if not changes:
         return scene
     try:
@@ -208,17 +208,17 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
     return dataclasses.replace(changed, name=name, description=description)
 
 
-def _named(name: str, args: argparse.Namespace) -> Scene:
-    """The named scene, built at the ``--angle`` and ``--rpm`` asked for when it is one of the
-    paper's (so that its parameter set's choices, such as the load that gives the case's mean input
-    torque, are made for that angle and speed; the override then changes nothing)."""
+def _named(name: str, labels: list[tuple[str, str]]) -> Scene:
+    """The named scene, built at the ``--angle`` and ``--rpm`` asked for (their ``labels``) when it
+    is one of the paper's (so that its parameter set's choices, such as the load that gives the
+    case's mean input torque, are made for that angle and speed; the override then changes
+    nothing)."""
     scene = named_scene(name)
-    labels = [(k, f"{v:g}{k.replace('angle', 'deg')}") for k, v in (("angle", args.angle), ("rpm", args.rpm))
-              if v is not None and v >= 0.0]
-    if not scene.parameter_set or not labels:
+    tokens = [(k, text) for k, text in labels if k in ("angle", "rpm") and not text.startswith("-")]
+    if not scene.parameter_set or not tokens:
         return scene
     try:
-        return named_scene(override_name(scene.name, labels))
+        return named_scene(override_name(scene.name, tokens))
     except SceneError:
         return scene  # not a name the paper's scenes take (e.g. 92 deg): the override will say why
 

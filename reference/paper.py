@@ -237,12 +237,30 @@ def plausible_box() -> dict[str, dict[str, Any]]:
     return dict(paper_data()["plausible"])
 
 
+LEVER_DIMENSIONS = {"spider_lever": ("arm_radius", 2.0), "frame_lever": ("support_spacing", 1.0)}
+"""A lever given as a number stands for a dimension of the lumped pair: the spider lever for
+2 x arm radius, the frame lever for the support spacing (name -> (dimension, factor))."""
+
+
+def _set_of(parameters: str | dict[str, Any]) -> tuple[str, dict[str, Any]]:
+    """The label (a set's name, or ``custom`` for values given) and the values of ``parameters``."""
+    if isinstance(parameters, dict):
+        return "custom", dict(parameters)
+    label = parameter_set_name(parameters)
+    return label, set_values(label)
+
+
 def parameter_table(name: str) -> list[dict[str, Any]]:
-    """Rows for a report: name, value, unit, plausible range, inside it, fitted, reason."""
+    """Rows for a report: name, value, unit, plausible range, inside it, fitted, reason. A lever
+    given as a number is checked against the range of the dimension it stands for
+    (:data:`LEVER_DIMENSIONS`)."""
     box = plausible_box()
     rows = []
     for key, entry in parameter_set(name)["values"].items():
         plaus = box.get(key, {})
+        if key in LEVER_DIMENSIONS:
+            dimension, factor = LEVER_DIMENSIONS[key]
+            plaus = {"range": [factor * v for v in box[dimension]["range"]]}
         lo_hi = plaus.get("range") or plaus.get("options")
         inside = _inside(entry["value"], plaus)
         rows.append({"name": key, "value": entry["value"], "unit": entry.get("unit", "-"),
@@ -406,11 +424,7 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
         speed_rpm = finite("speed_rpm", speed_rpm)
     if not isinstance(friction, bool):
         raise SceneTypeError(f"`friction` must be True or False, got {friction!r:.80}")
-    if isinstance(parameters, dict):
-        label, values = "custom", dict(parameters)
-    else:
-        label = parameter_set_name(parameters)
-        values = set_values(label)
+    label, values = _set_of(parameters)
     rpm = value("case.multibody.speed") if speed_rpm is None else speed_rpm
     scene = Scene(
         joint=paper_joint(shaft_angle_deg, reading, friction),
@@ -455,11 +469,7 @@ def rig_scene(friction: bool = True, parameters: str | dict[str, Any] = DEFAULT_
     for name, flag in (("friction", friction), ("errors", errors)):
         if not isinstance(flag, bool):
             raise SceneTypeError(f"`{name}` must be True or False, got {flag!r:.80}")
-    if isinstance(parameters, dict):
-        label, values = "custom", dict(parameters)
-    else:
-        label = parameter_set_name(parameters)
-        values = set_values(label)
+    label, values = _set_of(parameters)
     joint = paper_joint(value("case.rig.shaft_angle"), friction=False)
     f = value("case.rig.friction") if friction else 0.0
     pairs = Pairs(**{n: Pair(f, p.journal_diameter, p.moment_lever) for n, p in joint.pairs.items()})
@@ -525,6 +535,13 @@ def named_scene(name: str) -> Scene:
 def case_key(case: dict[str, Any]) -> str:
     """``study:angle:rpm``, the key of one of :func:`paper_cases` (``table2:10:2000``)."""
     return f"{case['study']}:{case['shaft_angle_deg']:g}:{case['speed_rpm']:g}"
+
+
+def in_fit(case: dict[str, Any], fit: list[str] | tuple[str, ...]) -> bool:
+    """Whether ``case`` is one of the fit cases ``fit`` (:func:`case_key` keys) or the same scene
+    (angle and speed) as one: the speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case."""
+    scene = (float(case["shaft_angle_deg"]), float(case["speed_rpm"]))
+    return any((float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
 
 
 def envelope() -> list[dict[str, Any]]:

@@ -77,6 +77,10 @@ def test_physical_values_lie_in_the_plausible_box():
         assert row["plausible_value"] is (True if row["name"] in box else None), row
     matched = {r["name"]: r["plausible_value"] for r in parameter_table("matched")}
     assert matched["spider_com_offset"] is False  # 8.5 mm: the set says so itself
+    # levers as the dimensions they stand for: 60 mm is a 30 mm arm radius, 0.59 m a bearing spacing
+    assert matched["spider_lever"] is False and matched["frame_lever"] is False
+    literal = {r["name"]: r["plausible_value"] for r in parameter_table("literal")}
+    assert literal["spider_lever"] is False and literal["gravity"] is False
 
 
 def test_mean_input_reading_gives_the_mean_input_torque():

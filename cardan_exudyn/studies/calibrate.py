@@ -33,10 +33,9 @@ from cardan_exudyn.studies.fitting import (
     CaseModel,
     Space,
     cases_named,
-    in_fit,
     set_space,
 )
-from reference.paper import case_key, paper_cases, parameter_set
+from reference.paper import case_key, in_fit, paper_cases, parameter_set
 
 FIT_SETS = ("physical", "matched")
 CASE_COLUMNS = ["case", "used in fit", "paper", "model", "difference"]
@@ -44,7 +43,7 @@ CASE_FORMATS = {"paper": ".3f", "model": ".4f", "difference": "+.4f"}
 XTOL = 1e-8
 """``least_squares`` step tolerance in the unit box: 1e-8 of a parameter's range."""
 
-__all__ = ["FIT_SETS", "calibrate", "fit", "fit_statistics", "in_fit", "register"]
+__all__ = ["FIT_SETS", "calibrate", "fit", "fit_statistics", "register"]
 
 
 def residuals(model: CaseModel, cases: Sequence[Mapping[str, Any]], values: Mapping[str, Any]) -> np.ndarray:

@@ -37,13 +37,6 @@ MATCHED_BOUNDS = {
 not held to plausible dimensions; searched on a log scale."""
 
 
-def in_fit(case: Mapping[str, Any], fit: Sequence[str]) -> bool:
-    """Whether ``case`` is one of the fit cases or the same scene (angle and speed) as one:
-    the speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case."""
-    scene = (case["shaft_angle_deg"], case["speed_rpm"])
-    return any((float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
-
-
 def cases_named(keys: Sequence[str]) -> list[dict[str, Any]]:
     """The paper's cases named by ``keys`` (:func:`reference.paper.case_key`), in that order."""
     by_key = {case_key(c): c for c in paper_cases()}

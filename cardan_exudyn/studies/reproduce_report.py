@@ -19,18 +19,18 @@ from cardan_exudyn.report.format import markdown_table, number
 from reference.joint import PAIR_NAMES
 from reference.paper import (
     DEFAULT_PARAMETER_SET,
+    LEVER_DIMENSIONS,
     PARAMETER_SETS,
     assumption_register,
-    case_key,
     envelope,
+    in_fit,
     parameter_set,
     parameter_table,
-    plausible_box,
     stated_values,
 )
 from reference.schema import Status
 
-__all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "fitted", "case_row", "write_report",
+__all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_report",
            "draw_figures", "report_text", "error_summary", "parameter_rows", "steady_revolution"]
 
 # the numbers of a run, in the order of the report's results.csv (after difference_to_paper)
@@ -62,22 +62,11 @@ which excites a period-two oscillation of the reactions (and of every pair's fri
 follows them) that decays by a factor of about 0.8 per step at spectral radius 0.6 (0.6 at 0.3,
 gone after three steps at 0): the reactions at the same input angle one revolution later are
 smooth. After 40 steps it is below 1e-3 of its first amplitude."""
-# a set's moment levers as the dimension they stand for under the lumped-pair reading
-# (docs/paper.md): spider lever = 2 x arm radius, frame lever = support spacing
-LEVER_DIMENSIONS = {"spider_lever": ("arm_radius", 2.0), "frame_lever": ("support_spacing", 1.0)}
 
 
 def fit_case_keys(parameters: str) -> list[str]:
     """The cases a parameter set was fitted to, as ``study:angle:rpm`` keys (none: not fitted)."""
     return list(parameter_set(parameters).get("fit_cases", []))
-
-
-def fitted(case: Mapping[str, Any], fit: Sequence[str]) -> bool:
-    """Whether ``case`` is one of the fit cases ``fit`` or the same scene (angle and speed) as
-    one: the speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case."""
-    scene = (float(case["shaft_angle_deg"]), float(case["speed_rpm"]))
-    return case_key(case) in fit or any(
-        (float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
 
 
 def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]) -> dict[str, Any]:
@@ -99,7 +88,7 @@ def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]
         a run that is ``ok``, its numbers (works in J, torques in N m, step and wall time in s,
         efficiencies and shares dimensionless).
     """
-    used = fitted(case, fit_case_keys(parameters))
+    used = in_fit(case, fit_case_keys(parameters))
     row: dict[str, Any] = {
         "parameters": parameters,
         "study": case["study"],
@@ -330,17 +319,12 @@ def parameter_rows(parameters: str) -> list[dict[str, Any]]:
     """A set's parameter table (:func:`reference.paper.parameter_table`) for the report: the
     plausible range as text and ``inside`` as ``yes``, ``**NO**`` (outside: not a plausible
     dimension) or ``-`` (no range). A moment lever is checked as the dimension it stands for
-    under the lumped-pair reading (:data:`LEVER_DIMENSIONS`: spider lever = 2 x arm radius, frame
-    lever = the support spacing)."""
-    box = plausible_box()
+    (:data:`reference.paper.LEVER_DIMENSIONS`), which its reason then names."""
     out = []
     for row in parameter_table(parameters):
         plausible, inside = row["plausible"], row["plausible_value"]
-        if plausible is None and row["name"] in LEVER_DIMENSIONS:
+        if row["name"] in LEVER_DIMENSIONS:
             dimension, factor = LEVER_DIMENSIONS[row["name"]]
-            lo, hi = (factor * v for v in box[dimension]["range"])
-            plausible = [lo, hi]
-            inside = lo <= row["value"] <= hi
             row = {**row, "reason": f"{row['reason']} (as {'2 x ' if factor != 1 else ''}"
                                     f"{dimension}: {number(row['value'] / factor, 'g')} m)"}
         text = ("-" if plausible is None else
