@@ -160,8 +160,9 @@ def add_scene_options(p: argparse.ArgumentParser) -> None:
                    help="friction coefficient of the two spider pairs (the paper's f1)")
     p.add_argument("--friction-frame", metavar="F", type=number("-", non_negative=True),
                    help="friction coefficient of the two frame pairs (the paper's f2)")
-    p.add_argument("--coupling", choices=("converged", "lagged"),
-                   help="friction coupling: converged per step (default) or lagged one step "
+    p.add_argument("--coupling", choices=("extrapolated", "converged", "lagged"),
+                   help="friction coupling: one Newton solve per step on extrapolated law inputs "
+                        "(default), iterated to the fixed point per step, or lagged one step "
                         "(the paper's)")
     p.add_argument("--friction-law", choices=("paper", "resultant"),
                    help="friction of a pair that rotates and slides: the paper's eqs. (3), (5), "

@@ -15,15 +15,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import importlib
 import os
 import sys
 from collections.abc import Iterator
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import TYPE_CHECKING
-
-import tomli_w
 
 from cardan_exudyn.arguments import (
     EXIT_BAD_INPUT,
@@ -39,7 +37,7 @@ from cardan_exudyn.arguments import (
     path_value,
     scene_from_args,
 )
-from cardan_exudyn.engines import ENGINES, EngineUnavailable, run
+from cardan_exudyn.engines import ENGINES, EngineUnavailable, make_options, run
 from cardan_exudyn.interrupts import Terminated, exit_status, terminate_raises
 from cardan_exudyn.io import (
     WRITE_ERRORS,
@@ -74,10 +72,18 @@ def cmd_run(args: argparse.Namespace) -> int:
     estimated mean-efficiency error exceeds ``--accuracy`` (``accuracy_met`` false, a warning)."""
     if args.engine not in ENGINES:
         raise BadInput(f"`--engine` must be one of {sorted(ENGINES)}, got {args.engine!r}")
+    options = None
+    if args.projection:
+        try:
+            options = make_options(args.engine, velocity_projection=True)
+        except OptionsError:
+            raise BadInput(f"--projection is an exudyn option, not one of {args.engine!r}") from None
     out_folder(args.out)
     scene = scene_from_args(args)
+    if args.richardson:
+        scene = dataclasses.replace(scene, numerics=dataclasses.replace(scene.numerics, richardson=True))
     _warn_given_step(scene)
-    result = run(scene, args.engine)
+    result = run(scene, args.engine, options)
     if args.out:
         write_result(result, args.out)
     if args.json:
@@ -151,6 +157,8 @@ def _print_summary(s: Summary, out: str | None, files: list[str]) -> None:
 
 def cmd_scene(args: argparse.Namespace) -> int:
     """``cardan scene``: the resolved scene as TOML on stdout."""
+    import tomli_w  # import cost: only this command writes TOML
+
     scene = scene_from_args(args)
     print(tomli_w.dumps(scene_to_dict(scene)), end="")
     return EXIT_OK
@@ -208,16 +216,22 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return EXIT_OK if summary["failed"] == 0 else EXIT_FAILED
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``cardan`` parser: core commands, then the studies' and other packages' commands."""
+CORE_COMMANDS = ("run", "sweep", "scene")
+"""The commands this module defines; the studies' and other packages' are registered after them."""
+
+
+def build_parser(core_only: bool = False) -> argparse.ArgumentParser:
+    """The ``cardan`` parser: core commands, then (unless ``core_only``) the studies' and other
+    packages' commands."""
     parser = _Parser(
         prog="cardan", description="Mechanical efficiency of Cardan joints with Exudyn.")
     sub = parser.add_subparsers(dest="command", required=True)
     add_run_parser(sub)
     add_sweep_parser(sub)
     add_scene_parser(sub)
-    _add_study_commands(sub)
-    _add_plugin_commands(sub)
+    if not core_only:
+        _add_study_commands(sub)
+        _add_plugin_commands(sub)
     return parser
 
 
@@ -227,6 +241,12 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:
     add_scene_options(p)
     p.add_argument("--engine", default="exudyn",
                    help="exudyn (default), reference, or mujoco (frictionless; optional extra)")
+    p.add_argument("--richardson", action="store_true",
+                   help="run at the step and at half of it and report the Richardson-extrapolated "
+                        "histories (frictionless scenes; scene field numerics.richardson)")
+    p.add_argument("--projection", action="store_true",
+                   help="exudyn: velocities projected onto the velocity constraints (exact speed "
+                        "ratio; option velocity_projection)")
     p.add_argument("--out", metavar="DIR", help="write timeseries.csv and summary.json here")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     p.set_defaults(func=cmd_run)
@@ -276,6 +296,8 @@ def _add_study_commands(sub: argparse._SubParsersAction) -> None:
 def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:
     """Commands other packages register under the ``cardan.commands`` entry-point group (``cardan
     rig`` from ``rigdata``): imports keep pointing one way, this package never imports them."""
+    from importlib.metadata import entry_points  # import cost: ~30 ms, for these commands only
+
     for entry in sorted(entry_points(group="cardan.commands"), key=lambda e: e.name):
         entry.load()(sub)
 
@@ -285,9 +307,18 @@ def main(argv: list[str] | None = None) -> int:
 
     SIGTERM raises :class:`cardan_exudyn.interrupts.Terminated` while the command runs, so it
     stops as Ctrl-C does (cleanup, previous output kept, exit 143 instead of 130)."""
-    args = build_parser().parse_args(argv)
+    args = parse_args(argv)
     with terminate_raises():
         return _run_command(args)
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    """The parsed ``cardan`` command line ``argv`` (default: the process's arguments), as
+    :func:`main` runs it. A core command (``cardan run``) is parsed without importing the study
+    modules or looking up entry points (import cost); anything else (``cardan --help``, a study,
+    a mistyped command) gets the whole parser."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    return build_parser(core_only=bool(argv) and argv[0] in CORE_COMMANDS).parse_args(argv)
 
 
 def _run_command(args: argparse.Namespace) -> int:

@@ -12,11 +12,10 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
-import json
+import functools
 import math
 import os
 import re
-import secrets
 import shutil
 import sys
 from collections.abc import Callable, Iterator
@@ -79,7 +78,7 @@ def atomic_open(path: str | os.PathLike, mode: str = "wb", **kwargs: Any) -> Ite
         and the target is untouched.
     """
     target = Path(path)
-    tmp = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp")
+    tmp = target.with_name(f".{target.name}.{os.urandom(8).hex()}.tmp")
     # os.open applies the umask to 0o666, as open() would; mkstemp would leave the file 0o600
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     try:
@@ -101,6 +100,8 @@ def atomic_write(path: str | os.PathLike, write: Callable[[IO], Any]) -> None:
 
 
 def dumps(data: Any) -> str:
+    import json  # import cost: a plain `cardan run` writes no JSON
+
     return json.dumps(to_jsonable(data), indent=2, allow_nan=False)
 
 
@@ -262,11 +263,15 @@ def _remove(path: Path) -> None:
 
 
 def _sibling(target: Path, kind: str) -> Path:
-    return target.with_name(f".{target.name}.cardan-{kind}-{os.getpid()}-{secrets.token_hex(4)}")
+    return target.with_name(f".{target.name}.cardan-{kind}-{os.getpid()}-{os.urandom(4).hex()}")
 
 
+@functools.cache
 def _renameat2():
-    """libc's ``renameat2`` (Linux >= 3.15, glibc >= 2.28), or ``None``."""
+    """libc's ``renameat2`` (Linux >= 3.15, glibc >= 2.28), or ``None``; looked up on first use,
+    not at import."""
+    if not sys.platform.startswith("linux"):
+        return None
     try:
         function = ctypes.CDLL(None, use_errno=True).renameat2
     except (AttributeError, OSError, TypeError):
@@ -276,7 +281,6 @@ def _renameat2():
     return function
 
 
-_RENAMEAT2 = _renameat2() if sys.platform.startswith("linux") else None
 _AT_FDCWD, _RENAME_EXCHANGE = -100, 2
 
 
@@ -285,9 +289,10 @@ def exchange(a: str | os.PathLike, b: str | os.PathLike) -> bool:
 
     Returns False where the system or the file system cannot (the caller falls back to two
     renames); raises :class:`OSError` for any other failure."""
-    if _RENAMEAT2 is None:
+    renameat2 = _renameat2()
+    if renameat2 is None:
         return False
-    if _RENAMEAT2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+    if renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
         return True
     code = ctypes.get_errno()
     if code in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP, errno.EOPNOTSUPP):

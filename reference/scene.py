@@ -248,12 +248,17 @@ class Numerics:
         relative error of omega_out/omega_in. A time-stepping engine chooses its step to meet
         both when ``dt`` is None, and every run reports its estimated mean-efficiency error
         (``Summary.efficiency_error_estimate``, ``accuracy_met``; ``docs/accuracy.md``).
+    richardson : bool
+        Time stepping at ``h`` and ``h / 2``, extrapolated (``docs/bench.md``); reference: ignored.
     """
 
     dt: float | None = None
     accuracy: float = 1e-3
+    richardson: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.richardson, bool):
+            raise SceneError(f"`richardson` must be true or false, got {self.richardson!r}")
         if self.dt is not None:
             set_field(self, "dt", positive("dt", self.dt))
         acc = positive("accuracy", self.accuracy)
@@ -262,8 +267,7 @@ class Numerics:
         set_field(self, "accuracy", acc)
 
 
-
-COUPLINGS = ("converged", "lagged", "uncoupled")
+COUPLINGS = ("converged", "lagged", "uncoupled", "extrapolated")
 FRICTION_LAWS = ("paper", "resultant")
 DEFAULT_SIGN_BAND_RELATIVE = 1e-3
 """Default ``FrictionSettings.sign_band_relative`` [-] (``docs/paper.md``, "Friction at every speed")."""
@@ -276,14 +280,14 @@ class FrictionSettings:
     Attributes
     ----------
     coupling : str
-        ``"converged"``: within each time step, friction and reactions are iterated to a fixed
-        point (the friction applied is the friction of the step's own reactions);
+        ``"extrapolated"`` (default): one Newton solve per step, the law on extrapolated inputs
+        (``cardan_exudyn.model.coupling``); ``"converged"``: within each time step, friction and
+        reactions are iterated to a fixed point (the friction of the step's own reactions);
         ``"lagged"``: the paper's scheme (section 3.1), the reactions at the end of a step set the
         friction applied during the next step; ``"uncoupled"``: friction is *not* applied to the
         dynamics, eqs. (3), (5) are evaluated on the frictionless reactions and their power is
-        the loss (a first-order estimate, used to explain the paper's tolerance figure; the
-        energy balance then misses the loss). The reference engine has no time step: it solves
-        the converged fixed point for ``"converged"`` and ``"lagged"`` alike.
+        the loss (a first-order estimate, used to explain the paper's tolerance figure; the energy
+        balance then misses the loss). The reference solves the fixed point for the others.
     sign_band : float or None
         One absolute ramp width [m/s] for every pair: below it ``sign()`` of eqs. (3), (5) is
         replaced by a linear ramp ``clip(v / sign_band, -1, 1)`` of the relative surface speed
@@ -314,7 +318,7 @@ class FrictionSettings:
         for a revolute pair and a pair that does not slide (``docs/scenes.md``, "Friction law").
     """
 
-    coupling: str = "converged"
+    coupling: str = "extrapolated"
     sign_band: float | None = None
     sign_band_relative: float | None = None
     tolerance: float = 1e-6

@@ -190,8 +190,8 @@ def test_friction_machinery_only_for_pairs_with_friction():
     model = build_model(one)
     assert [p.name for p in model.friction.pairs] == ["frame_input"]
     # frame_input: ground -> input, so one torque load (on the input), no axial force
-    assert len(model.friction.pairs[0].torque_loads) == 1
-    assert not model.friction.pairs[0].force_loads
+    assert model.friction.loads.kinds == ["torque"]
+    assert not model.friction.pairs[0].slides
     assert PAIR_KIND["frame_input"] == "revolute"
 
 

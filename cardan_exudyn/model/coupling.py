@@ -2,39 +2,51 @@
 
 What is added to the model
 --------------------------
-For each pair with a non-zero friction coefficient (and only for those): a body-fixed
-``LoadTorqueVector`` about the pair axis on each non-ground body of the pair, and for cylindrical
-pairs of a joint with mounting errors a body-fixed ``LoadForceVector`` along the axis, applied at
-the pair point of each body. The ideal joint's cylindrical pairs cannot slide (their axial friction
-is 0, as the reference engine computes it); the solver leaves their slide with noise at the Newton
-tolerance (1e-11..1e-10 m/s with a measured angle drive), which the sign ramp would turn into an
-axial force that changes with every solve: at 0 deg, where the true friction is only the weights',
-the fixed point could not converge below it and the run stopped as self-locking.
-Body ``b`` receives the friction (torque ``M_z``, force ``F_z``), body ``a`` the opposite. Both
-load vectors are fixed in their body because the pair axis is fixed in both bodies of the pair.
+For each pair with a non-zero friction coefficient (and only for those) a friction torque about
+the pair axis, and for cylindrical pairs of a joint with mounting errors an axial force, on each
+moving body of the pair: merged per body into one body-fixed torque vector, and a force vector
+only where a pair slides (:class:`cardan_exudyn.model.friction_io.BodyLoads`). The ideal joint's
+cylindrical pairs cannot slide (their axial friction is 0, as the reference engine computes it);
+the solver leaves their slide with noise at the Newton tolerance (1e-11..1e-10 m/s with a
+measured angle drive), which the sign ramp would turn into an axial force that changes with every
+solve: at 0 deg, where the true friction is only the weights', the fixed point could not converge
+below it and the run stopped as self-locking. Body ``b`` receives the friction (torque ``M_z``,
+force ``F_z``), body ``a`` the opposite.
 
 How the friction is updated (``scene.friction.coupling``)
 ---------------------------------------------------------
-One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, after each
-converged Newton solve, the pair reactions (the joints' ``ForceLocal`` / ``TorqueLocal`` outputs;
-only their magnitudes normal to the pair axis enter eqs. (3)-(5), and these do not depend on
-which of the two pair frames, rotated about the axis, they are expressed in; the raw Lagrange
-multipliers are not used: for the joint to ground their force part is in global components)
-and the relative speeds (BDF2 derivatives of the pairs' relative coordinates, see
-``engine.relative_speeds``), computes the friction and sets the loads with ``SetLoadParameter``.
-Before the first step the friction is iterated to consistency with the initial state
-(``FrictionCoupling.initialise``), so no scheme starts frictionless.
+One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, after each Newton
+solve, the law's inputs -- per pair the magnitudes of the reaction force normal to the axis and of
+the bending moment (from the Lagrange multipliers, read once), and the relative angular and
+sliding speeds (BDF2 of the joint's own angle and slide outputs) -- computes the friction and sets
+the loads (:mod:`cardan_exudyn.model.friction_io`: plain floats, no small arrays). Before the first
+step the friction is iterated to consistency with the initial state (``FrictionCoupling.initialise``),
+so no scheme starts frictionless.
 
-- ``lagged`` (the paper's scheme): the function returns zero error, so the friction computed at
-  the end of step n acts during step n+1. First order in the step size (the friction is one
-  step late).
+- ``extrapolated`` (the default): one Newton solve per step. At the end of step ``n`` the law's
+  inputs ``x`` are extrapolated to the end of step ``n + 1`` as ``1.5 x_n - 0.5 x_{n-2}`` (linear
+  through steps ``n - 2`` and ``n``) and the law, sign ramps included, is evaluated on them: the
+  friction acting in step ``n + 1`` is that of its own (predicted) state, so the mean efficiency
+  converges at the integrator's order (second) where friction is smooth. The linear map of the
+  friction feedback (loop gain ``g``: reactions -> friction -> reactions) then iterates as
+  ``z^3 = g (1.5 z^2 - 0.5)``, whose roots lie inside the unit circle for every real ``g`` in
+  (-1, 1) (``tests/test_coupling_lean.py`` checks the roots and runs at gains near -1 and +1).
+  Extrapolating the friction itself instead of the inputs stays first order (a sign ramp crossed
+  in a step is not predicted), and ``2 x_n - x_{n-1}`` is unstable for ``g < -1/3``. The first
+  two steps extrapolate with what exists (constant, then linear through two steps). Every
+  :data:`PROBE_EVERY`-th step is solved twice, the second time with the friction of the first
+  solve's state: the ratio of the two friction changes estimates the loop gain
+  (``loop_gain_estimate``). A probe above :data:`ESCALATE_GAIN` switches the run to the converged
+  scheme (near self-locking the extrapolation amplifies its error by ``1 / (1 - g)``, and only the
+  fixed-point iteration tells a joint that locks).
 - ``converged``: the function returns the relative change of the friction as the error of
   Exudyn's *discontinuous iteration*; Exudyn repeats the Newton solve of the same step with the
   updated friction until the change is below ``tolerance``. The friction applied in a step is
-  then the friction of that step's own reactions (a fixed point per step), and the error of the
-  mean efficiency falls at the integrator's order (second). When a step is accepted, the
-  friction for the next step is predicted by linear extrapolation of the last two steps, which
-  only shortens the iteration (the fixed point does not depend on it).
+  then the friction of that step's own reactions (a fixed point per step). Costs 5-8 Newton
+  solves per step where the extrapolated scheme needs one.
+- ``lagged`` (the paper's scheme): the function returns zero error, so the friction computed at
+  the end of step n acts during step n+1. First order in the step size (the friction is one
+  step late).
 
 Self-locking
 ------------
@@ -43,9 +55,11 @@ reactions -> friction). In the converged scheme the ratio of successive correcti
 it (``loop_gain_estimate`` in the summary); a step whose iteration stalls (residual reduced by
 less than ``STALL_RATIO`` after ``max_iterations``) has no consistent friction state and stops
 the run with status ``self_locking``; a step that still converges but slowly is counted in
-``unconverged_steps`` and the run goes on. In the lagged scheme every step is one iteration of the same map,
-so a gain >= 1 shows as geometric growth of the friction from step to step: growth by more than
-a factor 1e3 over consecutive growing steps stops the run with status ``self_locking``.
+``unconverged_steps`` and the run goes on. In the lagged and extrapolated schemes every step is
+one iteration of the same map, so a gain >= 1 shows as growth of the friction from step to step:
+growth by more than a factor 1e3 over consecutive growing steps stops the run with status
+``self_locking`` (the extrapolated scheme escalates to the converged one before that, at its
+first probe above :data:`ESCALATE_GAIN`).
 """
 
 from __future__ import annotations
@@ -54,16 +68,15 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import exudyn as exu
-import exudyn.itemInterface as eii
 import numpy as np
 
-from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
+from cardan_exudyn.model import friction_io as io
+from cardan_exudyn.model.friction_law import PairLaw, magnitude_loads
 from reference.bands import sign_bands
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.schema import Status
 
-# geometric growth of the friction (lagged scheme) taken as self-locking
+# geometric growth of the friction (lagged and extrapolated schemes) taken as self-locking
 LAGGED_GROWTH_LIMIT = 1e3
 # converged scheme: a step whose fixed-point residual shrank less than this after
 # max_iterations is taken as self-locking (no consistent friction state)
@@ -76,10 +89,15 @@ GAIN_EVERY = 4
 # relative speeds, and a tolerance relative to the noise itself is never met (the step then
 # stalled and was reported as self-locking)
 REST_FLOOR = 1e-6
-
-
-# state of the ground in the per-body tuples (rotation, angular velocity, velocity, position)
-_GROUND = (np.eye(3), np.zeros(3), np.zeros(3), np.zeros(3))
+PROBE_EVERY = 25
+"""Extrapolated scheme: every this many steps one step is solved twice to estimate the loop gain."""
+ESCALATE_GAIN = 0.95
+"""Extrapolated scheme: a probed loop gain above this switches the run to the converged scheme."""
+RAMP_STEPS = 4
+"""Extrapolated scheme: a sign ramp crossed in fewer steps than this counts as a jump."""
+PROBE_NOISE = 1e-9
+"""A probe whose first friction change is below this share of the largest friction load is
+rounding noise and estimates nothing."""
 
 
 @dataclass
@@ -88,11 +106,9 @@ class _PairData:
     kind: str
     law: PairLaw
     joint: int                          # the pair's ObjectJointGeneric
-    bodies: tuple[str, str]
-    local: tuple[np.ndarray, np.ndarray]  # pair point in each body's node frame
-    axis_local: np.ndarray              # pair axis in node frames (same for a and b)
-    torque_loads: list = field(default_factory=list)  # (load number, +1 for b / -1 for a)
-    force_loads: list = field(default_factory=list)
+    bands: tuple[float, float, float]   # sign ramps: rotation, sliding, resultant [m/s]
+    slides: bool                        # carries an axial force (cylindrical, mounting errors)
+    weight: float                       # a force counts as the torque it makes: d / 2 [m]
 
 
 @dataclass
@@ -113,30 +129,26 @@ class FrictionCoupling:
         self.mbs = model.mbs
         self.settings = scene.friction
         self.bands = sign_bands(scene)  # per pair (rotation, sliding, resultant) [m/s], as every engine
-        self.converged = scene.friction.coupling == "converged"
+        self.mode = scene.friction.coupling
+        self.converged = self.mode == "converged"
         self.pairs: list[_PairData] = []
+        contributions, axes = [], []
         for name, pair in scene.joint.friction_pairs():
             if pair.friction_coefficient <= 0.0:
                 continue
-            frame = model.pair_frames[name]
+            # the ideal joint's cylindrical pairs cannot slide: their axial friction is 0 (as
+            # the reference's); the law would turn the solver's noise in the slide into force
+            slides = PAIR_KIND[name] == "cylindrical" and scene.joint.errors.any
             law = PairLaw.of(PAIR_KIND[name], pair, scene.friction.law)
-            p = _PairData(name=name, kind=PAIR_KIND[name], law=law, joint=model.joints[name],
-                          bodies=PAIR_BODIES[name], local=model.marker_local[name],
-                          axis_local=frame[:, 2].copy())
-            for role, body, local in zip((-1, 1), p.bodies, p.local, strict=True):
-                if body == "ground":
-                    continue
-                marker = self.mbs.AddMarker(eii.MarkerBodyRigid(
-                    bodyNumber=model.bodies[body], localPosition=list(local)))
-                p.torque_loads.append((self.mbs.AddLoad(eii.LoadTorqueVector(
-                    markerNumber=marker, loadVector=[0.0, 0.0, 0.0], bodyFixed=True)), role))
-                # the ideal joint's cylindrical pairs cannot slide: their axial friction is 0 (as
-                # the reference's); the law would turn the solver's noise in the slide into force
-                if p.kind == "cylindrical" and scene.joint.errors.any:
-                    p.force_loads.append((self.mbs.AddLoad(eii.LoadForceVector(
-                        markerNumber=marker, loadVector=[0.0, 0.0, 0.0], bodyFixed=True)), role))
-            self.pairs.append(p)
+            self.pairs.append(_PairData(name, PAIR_KIND[name], law, model.joints[name],
+                                        tuple(self.bands[name]), slides, 0.5 * law.d))
+            contributions.append([(model.bodies[body], local, role) for role, body, local in
+                                  zip((-1, 1), PAIR_BODIES[name], model.marker_local[name], strict=True)
+                                  if body != "ground"])
+            axes.append(model.pair_frames[name][:, 2].copy())
+        self.loads = io.BodyLoads(self.mbs, contributions, axes, [p.slides for p in self.pairs])
         self.n = len(self.pairs)
+        self.channels: list[io.PairChannel] = []
         self.applied = np.zeros((self.n, 2))
         self.log = FrictionLog()
         self.initial: np.ndarray | None = None  # friction consistent with the initial state
@@ -148,102 +160,78 @@ class FrictionCoupling:
         self._step_gain = 0.0
         self._gains: list[float] = []
         self._broyden_b = None
-        self._load_axes: list | None = None
         self._accepted_steps = 0
+        self._inputs: list[list] = []      # extrapolated scheme: law inputs of the last 3 steps
+        self._probe: tuple | None = None   # (friction of the first solve, its change) in a probe
+        self.escalated_at: float | None = None
+        self._iterating = False            # extrapolated scheme: this step is iterated (reversal)
+        self.iterated_steps = 0
+        self._predicted_regime: list = []
+        self._last_inputs: list = []
         mask = np.zeros((self.n, 2), dtype=bool)
         self._weight = np.ones((self.n, 2))
         for k, p in enumerate(self.pairs):
             mask[k, 0] = True
-            mask[k, 1] = bool(p.force_loads)
-            self._weight[k, 1] = 0.5 * p.law.d
+            mask[k, 1] = p.slides
+            self._weight[k, 1] = p.weight
         self._mask = mask.ravel()
         self.unconverged_steps = 0
         self.status, self.reason = Status.OK, ""
         self.error: Exception | None = None  # raised inside the user function (see post_newton)
         self.scale_floor = 0.0  # set by evaluate (REST_FLOOR)
         self._growth_steps, self._growth_start = 0, 0.0
-        self._ode2 = {}
 
     def prepare(self) -> None:
-        """Look up coordinate indices (after ``mbs.Assemble``) and register the user functions."""
-        for name, node in self.model.nodes.items():
-            start = self.mbs.GetNodeODE2Index(node)
-            rot = self.model.rotations[name]
-            reference = None if rot.zero_reference else np.asarray(rot.reference)
-            # rotation coordinates [start + 3, end), the node type's frame function and reference
-            # coordinates (None when zero)
-            self._ode2[name] = (start, start + 3 + rot.size, rot.frame_one, reference)
-        self._history = [(self.model.start_time, self._pair_coordinates(self._body_states()))]
+        """Look up the multipliers (after ``mbs.Assemble``) and register the user function."""
+        self.channels = [io.pair_channel(self.mbs, p.joint, PAIR_BODIES[p.name][0] == "ground",
+                                         self.model.pair_frames[p.name], p.slides) for p in self.pairs]
+        self._history = [(self.model.start_time, io.pair_coordinates(self.mbs, self.channels))]
+        self._coords = self._history[0][1]
         self.mbs.SetPostNewtonUserFunction(self.post_newton)
         self.model.user_functions.append(self.post_newton)
 
     def configure(self, settings: Any) -> None:
-        """Discontinuous-iteration settings for the chosen coupling."""
+        """Discontinuous-iteration settings for the chosen coupling (the extrapolated scheme
+        repeats a solve only to probe or after escalating to the converged scheme)."""
         d = settings.timeIntegration.discontinuous
-        d.iterationTolerance = self.settings.tolerance if self.converged else 1.0
-        d.maxIterations = self.settings.max_iterations + 1 if self.converged else 1
+        iterating = self.mode != "lagged"
+        d.iterationTolerance = self.settings.tolerance if iterating else 1.0
+        d.maxIterations = self.settings.max_iterations + 1 if iterating else 1
         d.ignoreMaxIterations = True
         d.useRecommendedStepSize = False
 
-    def _body_states(self) -> dict[str, tuple]:
-        sd = self.mbs.systemData
-        q = sd.GetODE2Coordinates(exu.ConfigurationType.Current)
-        q_t = sd.GetODE2Coordinates_t(exu.ConfigurationType.Current)
-        states = {}
-        for name, (i, end, frame, reference) in self._ode2.items():
-            p = q[i + 3:end]
-            a, omega = frame(p if reference is None else p + reference, q_t[i + 3:end])
-            states[name] = (a, omega, np.asarray(q_t[i:i + 3]),
-                            self.model.com_reference[name] + np.asarray(q[i:i + 3]))
-        return states
+    def _read_inputs(self, t: float | None) -> list[tuple[float, float, float, float]]:
+        """Per pair the law's inputs ``(|F|, |M|, omega_rel, slide_rel)`` at the current state
+        (``t`` None: the initial state, with velocity-level speeds); keeps the coordinates."""
+        reactions = io.read_reactions(self.mbs, self.channels)
+        if t is None:
+            speeds = io.initial_speeds(self.mbs, self.channels)
+        else:
+            self._coords = io.pair_coordinates(self.mbs, self.channels)
+            (t1, c1) = self._history[-1]
+            if len(self._history) < 2:
+                speeds = io.bdf2_speeds(self._coords, t - t1, c1)
+            else:
+                t2, c2 = self._history[-2]
+                speeds = io.bdf2_speeds(self._coords, t - t1, c1, t1 - t2, c2)
+        self._last_inputs = [(math.hypot(fx, fy), math.hypot(mx, my), w, v)
+                             for (fx, fy, mx, my), (w, v) in zip(reactions, speeds, strict=True)]
+        return self._last_inputs
 
-    def _pair_coordinates(self, states: dict[str, tuple]) -> np.ndarray:
-        """Per pair: relative rotation angle of b about the axis, and axial slide of b [m].
+    def _law(self, inputs: list) -> list[list[float]]:
+        """Friction ``[M_z, F_z]`` of each pair for the law's ``inputs``; sets :attr:`scale_floor`."""
+        friction, sliding = [], 0.0
+        for p, (force_n, moment_n, omega, slide) in zip(self.pairs, inputs, strict=True):
+            torque, force, scale = magnitude_loads(p.law, force_n, moment_n, omega, slide, *p.bands)
+            friction.append([torque, force if p.slides else 0.0])
+            sliding = max(sliding, scale)
+        self.scale_floor = REST_FLOOR * sliding
+        return friction
 
-        Computed from positions, which index-3 integration keeps on the constraint manifold to
-        the Newton tolerance; their time derivatives are the relative speeds used by the law.
-        """
-        coords = np.zeros((self.n, 2))
-        for k, p in enumerate(self.pairs):
-            a_a, _, _, r_a = states.get(p.bodies[0], _GROUND)
-            a_b, _, _, r_b = states.get(p.bodies[1], _GROUND)
-            frame = self.model.pair_frames[p.name]
-            # (A_a F)^T (A_b F): only its first column is needed, (x_a . x_b, y_a . x_b)
-            x_b = a_b @ frame[:, 0]
-            x_a, y_a = a_a @ frame[:, 0], a_a @ frame[:, 1]
-            coords[k, 0] = math.atan2(float(y_a @ x_b), float(x_a @ x_b))
-            if p.kind == "cylindrical":
-                d = (r_b + a_b @ p.local[1]) - (r_a + a_a @ p.local[0])
-                coords[k, 1] = float(d @ (a_a @ p.axis_local))
-        return coords
-
-    def _speeds(self, coords: np.ndarray, t: float) -> np.ndarray:
-        """Relative angular and sliding speeds: BDF2 of the pair coordinates (BDF1 at the start)."""
-        hist = self._history
-        c1 = hist[-1][1]
-        delta = coords - c1
-        delta[:, 0] = (delta[:, 0] + math.pi) % (2.0 * math.pi) - math.pi  # unwrap the angle
-        h1 = t - hist[-1][0]
-        if len(hist) < 2:
-            return delta / h1
-        c2 = hist[-2][1]
-        delta2 = c1 - c2
-        delta2[:, 0] = (delta2[:, 0] + math.pi) % (2.0 * math.pi) - math.pi
-        w1, w2 = bdf2_weights(h1, hist[-1][0] - hist[-2][0])
-        return (w1 * delta - w2 * delta2) / h1
-
-    def _velocity_level_speeds(self, states: dict[str, tuple]) -> np.ndarray:
-        """Relative speeds from the body velocities (used at the initial, consistent state)."""
-        speeds = np.zeros((self.n, 2))
-        for k, p in enumerate(self.pairs):
-            a_a, w_a, v_a, _ = states.get(p.bodies[0], _GROUND)
-            a_b, w_b, v_b, _ = states.get(p.bodies[1], _GROUND)
-            axis = a_a @ p.axis_local
-            speeds[k, 0] = float((w_b - w_a) @ axis)
-            if p.kind == "cylindrical":
-                r_a, r_b = a_a @ p.local[0], a_b @ p.local[1]
-                speeds[k, 1] = float((v_b + np.cross(w_b, r_b) - v_a - np.cross(w_a, r_a)) @ axis)
-        return speeds
+    def evaluate(self, t: float | None) -> np.ndarray:
+        """Friction (M_z, F_z on body b) of each pair at the current state, shape (n, 2) (``t``
+        None: the initial state, with velocity-level speeds)."""
+        return np.array(self._law(self._read_inputs(t))).reshape(self.n, 2)
 
     def initialise(self, solver: Any, settings: Any, max_iterations: int = 60) -> None:
         """Friction consistent with the initial reactions, before the first step.
@@ -257,7 +245,8 @@ class FrictionCoupling:
         x_prev = r_prev = None
         x = np.zeros(int(self._mask.sum()))
         for _ in range(max_iterations):
-            friction, _ = self.evaluate(None)
+            inputs = self._read_inputs(None)
+            friction = np.array(self._law(inputs)).reshape(self.n, 2)
             g = friction.ravel()[self._mask]
             r = g - x
             scale = max(float((np.abs(friction) * self._weight).max()), self.scale_floor)
@@ -266,6 +255,8 @@ class FrictionCoupling:
                 self.apply(friction)
                 solver.InitializeSolverInitialConditions(self.mbs, settings)
                 self._accepted = [friction.copy()]
+                self._inputs = [inputs]
+                self._predicted_regime = self._regime(inputs)
                 self.initial = friction.copy()
                 return
             if b is None:
@@ -284,45 +275,11 @@ class FrictionCoupling:
         self.reason = (f"no consistent friction state at the start: the fixed-point iteration "
                        f"did not converge in {max_iterations} iterations (loop gain >= 1)")
 
-    def evaluate(self, t: float | None) -> tuple[np.ndarray, np.ndarray]:
-        """Friction (M_z, F_z on body b) of each pair, and the pair coordinates, at the current
-        state (``t`` None: the initial state, with velocity-level speeds)."""
-        get = self.mbs.GetObjectOutput
-        force_local, torque_local = exu.OutputVariableType.ForceLocal, exu.OutputVariableType.TorqueLocal
-        states = self._body_states()
-        coords = self._pair_coordinates(states)
-        speeds = self._velocity_level_speeds(states) if t is None else self._speeds(coords, t)
-        friction = np.zeros((self.n, 2))
-        sliding = 0.0  # largest load a pair would carry sliding (forces weighted by d / 2)
-        for k, p in enumerate(self.pairs):
-            lx, ly, _ = get(p.joint, force_local)
-            tx, ty, _ = get(p.joint, torque_local)
-            omega_rel, slide = speeds[k]
-            # a pair that cannot slide (no axial load: the ideal joint) has solver noise as its
-            # slide; under the resultant law it would enter the slip direction
-            slide = float(slide) if p.force_loads else 0.0
-            band = self.bands[p.name]
-            # TorqueLocal's in-plane components are rotated by 90 deg; only the magnitude enters
-            loads = pair_loads(p.law, lx, ly, tx, ty, float(omega_rel), slide, band.rotation,
-                               band.sliding, band.resultant)
-            friction[k] = loads.torque, (loads.force if p.force_loads else 0.0)
-            sliding = max(sliding, loads.sliding_scale)
-        self.scale_floor = REST_FLOOR * sliding
-        return friction, coords
-
-    def apply(self, friction: np.ndarray) -> None:
-        """Set every friction load (called once or more per step: plain floats, no arrays)."""
-        if self._load_axes is None:  # (load, column of friction, role times the axis in node axes)
-            self._load_axes = [(load, k, j, tuple(float(role * c) for c in p.axis_local))
-                               for k, p in enumerate(self.pairs)
-                               for j, loads in ((0, p.torque_loads), (1, p.force_loads))
-                               for load, role in loads]
-        set_load = self.mbs.SetLoadParameter
-        values = friction.tolist()
-        for load, k, j, (x, y, z) in self._load_axes:
-            value = values[k][j]
-            set_load(load, "loadVector", [value * x, value * y, value * z])
-        self.applied = friction.copy()
+    def apply(self, friction: Any) -> None:
+        """Set every friction load from ``friction`` (per pair ``(M_z, F_z)``, list or array)."""
+        values = friction.tolist() if isinstance(friction, np.ndarray) else friction
+        self.loads.apply(values)
+        self.applied = values
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
         """Exudyn's post-Newton user function: update the friction, return the change as the
@@ -333,38 +290,146 @@ class FrictionCoupling:
         :func:`cardan_exudyn.model.solve.solve` re-raises it: a bug is not a physical outcome.
         """
         try:
+            if self.mode == "extrapolated" and self.escalated_at is None:
+                return self._extrapolated(t)
             return self._update(t)
         except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it
             self.error = exc
             self.status, self.reason = Status.INTEGRATION_FAILURE, f"friction update raised {exc!r}"
             return [0.0, -1.0]
 
-    def _update(self, t: float) -> list[float]:
-        if t != self._step_t and self._step_t is not None:  # the previous step was accepted
+    def _new_step(self, t: float) -> bool:
+        """Bookkeeping at each evaluation; True at the first evaluation of a step (the one before
+        was then accepted: its coordinates join the BDF2 history)."""
+        if t == self._step_t:
+            self._step_iter += 1
+            self.log.applied[-1] = list(self.applied)
+            self.log.iterations[-1] = self._step_iter + 1
+            return False
+        if self._step_t is not None:
             self._history = [self._history[-1], (self._step_t, self._coords)]
-        friction, self._coords = self.evaluate(t)
+        self._step_t, self._step_iter = t, 0
+        self.log.t.append(t)
+        self.log.applied.append(list(self.applied))
+        self.log.iterations.append(1)
+        return True
+
+    def _extrapolated(self, t: float) -> list[float]:
+        """One step of the extrapolated scheme (module doc): the friction for the next step from
+        the law on extrapolated inputs; a probe step is solved twice, a step next to a reversal
+        is solved to its fixed point."""
+        first = self._new_step(t)
+        if self._iterating:
+            return self._update(t, counted=True)
+        inputs = self._read_inputs(t)
+        if first:
+            self._accepted_steps += 1
+            if self._reversed(inputs):
+                self._iterating = True
+                self.iterated_steps += 1
+                return self._update(t, counted=True)
+            if self._accepted_steps % PROBE_EVERY == 0:
+                friction = self._law(inputs)
+                self._probe = (friction, self._change(friction, self.applied))
+                self.apply(friction)
+                return [1.0, -1.0]  # above any tolerance: Exudyn solves the step again
+        elif self._probe is not None:
+            self._finish_probe(t, self._law(inputs))
+            if self.escalated_at is not None:
+                return self._update(t, counted=True)
+        self._predict(inputs)
+        return [0.0, -1.0]
+
+    def _reversed(self, inputs: list) -> bool:
+        """Whether a pair's motion crossed its sign ramp in fewer than :data:`RAMP_STEPS` steps
+        (from one side to the other or into it) between ``inputs`` and the steps the
+        extrapolation through them would use, or against the prediction this step was solved
+        with: its friction then jumps, and so do the reactions (the friction feeds back), which a
+        line through the jump would carry into the next steps as an error of order one. The step
+        is then solved to its fixed point (about three steps per reversal). A ramp resolved by the
+        step is crossed smoothly and needs nothing (iterating there mixes fixed-point and
+        extrapolated states in the stencil, which measured worse)."""
+        regime = self._regime(inputs)
+        others = [self._predicted_regime, *(self._regime(x) for x in self._inputs)]
+        if all(regime == other for other in others):
+            return False
+        last = self._inputs[-1] if self._inputs else inputs
+        for k, p in enumerate(self.pairs):
+            for j, scale in ((0, p.weight), (1, 1.0)):
+                if all(other[k][j] == regime[k][j] for other in others):
+                    continue
+                if abs(inputs[k][2 + j] - last[k][2 + j]) * scale * RAMP_STEPS > p.bands[j]:
+                    return True
+        return False
+
+    def _regime(self, inputs: list) -> list[tuple[int, int]]:
+        """Per pair the side of its sign ramps each motion is on: -1, 0 (inside), +1."""
+        out = []
+        for p, (_, _, w, v) in zip(self.pairs, inputs, strict=True):
+            surface, band, slide_band = w * p.weight, p.bands[0], p.bands[1]
+            out.append(((surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band)))
+        return out
+
+    def _predict(self, inputs: list) -> None:
+        """Accept the step's ``inputs`` and apply the friction of the law on the inputs
+        extrapolated to the end of the next step (``1.5 x_n - 0.5 x_{n-2}``, module doc)."""
+        hist = self._inputs
+        hist.append(inputs)
+        if len(hist) > 3:
+            hist.pop(0)
+        if len(hist) == 3:
+            predicted = [tuple(1.5 * a - 0.5 * c for a, c in zip(x, z, strict=True))
+                         for x, z in zip(hist[2], hist[0], strict=True)]
+        elif len(hist) == 2:
+            predicted = [tuple(2.0 * a - b for a, b in zip(x, y, strict=True))
+                         for x, y in zip(hist[1], hist[0], strict=True)]
+        else:
+            predicted = inputs
+        self._predicted_regime = self._regime(predicted)
+        friction = self._law(predicted)
+        self._watch_growth(friction)
+        self.apply(friction)
+
+    def _change(self, friction: list, before: list) -> float:
+        """Largest change between two friction states, forces weighted by ``d / 2`` [N m]."""
+        return max((max(abs(a[0] - b[0]), p.weight * abs(a[1] - b[1]))
+                    for p, a, b in zip(self.pairs, friction, before, strict=True)), default=0.0)
+
+    def _finish_probe(self, t: float, friction: list) -> None:
+        """Second solve of a probe step: the loop gain from the two changes; escalation."""
+        first, change0 = self._probe
+        self._probe = None
+        size = max((max(abs(f[0]), p.weight * abs(f[1])) for p, f in zip(self.pairs, friction, strict=True)),
+                   default=0.0)
+        if change0 <= PROBE_NOISE * max(size, self.scale_floor):
+            return
+        gain = self._change(friction, first) / change0
+        self._gains.append(gain)
+        if gain > ESCALATE_GAIN:
+            self.escalated_at = t
+            self.converged = True
+            self._xs, self._gs = [], []  # the converged iteration takes over within this step
+
+    def _update(self, t: float, counted: bool = False) -> list[float]:
+        """One evaluation of the converged or lagged scheme (``counted``: :meth:`_new_step` was
+        already called for it)."""
+        if not counted:
+            self._new_step(t)
+        friction = self.evaluate(t)
+        applied = np.asarray(self.applied, dtype=float).reshape(self.n, 2)
         # forces enter as the torque they make at the journal radius, so one relative measure
         # covers both kinds of load
         weighted = np.abs(friction) * self._weight
         scale = max(float(weighted.max()), self.scale_floor)
-        change = float((np.abs(friction - self.applied) * self._weight).max())
+        change = float((np.abs(friction - applied) * self._weight).max())
         error = change / scale if scale > 0.0 else 0.0
-        if t != self._step_t:  # first evaluation of a new step
-            self._step_t, self._step_iter = t, 0
-            self.log.t.append(t)
-            self.log.applied.append(self.applied.copy())
-            self.log.iterations.append(1)
-        else:
-            self._step_iter += 1
-            self.log.applied[-1] = self.applied.copy()
-            self.log.iterations[-1] = self._step_iter + 1
-        if not self.converged:
+        if self.mode == "lagged":
             self._watch_growth(friction)
             self.apply(friction)
             return [0.0, -1.0]
         if self._step_iter == 0:
             self._xs, self._gs = [], []
-        self._xs.append(self.applied.ravel().copy())
+        self._xs.append(applied.ravel().copy())
         self._gs.append(friction.ravel().copy())
         residuals = [g - x for x, g in zip(self._xs, self._gs, strict=True)]
         if len(residuals) == 2:  # after one plain update: the contraction of the map
@@ -432,6 +497,10 @@ class FrictionCoupling:
         about 1e-4 of its fixed point at the default step sizes, so one Broyden correction
         usually meets the tolerance. It only sets the starting guess.
         """
+        if self.mode == "extrapolated" and self.escalated_at is None:  # back to one solve per step
+            self._iterating = False
+            self._predict(self._last_inputs)
+            return
         self._accepted_steps += 1
         # the eigenvalues cost as much as a friction evaluation: every GAIN_EVERY-th step
         if self._broyden_b is not None and self._accepted_steps % GAIN_EVERY == 1:
@@ -455,16 +524,20 @@ class FrictionCoupling:
         return (" (with a sign band of 0 the exact sign of rounding-level relative speeds decides "
                 "the direction of friction in pairs that do not move; use a positive band)")
 
-    def _watch_growth(self, friction: np.ndarray) -> None:
-        size = float(np.max(np.abs(friction)))
-        before = float(np.max(np.abs(self.applied)))
+    def _watch_growth(self, friction: Any) -> None:
+        size = max(abs(v) for row in friction for v in row)
+        before = max(abs(v) for row in self.applied for v in row)
         if before > 0.0 and size > before:
             if self._growth_steps == 0:  # growth out of rounding noise (pairs at rest) is no locking
                 self._growth_start = max(before, self.scale_floor)
             self._growth_steps += 1
-            if size > LAGGED_GROWTH_LIMIT * self._growth_start:
+            if size > LAGGED_GROWTH_LIMIT * self._growth_start and self.mode == "extrapolated":
+                # growth of the extrapolated scheme is a gain >= 1 or an unstable step: only the
+                # fixed-point iteration can tell, from the next step on
+                self.escalated_at, self.converged, self._growth_steps = self._step_t, True, 0
+            elif size > LAGGED_GROWTH_LIMIT * self._growth_start:
                 self.status = Status.SELF_LOCKING
-                self.reason = (f"lagged friction grew geometrically by more than "
+                self.reason = (f"{self.mode} friction grew geometrically by more than "
                                f"{LAGGED_GROWTH_LIMIT:g}x over {self._growth_steps} steps up to "
                                f"t = {self._step_t:.6g} s: the friction feedback loop gain is >= 1"
                                + self._band_hint())
@@ -477,10 +550,15 @@ class FrictionCoupling:
             "coupling": self.settings.coupling,
             "sign_bands_m_s": {p.name: list(self.bands[p.name]) for p in self.pairs},
             "pairs_with_friction": [p.name for p in self.pairs],
-            "tolerance": self.settings.tolerance if self.converged else None,
+            "tolerance": self.settings.tolerance if self.mode != "lagged" else None,
             "mean_iterations_per_step": float(iterations.mean()) if iterations.size else 0.0,
             "max_iterations_in_a_step": int(iterations.max()) if iterations.size else 0,
             "unconverged_steps": self.unconverged_steps,
+            # extrapolated scheme: the time its first probe above ESCALATE_GAIN switched it to the
+            # converged scheme (None: it never did)
+            "escalated_to_converged_at": self.escalated_at,
+            # extrapolated scheme: steps solved to their fixed point because a motion reversed
+            "steps_iterated_at_reversals": self.iterated_steps,
             # spectral radius of the secant estimate of the friction feedback map, every
             # GAIN_EVERY-th accepted
             # step (see _accept); the median is robust to the start-up steps

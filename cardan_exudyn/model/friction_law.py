@@ -40,7 +40,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-__all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "bdf2_weights"]
+__all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "magnitude_loads", "bdf2_weights"]
 
 
 @dataclass(frozen=True)
@@ -131,8 +131,16 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
         Resultant-slip law: width of the ramp of the slip speed ``hypot(omega_rel d / 2,
         slide_rel)`` [m/s]; None: ``band``.
     """
-    force_n = math.hypot(force_x, force_y)
-    moment_n = math.hypot(moment_x, moment_y)
+    return FrictionLoads(*magnitude_loads(law, math.hypot(force_x, force_y), math.hypot(moment_x, moment_y),
+                                          omega_rel, slide_rel, band, slide_band, resultant_band))
+
+
+def magnitude_loads(law: PairLaw, force_n: float, moment_n: float, omega_rel: float, slide_rel: float,
+                    band: float, slide_band: float | None = None,
+                    resultant_band: float | None = None) -> tuple[float, float, float]:
+    """:func:`pair_loads` from the magnitudes ``force_n`` [N] of the reaction force normal to the
+    axis and ``moment_n`` [N m] of the bending moment: ``(torque, force, sliding_scale)`` as a plain
+    tuple (the coupling's hot path; ``force`` is 0 for a revolute pair)."""
     radius = 0.5 * law.d
     torque = law.f * law.d * moment_n / law.lever + law.f * radius * force_n
     magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
@@ -143,13 +151,12 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
         width = band if resultant_band is None else resultant_band
         slip = max(math.hypot(surface, slide), width)
         if slip <= 0.0:
-            return FrictionLoads(0.0, 0.0, scale)
-        return FrictionLoads(-torque * surface / slip,
-                             -magnitude * slide / slip if law.cylindrical else 0.0, scale)
+            return 0.0, 0.0, scale
+        return -torque * surface / slip, (-magnitude * slide / slip if law.cylindrical else 0.0), scale
     axial = 0.0
     if law.cylindrical:
         axial = -ramp_sign(slide_rel, band if slide_band is None else slide_band) * magnitude
-    return FrictionLoads(-ramp_sign(surface, band) * torque, axial, scale)
+    return -ramp_sign(surface, band) * torque, axial, scale
 
 
 def bdf2_weights(h1: float, h2: float) -> tuple[float, float]:

@@ -18,7 +18,7 @@ import numpy as np
 
 from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
-from cardan_exudyn.model.projection import project_velocities
+from cardan_exudyn.model.projection import cross_rows, project_velocities
 from reference.bands import sign_bands
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.scene import AngleDrive
@@ -90,8 +90,8 @@ def pair_kinematics(model: ExudynModel, states: dict, n: int) -> dict[str, dict[
         sb = ground_state(n) if body_b == "ground" else states[body_b]
         pa = sa["r"][:n] + sa["A"][:n] @ l_a
         pb = sb["r"][:n] + sb["A"][:n] @ l_b
-        va = sa["v"][:n] + np.cross(sa["omega"][:n], pa - sa["r"][:n])
-        vb = sb["v"][:n] + np.cross(sb["omega"][:n], pb - sb["r"][:n])
+        va = sa["v"][:n] + cross_rows(sa["omega"][:n], pa - sa["r"][:n])
+        vb = sb["v"][:n] + cross_rows(sb["omega"][:n], pb - sb["r"][:n])
         out[name] = {
             "frame_a": sa["A"][:n] @ frame,
             "frame_b": sb["A"][:n] @ frame,
@@ -289,5 +289,5 @@ def constraint_violation(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> d
         if PAIR_KIND[name] == "cylindrical":
             d = d - np.einsum("ij,ij->i", d, za)[:, None] * za
         pos = max(pos, float(np.max(np.linalg.norm(d, axis=1))))
-        ang = max(ang, float(np.max(np.linalg.norm(np.cross(za, zb), axis=1))))
+        ang = max(ang, float(np.max(np.linalg.norm(cross_rows(za, zb), axis=1))))
     return {"max_constraint_violation_m": pos, "max_constraint_violation_rad": ang}

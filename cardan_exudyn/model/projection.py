@@ -40,12 +40,23 @@ import numpy as np
 
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 
+__all__ = ["BODIES", "cross_rows", "constraint_jacobian", "project_velocities"]
+
 BODIES = ("input", "spider", "output")
+
+
+def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a x b`` row by row for ``(n, 3)`` arrays (either may be one ``(3,)`` vector): the same
+    as ``np.cross`` without its axis handling, which costs more than the product on short runs."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def _skew_rows(rho: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """Coefficients of omega in ``axis . (omega x rho)``, i.e. ``rho x axis`` (rows)."""
-    return np.cross(rho, axis)
+    return cross_rows(rho, axis)
 
 
 def constraint_jacobian(states: dict[str, dict[str, np.ndarray]],

@@ -14,6 +14,7 @@ import exudyn as exu
 import numpy as np
 
 from cardan_exudyn.interrupts import watch_signals
+from cardan_exudyn.model import richardson as two_step
 from cardan_exudyn.model.build import ExudynModel, build_model
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.postprocess import constraint_violation, first_non_finite, postprocess
@@ -40,7 +41,7 @@ from reference.schema import (
     Summary,
     result_table,
 )
-from reference.validation import check_steps
+from reference.validation import SceneError, check_steps
 
 ENGINE_NAME = "exudyn"
 
@@ -167,16 +168,25 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     estimate from the two (:func:`_estimate`) is the run's ``summary.efficiency_error_estimate``
     (``accuracy_met``, ``extras["accuracy"]``). A given ``numerics.dt`` has its companion at
     twice the step; an automatic step is chosen by :func:`_automatic_runs`. Without friction the
-    mean efficiency is 1 exactly and nothing else runs.
+    mean efficiency is 1 exactly and nothing else runs. With ``numerics.richardson`` (frictionless
+    scenes only) the scene runs at its step and at half of it, and the result is the Richardson
+    combination of the two (:func:`_richardson_run`).
 
     Raises
     ------
     SceneError
         ``numerics.accuracy`` needs more steps than allowed (the message gives the predicted
-        steps per revolution and run time).
+        steps per revolution and run time); ``numerics.richardson`` with friction.
     """
     options = options or ExudynOptions()
     wall_start = time.perf_counter()
+    if scene.numerics.richardson:
+        why = two_step.refusal(scene)
+        if why is not None:
+            raise SceneError(why)
+        result = _richardson_run(scene, options)
+        _report_accuracy(result, None, scene, options)
+        return result
     if not scene.has_friction:
         result = run_once(scene, options)
         _report_accuracy(result, None, scene, options)
@@ -321,6 +331,14 @@ def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions
 def run_once(scene: Scene, options: ExudynOptions) -> Result:
     """One Exudyn run of ``scene`` at its own step (given, or :func:`choose_step`'s), without the
     companion run and error estimate of :func:`run`."""
+    summary, columns, origin = run_columns(scene, options)
+    return _result(scene, summary, columns, origin)
+
+
+def run_columns(scene: Scene, options: ExudynOptions) -> tuple[Summary, dict[str, np.ndarray] | None, float]:
+    """One run as :func:`run_once` does it, before the table: its summary (means included), its
+    columns on the model's clock (None when nothing usable was recorded) and the scene's time at
+    the model's ``t = 0`` [s]."""
     wall_start = time.perf_counter()
     summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=engine_version(),
                       scene=scene_to_dict(scene),
@@ -330,7 +348,7 @@ def run_once(scene: Scene, options: ExudynOptions) -> Result:
     except LoopClosureError as exc:  # mounting errors the loop cannot be assembled with
         summary.fail(Status.LOOP_DOES_NOT_CLOSE, str(exc))
         summary.wall_time_s = time.perf_counter() - wall_start
-        return Result(None, summary)
+        return summary, None, 0.0
     model, solver = solved.model, solved.solver
     summary.status, summary.reason = Status(solved.status), solved.reason
     summary.dt, summary.dt_choice = solved.dt, solved.dt_reason
@@ -347,11 +365,51 @@ def run_once(scene: Scene, options: ExudynOptions) -> Result:
     except ValueError as exc:  # no data recorded, e.g. a failure in the first step
         if summary.success:
             summary.fail(Status.INTEGRATION_FAILURE, f"no usable output: {exc}")
-        return Result(None, summary)
+        return summary, None, model.time_origin
     _check_columns(scene, model, columns, summary, options)
-    columns["t"] = columns["t"] + model.time_origin  # the scene's own time (means taken before)
+    return summary, columns, model.time_origin
+
+
+def _result(scene: Scene, summary: Summary, columns: dict[str, np.ndarray] | None,
+            origin: float) -> Result:
+    """The result of a run's columns: the scene's own time (the means were taken before) and the
+    table when the scene records one."""
+    if columns is None:
+        return Result(None, summary)
+    columns["t"] = columns["t"] + origin
     table = result_table(columns, scene.record.every) if scene.record.timeseries else None
     return Result(table, summary)
+
+
+def _richardson_run(scene: Scene, options: ExudynOptions) -> Result:
+    """``scene`` at its step and at half of it, combined (:mod:`cardan_exudyn.model.richardson`):
+    the fine run's summary with the combined table's means, the coarse run's step and grid, both
+    runs' counters and wall time; ``extras["richardson"]`` says what was combined."""
+    wall_start = time.perf_counter()
+    origin = [0.0]
+
+    def one(s: Scene) -> tuple[Summary, dict[str, np.ndarray] | None]:
+        summary_, columns_, origin[0] = run_columns(s, options)
+        return summary_, columns_
+
+    coarse, fine, columns = two_step.run_pair(scene, one)
+    summary = coarse if fine is None or not coarse.success else fine
+    if summary is fine:
+        summary.extras["richardson"] = {
+            "coarse_dt": coarse.dt, "fine_dt": fine.dt, "coarse_wall_time_s": coarse.wall_time_s,
+            "fine_wall_time_s": fine.wall_time_s, "extrapolated": list(two_step.EXTRAPOLATED),
+            "from_fine": list(two_step.FROM_FINE), "recomputed": ["power_in", "power_out", "efficiency"]}
+        summary.dt, summary.dt_choice = coarse.dt, f"{coarse.dt_choice}; Richardson with a run at dt/2"
+        for key in ("steps", "newton_iterations", "jacobian_evaluations"):
+            setattr(summary, key, (getattr(coarse, key) or 0) + (getattr(fine, key) or 0))
+        if columns is not None and summary.success:
+            summary.clear_means()
+            means = summary.whole_revolution_means(columns, scene.record.skip_revolutions)
+            if means is not None:
+                summary.set_means(means)
+    summary.scene = scene_to_dict(scene)
+    summary.wall_time_s = time.perf_counter() - wall_start
+    return _result(scene, summary, columns if summary is fine else None, origin[0])
 
 
 def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarray],

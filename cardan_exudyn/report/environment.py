@@ -8,7 +8,6 @@ import datetime
 import os
 import platform
 import subprocess
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +19,8 @@ ENVIRONMENT_PACKAGES = ("cardan-exudyn", "numpy", "scipy", "exudyn", "distribute
 
 def environment() -> dict[str, Any]:
     """Versions, CPU, date and commit, for the head of ``sweep.json`` (and other reports)."""
+    from importlib import metadata  # import cost: ~15 ms, for a report only
+
     versions = {}
     for package in ENVIRONMENT_PACKAGES:
         try:

@@ -1,17 +1,20 @@
 """``cardan bench``: work-precision runs of every engine on a small fixed set of scenes.
 
-For each scene (frictionless and with the paper's friction, 10 and 35 deg, at 2000 rpm) and each
-engine configuration (Exudyn's step size, Newton settings, node type, friction coupling and
-velocity projection; the reference engine's sampling and quadrature tolerance; MuJoCo with its
-recommended settings and a shorter constraint time constant, frictionless scenes only) the bench
-records the errors against the reference engine, the median wall time per simulated second and
-the engine's cost counters. Then it evaluates the speed targets side by side from the same run,
-times the paper's eleven scenes with both engines and measures what each "skip" of the Exudyn
-build saves. ``docs/bench.md`` has the definitions. The modules, by concept:
+For each scene (frictionless and with the paper's friction, 10 and 35 deg, and 10 deg with the
+paper's mounting tolerances so that pairs slide, at 2000 rpm) and each engine configuration
+(Exudyn's step size, Newton settings, node type, friction coupling, velocity projection and
+Richardson extrapolation; the reference engine's sampling and quadrature tolerance; MuJoCo with
+its recommended settings and a shorter constraint time constant, frictionless scenes only) the
+bench records the errors against the reference engine, the median wall time per simulated second
+and the engine's cost counters. Then it times the paper's eleven scenes with both engines,
+measures the import cost of ``cardan run`` and what each "skip" of the Exudyn build saves, and
+evaluates the targets side by side from the same run. ``docs/bench.md`` has the definitions. The
+modules, by concept:
 
 - :mod:`~cardan_exudyn.studies.bench_configs`: the scenes and the engine configurations;
 - :mod:`~cardan_exudyn.studies.bench_ladders`: the runs, their errors and wall times;
 - :mod:`~cardan_exudyn.studies.bench_targets`: the targets and the paper scenes' timing;
+- :mod:`~cardan_exudyn.studies.bench_startup`: the import cost of ``cardan run``;
 - :mod:`~cardan_exudyn.studies.bench_audit`: the skip audit;
 - :mod:`~cardan_exudyn.studies.bench_result`: the whole bench in one call, :func:`run_bench`;
 - :mod:`~cardan_exudyn.studies.bench_report`: the results folder and ``report.md``;
@@ -34,21 +37,29 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``bench`` subcommand to the ``cardan`` parser."""
     p = subparsers.add_parser(
         "bench", help="work-precision benchmark of the engines, targets, skip audit",
-        description="Error against wall time for every engine configuration on the frictionless "
-                    "and friction scenes at 10 and 35 deg, 2000 rpm; the speed targets as ratios "
-                    "from the same run; the paper's eleven scenes timed; what each skip of the "
-                    "Exudyn build saves.")
+        description="Error against wall time for every engine configuration (each friction "
+                    "coupling) on the frictionless and friction scenes at 10 and 35 deg and with "
+                    "sliding pairs, 2000 rpm; the paper's eleven scenes timed; the import cost of "
+                    "`cardan run`; what each skip of the Exudyn build saves; the targets side by "
+                    "side from the same run.")
     p.add_argument("--out", metavar="DIR",
-                   help="results folder: bench.csv, targets.csv, audit.csv, bench.json, report.md, "
-                        "work_precision.png")
+                   help="results folder: bench.csv, targets.csv, ladders.csv, audit.csv, bench.json, "
+                        "report.md, work_precision.png")
     p.add_argument("--quick", action="store_true", help="short ladders, one repeat (< 1 min)")
     p.add_argument("--repeats", type=count("--repeats"), metavar="N",
                    help="timed runs per configuration, median reported (default 3, quick 1)")
     p.add_argument("--scenes", metavar="A,B", help="subset of frictionless-10deg, frictionless-35deg, "
-                                                    "friction-10deg, friction-35deg")
+                                                    "frictionless-errors-10deg, friction-10deg, "
+                                                    "friction-35deg, friction-errors-10deg")
     p.add_argument("--engines", metavar="A,B", help="subset of exudyn, mujoco, reference")
     p.add_argument("--no-audit", action="store_true", help="leave out the skip audit")
     p.add_argument("--no-paper", action="store_true", help="leave out the paper's eleven scenes")
+    p.add_argument("--no-startup", action="store_true",
+                   help="leave out the import cost of `cardan run`")
+    p.add_argument("--paper-steps", type=count("--paper-steps"), default=None, metavar="N",
+                   help="Exudyn's steps per revolution in the paper's eleven scenes (default 800)")
+    p.add_argument("--paper-coupling", metavar="NAME", default=None,
+                   help="Exudyn's friction coupling in the paper's eleven scenes (default extrapolated)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
     p.set_defaults(func=handler)
 
@@ -70,6 +81,7 @@ def handler(args: argparse.Namespace) -> int:
     from cardan_exudyn.studies.bench_configs import ENGINE_NAMES, BenchError
     from cardan_exudyn.studies.bench_report import write_bench
     from cardan_exudyn.studies.bench_result import run_bench
+    from cardan_exudyn.studies.bench_targets import PAPER_EXUDYN_COUPLING, PAPER_EXUDYN_STEPS
 
     out_folder(args.out)
     engines = names(args.engines)
@@ -77,7 +89,10 @@ def handler(args: argparse.Namespace) -> int:
         result = run_bench(quick=args.quick, repeats=args.repeats, scenes=names(args.scenes),
                            engines=ENGINE_NAMES if engines is None else engines,
                            audit=not args.no_audit, paper=not args.no_paper,
-                           progress=None if args.json or not sys.stderr.isatty() else show_progress)
+                           progress=None if args.json or not sys.stderr.isatty() else show_progress,
+                           startup=not args.no_startup,
+                           paper_steps=args.paper_steps or PAPER_EXUDYN_STEPS,
+                           paper_coupling=args.paper_coupling or PAPER_EXUDYN_COUPLING)
     except BenchError as exc:
         raise BadInput(str(exc)) from None
     if args.out:
@@ -86,7 +101,7 @@ def handler(args: argparse.Namespace) -> int:
         print(dumps(result.summary()))
         return EXIT_OK
     for t in result.targets:
-        print(f"{t['target']:16s} {t['scene']:20s} {t['variant']:28s} "
+        print(f"{t['target']:16s} {t['scene']:22s} {t['variant']:38s} "
               f"{number(t['measured'], '8.3g', '  failed')} (limit {t['limit']:g}) "
               f"{'met' if t['met'] else 'MISSED'}")
     if args.out:

@@ -1,6 +1,7 @@
 """The results folder of ``cardan bench``: ``bench.csv`` and ``audit.csv`` opening with an
-environment header, ``targets.csv``, ``bench.json``, ``report.md`` and the log-log
-work-precision plot ``work_precision.png``, written atomically."""
+environment header, ``targets.csv``, ``ladders.csv`` (every friction run next to its frictionless
+twin), ``bench.json``, ``report.md`` and the log-log work-precision plot ``work_precision.png``
+(a panel per scene), written atomically."""
 
 from __future__ import annotations
 
@@ -15,13 +16,21 @@ from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.bench_result import BenchResult
-from cardan_exudyn.studies.bench_targets import EFFICIENCY_TARGET, SPEED_RATIO_TARGET, TARGETS
+from cardan_exudyn.studies.bench_targets import (
+    EFFICIENCY_TARGET,
+    SPEED_RATIO_TARGET,
+    TARGETS,
+    friction_ladders,
+)
 
-__all__ = ["header", "write_bench", "report_markdown"]
+__all__ = ["header", "write_bench", "bench_command", "report_markdown"]
 
 TARGET_COLUMNS = ["target", "scene", "variant", "measured", "limit", "met", "exudyn", "other", "detail"]
 AUDIT_COLUMNS = ["item", "removal", "without_s", "with_s", "with_over_without", "saved_share"]
 AUDIT_FORMATS = {"without_s": ".4f", "with_s": ".4f", "with_over_without": ".2f", "saved_share": ".0%"}
+LADDER_COLUMNS = ["config", "steps_per_revolution", "status", "mean_efficiency_error",
+                  "wall_per_simulated_s", "frictionless_wall_per_simulated_s", "cost_ratio"]
+LADDER_FORMATS = {"steps_per_revolution": "d", "cost_ratio": ".2f"}
 ROW_COLUMNS = ["scene", "config", "steps_per_revolution", "status", "wall_per_simulated_s",
                "speed_ratio_error", "torque_in_error", "torque_in_error_steady",
                "mean_efficiency_error", "mean_torque_in_error", "newton_iterations",
@@ -44,6 +53,7 @@ def write_bench(result: BenchResult, out: str | os.PathLike) -> Path:
         (tmp / "bench.csv").write_text(head + rows.to_csv(index=False, float_format="%.6g"),
                                        encoding="utf-8")
         pd.DataFrame(result.targets).to_csv(tmp / "targets.csv", index=False, float_format="%.4g")
+        friction_ladders(result.rows).to_csv(tmp / "ladders.csv", index=False, float_format="%.6g")
         if result.audit is not None:
             (tmp / "audit.csv").write_text(head + result.audit.to_csv(index=False, float_format="%.4g"),
                                            encoding="utf-8")
@@ -63,6 +73,25 @@ def table(frame: pd.DataFrame, columns: Sequence[str], formats: Mapping[str, str
     return markdown_table(frame, columns, {**floats, **(formats or {})})
 
 
+def bench_command(settings: Mapping[str, Any]) -> str:
+    """The ``cardan bench`` command line that runs the bench of ``settings`` again."""
+    parts = ["cardan bench"]
+    if settings.get("quick"):
+        parts.append("--quick")
+    if settings.get("repeats") is not None:
+        parts.append(f"--repeats {settings['repeats']}")
+    for key in ("scenes", "engines"):
+        if settings.get(key):
+            parts.append(f"--{key} {','.join(settings[key])}")
+    for key in ("audit", "paper", "startup"):
+        if settings.get(key) is False:
+            parts.append(f"--no-{key}")
+    if settings.get("paper", True) and settings.get("paper_steps") is not None:
+        parts.append(f"--paper-steps {settings['paper_steps']} "
+                     f"--paper-coupling {settings['paper_coupling']}")
+    return " ".join(parts)
+
+
 def intro(result: BenchResult) -> str:
     """Title, environment and how to read the numbers."""
     env = result.environment
@@ -78,8 +107,8 @@ def intro(result: BenchResult) -> str:
 
 
 def targets_section(result: BenchResult) -> str:
-    """The targets table and what each target means."""
-    out = "## Targets\n"
+    """The targets table, the command that produced it and what each target means."""
+    out = f"## Targets\n`{bench_command(result.settings)}`\n\n"
     if result.targets:
         targets = pd.DataFrame(result.targets)
         targets["met"] = targets["met"].map({True: "yes", False: "**no**"})
@@ -98,6 +127,33 @@ def paper_section(paper: Mapping[str, Any]) -> str:
     return out
 
 
+def ladders_section(rows: pd.DataFrame) -> str:
+    """Per friction scene: every Exudyn configuration's ladder, its efficiency error and its cost
+    over the frictionless twin at the same step (what the friction-cost target reads)."""
+    ladders = friction_ladders(rows)
+    if ladders.empty:
+        return ""
+    out = ("\n## Friction ladders: error against cost, per coupling\n"
+           f"The friction-cost target reads the cheapest step with an error <= {EFFICIENCY_TARGET:g}; "
+           "`cost_ratio` is the wall time over the same configuration without its coupling on the "
+           "frictionless twin scene at the same step.\n")
+    for scene, part in ladders.groupby("scene", sort=False):
+        out += f"\n### {scene}\n" + table(part, LADDER_COLUMNS, LADDER_FORMATS)
+    return out
+
+
+def startup_section(startup: Mapping[str, Any]) -> str:
+    """The import cost of ``cardan run`` and its most expensive top-level imports."""
+    out = (f"\n## Import cost of `cardan run` up to the engine\n"
+           f"{number(startup.get('import_ms'), '.0f')} ms (median of {startup.get('repeats')} "
+           f"fresh interpreters under `python -X importtime`): "
+           f"{number(startup.get('before_scene_ms'), '.0f')} ms before the scene is built, "
+           f"{number(startup.get('scene_build_ms'), '.0f')} ms while it is built. Largest "
+           f"top-level imports [ms]: "
+           + ", ".join(f"`{name}` {ms:.0f}" for name, ms in startup.get("top") or []) + ".\n")
+    return out
+
+
 def audit_section(audit: pd.DataFrame) -> str:
     """The skip audit's table and its scene."""
     return ("\n## What each skip saves (Exudyn)\n" + table(audit, AUDIT_COLUMNS, AUDIT_FORMATS)
@@ -105,10 +161,14 @@ def audit_section(audit: pd.DataFrame) -> str:
 
 
 def report_markdown(result: BenchResult) -> str:
-    """``report.md``: environment, targets, paper scenes, skip audit, the work-precision table."""
+    """``report.md``: environment, targets, paper scenes, import cost, friction ladders, skip
+    audit, the work-precision table and plot."""
     out = [intro(result), targets_section(result)]
     if result.paper:
         out.append(paper_section(result.paper))
+    if result.startup:
+        out.append(startup_section(result.startup))
+    out.append(ladders_section(result.rows))
     if result.audit is not None:
         out.append(audit_section(result.audit))
     out += ["\n## Work-precision table\n",

@@ -12,12 +12,26 @@ import pandas as pd
 
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.studies.bench_audit import skip_audit
-from cardan_exudyn.studies.bench_configs import ENGINE_NAMES, SCENES, BenchError, Progress
+from cardan_exudyn.studies.bench_configs import (
+    ENGINE_NAMES,
+    SCENES,
+    BenchError,
+    Progress,
+    frictionless_twin_scene,
+    is_friction_scene,
+)
 from cardan_exudyn.studies.bench_ladders import work_precision
-from cardan_exudyn.studies.bench_targets import evaluate_targets, paper_scenes_timing
+from cardan_exudyn.studies.bench_startup import import_cost
+from cardan_exudyn.studies.bench_targets import (
+    PAPER_EXUDYN_COUPLING,
+    PAPER_EXUDYN_STEPS,
+    evaluate_targets,
+    paper_scenes_timing,
+)
+from reference.scene import COUPLINGS
 from reference.schema import Status
 
-__all__ = ["BenchResult", "check_inputs", "run_bench"]
+__all__ = ["BenchResult", "check_inputs", "check_paper", "run_bench"]
 
 
 @dataclass
@@ -32,12 +46,16 @@ class BenchResult:
         :func:`cardan_exudyn.studies.bench_targets.evaluate_targets`.
     paper : dict or None
         The paper scenes' timing, None when not run.
+    startup : dict or None
+        The import cost of ``cardan run``
+        (:func:`cardan_exudyn.studies.bench_startup.import_cost`), None when not measured.
     audit : pandas.DataFrame or None
         The skip audit, None when not run.
     environment : dict
         Versions, CPU, date and commit.
     settings : dict
-        ``quick``, ``repeats``, ``scenes``, ``engines``.
+        ``quick``, ``repeats``, ``scenes``, ``engines``, ``audit``, ``paper``, ``startup``,
+        ``paper_steps``, ``paper_coupling``.
     wall_s : float
         Wall time of the whole bench [s].
     """
@@ -47,6 +65,7 @@ class BenchResult:
     paper: dict[str, Any] | None
     audit: pd.DataFrame | None
     environment: dict[str, Any]
+    startup: dict[str, Any] | None = None
     settings: dict[str, Any] = field(default_factory=dict)
     wall_s: float = 0.0
 
@@ -59,14 +78,15 @@ class BenchResult:
                          "fastest_wall_per_simulated_s": float(ok["wall_per_simulated_s"].min())
                          if not ok.empty else None})
         return {"environment": self.environment, "settings": self.settings, "wall_s": self.wall_s,
-                "targets": self.targets, "paper_scenes": self.paper,
+                "targets": self.targets, "paper_scenes": self.paper, "startup": self.startup,
                 "audit": None if self.audit is None else self.audit.to_dict(orient="records"),
                 "configurations": best}
 
 
 def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
                  repeats: int | None, quick: bool) -> tuple[list[str], list[str], int]:
-    """The scene keys, engines and repeats of a bench run (defaults filled in).
+    """The scene keys, engines and repeats of a bench run (defaults filled in; each friction
+    scene's frictionless twin added before it).
 
     Raises
     ------
@@ -77,6 +97,9 @@ def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
     unknown = [k for k in keys if k not in SCENES]
     if unknown:
         raise BenchError(f"`--scenes` must be among {list(SCENES)}, got {unknown}")
+    # a friction scene's cost is read against its frictionless twin at the same step
+    keys = list(dict.fromkeys(twin for k in keys for twin in (
+        (frictionless_twin_scene(k), k) if is_friction_scene(k) else (k,))))
     engines = list(engines)
     bad = [e for e in engines if e not in ENGINE_NAMES]
     if bad:
@@ -87,10 +110,27 @@ def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
     return keys, engines, repeats
 
 
+def check_paper(steps: int, coupling: str) -> None:
+    """Check the paper timing's Exudyn steps per revolution and coupling.
+
+    Raises
+    ------
+    BenchError
+        Steps that are not a positive integer, or an unknown coupling.
+    """
+    if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+        raise BenchError(f"`--paper-steps` must be a positive integer, got {steps!r}")
+    if coupling not in COUPLINGS:
+        raise BenchError(f"`--paper-coupling` must be one of {list(COUPLINGS)}, got {coupling!r}")
+
+
 def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[str] | None = None,
               engines: Iterable[str] = ENGINE_NAMES, audit: bool = True, paper: bool = True,
-              progress: Progress | None = None) -> BenchResult:
-    """The whole bench: work-precision runs, the paper scenes' timing, the skip audit, targets.
+              progress: Progress | None = None, startup: bool = True,
+              paper_steps: int = PAPER_EXUDYN_STEPS,
+              paper_coupling: str = PAPER_EXUDYN_COUPLING) -> BenchResult:
+    """The whole bench: work-precision runs, the paper scenes' timing, the import cost of
+    ``cardan run``, the skip audit, and the targets from all of them.
 
     Parameters
     ----------
@@ -102,27 +142,40 @@ def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[
         Keys of :data:`~cardan_exudyn.studies.bench_configs.SCENES` (default all).
     engines : iterable of str
         Engines to run; the paper timing needs Exudyn and the reference, the audit Exudyn.
-    audit, paper : bool
-        Run the skip audit, the paper scenes' timing.
+    audit, paper, startup : bool
+        Run the skip audit, the paper scenes' timing, the import-cost measurement.
     progress : callable, optional
         Called with one line of text per finished piece of work.
+    paper_steps : int
+        Exudyn's steps per revolution in the paper scenes' timing.
+    paper_coupling : str
+        Exudyn's friction coupling there (one of :data:`reference.scene.COUPLINGS`).
 
     Raises
     ------
     BenchError
-        Bad scenes, engines or repeats.
+        Bad scenes, engines, repeats, paper steps or coupling.
     """
     keys, engines, repeats = check_inputs(scenes, engines, repeats, quick)
+    check_paper(paper_steps, paper_coupling)
     start = time.perf_counter()
     env = environment()
     rows = work_precision(keys, quick, repeats, engines, progress)
     paper_result = None
     if paper and "exudyn" in engines and "reference" in engines:
-        paper_result = paper_scenes_timing(repeats=repeats, progress=progress)
+        paper_result = paper_scenes_timing(repeats=repeats, exudyn_steps=paper_steps,
+                                           exudyn_coupling=paper_coupling, progress=progress)
+    startup_result = None
+    if startup:
+        startup_result = import_cost(repeats=3 if quick else 5)
+        if progress:
+            progress("import cost of cardan run measured")
     audit_table = None
     if audit and "exudyn" in engines:
         audit_table = skip_audit(repeats=3 if quick else 7, progress=progress, fast_module=not quick)
-    targets = evaluate_targets(rows, paper_result)
-    return BenchResult(rows, targets, paper_result, audit_table, env,
-                       {"quick": quick, "repeats": repeats, "scenes": keys, "engines": engines},
+    targets = evaluate_targets(rows, paper_result, startup_result)
+    settings = {"quick": quick, "repeats": repeats, "scenes": keys, "engines": engines,
+                "audit": audit, "paper": paper, "startup": startup, "paper_steps": paper_steps,
+                "paper_coupling": paper_coupling}
+    return BenchResult(rows, targets, paper_result, audit_table, env, startup_result, settings,
                        time.perf_counter() - start)

@@ -99,7 +99,8 @@ def drift_scene(revolutions: int) -> Scene:
     scene = named_scene(DRIFT_SCENE)
     dt = 2.0 * math.pi / scene.drive.speed / DRIFT_STEPS_PER_REVOLUTION
     return replace(scene, revolutions=float(revolutions),
-                   **{"record.timeseries": False, "numerics.dt": dt})
+                   **{"record.timeseries": False, "numerics.dt": dt,
+                      "friction.coupling": "converged"})
 
 
 def energy_scene(shaft_angle_deg: float, revolutions: int,

@@ -70,7 +70,7 @@ SAFETY = 3.0                 # factor on the promised error
 RATIO_FLOOR = 1e-8           # speed-ratio error the Newton tolerance leaves at zero shaft angle
 EFFICIENCY_FLOOR = 1e-4      # efficiency difference below which the engines count as equal
 CONSTRAINT_LIMIT = 1e-6      # [m] and [rad]: pair constraints of an index-3 solve hold far better
-ORDER = {"converged": 2, "lagged": 1}  # convergence order of the mean efficiency in the step
+ORDER = {"converged": 2, "extrapolated": 2, "lagged": 1}  # order of the mean efficiency in the step
 REFERENCE_OPTIONS = ReferenceOptions(samples_per_revolution=72, quadrature_rtol=1e-8)
 
 CLASSES = ("converged", "drift", "self_locking", "integration_failure", "error")
@@ -128,6 +128,8 @@ def panels(quick: bool = False) -> list[Panel]:
         return [
             Panel("friction", "converged coupling, Rxyz", "friction", friction, angles),
             Panel("lagged", "lagged coupling, Rxyz", "friction", friction, angles, coupling="lagged"),
+            Panel("extrapolated", "extrapolated coupling, Rxyz", "friction", friction, angles,
+                  coupling="extrapolated"),
             Panel("ep", "converged, Euler parameters", "friction", (0.0, 0.2), few, node_type="EP"),
             Panel("rotveclg", "converged, rotation vector (Lie group)", "friction", (0.0, 0.2),
                   few, node_type="RotVecLG"),
@@ -139,6 +141,8 @@ def panels(quick: bool = False) -> list[Panel]:
     return [
         Panel("friction", "converged coupling, Rxyz", "friction", friction, angles),
         Panel("lagged", "lagged coupling, Rxyz", "friction", friction, angles, coupling="lagged"),
+        Panel("extrapolated", "extrapolated coupling, Rxyz", "friction", friction, angles,
+              coupling="extrapolated"),
         Panel("ep", "converged, Euler parameters", "friction", friction, angles, node_type="EP"),
         Panel("rotveclg", "converged, rotation vector (Lie group)", "friction", friction, angles,
               node_type="RotVecLG"),

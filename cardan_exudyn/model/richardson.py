@@ -1,0 +1,162 @@
+"""Richardson extrapolation of two Exudyn runs (``Numerics.richardson``, frictionless scenes).
+
+Generalized-alpha is second order: a history ``x`` computed at the step ``h`` is
+``x_h = x + c h^2 + O(h^3)``. The run at ``h / 2`` lands on every time of the run at ``h`` (both
+split the same span into whole steps, ``N`` and ``2 N``), and on those rows
+``(4 x_{h/2} - x_h) / 3`` removes the ``c h^2`` term.
+
+What is extrapolated, and what is taken from the fine run (:data:`EXTRAPOLATED`, :func:`combine`):
+
+- extrapolated: the drive torque, the pair reactions, the shaft speeds, the pairs' relative speeds
+  and the kinetic energy (velocity-level histories, smooth in time, whose error is the
+  integrator's ``O(h^2)``); the input and output powers are recomputed as the products of the
+  extrapolated torques and speeds, and the instantaneous efficiency from those;
+- from the fine run: time, angles and potential energy (positions: index-3 integration keeps them
+  on the constraint manifold to the Newton tolerance, so their error is not ``c h^2`` and the
+  combination would only amplify that noise by 5/3), the prescribed output load and the friction
+  columns (zero: the combination is refused with friction).
+
+The force-level histories (drive torque, reactions: the Lagrange multipliers) carry
+generalized-alpha's start-up oscillation, which alternates in sign from step to step and decays
+over about a revolution. Taking every other row of the fine run aliases it (measured at 35 deg, 50
+steps per revolution: the mean input torque 9x worse than the coarse run's). Those columns
+(:data:`FILTERED`) are therefore smoothed on each run's own grid by the three-point filter
+``(x[i-1] + 2 x[i] + x[i+1]) / 4`` (first and last rows kept), which removes the alternating
+part and adds ``h^2 x'' / 4 + O(h^4)`` to a smooth history: a ``c h^2`` term of the same form in
+both runs, which the extrapolation removes with the integrator's own.
+
+With the velocity projection the speeds of both runs are already exact; their combination stays
+exact (they are not filtered). The relative speeds are backward differences of the relative
+coordinates (BDF2, BDF1 in the second row): their first rows keep a first-order error, like every
+start-up row. Measured
+(``docs/bench.md``, "Velocity projection"): the steady drive-torque error at 35 deg falls from
+2.1e-3 (100 steps per revolution) and 5.3e-4 (200) to 9.1e-6 for the combination.
+
+Friction: the mean efficiency is first order where the pairs' sign ramps are not resolved by the
+step, so an extrapolation at order 2 can make it worse; :func:`refusal` refuses the combination
+for a scene with friction.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+import numpy as np
+
+from reference.joint import PAIR_NAMES
+from reference.scene import Scene, replace
+from reference.schema import Summary, instantaneous_efficiency
+
+__all__ = ["EXTRAPOLATED", "FROM_FINE", "FILTERED", "smooth", "extrapolate", "combine", "refusal",
+           "run_pair"]
+
+_PAIR_SUFFIXES = ("fx", "fy", "fz", "mx", "my", "mz", "omega_rel", "slide_rel")
+EXTRAPOLATED = ("omega_in", "omega_out", "torque_in", "energy_kinetic",
+                *(f"{p}_{s}" for p in PAIR_NAMES for s in _PAIR_SUFFIXES))
+"""Columns combined as ``(4 x_fine - x_coarse) / 3`` (``power_in``, ``power_out`` and
+``efficiency`` are recomputed from them)."""
+FROM_FINE = ("t", "theta_in", "theta_out", "torque_out", "energy_potential", "power_loss",
+             *(f"power_loss_{p}" for p in PAIR_NAMES),
+             *(f"{p}_{s}" for p in PAIR_NAMES for s in ("friction_torque", "friction_force")))
+"""Columns taken from the fine run's rows at the coarse run's times."""
+FILTERED = ("torque_in", *(f"{p}_{s}" for p in PAIR_NAMES for s in ("fx", "fy", "fz", "mx", "my", "mz")))
+"""Extrapolated columns smoothed first by :func:`smooth` on each run's grid (force level)."""
+
+
+def smooth(x: np.ndarray) -> np.ndarray:
+    """``(x[i-1] + 2 x[i] + x[i+1]) / 4`` on the inner rows (the ends kept): removes a history's
+    component that alternates in sign from row to row, adds ``h^2 x'' / 4 + O(h^4)`` to a smooth
+    one (``h`` the row spacing)."""
+    x = np.asarray(x, float)
+    out = x.copy()
+    if len(x) > 2:
+        out[1:-1] = 0.25 * (x[:-2] + 2.0 * x[1:-1] + x[2:])
+    return out
+
+
+def extrapolate(fine: np.ndarray, coarse: np.ndarray, ratio: float = 2.0, order: int = 2) -> np.ndarray:
+    """``x_fine + (x_fine - x_coarse) / (ratio^order - 1)``: exact for an error ``c h^order``.
+
+    ``fine`` and ``coarse`` are the histories on the same rows, ``ratio`` the step ratio [-].
+    """
+    factor = 1.0 / (ratio ** order - 1.0)
+    fine, coarse = np.asarray(fine, float), np.asarray(coarse, float)
+    return fine + factor * (fine - coarse)
+
+
+def combine(coarse: Mapping[str, np.ndarray], fine: Mapping[str, np.ndarray],
+            rtol: float = 1e-9) -> dict[str, np.ndarray]:
+    """The extrapolated columns on the coarse run's rows (see the module docstring).
+
+    Parameters
+    ----------
+    coarse, fine : mapping
+        Column dicts (the result schema's columns, at least ``t``, the angles, speeds, torques and
+        ``energy_*``) of the runs at ``h`` (``N + 1`` rows) and ``h / 2`` (``2 N + 1`` rows).
+    rtol : float
+        Tolerance on the time grids, relative to the coarse step.
+
+    Returns
+    -------
+    dict
+        Every column of ``coarse``: :data:`EXTRAPOLATED` combined (:data:`FILTERED` smoothed
+        first), ``power_in``, ``power_out``
+        and ``efficiency`` recomputed, the rest from the fine run's even rows.
+
+    Raises
+    ------
+    ValueError
+        When the fine run's even rows are not at the coarse run's times.
+    """
+    t_c, t_f = np.asarray(coarse["t"], float), np.asarray(fine["t"], float)
+    n = len(t_c)
+    step = (t_c[-1] - t_c[0]) / max(n - 1, 1)
+    if len(t_f) != 2 * n - 1 or np.max(np.abs(t_f[::2] - t_c)) > rtol * step + 1e-15:
+        raise ValueError(f"the fine run's rows ({len(t_f)}) are not the coarse run's ({n}) "
+                         f"halved: Richardson needs the steps h and h/2 over the same span")
+    out: dict[str, np.ndarray] = {}
+    for key, values in coarse.items():
+        if key in FILTERED:
+            out[key] = extrapolate(smooth(fine[key])[::2], smooth(values))
+        elif key in EXTRAPOLATED:
+            out[key] = extrapolate(np.asarray(fine[key])[::2], values)
+        else:
+            out[key] = np.array(fine[key][::2], dtype=np.asarray(fine[key]).dtype)
+    if "torque_in" in out and "omega_in" in out:
+        out["power_in"] = out["torque_in"] * out["omega_in"]
+    if "torque_out" in out and "omega_out" in out:
+        out["power_out"] = out["torque_out"] * out["omega_out"]
+    if "power_in" in out and "power_loss" in out:
+        out["efficiency"] = instantaneous_efficiency(out["power_in"], out["power_loss"])
+    return out
+
+
+def refusal(scene: Scene) -> str | None:
+    """Why ``scene`` cannot be extrapolated (one line), or None when it can."""
+    if scene.has_friction:
+        return ("`numerics.richardson` applies to frictionless scenes only: with friction the "
+                "mean efficiency is first order where the sign ramps are unresolved, and "
+                "extrapolating it at order 2 can make it worse")
+    return None
+
+
+Columns = dict[str, np.ndarray]
+
+
+def run_pair(scene: Scene, run: Callable[[Scene], tuple[Summary, Columns | None]]
+             ) -> tuple[Summary, Summary | None, Columns | None]:
+    """The two runs: ``scene`` at its step ``h`` (the given ``numerics.dt`` or the engine's
+    choice, read back from the coarse run's ``summary.dt``) and at ``h / 2``, with
+    ``run(scene) -> (summary, columns)`` (columns on the model's clock, before any table).
+
+    Returns ``(coarse_summary, fine_summary, combined columns)``: the fine summary is None when
+    the coarse run has no columns, the columns None when either run has none (the summaries say
+    why). Raises ``ValueError`` (:func:`combine`) when the time grids do not match.
+    """
+    coarse_summary, coarse = run(scene)
+    if coarse is None or not coarse_summary.dt:
+        return coarse_summary, None, None
+    fine_summary, fine = run(replace(scene, **{"numerics.dt": 0.5 * coarse_summary.dt}))
+    if fine is None:
+        return coarse_summary, fine_summary, None
+    return coarse_summary, fine_summary, combine(coarse, fine)
