@@ -166,6 +166,8 @@ class FrictionCoupling:
         self.escalated_at: float | None = None
         self._iterating = False            # extrapolated scheme: this step is iterated (reversal)
         self.iterated_steps = 0
+        self._regimes: list = []           # the regimes of self._inputs
+        self._current_regime: list = []    # of the inputs of the step's first solve
         self._predicted_regime: list = []
         self._last_inputs: list = []
         mask = np.zeros((self.n, 2), dtype=bool)
@@ -257,6 +259,7 @@ class FrictionCoupling:
                 self._accepted = [friction.copy()]
                 self._inputs = [inputs]
                 self._predicted_regime = self._regime(inputs)
+                self._regimes = [self._predicted_regime]
                 self.initial = friction.copy()
                 return
             if b is None:
@@ -337,7 +340,7 @@ class FrictionCoupling:
             self._finish_probe(t, self._law(inputs))
             if self.escalated_at is not None:
                 return self._update(t, counted=True)
-        self._predict(inputs)
+        self._predict(inputs, self._current_regime if first else None)
         return [0.0, -1.0]
 
     def _reversed(self, inputs: list) -> bool:
@@ -349,8 +352,8 @@ class FrictionCoupling:
         is then solved to its fixed point (about three steps per reversal). A ramp resolved by the
         step is crossed smoothly and needs nothing (iterating there mixes fixed-point and
         extrapolated states in the stencil, which measured worse)."""
-        regime = self._regime(inputs)
-        others = [self._predicted_regime, *(self._regime(x) for x in self._inputs)]
+        regime = self._current_regime = self._regime(inputs)
+        others = [self._predicted_regime, *self._regimes]
         if all(regime == other for other in others):
             return False
         last = self._inputs[-1] if self._inputs else inputs
@@ -370,19 +373,22 @@ class FrictionCoupling:
             out.append(((surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band)))
         return out
 
-    def _predict(self, inputs: list) -> None:
-        """Accept the step's ``inputs`` and apply the friction of the law on the inputs
-        extrapolated to the end of the next step (``1.5 x_n - 0.5 x_{n-2}``, module doc)."""
-        hist = self._inputs
+    def _predict(self, inputs: list, regime: list | None = None) -> None:
+        """Accept the step's ``inputs`` (``regime``: theirs, when known) and apply the friction of
+        the law on the inputs extrapolated to the end of the next step (``1.5 x_n - 0.5 x_{n-2}``,
+        module doc)."""
+        hist, regimes = self._inputs, self._regimes
         hist.append(inputs)
+        regimes.append(self._regime(inputs) if regime is None else regime)
         if len(hist) > 3:
             hist.pop(0)
+            regimes.pop(0)
         if len(hist) == 3:
-            predicted = [tuple(1.5 * a - 0.5 * c for a, c in zip(x, z, strict=True))
-                         for x, z in zip(hist[2], hist[0], strict=True)]
+            predicted = [(1.5 * f - 0.5 * f2, 1.5 * m - 0.5 * m2, 1.5 * w - 0.5 * w2, 1.5 * v - 0.5 * v2)
+                         for (f, m, w, v), (f2, m2, w2, v2) in zip(inputs, hist[0], strict=True)]
         elif len(hist) == 2:
-            predicted = [tuple(2.0 * a - b for a, b in zip(x, y, strict=True))
-                         for x, y in zip(hist[1], hist[0], strict=True)]
+            predicted = [(2.0 * f - f1, 2.0 * m - m1, 2.0 * w - w1, 2.0 * v - v1)
+                         for (f, m, w, v), (f1, m1, w1, v1) in zip(inputs, hist[0], strict=True)]
         else:
             predicted = inputs
         self._predicted_regime = self._regime(predicted)
