@@ -103,7 +103,6 @@ rounding noise and estimates nothing."""
 @dataclass
 class _PairData:
     name: str
-    kind: str
     law: PairLaw
     joint: int                          # the pair's ObjectJointGeneric
     bands: tuple[float, float, float]   # sign ramps: rotation, sliding, resultant [m/s]
@@ -130,7 +129,6 @@ class FrictionCoupling:
         self.settings = scene.friction
         self.bands = sign_bands(scene)  # per pair (rotation, sliding, resultant) [m/s], as every engine
         self.mode = scene.friction.coupling
-        self.converged = self.mode == "converged"
         self.pairs: list[_PairData] = []
         contributions, axes = [], []
         for name, pair in scene.joint.friction_pairs():
@@ -140,7 +138,7 @@ class FrictionCoupling:
             # the reference's); the law would turn the solver's noise in the slide into force
             slides = PAIR_KIND[name] == "cylindrical" and scene.joint.errors.any
             law = PairLaw.of(PAIR_KIND[name], pair, scene.friction.law)
-            self.pairs.append(_PairData(name, PAIR_KIND[name], law, model.joints[name],
+            self.pairs.append(_PairData(name, law, model.joints[name],
                                         tuple(self.bands[name]), slides, 0.5 * law.d))
             contributions.append([(model.bodies[body], local, role) for role, body, local in
                                   zip((-1, 1), PAIR_BODIES[name], model.marker_local[name], strict=True)
@@ -405,15 +403,13 @@ class FrictionCoupling:
         """Second solve of a probe step: the loop gain from the two changes; escalation."""
         first, change0 = self._probe
         self._probe = None
-        size = max((max(abs(f[0]), p.weight * abs(f[1])) for p, f in zip(self.pairs, friction, strict=True)),
-                   default=0.0)
+        size = self._change(friction, [(0.0, 0.0)] * self.n)
         if change0 <= PROBE_NOISE * max(size, self.scale_floor):
             return
         gain = self._change(friction, first) / change0
         self._gains.append(gain)
         if gain > ESCALATE_GAIN:
             self.escalated_at = t
-            self.converged = True
             self._xs, self._gs = [], []  # the converged iteration takes over within this step
 
     def _update(self, t: float, counted: bool = False) -> list[float]:
@@ -540,7 +536,7 @@ class FrictionCoupling:
             if size > LAGGED_GROWTH_LIMIT * self._growth_start and self.mode == "extrapolated":
                 # growth of the extrapolated scheme is a gain >= 1 or an unstable step: only the
                 # fixed-point iteration can tell, from the next step on
-                self.escalated_at, self.converged, self._growth_steps = self._step_t, True, 0
+                self.escalated_at, self._growth_steps = self._step_t, 0
             elif size > LAGGED_GROWTH_LIMIT * self._growth_start:
                 self.status = Status.SELF_LOCKING
                 self.reason = (f"{self.mode} friction grew geometrically by more than "
