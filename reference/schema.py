@@ -28,7 +28,7 @@ part excludes the applied friction; friction appears in ``<pair>_friction_torque
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from enum import Enum
 from typing import Any
@@ -37,6 +37,7 @@ import numpy as np
 
 from reference.joint import PAIR_NAMES
 from reference.power_flow import PowerFlow, classify_works, likely_cause, sign_changes, source_power
+from reference.quadrature import jump_breaks, segment_integrals
 
 KINEMATIC_COLUMNS = ("t", "theta_in", "theta_out", "omega_in", "omega_out")
 POWER_COLUMNS = ("torque_in", "torque_out", "power_in", "power_out", "power_loss", "efficiency",
@@ -385,20 +386,23 @@ def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tu
     return theta_0, theta_0 + sign * 2.0 * math.pi * n, max(n, 0)
 
 
-def cumulative(y: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Trapezoidal integral of ``y dt`` from the first row to each row."""
-    out = np.zeros_like(t)
-    out[1:] = np.cumsum(0.5 * (y[1:] + y[:-1]) * np.diff(t))
+def cumulative(y: np.ndarray, t: np.ndarray, breaks: Sequence[tuple[int, int, float]] = ()) -> np.ndarray:
+    """Integral of ``y dt`` from the first row to each row: trapezoidal, except across the
+    friction jumps ``breaks`` (:func:`reference.quadrature.jump_breaks`)."""
+    out = np.zeros(np.shape(t), float)
+    out[1:] = np.cumsum(segment_integrals(y, t, breaks))
     return out
 
 
 def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
-                    theta_0: float, theta_1: float) -> float:
-    """Trapezoidal integral of y dt between the instants where theta passes theta_0 and theta_1.
+                    theta_0: float, theta_1: float,
+                    breaks: Sequence[tuple[int, int, float]] = ()) -> float:
+    """Integral of y dt between the instants where theta passes theta_0 and theta_1
+    (:func:`cumulative`, with the friction jumps ``breaks``).
 
     ``theta`` must be monotonic; the ends are interpolated linearly in theta.
     """
-    cum = cumulative(np.asarray(y, float), np.asarray(t, float))
+    cum = cumulative(np.asarray(y, float), np.asarray(t, float), breaks)
     th = np.asarray(theta, float)
     if th[-1] < th[0]:
         th, cum, theta_0, theta_1 = -th, cum, -theta_0, -theta_1
@@ -448,8 +452,10 @@ def mean_values(columns: Mapping[str, np.ndarray], skip_revolutions: float,
     if n < 1:
         return {"revolutions": 0, "mean_status": "less than one whole revolution after skipping"}
 
+    breaks = jump_breaks(columns)  # friction's sign jumps: each side integrated on its own
+
     def integral(y: np.ndarray) -> float:
-        return window_integral(y, t, theta, theta_0, theta_1)
+        return window_integral(y, t, theta, theta_0, theta_1, breaks)
 
     duration = window_duration(t, theta, theta_0, theta_1)
     out: dict[str, Any] = {

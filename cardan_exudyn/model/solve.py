@@ -262,8 +262,10 @@ MAX_COMPANION_RATIO = 3.0
 companion at exactly twice the main step runs): Richardson from far coarser steps is unreliable
 (ratios up to 11.6 gave true/estimate 0.03-6)."""
 MODEL_FLOOR = 1.0 / 3.0
-"""At first order (unresolved sign ramps) the estimate is at least this share of the a-priori
-model: the error there is irregular in the step, and the two runs can agree by chance."""
+"""At first order (the lagged coupling), and wherever friction reverses, the estimate is at least
+this share of the a-priori model: the error there is irregular in the step (each reversal falls
+elsewhere within its step), and the two runs can agree by chance (measured: 20 deg, 1500 rpm,
+f = 0.2, angle drive: Richardson 2.0e-5 against a true 6.7e-5)."""
 
 
 def reversing_fraction(scene: Scene, result: Result) -> float | None:
@@ -318,9 +320,10 @@ def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions
         return model
     ratio = coarse.summary.dt / s.dt
     info["richardson"] = richardson(s.mean_efficiency, eta_c, ratio, order)
-    estimate = max(info["richardson"], MODEL_FLOOR * model if order == 1 else 0.0)
+    floored = order == 1 or bool(reversing_parts(scene))
+    estimate = max(info["richardson"], MODEL_FLOOR * model if floored else 0.0)
     info["method"] = (f"Richardson, companion at {ratio:.3g} x the step, order {order}"
-                      + (f", at least {MODEL_FLOOR:.2g} x the a-priori model" if order == 1 else ""))
+                      + (f", at least {MODEL_FLOOR:.2g} x the a-priori model" if floored else ""))
     if steps / ratio < MIN_COMPANION_STEPS:  # too coarse for the asymptotic range
         estimate = max(estimate, model)
         info["method"] += (f"; the companion's {steps / ratio:.3g} steps per revolution are "
