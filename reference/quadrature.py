@@ -11,12 +11,13 @@ engine's own, exact rows of paper-literal-10deg: mean-efficiency error 1.1e-3, 5
 
 :func:`jump_breaks` finds every reversal from the table's relative speeds (the crossing instant
 interpolated linearly between the rows around it) and :func:`segment_integrals` integrates each
-side of it with the value of the nearest row on that side. A row closer than :data:`NEAR` of a
+side of it along the line through the two nearest rows on that side. A row closer than :data:`NEAR` of a
 step to the crossing (in particular a row exactly at it, as on a constant-speed grid of 4k steps
 per revolution, where the crossings of a symmetric joint fall on rows) may lie inside the sign
 ramp, where its value belongs to neither side: it is left out and the two steps around it are
-integrated as one. With the same exact rows the error falls to 9.8e-5, 3.7e-5, 2.7e-6 and
--1.5e-5 (``tests/test_quadrature.py`` pins the improvement).
+integrated as one; so are the rows of a ramp the steps partly resolve (:data:`RAMP_GROWTH`).
+With the same exact rows the error falls to 1.1e-4, 3.7e-5, 1.9e-6 and -1.6e-5
+(``tests/test_reference_quadrature.py`` pins the improvement).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import numpy as np
 
 from reference.joint import PAIR_NAMES
 
-__all__ = ["NEAR", "NOISE", "RAMP_SHARE", "jump_breaks", "segment_integrals"]
+__all__ = ["NEAR", "NOISE", "RAMP_SHARE", "RAMP_GROWTH", "MAX_RAMP_ROWS", "jump_breaks", "segment_integrals"]
 
 NEAR = 0.25
 """A row within this fraction of a step of a crossing may be inside the sign ramp: left out."""
@@ -37,6 +38,14 @@ zero: the constraint solver's residue, not motion (a crossing within it is withi
 RAMP_SHARE = 1e-3
 """A row whose friction is below this share of the pair's largest is inside its sign ramp (or
 at rest): its sign is not a side of a jump."""
+RAMP_GROWTH = 0.1
+"""Going away from a crossing, a row whose friction is more than this share below the next
+row's is still on the sign ramp (a ramp the steps partly resolve): it is left out too, and the
+ramp, symmetric about the crossing, is integrated as the jump at its middle (exact for the
+ramp's own part). Away from ramps friction changes far less per step."""
+MAX_RAMP_ROWS = 8
+"""At most this many rows on either side are left out as ramp rows (a wider ramp is resolved:
+the trapezoid across the single step of the sign change is then accurate)."""
 
 _MOTIONS = (("friction_torque", "omega_rel"), ("friction_force", "slide_rel"))
 
@@ -55,6 +64,17 @@ def _crossings(w: np.ndarray, f: np.ndarray, t: np.ndarray, noise: float) -> lis
     a, b = a[change], b[change]
     ts = t[a] + (t[b] - t[a]) * w[a] / (w[a] - w[b])
     return list(zip(a.tolist(), b.tolist(), ts.tolist(), strict=True))
+
+
+def _off_ramp(f: np.ndarray, row: int, away: int) -> int:
+    """The first row from ``row`` in the direction ``away`` that is off the sign ramp (its
+    friction within :data:`RAMP_GROWTH` of the next row's, going away from the crossing)."""
+    for _ in range(MAX_RAMP_ROWS):
+        beyond = row + away
+        if not 0 <= beyond < f.size or abs(f[beyond]) <= (1.0 + RAMP_GROWTH) * abs(f[row]):
+            break
+        row = beyond
+    return row
 
 
 def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float]]:
@@ -77,7 +97,9 @@ def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float
             f, w = columns.get(f"{p}_{load}"), columns.get(f"{p}_{motion}")
             if f is None or w is None or not np.any(np.asarray(f, float)):
                 continue
-            for a, b, ts in _crossings(np.asarray(w, float), np.asarray(f, float), t, noise):
+            f = np.asarray(f, float)
+            for a, b, ts in _crossings(np.asarray(w, float), f, t, noise):
+                a, b = _off_ramp(f, a, -1), _off_ramp(f, b, +1)
                 if b == a + 1:
                     frac = (ts - t[a]) / (t[b] - t[a])
                     if frac < NEAR and a >= 1:
