@@ -28,7 +28,7 @@ import numpy as np
 
 from reference.joint import PAIR_NAMES
 
-__all__ = ["NEAR", "NOISE", "RAMP_SHARE", "RAMP_GROWTH", "MAX_RAMP_ROWS", "jump_breaks", "segment_integrals"]
+__all__ = ["NEAR", "NOISE", "RAMP_SHARE", "RAMP_GROWTH", "RESOLVED_ROWS", "jump_breaks", "segment_integrals"]
 
 NEAR = 0.25
 """A row within this fraction of a step of a crossing may be inside the sign ramp: left out."""
@@ -40,12 +40,15 @@ RAMP_SHARE = 1e-3
 at rest): its sign is not a side of a jump."""
 RAMP_GROWTH = 0.1
 """Going away from a crossing, a row whose friction is more than this share below the next
-row's is still on the sign ramp (a ramp the steps partly resolve): it is left out too, and the
-ramp, symmetric about the crossing, is integrated as the jump at its middle (exact for the
-ramp's own part). Away from ramps friction changes far less per step."""
-MAX_RAMP_ROWS = 8
-"""At most this many rows on either side are left out as ramp rows (a wider ramp is resolved:
-the trapezoid across the single step of the sign change is then accurate)."""
+row's is still on the sign ramp: it is left out too (the ramp's signed part, symmetric about the
+crossing, integrates as the jump at its middle). Away from ramps friction changes far less per
+step."""
+RESOLVED_ROWS = 4
+"""A ramp with more rows than this on it is resolved by the steps: the trapezoid is accurate across
+it (second order), and no break is made. (A ramp the steps only partly resolve is integrated as
+the jump at its middle, which leaves out its dip in the powers, where the friction's magnitude
+passes through zero: an error proportional to the ramp's width, small for the default bands.)"""
+
 
 _MOTIONS = (("friction_torque", "omega_rel"), ("friction_force", "slide_rel"))
 
@@ -68,8 +71,9 @@ def _crossings(w: np.ndarray, f: np.ndarray, t: np.ndarray, noise: float) -> lis
 
 def _off_ramp(f: np.ndarray, row: int, away: int) -> int:
     """The first row from ``row`` in the direction ``away`` that is off the sign ramp (its
-    friction within :data:`RAMP_GROWTH` of the next row's, going away from the crossing)."""
-    for _ in range(MAX_RAMP_ROWS):
+    friction within :data:`RAMP_GROWTH` of the next row's, going away from the crossing; at
+    most :data:`RESOLVED_ROWS` + 1 rows away)."""
+    for _ in range(RESOLVED_ROWS + 1):
         beyond = row + away
         if not 0 <= beyond < f.size or abs(f[beyond]) <= (1.0 + RAMP_GROWTH) * abs(f[row]):
             break
@@ -100,6 +104,8 @@ def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float
             f = np.asarray(f, float)
             for a, b, ts in _crossings(np.asarray(w, float), f, t, noise):
                 a, b = _off_ramp(f, a, -1), _off_ramp(f, b, +1)
+                if b - a - 1 > RESOLVED_ROWS:
+                    continue
                 if b == a + 1:
                     frac = (ts - t[a]) / (t[b] - t[a])
                     if frac < NEAR and a >= 1:

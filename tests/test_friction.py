@@ -226,8 +226,11 @@ def test_sign_band_does_not_change_the_0deg_result():
 
 def test_converged_coupling_beats_lagged_at_every_step():
     """`cardan study coupling --quick`: at 100, 200, 400 steps per revolution the converged
-    scheme's error of mean efficiency is below the lagged scheme's, and it falls by more than 4
-    over the ladder (measured 7.8)."""
+    scheme's error of mean efficiency is below the lagged scheme's (measured 1.0e-3, 3.7e-4,
+    3.4e-4 against 6.8e-3, 3.4e-3, 1.5e-3), and the lagged one falls at first order. (The
+    converged one fell by 7.8 over the ladder while the table's trapezoid was first order across
+    friction's sign jumps; integrated across them, what is left at 200-800 steps is the dip of
+    this 1 mm/s ramp, which the steps only partly resolve: 3.6e-4 at 800, 6.8e-7 at 1600.)"""
     from cardan_exudyn.studies.friction_numerics import COUPLING_QUICK, coupling_study
 
     rows = coupling_study(COUPLING_QUICK["names"], COUPLING_QUICK["ladder"])
@@ -235,4 +238,4 @@ def test_converged_coupling_beats_lagged_at_every_step():
     for n in COUPLING_QUICK["ladder"]:
         assert err[("converged", n)] < err[("lagged", n)], n
     first, last = COUPLING_QUICK["ladder"][0], COUPLING_QUICK["ladder"][-1]
-    assert err[("converged", first)] > 4.0 * err[("converged", last)]
+    assert err[("lagged", first)] > 0.5 * (last / first) * err[("lagged", last)]

@@ -211,8 +211,10 @@ def test_load_history_alone_starts_the_clock():
 
 def test_long_load_history_costs_about_a_constant_load():
     """Exudyn with a 30,000-sample load history (flat, so the answer is the constant load's)
-    runs in about the time of the constant load: before, every step converted the whole
-    history (minutes). Measured in one run on 2 shared cores: ratio 1.38; bound 3."""
+    costs the constant load's run plus a fixed cost for the history, not a cost per step:
+    before, every step converted the whole history (minutes). Measured on 2 cores: 0.10 s
+    against 0.22 s at 100 steps per revolution (the history's fixed cost ~0.12 s; the ratio
+    was 1.38 when the step model asked for more steps); bound: 1 s more."""
     import time
 
     base = named_scene("rig-matched")
@@ -229,4 +231,4 @@ def test_long_load_history_costs_about_a_constant_load():
         seconds[name] = best
     assert results["history"].summary.mean_efficiency == pytest.approx(
         results["constant"].summary.mean_efficiency, rel=0, abs=1e-12)
-    assert seconds["history"] < 3 * seconds["constant"]
+    assert seconds["history"] < seconds["constant"] + 1.0
