@@ -4,12 +4,16 @@ returns a :class:`reference.schema.Result` with the same columns and summary fie
 Like scipy's ``solve_ivp(method=...)`` over its ``METHODS`` table: callers name an engine (or
 pass options of an engine's class) and never import an engine module themselves. Engines are
 imported on first use, so a missing optional engine (MuJoCo) costs nothing until asked for.
+
+Many scenes at once: :func:`run_batch`. An engine with a batched pass (the reference engine's
+:mod:`reference.batch`) runs the scenes of equal :func:`batch_key` together; the others, and
+scenes whose key is None, run one at a time as :func:`run` would.
 """
 
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -27,6 +31,8 @@ class Engine:
     module: str
     options: str
     description: str
+    batch: str = ""
+    """Module with ``batch_key(scene)`` and ``run_batch(scenes, options)``; "": no batched pass."""
 
     @property
     def options_name(self) -> str:
@@ -38,10 +44,14 @@ ENGINES: dict[str, Engine] = {
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
     "reference": Engine("reference", "reference.engine", "reference.engine:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "
-                        "minimal-coordinate dynamics, adaptive work quadrature"),
+                        "minimal-coordinate dynamics, adaptive work quadrature", batch="reference.batch"),
     "mujoco": Engine("mujoco", "cardan_exudyn.mujoco_engine", "cardan_exudyn.mujoco_engine:MujocoOptions",
                      "MuJoCo (optional extra): frictionless scenes with a constant load only"),
 }
+
+
+__all__ = ["Engine", "ENGINES", "DEFAULT_ENGINE", "EngineUnavailable", "options_class", "make_options",
+           "get_engine", "engine_of", "resolve", "run", "has_batch", "batch_key", "run_batch"]
 
 
 class EngineUnavailable(ValueError):
@@ -149,3 +159,73 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
         return run_function(scene, options)
     except NotImplementedError as exc:
         raise EngineUnavailable(f"engine {engine!r} cannot run scene {scene.name!r}: {exc}") from None
+
+
+def has_batch(engine: str) -> bool:
+    """Whether ``engine`` has a batched pass (:func:`run_batch` then runs scenes together)."""
+    return bool(_entry(engine).batch)
+
+
+def batch_key(scene: Scene, engine: str | None = None) -> Hashable | None:
+    """Scenes of one engine with equal keys run together in :func:`run_batch`; None: the scene
+    runs on its own (always None for an engine without a batched pass).
+
+    Raises
+    ------
+    TypeError
+        ``scene`` is not a Scene, or ``engine`` not a string.
+    EngineUnavailable
+        Unknown or uninstalled engine.
+    """
+    require_scene(scene)
+    engine = DEFAULT_ENGINE if engine is None else engine
+    entry = _entry(engine)
+    return _import(engine, entry.batch).batch_key(scene) if entry.batch else None
+
+
+def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any = None,
+              **option_values: Any) -> list[Result]:
+    """Run many scenes with one engine: one :class:`Result` per scene, in order, each equal to
+    ``run(scene, engine, options)`` (to rounding, or to the quadrature tolerance where the batched
+    pass adapts differently: :mod:`reference.batch`).
+
+    Scenes of equal :func:`batch_key` run in one pass of the engine's batched evaluation (a scene
+    that locks or fails gets its own failed Result); the others, and every scene of an engine
+    without a batched pass, run one at a time.
+
+    Parameters
+    ----------
+    scenes : sequence of Scene
+    engine, options, option_values
+        As in :func:`run`.
+
+    Raises
+    ------
+    TypeError
+        ``scenes`` is not a sequence, or one of them not a Scene (the message names its index).
+    EngineUnavailable, OptionsError
+        As in :func:`run`; raised before any scene runs.
+    """
+    if isinstance(scenes, (Scene, str, bytes)) or not isinstance(scenes, Sequence):
+        raise TypeError(f"`scenes` must be a sequence of Scene, got {type(scenes).__name__} {scenes!r:.80}")
+    for i, scene in enumerate(scenes):
+        require_scene(scene, f"scenes[{i}]")
+    engine, options = resolve(engine, options, **option_values)
+    entry, run_function = _entry(engine), get_engine(engine)
+    module = _import(engine, entry.batch) if entry.batch else None
+    groups: dict[Hashable, list[int]] = {}
+    for i, scene in enumerate(scenes):
+        key = module.batch_key(scene) if module is not None else None
+        groups.setdefault(("batch", key) if key is not None else ("single", i), []).append(i)
+    results: list[Result | None] = [None] * len(scenes)
+    for (kind, _), indices in groups.items():
+        members = [scenes[i] for i in indices]
+        try:
+            done = (module.run_batch(members, options) if kind == "batch"
+                    else [run_function(members[0], options)])
+        except NotImplementedError as exc:
+            raise EngineUnavailable(f"engine {engine!r} cannot run scene {members[0].name!r}: "
+                                    f"{exc}") from None
+        for i, result in zip(indices, done, strict=True):
+            results[i] = result
+    return results

@@ -90,9 +90,16 @@ def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
         and acceleration [m/s^2], shape (..., 3); ``inertia`` about the centre of mass
         [kg m^2], shape (..., 3, 3).
     """
-    mass, com, inertia = body.canonical()
+    return mass_kinematics(*body.canonical(), motion)
+
+
+def mass_kinematics(mass: float | np.ndarray, com: np.ndarray, inertia: np.ndarray,
+                    motion: BodyMotion) -> dict[str, np.ndarray]:
+    """:func:`body_kinematics` from the canonical mass properties (:meth:`Body.canonical`):
+    ``mass`` [kg], ``com`` (3,) [m] and ``inertia`` (3, 3) [kg m^2], or one per sample, shapes
+    (...,), (..., 3), (..., 3, 3) (many scenes in one pass, :mod:`reference.batch`)."""
     rot = motion.rotation
-    c = rot @ com
+    c = rot @ com if np.ndim(com) == 1 else np.einsum("...ij,...j->...i", rot, com)
     w_c = cross(motion.omega, c)
     return {"mass": mass, "r": motion.origin + c, "v": motion.velocity + w_c,
             "a": motion.acceleration + cross(motion.alpha, c) + cross(motion.omega, w_c),
@@ -259,18 +266,26 @@ class FrictionLaw:
             Derivatives with respect to ``x``; where a norm is exactly zero, the zero
             subgradient.
         """
-        c = x[:, self.index]  # (n, K, 4): fx, fy, mx, my
-        force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
-        norms = np.stack([force, force, moment, moment], -1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            unit = np.where(norms > 0, c / norms, 0.0)
-        s = -signs
-        values = s * (self.k_force * force + self.k_moment * moment)
-        gains = np.stack([self.k_force, self.k_force, self.k_moment, self.k_moment], -1)
-        jacobian = np.zeros(x.shape[:1] + self.index.shape[:1] + x.shape[1:])
-        rows = np.arange(self.index.shape[0])[:, None]
-        jacobian[:, rows, self.index] = s[..., None] * gains * unit
-        return values, jacobian
+        return friction_law_values(x, self.index, signs, self.k_force, self.k_moment)
+
+
+def friction_law_values(x: np.ndarray, index: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
+                        k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`FrictionLaw.__call__` with its coefficients given: ``index`` (K, 4) the columns of
+    ``x`` holding each slot's fx, fy, mx, my; ``k_force`` [m or -] and ``k_moment`` [-, 1/m]
+    the law's factors of ``|F|`` and ``|M|``, shape (K,) or one row per sample (n, K)."""
+    c = x[:, index]  # (n, K, 4): fx, fy, mx, my
+    force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
+    norms = np.stack([force, force, moment, moment], -1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(norms > 0, c / norms, 0.0)
+    s = -signs
+    values = s * (k_force * force + k_moment * moment)
+    gains = np.stack([k_force, k_force, k_moment, k_moment], -1)
+    jacobian = np.zeros(x.shape[:1] + index.shape[:1] + x.shape[1:])
+    rows = np.arange(index.shape[0])[:, None]
+    jacobian[:, rows, index] = s[..., None] * gains * unit
+    return values, jacobian
 
 
 def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
@@ -377,9 +392,9 @@ class FixedPoint:
         return ~self.converged | ~(self.loop_gain < 1.0)
 
 
-def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
-                   signs: np.ndarray, tolerance: float = 1e-13,
-                   max_iterations: int = 50) -> FixedPoint:
+def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
+                   tolerance: float = 1e-13, max_iterations: int = 50,
+                   exact_gain: float = 0.5) -> FixedPoint:
     """Solve ``phi = G(x0 - S phi)`` for every sample by Newton's method.
 
     Parameters
@@ -397,6 +412,8 @@ def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
         value of the sample (or of the frictionless estimate, whichever is larger).
     max_iterations : int
         Newton iterations before a sample is declared not converged.
+    exact_gain : float
+        Loop gain: the spectral radius where its norm bound reaches this, else the bound.
     """
     n, k = x0.shape[0], s.shape[-1]
     if k == 0:
@@ -426,9 +443,8 @@ def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray,
     with np.errstate(all="ignore"):
         gain_matrix = np.nan_to_num(g_x @ s, nan=np.inf, posinf=np.inf, neginf=-np.inf)
     finite = np.all(np.isfinite(gain_matrix), (-2, -1))
-    # the spectral radius is at most any induced norm: eigenvalues only where the norm is >= 0.5
     gain = np.where(finite, np.max(np.sum(np.abs(gain_matrix), -1), -1), np.inf)
-    exact = finite & (gain >= 0.5)
+    exact = finite & (gain >= exact_gain)  # the spectral radius is at most any induced norm
     gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
     gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
     return FixedPoint(x, phi, converged, gain, iterations)
@@ -516,23 +532,34 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     """
     motion, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in, method, load_torque)
     theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
-    locked = fixed.self_locking
+    unknown = np.where(fixed.self_locking, np.nan, fixed.x[:, -1])  # drive torque or acceleration
+    if torque_in is None:
+        accel, drive = np.broadcast_to(np.asarray(theta_tt, float), theta.shape) + 0.0, unknown
+    else:
+        accel, drive = unknown, np.where(fixed.self_locking, np.nan, np.broadcast_to(torque_in, theta.shape))
+    load = constant_load(scene) if load_torque is None else load_torque
+    return solution_columns(motion, fixed, friction_slots(scene), (theta, theta_t, accel), drive, load,
+                            mechanical_energy(scene, motion.bodies)), fixed
+
+
+def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[str, str]],
+                     inputs: tuple[np.ndarray, np.ndarray, np.ndarray], drive: np.ndarray,
+                     load: float | np.ndarray,
+                     energy: tuple[np.ndarray, np.ndarray]) -> dict[str, np.ndarray]:
+    """:func:`dynamics_columns`' columns from the solution: ``inputs`` the input angle [rad],
+    speed [rad/s] and acceleration [rad/s^2], ``drive`` the drive torque [N m], ``load`` the
+    output load [N m], ``energy`` the kinetic and potential energy [J], all per sample (n,)."""
+    (theta, theta_t, accel), locked = inputs, fixed.self_locking
     x = np.where(locked[:, None], np.nan, fixed.x)
     phi = np.where(locked[:, None], np.nan, fixed.friction)
-    if torque_in is None:
-        accel = np.broadcast_to(np.asarray(theta_tt, float), theta.shape) + 0.0
-        drive = x[:, -1]
-    else:
-        accel, drive = x[:, -1], np.where(locked, np.nan, np.broadcast_to(torque_in, theta.shape))
     theta_out, omega_out, _ = motion.output
     zero = np.zeros_like(theta_out)
     cols = {"theta_in": theta + zero, "theta_out": theta_out, "omega_in": theta_t + zero,
-            "omega_out": omega_out, "torque_in": drive + zero,
-            "torque_out": zero + (constant_load(scene) if load_torque is None else load_torque)}
+            "omega_out": omega_out, "torque_in": drive + zero, "torque_out": zero + load}
     cols["power_in"] = cols["torque_in"] * cols["omega_in"]
     cols["power_out"] = cols["torque_out"] * omega_out
-    cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(scene, motion.bodies)
-    applied = {(pair, kind): phi[:, j] for j, (pair, kind) in enumerate(friction_slots(scene))}
+    cols["energy_kinetic"], cols["energy_potential"] = energy
+    applied = {(pair, kind): phi[:, j] for j, (pair, kind) in enumerate(slots)}
     loss_total = zero.copy()
     for pair in PAIR_NAMES:
         torque = applied.get((pair, "torque"), zero)
@@ -554,10 +581,9 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
         cols[f"{pair}_{component}"] = x[:, j]
     cols["power_loss"] = loss_total
     cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
-    cols["input_acceleration"] = accel
-    cols["friction_loop_gain"] = fixed.loop_gain
+    cols["input_acceleration"], cols["friction_loop_gain"] = accel, fixed.loop_gain
     cols["self_locking"] = locked
-    return cols, fixed
+    return cols
 
 
 def inverse_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,

@@ -33,8 +33,6 @@ from reference.dynamics import (
     friction_slots,
     ramp_bands,
     ramp_speeds,
-    slot_bands,
-    solve_dynamics,
 )
 from reference.histories import run_clock
 from reference.joint import PAIR_NAMES
@@ -158,7 +156,6 @@ def _speed_motion(scene: Scene, drive: SpeedDrive) -> InputMotion:
 
 
 def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
-
     spline = drive.spline()
     t0 = drive.time[0]
     # a history shorter than the span ends first; the means say how many revolutions it holds
@@ -170,19 +167,21 @@ def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
 def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) -> InputMotion:
     from scipy.integrate import solve_ivp  # scipy.integrate takes ~0.5 s to import
 
+    from reference.forward import right_hand_side  # scipy.linalg: imported with scipy.integrate
+
     target = 2.0 * math.pi * scene.revolutions
     w0 = drive.initial_speed
     t_max = drive.time_allowed(target)  # the span every engine allows
     count = {"n": 0}
-    bands = slot_bands(scene, friction_slots(scene))  # once: one sample per call below
+    acceleration = right_hand_side(scene, drive.torque)  # microseconds a call (reference.forward)
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         count["n"] += 1
-        _, fixed = solve_dynamics(scene, y[:1], y[1:], torque_in=drive.torque,
-                                  load_torque=scene.load.at(np.array([t])), bands=bands)
-        if fixed.self_locking[0]:
-            raise SelfLocking(t, float(y[0]))
-        return np.array([y[1], fixed.x[0, -1]])
+        theta, theta_t = float(y[0]), float(y[1])
+        theta_tt, locked = acceleration(t, theta, theta_t)
+        if locked:
+            raise SelfLocking(t, theta)
+        return np.array([theta_t, theta_tt])
 
     def reached(t: float, y: np.ndarray) -> float:  # turned `target` either way, as Exudyn's stop
         return abs(y[0]) - target
@@ -235,10 +234,8 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np
     theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
     theta_t = np.broadcast_to(np.asarray(theta_t, float), np.shape(t))
     load = scene.load.at(np.asarray(t, float))
-    if theta_tt is None:
-        cols, _ = dynamics_columns(scene, theta, theta_t, torque_in=motion.torque_in, load_torque=load)
-    else:
-        cols, _ = dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt, load_torque=load)
+    cols, _ = dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt, load_torque=load,  # one of the two
+                               torque_in=motion.torque_in if theta_tt is None else None)
     return {"t": np.asarray(t, float), **cols}
 
 
@@ -299,8 +296,8 @@ def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.
 
 GROSS_SCALE = 1e-3
 DENSE_WIDTH, DENSE_NODES = 0.125, 3
-"""Panels mostly below ``DENSE_WIDTH`` of the initial width (dense history knots) get at most
-``DENSE_NODES`` Gauss nodes: smooth between knots, error O(h^7); 9 evaluations per knot, not 24."""
+"""History knots alone making panels mostly below ``DENSE_WIDTH`` of the initial width: at most
+``DENSE_NODES`` Gauss nodes each (smooth between knots, error O(h^7); 9 evaluations per knot, not 24)."""
 MAX_OPEN_PANELS = 20_000
 
 
@@ -388,7 +385,7 @@ WORK_KEYS = ("power_in", "power_out", "power_loss", "self_locking",
 """The columns :func:`work_quadrature` integrates over time, in this order."""
 
 
-def _window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
+def window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
                   theta_0: float, theta_1: float) -> tuple[float, float]:
     """Instants [s] at which the input passes ``theta_0`` and ``theta_1`` [rad], each solved
     between the table rows that bracket it."""
@@ -418,7 +415,7 @@ def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.
                               scale_floor=GROSS_SCALE * energy_scale)
 
 
-def _work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
+def work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
     """Summary keys from the works [J] over the window (the means derived from them are
     :func:`reference.schema.mean_values`')."""
     out = {"input_work": work["power_in"], "output_work": work["power_out"],
@@ -446,7 +443,7 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     theta_0, theta_1, n = whole_revolution_window(theta, scene.record.skip_revolutions)
     if n < 1:
         return {}
-    t_a, t_b = _window_times(motion, theta, t, theta_0, theta_1)
+    t_a, t_b = window_times(motion, theta, t, theta_0, theta_1)
     period = (t_b - t_a) / n
     # at constant speed every revolution repeats the first exactly: integrate one, times n
     repeats = n if motion.periodic else 1
@@ -455,18 +452,17 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     knots = np.concatenate([motion.knots, scene.load.knots])  # drive and load histories' knots
     knots = knots[(knots > t_a) & (knots < t_end)]
     edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
-    lo, hi = initial_panels(edges, period / options.panels_per_revolution)
-    dense = lo.size and np.median(hi - lo) < DENSE_WIDTH * period / options.panels_per_revolution
+    lo, hi = initial_panels(edges, width := period / options.panels_per_revolution)
+    k_lo, k_hi = initial_panels(np.unique(np.concatenate([[t_a, t_end], knots])), width)
+    dense = knots.size and np.median(k_hi - k_lo) < DENSE_WIDTH * width
     nodes = min(options.gauss_nodes, DENSE_NODES) if dense else options.gauss_nodes
     ends = columns_at(scene, motion, np.array([t_a, t_b]))
     values, info = _integrate_powers(scene, motion, lo, hi, ends, options, nodes)
     work = dict(zip(WORK_KEYS, (repeats * values).tolist(), strict=True))
-    out = _work_means(work, ends)
-    out["quadrature"] = {"method": "adaptive Gauss-Legendre panels",
-                         "nodes_per_panel": nodes,
-                         "rtol": options.quadrature_rtol,
-                         "sign_breakpoints": int(kinks.size), "knots": int(knots.size),
-                         "revolutions_integrated": n // repeats,
+    out = work_means(work, ends)
+    out["quadrature"] = {"method": "adaptive Gauss-Legendre panels", "nodes_per_panel": nodes,
+                         "rtol": options.quadrature_rtol, "sign_breakpoints": int(kinks.size),
+                         "knots": int(knots.size), "revolutions_integrated": n // repeats,
                          "evaluations": info["evaluations"], "rounds": info["rounds"],
                          "panels": info["panels"],
                          "input_work_error_estimate": info["error_estimate"][0],
@@ -476,7 +472,7 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     return out
 
 
-def _table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
+def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
     span = motion.t_end - motion.t0
     if options.samples_per_revolution is None and scene.numerics.dt is not None:
         check_steps(span / scene.numerics.dt,
@@ -547,8 +543,18 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
         summary.ode_evaluations = motion.ode_evaluations
     if motion.status == Status.SELF_LOCKING:
         return None
-    t = _table_times(scene, motion, options)
+    t = table_times(scene, motion, options)
     columns = columns_at(scene, motion, t)
+    table_verdict(t, columns, summary, origin)
+    if summary.success:  # the means over whole revolutions, from the works
+        means_from_works(scene, work_quadrature(scene, motion, columns, options), columns, options, summary)
+    columns["t"] = t + origin
+    return result_table(columns, scene.record.every, EXTRA_COLUMNS) if scene.record.timeseries else None
+
+
+def table_verdict(t: np.ndarray, columns: dict[str, np.ndarray], summary: Summary,
+                  origin: float = 0.0) -> None:
+    """Step, sample count, self-locking samples, loop gain of the table at ``t`` [s] into ``summary``."""
     locked = columns["self_locking"]
     summary.dt, summary.steps = float(t[1] - t[0]), int(t.size - 1)
     summary.extras["self_locking_samples"] = int(np.count_nonzero(locked))
@@ -560,17 +566,11 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
             f"first at t = {t[first] + origin:.6g} s, input angle "
             f"{math.degrees(columns['theta_in'][first]):.6g} deg (loop gain "
             f"{columns['friction_loop_gain'][first]:.3g}): no consistent friction"))
-    if summary.success:
-        _means(scene, motion, columns, options, summary)
-    columns["t"] = t + origin
-    return result_table(columns, scene.record.every, EXTRA_COLUMNS) if scene.record.timeseries else None
 
 
-def _means(scene: Scene, motion: InputMotion, columns: dict[str, np.ndarray],
-           options: ReferenceOptions, summary: Summary) -> None:
-    """The means over whole revolutions, every one taken from the works of :func:`work_quadrature`
-    (empty without a whole revolution: :meth:`Summary.whole_revolution_means` says so)."""
-    works = work_quadrature(scene, motion, columns, options)
+def means_from_works(scene: Scene, works: dict, columns: dict[str, np.ndarray],
+                     options: ReferenceOptions, summary: Summary) -> None:
+    """The means over whole revolutions from :func:`work_quadrature`'s ``works`` (consumed)."""
     if works.pop("self_locking_nodes", False):
         # as when it locks at a sample: no means (they were NaN or meaningless)
         summary.fail(Status.SELF_LOCKING,

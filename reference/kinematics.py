@@ -151,8 +151,8 @@ def body_motions(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
     ----------
     theta, theta_t, theta_tt : ndarray
         Input angle [rad], speed [rad/s] and acceleration [rad/s^2], same shape.
-    beta : float
-        Shaft angle [rad].
+    beta : float or ndarray
+        Shaft angle [rad] (an array: one per sample, broadcast with ``theta``).
 
     Returns
     -------
@@ -163,7 +163,10 @@ def body_motions(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
     theta, theta_t, theta_tt = np.broadcast_arrays(*(np.asarray(v, float)
                                                      for v in (theta, theta_t, theta_tt)))
     e_x = np.array([1.0, 0.0, 0.0])
-    a2 = np.array([np.cos(beta), np.sin(beta), 0.0])
+    if np.ndim(beta) == 0:
+        a2 = np.array([np.cos(beta), np.sin(beta), 0.0])
+    else:
+        a2 = np.stack(np.broadcast_arrays(np.cos(beta), np.sin(beta), 0.0), -1)
     gamma, gamma_t, gamma_tt = spider_motion(theta, theta_t, theta_tt, beta)
     theta_out, omega_out, alpha_out = output_motion(theta, theta_t, theta_tt, beta)
     a_in = rot_x(theta)

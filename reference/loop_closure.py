@@ -54,10 +54,15 @@ def angle_listing(angles: np.ndarray) -> str:
     return f"[{shown}{', ...' if angles.size > 8 else ''}] rad ({angles.size} sample(s))"
 
 
+def _defects(disc: np.ndarray, radius2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where the loop cannot close (discriminant < 0) and where its branches (nearly) meet."""
+    open_ = disc < -MIN_BRANCH_SEPARATION**2 * radius2
+    return open_, ~open_ & (disc <= MIN_BRANCH_SEPARATION**2 * radius2)
+
+
 def _check_closure(disc: np.ndarray, radius2: np.ndarray, theta1: np.ndarray, where: str) -> None:
     """Raise where the discriminant is negative or (relative to ``A^2 + B^2``) nearly zero."""
-    open_ = disc < -MIN_BRANCH_SEPARATION**2 * radius2
-    meet = ~open_ & (disc <= MIN_BRANCH_SEPARATION**2 * radius2)
+    open_, meet = _defects(disc, radius2)
     if open_.any():
         bad = theta1[open_]
         raise LoopClosureError(f"the RCCC loop cannot close (discriminant < 0) at {where} "
@@ -74,14 +79,16 @@ def _angle_about_z(v: Dual) -> Dual:
     return dual.atan2(v[..., 0], -v[..., 1])
 
 
-def solve_wrapped(twists: Dual, s1: float, theta1: np.ndarray, sign: float, where: str) -> Dual:
+def solve_wrapped(twists: Dual, s1: float | np.ndarray, theta1: np.ndarray, sign: float, where: str,
+                  strict: bool = True) -> Dual:
     """Dual joint angles closing the loop, real parts in (-pi, pi] (``theta_1`` as given).
 
     Parameters
     ----------
-    twists : Dual, shape (4,)
-        Dual link twists ``alpha_k + eps a_k`` [rad] + eps [m].
-    s1 : float
+    twists : Dual, shape (4,) or (..., 4)
+        Dual link twists ``alpha_k + eps a_k`` [rad] + eps [m] (per sample: broadcast with
+        ``theta1``, as ``s1``).
+    s1 : float or ndarray
         Slide of the revolute joint 1 [m].
     theta1 : ndarray
         Input angles [rad], any shape.
@@ -89,6 +96,9 @@ def solve_wrapped(twists: Dual, s1: float, theta1: np.ndarray, sign: float, wher
         The root of the input-output equation (the assembly branch).
     where : str
         What the angles are, for the error message.
+    strict : bool
+        False: no error; the samples where the loop does not close (or its branches meet) get
+        NaN angles and slides instead (many scenes in one pass, :mod:`reference.batch`).
 
     Returns
     -------
@@ -98,24 +108,28 @@ def solve_wrapped(twists: Dual, s1: float, theta1: np.ndarray, sign: float, wher
     Raises
     ------
     LoopClosureError
-        At input angles where the loop cannot close or the branches meet.
+        At input angles where the loop cannot close or the branches meet (``strict``).
     """
     tw = twists
     t1 = Dual(theta1, np.full_like(theta1, s1))
     # joint 2 in F_4 Z(theta_4) coordinates, against joint 3 = X(-alpha_4) Z(-theta_4) (0, w_y, w_z)
-    z2 = dual.matvec(dual.rot_x(tw[3]) @ dual.screw_transform(t1, tw[0]), E_Z)
-    w_y, w_z = dual.sin(tw[2]), dual.cos(tw[2])
-    a, b, c = z2[..., 1] * w_y, z2[..., 0] * w_y, dual.cos(tw[1]) - z2[..., 2] * w_z
+    z2 = dual.matvec(dual.rot_x(tw[..., 3]) @ dual.screw_transform(t1, tw[..., 0]), E_Z)
+    w_y, w_z = dual.sin(tw[..., 2]), dual.cos(tw[..., 2])
+    a, b, c = z2[..., 1] * w_y, z2[..., 0] * w_y, dual.cos(tw[..., 1]) - z2[..., 2] * w_z
     radius2 = a.re**2 + b.re**2
     disc = radius2 - c.re**2
-    _check_closure(disc, radius2, theta1, where)
+    if strict:
+        _check_closure(disc, radius2, theta1, where)
     x = np.arctan2(b.re, a.re) + sign * np.arctan2(np.sqrt(np.maximum(disc, 0.0)), c.re)
+    if not strict:
+        open_, meet = _defects(disc, radius2)
+        x = np.where(open_ | meet, np.nan, x)
     cx, sx = np.cos(x), np.sin(x)
     # eps part of A cos t4 + B sin t4 = C, linear in s_4; the coefficient is -+sqrt(disc) != 0
     s4 = (c.du - a.du * cx - b.du * sx) / (b.re * cx - a.re * sx)
     t4 = Dual(np.arctan2(sx, cx), s4)
-    z3_in_f1 = dual.matvec(dual.rot_x(-tw[3]) @ dual.rot_z(-t4) @ dual.rot_x(-tw[2]), E_Z)
-    t2 = _angle_about_z(dual.matvec(dual.rot_x(-tw[0]) @ dual.rot_z(-t1), z3_in_f1))
-    z4_in_f2 = dual.matvec(dual.rot_x(-tw[0]) @ dual.rot_z(-t1) @ dual.rot_x(-tw[3]), E_Z)
-    t3 = _angle_about_z(dual.matvec(dual.rot_x(-tw[1]) @ dual.rot_z(-t2), z4_in_f2))
+    z3_in_f1 = dual.matvec(dual.rot_x(-tw[..., 3]) @ dual.rot_z(-t4) @ dual.rot_x(-tw[..., 2]), E_Z)
+    t2 = _angle_about_z(dual.matvec(dual.rot_x(-tw[..., 0]) @ dual.rot_z(-t1), z3_in_f1))
+    z4_in_f2 = dual.matvec(dual.rot_x(-tw[..., 0]) @ dual.rot_z(-t1) @ dual.rot_x(-tw[..., 3]), E_Z)
+    t3 = _angle_about_z(dual.matvec(dual.rot_x(-tw[..., 1]) @ dual.rot_z(-t2), z4_in_f2))
     return dual.stack([t1, t2, t3, t4], -1)

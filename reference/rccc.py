@@ -173,16 +173,20 @@ class LoopPositions:
         Joint angles ``theta_1..theta_4`` [rad], continuous in ``theta_1``.
     s : ndarray, shape (..., 4)
         Joint slides ``s_1..s_4`` [m]; ``s_1`` is the constant parameter.
-    reference : ndarray, shape (4,)
+    reference : ndarray, shape (4,) or (..., 4)
         Joint angles at ``theta_1 = 0`` on the same branch [rad].
     branch : str
         One of :data:`BRANCHES`.
+    reference_slide : ndarray, shape (..., 4), or None
+        Joint slides at ``theta_1 = 0`` [m] when given with the positions (many parameter sets
+        in one array, :mod:`reference.batch`); None: solved from the parameters when needed.
     """
 
     theta: np.ndarray
     s: np.ndarray
     reference: np.ndarray
     branch: str
+    reference_slide: np.ndarray | None = None
 
     def dual_angles(self) -> Dual:
         """``theta_k + eps s_k``, shape (..., 4)."""
@@ -357,21 +361,37 @@ def solve_positions(params: DHParameters, theta1: ArrayLike, branch: str = "hook
     _check_windings(params, branch)
     reference = _at_zero(params, branch)[0]
     raw = _solve(params, theta1, branch, "input angles")
+    return LoopPositions(theta=continuous_angles(raw.re, reference, theta1), s=raw.du,
+                         reference=reference, branch=branch)
+
+
+def continuous_angles(wrapped: np.ndarray, reference: np.ndarray, theta1: np.ndarray) -> np.ndarray:
+    """Joint angles continuous in ``theta_1`` (module docstring), shape (..., 4) [rad].
+
+    ``wrapped`` (..., 4): the loop's solution in (-pi, pi]; ``reference`` (4,) or (..., 4): its
+    value at ``theta_1 = 0`` on the same branch; ``theta1`` (...): the input angles [rad].
+    """
     nominal = reference + _WINDING * theta1[..., None]
-    theta = nominal + np.remainder(raw.re - nominal + np.pi, 2.0 * np.pi) - np.pi
+    theta = nominal + np.remainder(wrapped - nominal + np.pi, 2.0 * np.pi) - np.pi
     theta[..., 0] = theta1
-    return LoopPositions(theta=theta, s=raw.du, reference=reference, branch=branch)
+    return theta
 
 
 def _joint_frames(params: DHParameters, positions: LoopPositions) -> Dual:
-    """``F_1..F_4`` as dual matrices in global components, shape (..., 4, 3, 3)."""
+    """``F_1..F_4`` as dual matrices in global components, shape (..., 4, 3, 3); kept with the
+    positions (frozen) for these parameters, since rates, poses and pair frames all need them."""
+    cached = positions.__dict__.get("_frames")
+    if cached is not None and cached[0] is params:
+        return cached[1]
     steps = dual.screw_transform(positions.dual_angles(), params.twists())
     frame = Dual(np.broadcast_to(_GLOBAL_FROM_F1, steps.shape[:-3] + (3, 3)))
     frames = [frame]
     for k in range(3):
         frame = frame @ steps[..., k, :, :]
         frames.append(frame)
-    return dual.stack(frames, -3)
+    out = dual.stack(frames, -3)
+    object.__setattr__(positions, "_frames", (params, out))
+    return out
 
 
 def joint_frames(params: DHParameters, positions: LoopPositions) -> tuple[np.ndarray, np.ndarray]:
@@ -404,7 +424,8 @@ def pair_frames(params: DHParameters, positions: LoopPositions,
     The frame is the D-H frame ``F_k`` of the pair's joint, fixed in body ``a``, with the axes of
     :func:`reference.kinematics.pair_frames` (z the pair axis). The origin is the point of body
     ``b`` on the axis that sits ``axial[k]`` from ``F_k``'s origin at input angle 0
-    (:func:`axial_positions`); when the pair slides it moves along the axis with body ``b``.
+    (:func:`axial_positions`; or one row per sample, shape (..., 4)); when the pair slides it
+    moves along the axis with body ``b``.
     Body ``b`` carries the bearing of the ``spider_output`` (output yoke) and ``output_frame``
     (frame) pairs; it is also the point Exudyn's joint reactions refer to.
 
@@ -413,8 +434,9 @@ def pair_frames(params: DHParameters, positions: LoopPositions,
     dict of str to (rotation (..., 3, 3) [-], origin (..., 3) [m])
     """
     rotation, origin = joint_frames(params, positions)
-    axial = np.asarray(_four("axial", axial))
-    start = _at_zero(params, positions.branch)[1]
+    axial = np.asarray(axial, float) if np.ndim(axial) > 1 else np.asarray(_four("axial", axial))
+    start = (_at_zero(params, positions.branch)[1] if positions.reference_slide is None
+             else positions.reference_slide)
     frames = rotation @ _PAIR_IN_F
     origins = origin + (axial + positions.s - start)[..., None] * rotation[..., :, 2]
     return {p: (frames[..., k, :, :], origins[..., k, :]) for k, p in enumerate(PAIR_NAMES)}

@@ -61,7 +61,33 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--paper-coupling", metavar="NAME", default=None,
                    help="Exudyn's friction coupling in the paper's eleven scenes (default extrapolated)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON on stdout")
+    p.add_argument("--only", choices=("batch",),
+                   help="batch: the batched reference engine alone (cost against batch size, the paper "
+                        "scenes in one batch, memory, the Monte Carlo target, Dask against in-process)")
+    p.add_argument("--sizes", type=sizes, metavar="A,B", help="--only batch: batch sizes (1,10,100,1000)")
+    p.add_argument("--samples", type=count("--samples", minimum=0), metavar="N",
+                   help="--only batch: Monte Carlo samples timed (10000, quick 20; 0: none)")
+    p.add_argument("--dask-samples", type=count("--dask-samples", minimum=0), metavar="N",
+                   help="--only batch: samples of the Dask comparison (1000, quick 8; 0: none)")
+    p.add_argument("--workers", type=count("--workers"), metavar="N",
+                   help="--only batch: local processes of the Monte Carlo run (default: all cores)")
     p.set_defaults(func=handler)
+
+
+BATCH_ONLY = ("sizes", "samples", "dask_samples", "workers")
+"""Options of ``--only batch`` alone."""
+
+
+def sizes(text: str) -> list[int]:
+    """``--sizes``: comma-separated batch sizes, each from 1 to 100000."""
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or any(not 1 <= v <= 100_000 for v in values):
+        raise argparse.ArgumentTypeError(f"--sizes must be integers in [1, 100000] like 1,10,100, "
+                                         f"got {text!r}")
+    return values
 
 
 def names(text: str | None) -> list[str] | None:
@@ -84,6 +110,13 @@ def handler(args: argparse.Namespace) -> int:
     from cardan_exudyn.studies.bench_targets import PAPER_EXUDYN_COUPLING, PAPER_EXUDYN_STEPS
 
     out_folder(args.out)
+    if args.only == "batch":
+        from cardan_exudyn.studies.bench_batch import handler as batch_handler  # as above
+
+        return batch_handler(args, None if args.json or not sys.stderr.isatty() else show_progress)
+    given = [f"--{k.replace('_', '-')}" for k in BATCH_ONLY if getattr(args, k) is not None]
+    if given:
+        raise BadInput(f"{', '.join(given)} apply to `cardan bench --only batch` only")
     engines = names(args.engines)
     try:
         result = run_bench(quick=args.quick, repeats=args.repeats, scenes=names(args.scenes),

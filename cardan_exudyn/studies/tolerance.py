@@ -267,7 +267,7 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
 
     distributions = dict(distributions or default_distributions())
     out = Path(out)
-    spec = {"scene": scene, "engine": engine,
+    spec = {"scene": scene, "engine": engine, "fixed": {"record.timeseries": False},  # summaries only
             "random": {"samples": samples, "seed": seed, "method": method,
                        "parameters": distributions}}
     sweep = run_sweep(spec, out / "cases", workers=workers, scheduler=scheduler, restart=restart,

@@ -15,13 +15,15 @@ Inside (``docs/sweep.md`` is the user's guide):
   (:class:`Plan`, :func:`make_plan`);
 - :mod:`~cardan_exudyn.sweep.records`: ``cases.jsonl``, resume, the results table, the default
   case function :func:`summary_outputs`;
+- :mod:`~cardan_exudyn.sweep.tasks`: what a worker runs, a case or a batch of cases of an engine
+  with a batched pass (:data:`BATCH_SIZE`, :func:`plan_tasks`);
 - :mod:`~cardan_exudyn.sweep.executors`: in the driver, a local process pool, a Dask cluster;
 - :mod:`~cardan_exudyn.sweep.runner`: :func:`run_sweep`, which ties them together.
 """
 
 from __future__ import annotations
 
-from cardan_exudyn.sweep.executors import SweepIncomplete, default_workers, run_case
+from cardan_exudyn.sweep.executors import SweepIncomplete, SweepInterrupted, default_workers
 from cardan_exudyn.sweep.plan import Case, Plan, expand_cases, make_plan
 from cardan_exudyn.sweep.records import (
     CASES_FILE,
@@ -48,10 +50,12 @@ from cardan_exudyn.sweep.spec import (
     read_spec_file,
     spec_from_mapping,
 )
+from cardan_exudyn.sweep.tasks import BATCH_SIZE, Batch, plan_tasks, run_case
 
 __all__ = [
     "run_sweep", "SweepSpec", "RandomSpec", "Distribution", "CaseFunction", "SweepError",
-    "SweepIncomplete", "spec_from_mapping", "read_spec_file", "load_spec", "looks_like_path",
+    "SweepIncomplete", "SweepInterrupted", "BATCH_SIZE", "Batch", "plan_tasks", "spec_from_mapping",
+    "read_spec_file", "load_spec", "looks_like_path",
     "flatten_paths", "Case", "Plan", "make_plan", "expand_cases", "run_case", "default_workers",
     "read_records", "results_table", "statistics", "scalar_summary", "summary_outputs",
     "DEFAULT_FUNCTION", "PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE",

@@ -1,14 +1,15 @@
 """Where a sweep's cases run: in the driver, in a local process pool, or on a Dask cluster.
 
-Every executor calls :func:`run_case` where the case runs and hands each record to ``emit`` in
-the driver as its case finishes; only the driver writes files. A worker process that dies is a
-record too (``WorkerCrash`` locally, ``KilledWorker`` on Dask), so one bad case never stops the
-others.
+Every executor runs tasks (:mod:`~cardan_exudyn.sweep.tasks`: a case, or a batch of cases) with
+:func:`run_task` where they run and hands the records of each task to ``emit`` in the driver as
+the task finishes; only the driver writes files. A worker process that dies is a record too
+(``WorkerCrash`` locally, ``KilledWorker`` on Dask), so one bad case never stops the others; a
+batch whose worker dies is run again case by case, so that the record is the failing case's only.
 
 An interruption (Ctrl-C, SIGTERM: a :class:`KeyboardInterrupt`) is never a record: it passes
-through :func:`run_case`; the executors then emit the cases already finished, cancel the others
-and stop the local workers at once (they ignore Ctrl-C themselves, so that the driver decides),
-and re-raise it.
+through :func:`run_task`; the executors then emit the tasks already finished, cancel the others
+(a batch in flight is not recorded: it runs again on resume) and stop the local workers at once
+(they ignore Ctrl-C themselves, so that the driver decides), and re-raise it.
 """
 
 from __future__ import annotations
@@ -17,28 +18,24 @@ import contextlib
 import multiprocessing
 import os
 import signal
-import time
-import traceback
 import uuid
 from collections import deque
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from cardan_exudyn.interrupts import deferred_signals
-from cardan_exudyn.io import to_jsonable
-from cardan_exudyn.sweep.plan import Case
-from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, error_record
-from cardan_exudyn.sweep.spec import DEFAULT_FUNCTION, CaseFunction, SweepError, flatten_paths
-from reference.scene import Scene, replace
-from reference.schema import Status
+from cardan_exudyn.sweep.records import error_record
+from cardan_exudyn.sweep.spec import CaseFunction, SweepError
+from cardan_exudyn.sweep.tasks import Batch, Task, run_case, run_task, task_cases, task_key
+from reference.scene import Scene
 
 __all__ = ["SweepIncomplete", "SweepInterrupted", "Emit", "default_workers", "run_case", "run_in_process",
            "run_pool", "ignore_interrupts", "connect", "run_dask"]
 
-Emit = Callable[[dict[str, Any]], None]
-"""The driver's callback receiving each record as its case finishes."""
+Emit = Callable[[list[dict[str, Any]]], None]
+"""The driver's callback receiving the records of a task (one per case) as the task finishes."""
 
 
 class SweepIncomplete(RuntimeError):
@@ -65,77 +62,27 @@ def default_workers() -> int:
         return os.cpu_count() or 1
 
 
-def run_case(case: Case, base: Scene, function: CaseFunction | str = DEFAULT_FUNCTION) -> dict[str, Any]:
-    """Run one case and return its record; an exception becomes a record with status ``error``.
-
-    Runs where the case is executed (the driver, a pool process or a Dask worker); nothing is
-    written here.
-
-    Parameters
-    ----------
-    case : Case
-        Id, engine and overrides of the base scene.
-    base : Scene
-        The sweep's base scene.
-    function : CaseFunction or str
-        The case function (a name alone: no arguments).
-
-    Returns
-    -------
-    dict
-        The record: :data:`cardan_exudyn.sweep.records.RECORD_KEYS`, the function's outputs and,
-        after an exception, its ``traceback``.
-    """
-    function = CaseFunction(function) if isinstance(function, str) else function
-    start = time.perf_counter()
-    record: dict[str, Any] = case.to_dict()
-    try:
-        scene = replace(base, **case.overrides) if case.overrides else base
-        outputs = _outputs(function, function(scene, case.engine))
-        status, reason = str(outputs.pop("status", Status.OK)), str(outputs.pop("reason", "") or "")
-        error_type = error = tb = None
-    except Exception as exc:  # the worker's boundary: any failure of the case becomes its record
-        outputs, status = {}, ERROR
-        error_type, error = type(exc).__name__, str(exc)
-        reason = f"{error_type}: {error}"
-        tb = "".join(traceback.format_exception(exc)[-12:])
-    record.update(status=status, reason=reason, error_type=error_type, error=error,
-                  case_wall_s=time.perf_counter() - start, **outputs)
-    if tb is not None:
-        record["traceback"] = tb
-    return record
+def run_in_process(tasks: Sequence[Task], base: Scene, function: CaseFunction, emit: Emit) -> None:
+    """Run the tasks one after the other in this process."""
+    for task in tasks:
+        emit(run_task(task, base, function))
 
 
-def _outputs(function: CaseFunction, outputs: Any) -> dict[str, Any]:
-    """A case function's return value checked and flattened into JSON-able record fields."""
-    if not isinstance(outputs, Mapping):
-        raise TypeError(f"case function {function.name} returned {type(outputs).__name__}, not a dict")
-    clash = sorted(RESERVED_OUTPUTS & set(outputs))
-    if clash:
-        raise ValueError(f"case function {function.name} returned reserved key(s) {clash}")
-    return to_jsonable(flatten_paths(outputs))
-
-
-def run_in_process(cases: Sequence[Case], base: Scene, function: CaseFunction, emit: Emit) -> None:
-    """Run the cases one after the other in this process."""
-    for case in cases:
-        emit(run_case(case, base, function))
-
-
-def run_pool(cases: Sequence[Case], base: Scene, function: CaseFunction, workers: int,
+def run_pool(tasks: Sequence[Task], base: Scene, function: CaseFunction, workers: int,
              emit: Emit) -> None:
-    """Run cases in spawned processes, at most ``2 workers`` submitted at a time.
+    """Run tasks in spawned processes, at most ``2 workers`` submitted at a time.
 
-    A worker that dies (crash, ``os._exit``, out of memory) breaks the pool and every case in
-    flight; those are rerun one at a time in a fresh process, where a case that kills the
+    A worker that dies (crash, ``os._exit``, out of memory) breaks the pool and every task in
+    flight; their cases are rerun one at a time in a fresh process, where a case that kills the
     process is the one running, and is recorded as ``WorkerCrash``.
     """
     # spawn, not fork: a worker inherits nothing from the driver (threads, locks, open files)
     context = multiprocessing.get_context("spawn")
-    queue = deque(cases)
+    queue = deque(tasks)
     while queue:
         victims = _pool_round(queue, base, function, workers, context, emit)
-        _run_one_at_a_time(deque(victims), base, function, context, emit)
+        _run_one_at_a_time(deque(c for task in victims for c in task_cases(task)), base, function,
+                           context, emit)
 
 
 def ignore_interrupts() -> None:
@@ -161,7 +108,7 @@ def _pool(workers: int, context) -> Iterator[ProcessPoolExecutor]:
     pool.shutdown(wait=True)
 
 
-def _emit_finished(running: dict[Any, Case], emit: Emit) -> None:
+def _emit_finished(running: dict[Any, Task], emit: Emit) -> None:
     """Emit the records of the futures in ``running`` that finished with one (at an interruption:
     cases done meanwhile are kept)."""
     for future in list(running):
@@ -171,15 +118,15 @@ def _emit_finished(running: dict[Any, Case], emit: Emit) -> None:
 
 
 def _pool_round(queue: deque, base: Scene, function: CaseFunction, workers: int, context,
-                emit: Emit) -> list[Case]:
-    """Run from ``queue`` until it is empty or the pool breaks; returns the cases in flight then."""
-    running: dict[Any, Case] = {}
+                emit: Emit) -> list[Task]:
+    """Run from ``queue`` until it is empty or the pool breaks; returns the tasks in flight then."""
+    running: dict[Any, Task] = {}
     with _pool(workers, context) as pool:
         try:
             while queue or running:
                 while queue and len(running) < 2 * workers:
-                    case = queue.popleft()
-                    running[pool.submit(run_case, case, base, function)] = case
+                    task = queue.popleft()
+                    running[pool.submit(run_task, task, base, function)] = task
                 done, _ = wait(running, return_when=FIRST_COMPLETED)
                 broken = False
                 for future in done:
@@ -202,17 +149,17 @@ def _run_one_at_a_time(queue: deque, base: Scene, function: CaseFunction, contex
         with _pool(1, context) as pool:
             while queue:
                 case = queue.popleft()
-                future = pool.submit(run_case, case, base, function)
+                future = pool.submit(run_task, case, base, function)
                 try:
-                    record = future.result()
+                    records = future.result()
                 except BrokenProcessPool:
-                    emit(error_record(case, "WorkerCrash", "the worker process died while running "
-                                      "this case alone (a crash, os._exit, or killed, e.g. out of memory)"))
+                    emit([error_record(case, "WorkerCrash", "the worker process died while running "
+                                       "this case alone (a crash, os._exit, or killed, e.g. out of memory)")])
                     break
                 except KeyboardInterrupt:
                     _emit_finished({future: case}, emit)
                     raise
-                emit(record)
+                emit(records)
 
 
 def connect(scheduler: Any):
@@ -235,11 +182,13 @@ def connect(scheduler: Any):
         raise SweepError(f"cannot connect to the Dask scheduler at {scheduler!r}: {exc}") from None
 
 
-def run_dask(cases: Sequence[Case], base: Scene, function: CaseFunction, client, emit: Emit) -> None:
-    """Submit every case to the cluster and record them as they complete.
+def run_dask(tasks: Sequence[Task], base: Scene, function: CaseFunction, client, emit: Emit) -> None:
+    """Submit every task to the cluster and record them as they complete.
 
-    A case whose worker dies repeatedly (Dask's ``KilledWorker``) is recorded as failed; any
-    other failure of the cluster stops the sweep, recording nothing for the cases in flight.
+    A task whose worker dies repeatedly (Dask's ``KilledWorker``) is recorded as failed if it is
+    one case; a batch's cases are submitted again one by one, so that only the case that kills
+    its worker is recorded. Any other failure of the cluster stops the sweep, recording nothing
+    for the tasks in flight.
 
     Raises
     ------
@@ -248,31 +197,47 @@ def run_dask(cases: Sequence[Case], base: Scene, function: CaseFunction, client,
     """
     from distributed import KilledWorker, as_completed  # optional, as in connect
 
-    if not cases:
+    if not tasks:
         return
     token = uuid.uuid4().hex[:8]
     base_future = client.scatter(base, broadcast=True)
-    futures = client.map(run_case, cases, base=base_future, function=function, pure=False,
-                         key=[f"cardan-sweep-{token}-{case.id}" for case in cases])
-    case_of = dict(zip(futures, cases, strict=True))
+
+    def submit(items: Sequence[Task]) -> list:
+        return client.map(run_task, items, base=base_future, function=function, pure=False,
+                          key=[f"cardan-sweep-{token}-{task_key(task)}" for task in items])
+
+    futures = submit(tasks)
+    task_of = dict(zip(futures, tasks, strict=True))
+    completed = as_completed(futures, with_results=True, raise_errors=False)
     try:
-        for future, result in as_completed(futures, with_results=True, raise_errors=False):
+        for future, result in completed:
+            task = task_of.pop(future)
+            if _killed_batch(future, task, KilledWorker):
+                again = submit(task_cases(task))
+                task_of.update(zip(again, task_cases(task), strict=True))
+                completed.update(again)
+                continue
             with deferred_signals():  # emitted and crossed off together
-                _emit_dask(future, result, case_of.pop(future), emit, KilledWorker)
-    except KeyboardInterrupt:  # keep the cases finished meanwhile
-        for future in [f for f in case_of if f.status == "finished"]:
+                _emit_dask(future, result, task, emit, KilledWorker)
+    except KeyboardInterrupt:  # keep the tasks finished meanwhile
+        for future in [f for f in task_of if f.status == "finished"]:
             emit(future.result())
         raise
     finally:
-        client.cancel(futures)
+        client.cancel(list(task_of))
 
 
-def _emit_dask(future, result, case: Case, emit: Emit, killed: type) -> None:
+def _killed_batch(future, task: Task, killed: type) -> bool:
+    return isinstance(task, Batch) and future.status == "error" and isinstance(future.exception(), killed)
+
+
+def _emit_dask(future, result, task: Task, emit: Emit, killed: type) -> None:
     if future.status == "finished":
         emit(result)
         return
     error = future.exception() if future.status == "error" else future.status
     if not isinstance(error, killed):
-        raise SweepIncomplete(f"the Dask cluster failed on case {case.id}: "
+        where = task_key(task) if isinstance(task, Batch) else f"case {task.id}"
+        raise SweepIncomplete(f"the Dask cluster failed on {where}: "
                               f"{type(error).__name__}: {error}; rerun to resume")
-    emit(error_record(case, "KilledWorker", str(error)))
+    emit([error_record(task, "KilledWorker", str(error))])

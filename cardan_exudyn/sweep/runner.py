@@ -19,7 +19,9 @@ Files in the output folder ``OUT``:
 
 Cases run in the driver (``workers=1``), in a local process pool (``workers=N``, spawned
 processes), or on a Dask distributed cluster (``scheduler="tcp://host:port"``). Workers return
-records; only the driver writes files.
+records; only the driver writes files. Cases of an engine with a batched pass (the reference
+engine) and the default case function run in batches (:mod:`~cardan_exudyn.sweep.tasks`): one
+record per case all the same, written as its batch finishes.
 """
 
 from __future__ import annotations
@@ -64,6 +66,7 @@ from cardan_exudyn.sweep.records import (
     write_text,
 )
 from cardan_exudyn.sweep.spec import SweepError, SweepSpec
+from cardan_exudyn.sweep.tasks import Batch, plan_tasks
 from reference.schema import Status
 
 __all__ = ["run_sweep", "environment"]
@@ -73,7 +76,8 @@ __all__ = ["run_sweep", "environment"]
 
 def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
               workers: int | None = None, scheduler: Any = None, restart: bool = False,
-              retry_failed: bool = False, progress: bool | None = None) -> dict[str, Any]:
+              retry_failed: bool = False, progress: bool | None = None,
+              batch_size: int | None = None) -> dict[str, Any]:
     """Run (or resume) a sweep into the folder ``out`` and return its summary (``sweep.json``).
 
     Parameters
@@ -92,6 +96,10 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
         Also rerun cases recorded with a status other than ``ok``.
     progress : bool, optional
         Progress bar on stderr; default when stderr is a terminal.
+    batch_size : int, optional
+        Most cases per batch of the batched engines (default
+        :data:`cardan_exudyn.sweep.tasks.BATCH_SIZE`, smaller when each worker would get fewer than
+        four batches); 1 runs every case on its own.
 
     Returns
     -------
@@ -109,8 +117,9 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
         recorded, none is recorded as failed for it, the workers are stopped; rerun to resume.
     """
     start = time.perf_counter()
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise SweepError(f"`workers` must be an integer >= 1, got {workers!r}")
+    for name, value in (("workers", workers), ("batch_size", batch_size)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value < 1):
+            raise SweepError(f"`{name}` must be an integer >= 1, got {value!r}")
     plan = make_plan(spec)
     out = Path(out)
     try:
@@ -126,8 +135,8 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
             records = _prepare(out, plan, restart)
             todo = [c for c in plan.cases if c.id not in records or interrupted_record(records[c.id])
                     or (retry_failed and records[c.id].get("status") != Status.OK)]
-            executor = _execute(plan, todo, records, out, workers, client, progress)
-            return _finish(plan, records, out, len(todo), time.perf_counter() - start, executor)
+            how = _execute(plan, todo, records, out, (workers, batch_size), client, progress)
+            return _finish(plan, records, out, len(todo), time.perf_counter() - start, how)
     finally:
         if client is not None and client is not scheduler:
             client.close()
@@ -147,23 +156,32 @@ def _prepare(out: Path, plan: Plan, restart: bool) -> dict[str, dict[str, Any]]:
     return records
 
 
-def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, workers: int | None,
+def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, sizes: tuple[int | None, int | None],
              client, progress: bool | None) -> dict[str, Any]:
-    """Run ``todo``, appending each record as it arrives; returns how the cases were run."""
+    """Run ``todo``, appending each task's records as they arrive; returns how the cases were run
+    (:func:`_dispatch`).
+    ``sizes``: ``workers`` and ``batch_size`` of :func:`run_sweep`."""
     rerun = {c.id for c in todo}
     failed = sum(r.get("status") != Status.OK for i, r in records.items() if i not in rerun)
     show = sys.stderr.isatty() if progress is None else progress
     bar = Progress(len(plan.cases), len(plan.cases) - len(todo), failed, show and bool(todo))
     writer = RecordWriter(out / CASES_FILE)
 
-    def emit(record: dict[str, Any]) -> None:
-        with deferred_signals():  # an interruption now counts this record as done
-            writer.write(record)
-            records[record["id"]] = record
-        bar.update(record.get("status") == Status.OK)
+    def emit(new: list[dict[str, Any]]) -> None:
+        with deferred_signals():  # an interruption now counts these records as done
+            # one fsync per task (a few ms each: per case, they would cost more than a batched case)
+            if len(new) == 1:
+                writer.write(new[0])
+            else:
+                writer.write_many(new)
+            records.update((r["id"], r) for r in new)
+        for record in new:
+            bar.update(record.get("status") == Status.OK)
 
+    workers, batch_size = sizes
     try:
-        return _dispatch(plan, todo, min(workers or default_workers(), max(len(todo), 1)), client, emit)
+        return _dispatch(plan, todo, min(workers or default_workers(), max(len(todo), 1)), client, emit,
+                         batch_size)
     except KeyboardInterrupt as exc:
         done = sum(c.id in records and not interrupted_record(records[c.id]) for c in plan.cases)
         raise SweepInterrupted(done, len(plan.cases), out / CASES_FILE,
@@ -173,24 +191,33 @@ def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, workers: in
         bar.close()
 
 
-def _dispatch(plan: Plan, todo: list[Case], workers: int, client, emit: Emit) -> dict[str, Any]:
-    """Hand ``todo`` to the executor: the cluster, this process, or a local pool."""
+def _dispatch(plan: Plan, todo: list[Case], workers: int, client, emit: Emit,
+              batch_size: int | None = None) -> dict[str, Any]:
+    """Hand ``todo`` to the executor (the cluster, this process, or a local pool) as tasks;
+    returns the executor and how many cases ran in batches."""
     function = plan.spec.case_function()
     if client is not None:
         executor = {"kind": "dask", "scheduler": client.scheduler.address,
                     "threads": sum(client.nthreads().values())}
-        run_dask(todo, plan.base, function, client, emit)
     elif workers == 1:
         executor = {"kind": "in-process", "workers": 1}
-        run_in_process(todo, plan.base, function, emit)
     else:
         executor = {"kind": "processes", "workers": workers}
-        run_pool(todo, plan.base, function, workers, emit)
-    return executor
+    tasks = plan_tasks(todo, function, executor.get("threads", workers), batch_size)
+    batches = [len(t.cases) for t in tasks if isinstance(t, Batch)]
+    batching = {"batches": len(batches), "batched_cases": sum(batches),
+                "largest_batch": max(batches, default=0)}
+    if client is not None:
+        run_dask(tasks, plan.base, function, client, emit)
+    elif workers == 1:
+        run_in_process(tasks, plan.base, function, emit)
+    else:
+        run_pool(tasks, plan.base, function, workers, emit)
+    return {"executor": executor, "batching": batching}
 
 
 def _finish(plan: Plan, records: dict, out: Path, run_now: int, wall: float,
-            executor: dict[str, Any]) -> dict[str, Any]:
+            how: dict[str, Any]) -> dict[str, Any]:
     """Write ``results.csv`` and ``sweep.json``; returns the latter's content."""
     table = results_table(plan, records)
     ok = table["status"] == Status.OK
@@ -205,7 +232,8 @@ def _finish(plan: Plan, records: dict, out: Path, run_now: int, wall: float,
         "status_counts": {str(k): int(v) for k, v in table["status"].value_counts().items()},
         "failed_ids": table.loc[~ok, "id"].tolist(),
         "run_now": run_now,
-        "executor": executor,
+        "executor": how["executor"],
+        "batching": how["batching"],
         "wall_time_s": wall,
         "case_time_s": float(np.nansum(table["case_wall_s"].to_numpy(dtype=float))),
         "statistics": statistics(table, plan.parameters),

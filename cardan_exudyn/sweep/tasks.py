@@ -1,0 +1,210 @@
+"""What a worker runs: one case, or a batch of cases through the engine's batched pass.
+
+A sweep's cases become *tasks* (:func:`plan_tasks`): a :class:`Case` runs on its own
+(:func:`run_case`); a :class:`Batch` holds cases of one engine with a batched pass
+(:func:`cardan_exudyn.engines.run_batch`) and the default case function, and runs them together
+(:func:`run_batch_cases`). Either way a task returns one record per case, the same record
+:func:`run_case` makes, so the executors, the records and resume see cases only.
+
+Only the default case function is batched: it keeps nothing but the summary's scalars, which the
+batched pass gives per scene. A custom function may do anything with its scene (write files, run
+other engines), so its cases run one at a time.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from cardan_exudyn import engines
+from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.sweep.plan import Case
+from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, scalar_summary
+from cardan_exudyn.sweep.spec import DEFAULT_FUNCTION, CaseFunction, flatten_paths, resolve_function
+from reference.scene import Scene, replace
+from reference.schema import Status
+
+__all__ = ["BATCH_SIZE", "BATCHES_PER_WORKER", "Batch", "Task", "batched_function", "batch_size_for",
+           "plan_tasks", "run_case", "run_batch_cases", "run_task", "task_cases", "task_key"]
+
+BATCH_SIZE = 1000
+"""Most cases in one batch. Memory grows linearly with the batch (the reference engine keeps every
+scene's samples and, unless ``record.timeseries`` is off, its 721 x 72 time table: about 0.4 MB a
+scene, 0.4 GB per 1000, so a batch's peak stays well inside a worker's memory), while the cost per
+case stops falling well before 1000: ``cardan bench --only batch`` measures both (per-sample cost
+against batch size and peak memory per 1000 scenes, docs/bench.md)."""
+BATCHES_PER_WORKER = 4
+"""Batches are cut so that each worker gets at least this many (smaller batches when the sweep is
+small): the last batch to finish does not leave the other workers idle for long, records land and
+the progress bar moves several times per worker, and Ctrl-C loses at most a quarter of a worker's
+share (the batch in flight is not recorded; it runs again on resume)."""
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Cases of one engine run together by :func:`run_batch_cases`."""
+
+    cases: tuple[Case, ...]
+
+    @property
+    def engine(self) -> str:
+        return self.cases[0].engine
+
+
+Task = Case | Batch
+
+
+def task_cases(task: Task) -> list[Case]:
+    """The cases of a task."""
+    return list(task.cases) if isinstance(task, Batch) else [task]
+
+
+def task_key(task: Task) -> str:
+    """A name of the task unique within its sweep (Dask's task keys)."""
+    if isinstance(task, Batch):
+        return f"batch-{task.cases[0].id}-{len(task.cases)}"
+    return task.id
+
+
+def batched_function(function: CaseFunction) -> bool:
+    """Whether the cases of ``function`` may run in batches: the default case function, no
+    arguments (by either of its names)."""
+    if function.args:
+        return False
+    return function.name == DEFAULT_FUNCTION or resolve_function(function.name) is resolve_function(
+        DEFAULT_FUNCTION)
+
+
+def batch_size_for(cases: int, workers: int, batch_size: int = BATCH_SIZE) -> int:
+    """Cases per batch: at most ``batch_size``, and small enough that each of ``workers`` gets
+    :data:`BATCHES_PER_WORKER` batches."""
+    return max(1, min(batch_size, math.ceil(cases / (BATCHES_PER_WORKER * max(workers, 1)))))
+
+
+def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
+               batch_size: int | None = None) -> list[Task]:
+    """The tasks of ``cases``: the cases of each engine with a batched pass cut into
+    :class:`Batch` es in plan order (the default case function only), every other case on its own.
+
+    Parameters
+    ----------
+    cases : sequence of Case
+    function : CaseFunction
+    workers : int
+        Processes or Dask threads that run tasks at once.
+    batch_size : int, optional
+        Most cases per batch (default :data:`BATCH_SIZE`); 1 runs every case on its own.
+    """
+    by_engine: dict[str, list[Case]] = {}
+    for case in cases:
+        by_engine.setdefault(case.engine, []).append(case)
+    limit = BATCH_SIZE if batch_size is None else batch_size
+    tasks: list[Task] = []
+    for engine, group in by_engine.items():
+        if limit <= 1 or not batched_function(function) or not engines.has_batch(engine):
+            tasks += group
+            continue
+        size = batch_size_for(len(group), workers, limit)
+        chunks = [group[i:i + size] for i in range(0, len(group), size)]
+        tasks += [Batch(tuple(c)) if len(c) > 1 else c[0] for c in chunks]
+    return tasks
+
+
+def run_task(task: Task, base: Scene,
+             function: CaseFunction | str = DEFAULT_FUNCTION) -> list[dict[str, Any]]:
+    """The records of a task's cases, in order (runs where the task is executed)."""
+    if isinstance(task, Batch):
+        return run_batch_cases(task, base)
+    return [run_case(task, base, function)]
+
+
+def run_case(case: Case, base: Scene, function: CaseFunction | str = DEFAULT_FUNCTION) -> dict[str, Any]:
+    """Run one case and return its record; an exception becomes a record with status ``error``.
+
+    Runs where the case is executed (the driver, a pool process or a Dask worker); nothing is
+    written here.
+
+    Parameters
+    ----------
+    case : Case
+        Id, engine and overrides of the base scene.
+    base : Scene
+        The sweep's base scene.
+    function : CaseFunction or str
+        The case function (a name alone: no arguments).
+
+    Returns
+    -------
+    dict
+        The record: :data:`cardan_exudyn.sweep.records.RECORD_KEYS`, the function's outputs and,
+        after an exception, its ``traceback``.
+    """
+    function = CaseFunction(function) if isinstance(function, str) else function
+    start = time.perf_counter()
+    try:
+        scene = replace(base, **case.overrides) if case.overrides else base
+        record = _record(case, _outputs(function.name, function(scene, case.engine)))
+    except Exception as exc:  # the worker's boundary: any failure of the case becomes its record
+        record = _failure(case, exc)
+    record["case_wall_s"] = time.perf_counter() - start
+    return record
+
+
+def run_batch_cases(batch: Batch, base: Scene) -> list[dict[str, Any]]:
+    """The default case function's records of a batch's cases, from one
+    :func:`cardan_exudyn.engines.run_batch` (records equal to :func:`run_case`'s).
+
+    A case whose scene cannot be built is recorded as ``error`` on its own; if the batched run
+    raises, every case runs again on its own (:func:`run_case`), so that a failure is recorded
+    for the case that causes it only. ``case_wall_s`` is the case's share of the batch: its wall
+    time (scene builds and the batched run) over its cases.
+    """
+    start = time.perf_counter()
+    records: dict[int, dict[str, Any]] = {}
+    scenes: dict[int, Scene] = {}
+    for i, case in enumerate(batch.cases):
+        try:
+            scenes[i] = replace(base, **case.overrides) if case.overrides else base
+        except Exception as exc:  # as in run_case: a case's failure is its record
+            records[i] = _failure(case, exc)
+    try:
+        results = engines.run_batch(list(scenes.values()), batch.engine) if scenes else []
+    except Exception:  # one case's exception must not fail its batch-mates: each runs alone
+        return [run_case(case, base) for case in batch.cases]
+    for i, result in zip(scenes, results, strict=True):
+        case = batch.cases[i]
+        try:
+            records[i] = _record(case, _outputs(DEFAULT_FUNCTION, scalar_summary(result.summary)))
+        except Exception as exc:  # as in run_case
+            records[i] = _failure(case, exc)
+    share = (time.perf_counter() - start) / len(batch.cases)
+    return [{**records[i], "case_wall_s": share} for i in range(len(batch.cases))]
+
+
+def _record(case: Case, outputs: dict[str, Any]) -> dict[str, Any]:
+    """The record of a case whose function returned ``outputs`` (``case_wall_s`` set by the caller)."""
+    status, reason = str(outputs.pop("status", Status.OK)), str(outputs.pop("reason", "") or "")
+    return {**case.to_dict(), "status": status, "reason": reason, "error_type": None, "error": None,
+            "case_wall_s": None, **outputs}
+
+
+def _failure(case: Case, exc: Exception) -> dict[str, Any]:
+    """The record of a case whose function raised ``exc``."""
+    error_type, error = type(exc).__name__, str(exc)
+    return {**case.to_dict(), "status": ERROR, "reason": f"{error_type}: {error}",
+            "error_type": error_type, "error": error, "case_wall_s": None,
+            "traceback": "".join(traceback.format_exception(exc)[-12:])}
+
+
+def _outputs(name: str, outputs: Any) -> dict[str, Any]:
+    """A case function's return value checked and flattened into JSON-able record fields."""
+    if not isinstance(outputs, Mapping):
+        raise TypeError(f"case function {name} returned {type(outputs).__name__}, not a dict")
+    clash = sorted(RESERVED_OUTPUTS & set(outputs))
+    if clash:
+        raise ValueError(f"case function {name} returned reserved key(s) {clash}")
+    return to_jsonable(flatten_paths(outputs))
