@@ -42,7 +42,7 @@ from reference.dynamics import (
 )
 from reference.friction import friction_magnitudes
 from reference.joint import BODY_NAMES, PAIR_NAMES
-from reference.joint_motion import JointMotion, ideal_pair_origins
+from reference.joint_motion import JointMotion, ideal_pair_origins, loop_motion
 from reference.loop_closure import solve_wrapped
 from reference.scene import Scene
 
@@ -183,15 +183,7 @@ class SceneStack:
     def _loop(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray,
               theta_tt: np.ndarray) -> JointMotion:
         params, positions, rates = self._loop_rates(idx, theta, theta_t, theta_tt)
-        frames = rccc.pair_frames(params, positions, self.axial[idx])
-        return JointMotion(
-            bodies=rccc.body_motions(params, positions, rates),
-            frames={p: f for p, (f, _) in frames.items()},
-            origins={p: o for p, (_, o) in frames.items()},
-            omega_rel={p: rates.theta_t[..., k] for k, p in enumerate(PAIR_NAMES)},
-            slide={p: positions.s[..., k] for k, p in enumerate(PAIR_NAMES)},
-            slide_rel={p: rates.s_t[..., k] for k, p in enumerate(PAIR_NAMES)},
-            output=rccc.output_motion(positions, rates))
+        return loop_motion(params, positions, rates, self.axial[idx])
 
     def _body(self, name: str, idx: np.ndarray, motion: JointMotion) -> dict[str, np.ndarray]:
         mass, com, inertia = self.mass[name]

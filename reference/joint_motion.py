@@ -93,7 +93,14 @@ def _loop(joint: Joint, theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.nda
     params = rccc.DHParameters.of_joint(joint)
     positions = rccc.solve_positions(params, theta)
     rates = rccc.solve_rates(params, positions, theta_t, theta_tt)
-    frames = rccc.pair_frames(params, positions, rccc.axial_positions(joint.geometry))
+    return loop_motion(params, positions, rates, rccc.axial_positions(joint.geometry))
+
+
+def loop_motion(params: rccc.DHParameters, positions: rccc.LoopPositions, rates: rccc.LoopRates,
+                axial) -> JointMotion:
+    """The joint's motion from the loop's solved positions and rates (``axial``: the pairs'
+    axial positions, one set or one per sample)."""
+    frames = rccc.pair_frames(params, positions, axial)
     return JointMotion(
         bodies=rccc.body_motions(params, positions, rates),
         frames={p: f for p, (f, _) in frames.items()},
