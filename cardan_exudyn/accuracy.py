@@ -43,7 +43,7 @@ import numpy as np
 
 from cardan_exudyn.engines import make_options, options_class
 from cardan_exudyn.engines import run as run_engine
-from cardan_exudyn.model.stepsize import convergence_order, revolution_period
+from cardan_exudyn.model.stepsize import convergence_order
 from cardan_exudyn.report.format import is_number
 from reference.scene import Scene, replace, scene_from_dict
 from reference.schema import MEAN_KEYS, Result, Summary, after_revolutions
@@ -153,7 +153,7 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
     scene = scene_of(result)
     order = STEP_ORDERS[summary.engine]
     if summary.dt:  # 1 with the lagged coupling or while friction sign ramps are unresolved
-        order = min(order, convergence_order(scene, revolution_period(scene) / summary.dt))
+        order = min(order, convergence_order(scene))
     estimate = step_halving_estimate(result, scene, options_of(result), order, run or run_engine,
                                      skip_revolutions)
     own = summary.efficiency_error_estimate

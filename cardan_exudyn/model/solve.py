@@ -216,8 +216,7 @@ def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
     pilot_steps = max(MIN_COMPANION_STEPS, math.ceil(0.5 * _kinematic_steps(scene, options)))
     pilot = run_once(_companion(scene, period / pilot_steps), options)
     cost = pilot.summary.wall_time_s / max(pilot.summary.steps or 1, 1)
-    steps, why = plan_steps(scene, loss_fraction(pilot), options.node_type, cost,
-                            reversing_fraction(scene, pilot))
+    steps, why = plan_steps(scene, loss_fraction(pilot), options.node_type, cost)
     coarse, steps = pilot, max(steps, 2 * pilot_steps)
     if steps > MAX_COMPANION_RATIO * pilot_steps:  # the pilot is too coarse: a companion at half
         coarse = run_once(_companion(scene, 2.0 * period / steps), options)
@@ -268,20 +267,6 @@ elsewhere within its step), and the two runs can agree by chance (measured: 20 d
 f = 0.2, angle drive: Richardson 2.0e-5 against a true 6.7e-5)."""
 
 
-def reversing_fraction(scene: Scene, result: Result) -> float | None:
-    """Share [-] of the input work a run loses in the motions that may reverse
-    (:func:`cardan_exudyn.model.stepsize.reversing_parts`); None without per-pair losses."""
-    s = result.summary
-    if not result.success or not s.input_work or not s.pair_loss_work:
-        return None
-    sliding = s.pair_sliding_loss_work or {}
-    lost = 0.0
-    for pair, part in reversing_parts(scene):
-        part_loss = sliding.get(pair, 0.0)
-        lost += part_loss if part == "sliding" else s.pair_loss_work.get(pair, 0.0) - part_loss
-    return min(abs(lost / s.input_work), 1.0)
-
-
 def _report_accuracy(main: Result, coarse: Result | None, scene: Scene, options: ExudynOptions) -> None:
     """The mean-efficiency error estimate of ``main`` into its summary (:func:`_estimate`; 0
     without friction), ``accuracy_met`` and a warning when the estimate exceeds the target."""
@@ -306,10 +291,9 @@ def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions
     model); the model when the companion failed or is too coarse. How, into ``info``."""
     s = main.summary
     steps, loss = revolution_period(scene) / s.dt, loss_fraction(main)
-    reversing = reversing_fraction(scene, main)
-    order = convergence_order(scene, steps)
-    model = efficiency_error(scene, steps, loss, options.node_type, reversing_fraction=reversing)
-    info.update(order=order, loss_fraction=loss, reversing_fraction=reversing,
+    order = convergence_order(scene)
+    model = efficiency_error(scene, steps, loss, options.node_type)
+    info.update(order=order, loss_fraction=loss,
                 steps_per_revolution=steps, model=model, companion_dt=coarse.summary.dt,
                 companion_status=str(coarse.summary.status),
                 companion_mean_efficiency=coarse.summary.mean_efficiency,

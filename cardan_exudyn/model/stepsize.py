@@ -146,32 +146,26 @@ def _monotonic(values: tuple) -> bool:
     return all(d > 0 for d in steps) or all(d < 0 for d in steps)
 
 
-def convergence_order(scene: Scene, steps: float) -> int:
-    """Order of convergence of the mean efficiency at ``steps`` per revolution: 1 with the
-    ``lagged`` coupling (friction one step late), else 2.
+def convergence_order(scene: Scene) -> int:
+    """Order of convergence of the mean efficiency in the step: 1 with the ``lagged`` coupling
+    (friction one step late), else 2.
 
     Friction's sign jumps at reversals used to make it 1 until the steps resolved the sign ramps:
     the table's trapezoid put each jump in the middle of its step. The window integral now
     integrates each side of a jump on its own (:mod:`reference.quadrature`): on the reference
     engine's own rows of ``paper-literal-10deg`` the error fell from 1.1e-3, 5.3e-4, 2.5e-4 to
     1.1e-4, 3.7e-5, 1.9e-6 at 200, 400, 800 steps per revolution, and Exudyn's (converged
-    coupling) from 1.0e-3, 5.2e-4, 2.5e-4 to 2.1e-5, 2.0e-5, -1.9e-6. ``steps`` is kept for the
-    callers (and a future model that needs it)."""
-    del steps
+    coupling) from 1.0e-3, 5.2e-4, 2.5e-4 to 2.1e-5, 2.0e-5, -1.9e-6."""
     return 1 if scene.has_friction and scene.friction.coupling == "lagged" else 2
 
 
-def efficiency_error(scene: Scene, steps: float, loss_fraction: float, node_type: str = "Rxyz",
-                     reversing_fraction: float | None = None) -> float:
+def efficiency_error(scene: Scene, steps: float, loss_fraction: float, node_type: str = "Rxyz") -> float:
     """A-priori error [-] of the mean efficiency at ``steps`` per revolution, for a run losing
     ``loss_fraction`` (``1 - eta``) of its input work: ``(C2 + K) h^2 (1 - eta)``, plus
     ``C1 h r`` with the ``lagged`` coupling (friction one step late: first order), ``r`` the
     loss fraction, ``C1`` larger with mounting errors; ``K`` the speed-ratio coefficient
     (:func:`error_coefficient`). The other couplings have no first-order term: friction's sign
-    jumps are integrated across (:func:`convergence_order`). ``reversing_fraction`` (the share
-    of the input work lost in motions that reverse, :func:`reversing_parts`) is recorded by the
-    callers; the model no longer needs it."""
-    del reversing_fraction
+    jumps are integrated across (:func:`convergence_order`)."""
     if not scene.has_friction:
         return 0.0
     h = 2.0 * math.pi / steps
@@ -184,13 +178,12 @@ def efficiency_error(scene: Scene, steps: float, loss_fraction: float, node_type
     return first + smooth * h * h * abs(loss_fraction)
 
 
-def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_type: str = "Rxyz",
-                     reversing_fraction: float | None = None) -> int:
+def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_type: str = "Rxyz") -> int:
     """Fewest steps per revolution whose :func:`efficiency_error` meets ``accuracy`` (may exceed
     :data:`MAX_STEPS_PER_REVOLUTION`: the caller refuses)."""
 
     def meets(n: int) -> bool:
-        return efficiency_error(scene, n, loss_fraction, node_type, reversing_fraction) <= accuracy
+        return efficiency_error(scene, n, loss_fraction, node_type) <= accuracy
 
     low, high = 1, MIN_STEPS_PER_REVOLUTION
     while not meets(high):
@@ -215,21 +208,19 @@ def refuse(scene: Scene, steps: float, why: str, seconds_per_step: float = SECON
 
 
 def plan_steps(scene: Scene, loss_fraction: float, node_type: str = "Rxyz",
-               seconds_per_step: float = SECONDS_PER_STEP,
-               reversing_fraction: float | None = None) -> tuple[int, str]:
+               seconds_per_step: float = SECONDS_PER_STEP) -> tuple[int, str]:
     """Steps per revolution meeting ``numerics.accuracy`` on the speed ratio and, for a run
-    losing ``loss_fraction`` of its input work (``reversing_fraction`` of it in reversing motions,
-    :func:`efficiency_error`), on the mean efficiency; and why.
+    losing ``loss_fraction`` of its input work (:func:`efficiency_error`), on the mean
+    efficiency; and why.
 
     Raises :class:`SceneError` (:func:`refuse`) beyond :data:`MAX_STEPS_PER_REVOLUTION`."""
     accuracy, beta = scene.numerics.accuracy, scene.joint.geometry.shaft_angle
     kinematic = kinematic_steps(beta, accuracy, node_type)
     refuse(scene, kinematic, f"a speed-ratio error of {accuracy:g} at {math.degrees(beta):g} deg",
            seconds_per_step)
-    friction = (efficiency_steps(scene, accuracy, loss_fraction, node_type, reversing_fraction)
-                if scene.has_friction else 0)
+    friction = efficiency_steps(scene, accuracy, loss_fraction, node_type) if scene.has_friction else 0
     refuse(scene, friction, f"a mean-efficiency error of {accuracy:g} (loss fraction "
-                            f"{loss_fraction:.3g}, order {convergence_order(scene, max(friction, 1))})",
+                            f"{loss_fraction:.3g}, order {convergence_order(scene)})",
            seconds_per_step)
     n = max(kinematic, friction, MIN_STEPS_PER_REVOLUTION)
     n += n % 2  # even: the companion at twice the step

@@ -106,8 +106,7 @@ def run_cell(cell: dict[str, Any], accuracy: float) -> dict[str, Any]:
                ratio=true / estimate if estimate else (0.0 if true == 0 else math.inf),
                cost_ratio=ex.wall_time_s / max(ex.wall_time_s - overhead, 1e-12),
                order=info.get("order"), loss_fraction=info.get("loss_fraction"),
-               model=info.get("model"), richardson=info.get("richardson"),
-               reversing_fraction=info.get("reversing_fraction"))
+               model=info.get("model"), richardson=info.get("richardson"))
     return row
 
 
@@ -174,8 +173,8 @@ def honesty(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
 
 
 def fit_constants(rows: Sequence[dict[str, Any]]) -> dict[str, float]:
-    """Envelopes of ``true_error / (r h)`` over the first-order cells (``r`` the loss fraction in
-    reversing motions, else the loss fraction) and ``true_error / ((1 - eta) h^2)`` over the
+    """Envelopes of ``true_error / (r h)`` over the first-order cells (``lagged``; ``r`` the loss
+    fraction) and ``true_error / ((1 - eta) h^2)`` over the
     second-order ones: the values ``EFFICIENCY_FIRST_ORDER`` and ``EFFICIENCY_SECOND_ORDER`` need
     (the first ignores the second-order part, the second includes ``K``: both bound from above)."""
     out = {"first_order": 0.0, "first_order_errors": 0.0, "second_order": 0.0}
@@ -184,9 +183,8 @@ def fit_constants(rows: Sequence[dict[str, Any]]) -> dict[str, float]:
             continue
         h = 2.0 * math.pi / r["steps_per_revolution"]
         if r["order"] == 1:
-            share = r.get("reversing_fraction") or r["loss_fraction"]
             key = "first_order_errors" if r["errors"] else "first_order"
-            out[key] = max(out[key], r["true_error"] / (share * h))
+            out[key] = max(out[key], r["true_error"] / (r["loss_fraction"] * h))
         else:
             out["second_order"] = max(out["second_order"], r["true_error"] / (r["loss_fraction"] * h * h))
     return out
