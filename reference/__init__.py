@@ -18,7 +18,8 @@ Modules, bottom up: ``validation`` (SceneError, unit constants), ``joint`` (bodi
 pairs, mounting errors), ``scene`` (drives, load, numerics, the scene and its dictionary form),
 ``paper`` (the paper's data as named scenes), ``scene_files`` (TOML files, ``base = "..."``),
 ``schema`` (the result), and the engine: ``kinematics``, ``dual``, ``loop_closure``, ``rccc``,
-``joint_motion``, ``friction``, ``dynamics``, ``engine``.
+``joint_motion``, ``friction``, ``dynamics``, ``gauss`` (panel quadrature), ``engine``;
+``quadrature`` (time-table integrals across friction jumps, for every engine's means), ``batch``.
 
 Names are imported on first use (PEP 562): every ``import reference.<module>`` runs this file
 first, so it imports nothing itself (the engine's modules and scipy load only when needed).

@@ -16,16 +16,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from reference.batch_model import SceneStack
-from reference.engine import (
-    GROSS_SCALE,
-    MAX_OPEN_PANELS,
-    WORK_KEYS,
-    InputMotion,
-    ReferenceOptions,
-    initial_panels,
-    window_times,
-    work_means,
-)
+from reference.engine import WORK_KEYS, InputMotion, ReferenceOptions, window_times, work_means
+from reference.gauss import GROSS_SCALE, MAX_OPEN_PANELS, initial_panels, quadrature_summary
 from reference.schema import whole_revolution_window
 
 BREAKPOINT_GRID = 1024
@@ -98,7 +90,7 @@ def _gauss(integrand: Callable, rules: dict, nodes: np.ndarray, owner: np.ndarra
 def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.ndarray,
                    nodes: np.ndarray, rtol: float, scale_floor: np.ndarray,
                    max_rounds: int = 40) -> tuple[np.ndarray, list[dict]]:
-    """:func:`reference.engine.adaptive_gauss` for many scenes: panels ``[a, b]`` of scene
+    """:func:`reference.gauss.adaptive_gauss` for many scenes: panels ``[a, b]`` of scene
     ``owner`` (0 .. S - 1), ``nodes`` and ``scale_floor`` per scene (S,); ``integrand`` maps
     scene indices and times (m,) to values (m, k). Returns the integrals (S, k) and per scene
     the info dict of the single version."""
@@ -190,12 +182,6 @@ def _works(values: np.ndarray, ends: dict[str, np.ndarray], info: dict, nodes: i
     """The dict :func:`reference.engine.work_quadrature` returns (one revolution integrated)."""
     work = dict(zip(WORK_KEYS, values.tolist(), strict=True))
     out = work_means(work, ends)
-    out["quadrature"] = {"method": "adaptive Gauss-Legendre panels", "nodes_per_panel": nodes,
-                         "rtol": options.quadrature_rtol, "sign_breakpoints": kinks,
-                         "knots": 0, "revolutions_integrated": 1,
-                         "evaluations": info["evaluations"], "rounds": info["rounds"],
-                         "panels": info["panels"],
-                         "input_work_error_estimate": info["error_estimate"][0],
-                         "loss_work_error_estimate": info["error_estimate"][2]}
+    out["quadrature"] = quadrature_summary(info, nodes, options.quadrature_rtol, kinks, 0, 1)
     out["self_locking_nodes"] = bool(work["self_locking"] != 0 or not np.isfinite(out["input_work"]))
     return out
