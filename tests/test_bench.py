@@ -41,17 +41,23 @@ from reference.scene import replace
 from reference.schema import Result, Status, Summary
 
 
+def tuned_errors(scene, steps) -> list[dict]:
+    """The bench's errors of Exudyn (tuned) on ``scene`` at each of ``steps`` per revolution,
+    against the reference's yardstick."""
+    yard = yardstick(scene)
+    out = []
+    for n in steps:
+        config = Config("exudyn", "exudyn tuned", n, EXUDYN_TUNED)
+        s = config.scene(scene)
+        out.append(run_errors(s, config.run(s), yard))
+    return out
+
+
 def test_run_errors_follow_the_integrators_order():
     """Halving Exudyn's step divides the speed-ratio and drive-torque errors (after the start-up
     revolution) by about four: the errors are measured against the exact reference, not against
     a run of the same engine."""
-    scene = named_scene("paper-literal-35deg-frictionless")
-    yard = yardstick(scene)
-    errs = []
-    for n in (100, 200):
-        config = Config("exudyn", "exudyn tuned", n, EXUDYN_TUNED)
-        s = config.scene(scene)
-        errs.append(run_errors(s, config.run(s), yard))
+    errs = tuned_errors(named_scene("paper-literal-35deg-frictionless"), (100, 200))
     for key in ("speed_ratio_error", "torque_in_error_steady"):
         assert 3.3 < errs[0][key] / errs[1][key] < 4.7, (key, errs)
     assert errs[1]["speed_ratio_error"] < 2e-4
@@ -318,13 +324,8 @@ def test_speed_ratio_error_with_mounting_errors_is_against_the_exact_ratio():
     """Hooke's law is the ideal joint's; with mounting errors the speed-ratio error is measured
     against the reference's exact RCCC ratio, so it still falls with the integrator's order
     (against Hooke it would stay at the tolerances' own 2.7e-5)."""
-    scene = bench_scene("frictionless-errors-10deg")
-    yard = yardstick(scene)
-    errs = []
-    for n in (100, 200):
-        config = Config("exudyn", "exudyn tuned", n, EXUDYN_TUNED)
-        s = config.scene(scene)
-        errs.append(run_errors(s, config.run(s), yard)["speed_ratio_error"])
+    runs = tuned_errors(bench_scene("frictionless-errors-10deg"), (100, 200))
+    errs = [e["speed_ratio_error"] for e in runs]
     assert 3.3 < errs[0] / errs[1] < 4.7, errs
     assert errs[1] < 1e-5
 
