@@ -10,7 +10,9 @@
   reports its arrays to);
 - the Monte Carlo target, ``cardan tolerance montecarlo`` with the reference engine, with some
   samples compared to single runs (:func:`monte_carlo_target`);
-- a Dask ``LocalCluster`` run of the same study against the in-process one (:func:`dask_equal`).
+- a Dask ``LocalCluster`` run of the same study against the in-process one (:func:`dask_equal`);
+- a torque-driven paper scene with friction at ``rtol`` 1e-8, wall time per simulated revolution
+  (:func:`torque_drive`; the reference engine's forward dynamics, :mod:`reference.forward`).
 
 Library code returns data (:func:`run_batch_bench`); :func:`write_batch_bench` writes the folder
 and :func:`handler` prints.
@@ -46,7 +48,8 @@ from reference.scene import Scene, replace
 from reference.schema import Status
 
 __all__ = ["SIZES", "QUICK_SIZES", "MONTE_CARLO_SAMPLES", "MONTE_CARLO_TARGET_S", "PAPER_BATCH_TARGET_S",
-           "DASK_SAMPLES", "tolerance_scenes", "cost_by_batch_size", "paper_batch", "batch_memory",
+           "DASK_SAMPLES", "TORQUE_TARGET_S", "torque_drive", "tolerance_scenes", "cost_by_batch_size",
+           "paper_batch", "batch_memory",
            "monte_carlo_target", "dask_equal", "run_batch_bench", "batch_targets", "write_batch_bench",
            "report_markdown", "handler"]
 
@@ -55,6 +58,10 @@ QUICK_SIZES = (1, 10)
 MONTE_CARLO_SAMPLES = 10_000       # the issue's tolerance study
 MONTE_CARLO_TARGET_S = 30.0        # ... in at most this wall time on this 2-core machine [s]
 PAPER_BATCH_TARGET_S = 0.1         # the eleven paper scenes in one batch [s]
+TORQUE_TARGET_S = 0.2              # a torque-driven paper scene with friction, per revolution [s]
+TORQUE_DRIVE = {"scene": "paper-physical-10deg", "torque": 2.05, "initial_speed": 209.44, "rtol": 1e-8}
+"""The torque-drive target's scene: 10 deg, started at 2000 rpm under about the drive torque the
+prescribed-speed scene needs at its 2 N m mean input torque reading."""
 DASK_SAMPLES = 1000                # the Dask comparison's samples (the issue's 100,000: --dask-samples)
 QUICK = {"samples": 40, "dask_samples": 16, "memory_sizes": [2, 10], "checked": 4}
 FULL = {"samples": MONTE_CARLO_SAMPLES, "dask_samples": DASK_SAMPLES, "memory_sizes": [100, 1000],
@@ -142,6 +149,27 @@ def paper_batch(repeats: int = 3) -> dict[str, Any]:
     return {"scenes": len(scenes), "wall_s": float(np.median(walls)), "walls_s": walls,
             "failed": sum(not r.success for r in results),
             "max_difference": _largest_difference(results, single)}
+
+
+def torque_drive(repeats: int = 3) -> dict[str, Any]:
+    """The reference engine on :data:`TORQUE_DRIVE` (friction, ``rtol`` = ``atol``): median wall
+    time per simulated revolution [s] after one untimed run (imports), right-hand-side
+    evaluations, status, mean efficiency."""
+    t = TORQUE_DRIVE
+    scene = replace(named_scene(t["scene"]), drive={"kind": "torque", "torque": t["torque"],
+                                                    "initial_speed": t["initial_speed"]},
+                    **{"record.timeseries": False})
+    options = ReferenceOptions(ode_rtol=t["rtol"], ode_atol=t["rtol"])
+    walls, result = [], engines.run(scene, "reference", options)
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = engines.run(scene, "reference", options)
+        walls.append(time.perf_counter() - start)
+    s = result.summary
+    per_revolution = float(np.median(walls)) / scene.revolutions
+    return {**t, "revolutions": scene.revolutions, "per_revolution_s": per_revolution, "walls_s": walls,
+            "status": str(s.status), "mean_efficiency": s.mean_efficiency,
+            "ode_evaluations": s.ode_evaluations}
 
 
 def batch_memory(sizes: Sequence[int] = (100, 1000), seed: int = SEED) -> dict[str, Any]:
@@ -264,6 +292,8 @@ def run_batch_bench(quick: bool = False, sizes: Sequence[int] | None = None, sam
     result["cost"] = cost_by_batch_size(settings["sizes"], progress=progress).to_dict(orient="records")
     result["paper"] = paper_batch()
     progress(f"paper scenes in one batch: {result['paper']['wall_s']:.3g} s")
+    result["torque"] = torque_drive()
+    progress(f"torque drive: {result['torque']['per_revolution_s']:.3g} s per revolution")
     result["memory"] = batch_memory(settings["memory_sizes"])
     progress(f"peak memory: {result['memory']['per_1000_mb']:.3g} MB per 1000 scenes")
     with tempfile.TemporaryDirectory(prefix="cardan-bench-batch-") as tmp:
@@ -287,6 +317,16 @@ def batch_targets(result: dict[str, Any]) -> list[dict[str, Any]]:
              "met": paper["wall_s"] <= PAPER_BATCH_TARGET_S and paper["failed"] == 0,
              "detail": f"{paper['scenes']} scenes, median of {len(paper['walls_s'])}; largest difference "
                        f"from single runs {number(paper['max_difference'], '.2g')}"}]
+    torque = result.get("torque")
+    if torque:
+        rows.append({"target": "torque_drive", "measured": torque["per_revolution_s"],
+                     "limit": TORQUE_TARGET_S,
+                     "met": torque["per_revolution_s"] <= TORQUE_TARGET_S and torque["status"] == Status.OK,
+                     "detail": f"{torque['scene']}, {torque['torque']:g} N m from "
+                               f"{torque['initial_speed']:g} rad/s, rtol {torque['rtol']:g}: "
+                               f"{torque['status']}, mean efficiency "
+                               f"{number(torque['mean_efficiency'], '.6g')}, {torque['ode_evaluations']} "
+                               f"right-hand sides, median of {len(torque['walls_s'])}"})
     if result.get("monte_carlo"):
         rows.append(_monte_carlo_row(result["monte_carlo"]))
     dask = result.get("dask")
