@@ -126,7 +126,12 @@ def _pool_round(queue: deque, base: Scene, function: CaseFunction, workers: int,
             while queue or running:
                 while queue and len(running) < 2 * workers:
                     task = queue.popleft()
-                    running[pool.submit(run_task, task, base, function)] = task
+                    try:
+                        running[pool.submit(run_task, task, base, function)] = task
+                    except BrokenProcessPool:  # a worker died since the last wait: the round ends
+                        queue.appendleft(task)  # never started: the next round runs it
+                        _emit_finished(running, emit)
+                        return list(running.values())
                 done, _ = wait(running, return_when=FIRST_COMPLETED)
                 broken = False
                 for future in done:
