@@ -29,6 +29,10 @@ __all__ = ["postprocess", "body_states", "pair_kinematics", "relative_speeds", "
 
 
 def first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
+    """The first column (``efficiency`` aside) with a non-finite value, None when all are finite."""
+    checked = [v for k, v in columns.items() if k != "efficiency"]
+    if not checked or np.isfinite(np.concatenate([np.ravel(v) for v in checked])).all():
+        return None  # one test of all the columns, the common case
     for key, values in columns.items():
         if key != "efficiency" and not np.all(np.isfinite(values)):
             return key
@@ -74,31 +78,55 @@ def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
     return states
 
 
-def ground_state(n: int) -> dict[str, np.ndarray]:
-    return {"r": np.zeros((n, 3)), "v": np.zeros((n, 3)),
-            "A": np.broadcast_to(np.eye(3), (n, 3, 3)), "omega": np.zeros((n, 3))}
+Kinematics = dict[str, dict[str, np.ndarray]]
 
 
-def pair_kinematics(model: ExudynModel, states: dict, n: int) -> dict[str, dict[str, np.ndarray]]:
-    """Pair axes, marker points and their velocities (global) for both bodies of each pair."""
+def pair_kinematics(model: ExudynModel, states: dict, n: int,
+                    positions: Kinematics | None = None) -> Kinematics:
+    """Pair axes, marker points and their velocities (global) for both bodies of each pair, and
+    ``relative`` (``frame_a^T frame_b``, the pair frame of body b in that of body a).
+
+    ``positions``: an earlier result for the same positions (e.g. before a velocity projection,
+    which keeps them): its position-level entries are taken over and only the velocities computed.
+    """
     out = {}
     for name in PAIR_NAMES:
         body_a, body_b = PAIR_BODIES[name]
-        l_a, l_b = model.marker_local[name]
-        frame = model.pair_frames[name]
-        sa = ground_state(n) if body_a == "ground" else states[body_a]
-        sb = ground_state(n) if body_b == "ground" else states[body_b]
-        pa = sa["r"][:n] + sa["A"][:n] @ l_a
-        pb = sb["r"][:n] + sb["A"][:n] @ l_b
-        va = sa["v"][:n] + cross_rows(sa["omega"][:n], pa - sa["r"][:n])
-        vb = sb["v"][:n] + cross_rows(sb["omega"][:n], pb - sb["r"][:n])
-        out[name] = {
-            "frame_a": sa["A"][:n] @ frame,
-            "frame_b": sb["A"][:n] @ frame,
-            "pa": pa, "pb": pb, "va": va, "vb": vb,
-            "omega_a": sa["omega"][:n], "omega_b": sb["omega"][:n],
-        }
+        sa = None if body_a == "ground" else states[body_a]
+        sb = None if body_b == "ground" else states[body_b]
+        if positions is None:
+            k = _pair_positions(model, name, sa, sb, n)
+        else:
+            k = {key: positions[name][key] for key in ("frame_a", "frame_b", "pa", "pb", "relative")}
+        k["va"], k["omega_a"] = _marker_velocity(sa, k["pa"], n)
+        k["vb"], k["omega_b"] = _marker_velocity(sb, k["pb"], n)
+        out[name] = k
     return out
+
+
+def _pair_positions(model: ExudynModel, name: str, sa: dict | None, sb: dict | None,
+                    n: int) -> dict[str, np.ndarray]:
+    """Pair frames and marker points of one pair (a ground body: None)."""
+    l_a, l_b = model.marker_local[name]
+    frame = model.pair_frames[name]
+    k = {}
+    for side, s, local in (("a", sa, l_a), ("b", sb, l_b)):
+        if s is None:  # the ground: identity rotation, origin at zero
+            k[f"frame_{side}"] = np.broadcast_to(frame, (n, 3, 3))
+            k[f"p{side}"] = np.broadcast_to(np.asarray(local, float), (n, 3))
+        else:
+            k[f"frame_{side}"] = s["A"][:n] @ frame
+            k[f"p{side}"] = s["r"][:n] + s["A"][:n] @ local
+    k["relative"] = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])  # frame_a^T frame_b
+    return k
+
+
+def _marker_velocity(s: dict | None, p: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity of the body point ``p`` (n, 3) and the body's angular velocity (ground: zeros)."""
+    if s is None:
+        zero = np.zeros((n, 3))
+        return zero, zero
+    return s["v"][:n] + cross_rows(s["omega"][:n], p - s["r"][:n]), s["omega"][:n]
 
 
 def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarray]:
@@ -112,9 +140,10 @@ def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarr
     n = min(len(s["t"]) for s in states.values())
     if n < 2:
         raise ValueError("fewer than two recorded steps")
-    if project:
-        states = projected_states(model, states, n)
     kin = pair_kinematics(model, states, n)
+    if project:
+        states = projected_states(model, states, n, kin)
+        kin = pair_kinematics(model, states, n, positions=kin)
     cols = _shaft_columns(model, states, kin, n)
     for name in PAIR_NAMES:
         cols.update(_pair_columns(model, name, kin[name], cols["t"], n))
@@ -165,8 +194,7 @@ def _pair_columns(model: ExudynModel, name: str, k: dict[str, np.ndarray], t: np
     fx, fy, fz = (-force).T
     # TorqueLocal: 90-degree in-plane swap, sign flip, and components in the frame of body b
     m_b = np.stack([-torque[:, 1], torque[:, 0], -torque[:, 2]], axis=1)
-    relative = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])  # frame_a^T frame_b
-    mx, my, mz = np.einsum("nij,nj->ni", relative, m_b).T
+    mx, my, mz = np.einsum("nij,nj->ni", k["relative"], m_b).T
     omega_rel, slide_rel = relative_speeds(t, k, cylindrical=PAIR_KIND[name] == "cylindrical")
     values = (fx, fy, fz, mx, my, mz, omega_rel, slide_rel)
     suffixes = ("fx", "fy", "fz", "mx", "my", "mz", "omega_rel", "slide_rel")
@@ -201,8 +229,9 @@ def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
     return out
 
 
-def projected_states(model: ExudynModel, states: dict, n: int) -> dict:
-    """``states`` with velocities projected onto the joint's velocity constraints."""
+def projected_states(model: ExudynModel, states: dict, n: int, kin: dict | None = None) -> dict:
+    """``states`` with velocities projected onto the joint's velocity constraints (``kin``: their
+    :func:`pair_kinematics`, computed when not given)."""
     drive = model.scene.drive
     if isinstance(drive, AngleDrive):
         spline = drive.spline()
@@ -215,7 +244,8 @@ def projected_states(model: ExudynModel, states: dict, n: int) -> dict:
     else:
         input_speed = None
     trimmed = {name: {k: v[:n] for k, v in s.items()} for name, s in states.items()}
-    projected = project_velocities(trimmed, pair_kinematics(model, trimmed, n), model.mass,
+    kin = pair_kinematics(model, trimmed, n) if kin is None else kin
+    projected = project_velocities(trimmed, kin, model.mass,
                                    model.inertia, model.pair_frames["frame_input"][:, 2], input_speed)
     model.velocity_correction = projected.pop("max_velocity_correction")
     return projected
@@ -223,7 +253,7 @@ def projected_states(model: ExudynModel, states: dict, n: int) -> dict:
 
 def relative_angle(k: dict[str, np.ndarray]) -> np.ndarray:
     """Rotation of body b's pair frame relative to body a's about the pair axis [rad], unwrapped."""
-    rel = np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])
+    rel = k["relative"] if "relative" in k else np.einsum("nji,njk->nik", k["frame_a"], k["frame_b"])
     return np.unwrap(np.arctan2(rel[:, 1, 0], rel[:, 0, 0]))
 
 

@@ -51,7 +51,11 @@ def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a, b = np.asarray(a, float), np.asarray(b, float)
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
 
 
 def _skew_rows(rho: np.ndarray, axis: np.ndarray) -> np.ndarray:
@@ -68,31 +72,25 @@ def constraint_jacobian(states: dict[str, dict[str, np.ndarray]],
     pair axes of body a), ``pa``, ``pb`` (n, 3); ``states[body]`` holds ``r`` (n, 3).
     """
     n = next(iter(pairs.values()))["pa"].shape[0]
-    rows = []
+    jac = np.zeros((n, 17, 18))
+    row = 0
     for name in PAIR_NAMES:
         body_a, body_b = PAIR_BODIES[name]
         k = pairs[name]
         frame, p_b = k["frame_a"][:n], k["pb"][:n]
-        linear = (0, 1, 2) if PAIR_KIND[name] == "revolute" else (0, 1)
-        for j in linear:
+        bodies = [(BODIES.index(body), sign) for body, sign in ((body_b, 1.0), (body_a, -1.0))
+                  if body != "ground"]
+        for j in (0, 1, 2) if PAIR_KIND[name] == "revolute" else (0, 1):
             axis = frame[:, :, j]
-            row = np.zeros((n, 18))
-            for body, sign in ((body_b, 1.0), (body_a, -1.0)):
-                if body == "ground":
-                    continue
-                i = 6 * BODIES.index(body)
-                row[:, i:i + 3] = sign * axis
-                row[:, i + 3:i + 6] = sign * _skew_rows(p_b - states[body]["r"][:n], axis)
-            rows.append(row)
+            for i, sign in bodies:
+                jac[:, row, 6 * i:6 * i + 3] = sign * axis
+                jac[:, row, 6 * i + 3:6 * i + 6] = sign * _skew_rows(p_b - states[BODIES[i]]["r"][:n], axis)
+            row += 1
         for j in (0, 1):
-            axis = frame[:, :, j]
-            row = np.zeros((n, 18))
-            for body, sign in ((body_b, 1.0), (body_a, -1.0)):
-                if body != "ground":
-                    i = 6 * BODIES.index(body) + 3
-                    row[:, i:i + 3] = sign * axis
-            rows.append(row)
-    return np.stack(rows, axis=1)
+            for i, sign in bodies:
+                jac[:, row, 6 * i + 3:6 * i + 6] = sign * frame[:, :, j]
+            row += 1
+    return jac
 
 
 def project_velocities(states: dict[str, dict[str, np.ndarray]],

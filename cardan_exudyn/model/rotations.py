@@ -280,6 +280,11 @@ class WholeTurns:
         """Whole revolutions removed up to now."""
         return self.counts[-1] if self.counts else self.start
 
+    def reset(self) -> None:
+        """Forget the revolutions removed (the model is about to be solved again from its start)."""
+        self.times.clear()
+        self.counts.clear()
+
     def remove(self, coordinate: float, t: float) -> float:
         """``coordinate`` [rad] less its nearest whole revolutions (recorded at time ``t`` [s])."""
         k = round(coordinate / TWO_PI)
