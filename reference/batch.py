@@ -45,6 +45,7 @@ from reference.engine import (
     table_verdict,
 )
 from reference.loop_closure import LoopClosureError
+from reference.periodic import period_rows, repeat_period
 from reference.rccc import DHParameters, solve_positions
 from reference.scene import Scene, SpeedDrive, scene_to_dict
 from reference.schema import OptionsError, Result, Status, Summary, result_table
@@ -149,11 +150,14 @@ def _tables(stack: SceneStack, options: ReferenceOptions) -> list[Result]:
     """Every scene of ``stack``: time table, verdict, works and means (in ``stack`` order)."""
     motions = [input_motion(scene, options) for scene in stack.scenes]
     times = [table_times(scene, motion, options) for scene, motion in zip(stack.scenes, motions, strict=True)]
-    owner = np.repeat(np.arange(len(times)), [t.size for t in times])
-    columns = stack.columns(owner, np.concatenate(times))
-    bounds = np.cumsum([0] + [t.size for t in times])
-    tables = [{key: value[bounds[k]:bounds[k + 1]] for key, value in columns.items()}
-              for k in range(len(times))]
+    # summary only: the first period of each table, repeated (reference.engine.table_columns)
+    rows = [(None if scene.record.timeseries else period_rows(t, speed)) or t.size
+            for scene, t, speed in zip(stack.scenes, times, stack.speed, strict=True)]
+    owner = np.repeat(np.arange(len(times)), rows)
+    columns = stack.columns(owner, np.concatenate([t[:n] for t, n in zip(times, rows, strict=True)]))
+    bounds = np.cumsum([0, *rows])
+    tables = [repeat_period({key: value[bounds[k]:bounds[k + 1]] for key, value in columns.items()},
+                            times[k], stack.speed[k]) for k in range(len(times))]
     summaries = []
     for k, scene in enumerate(stack.scenes):
         summary = _summary(scene, options)

@@ -25,9 +25,7 @@ from reference import kinematics, rccc
 from reference.dual import Dual
 from reference.dynamics import (
     DRIVE_ROW,
-    FixedPoint,
     cross,
-    friction_law_values,
     friction_matrix,
     friction_slots,
     mass_kinematics,
@@ -36,10 +34,10 @@ from reference.dynamics import (
     slot_bands,
     slot_signs,
     solution_columns,
-    solve_friction,
     unknowns,
     wrench_columns,
 )
+from reference.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
 from reference.friction import friction_magnitudes
 from reference.joint import BODY_NAMES, PAIR_NAMES
 from reference.joint_motion import JointMotion, ideal_pair_origins, loop_motion
@@ -75,7 +73,7 @@ class StackedLoop:
 
 
 class StackedLaw:
-    """Eqs. (3) and (5) with per-sample coefficients, for :func:`reference.dynamics.solve_friction`
+    """Eqs. (3) and (5) with per-sample coefficients, for :func:`reference.fixed_point.solve_friction`
     (which hands its ``signs`` argument through): ``signs`` packs, on a last axis of 3, each
     slot's friction factor, ``k_force`` and ``k_moment``."""
 
@@ -87,6 +85,10 @@ class StackedLaw:
     def __call__(self, x: np.ndarray, packed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Friction values (n, K) and their Jacobian (n, K, 18)."""
         return friction_law_values(x, self.index, packed[..., 0], packed[..., 1], packed[..., 2])
+
+    def reduced(self, c: np.ndarray, packed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`reference.fixed_point.reduced_law_values` of ``c`` = ``x[:, index]`` (n, K, 4)."""
+        return reduced_law_values(c, packed[..., 0], packed[..., 1], packed[..., 2])
 
 
 def _slot_coefficients(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:

@@ -16,23 +16,35 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from reference.batch_model import SceneStack
+from reference.crossings import (
+    SCAN_PER_REVOLUTION,
+    grazing_brackets,
+    grazing_candidates,
+    sign_change_brackets,
+)
 from reference.engine import WORK_KEYS, InputMotion, ReferenceOptions, window_times, work_means
 from reference.gauss import GROSS_SCALE, MAX_OPEN_PANELS, initial_panels, quadrature_summary
 from reference.schema import whole_revolution_window
 
-BREAKPOINT_GRID = 1024
-"""Samples per revolution of the sign-breakpoint search (as :func:`reference.engine.sign_breakpoints`)."""
 
-
-def _brackets(values: np.ndarray, grid: np.ndarray, bands: np.ndarray) -> list[tuple]:
-    """Cells of ``grid`` where a speed crosses ``+-band`` (:func:`reference.engine.sign_breakpoints`)."""
-    out = []
-    for levels in (-bands, bands):
-        g = values - levels
-        cell, slot = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)
-        out += [(grid[i], grid[i + 1], g[i, j], g[i + 1, j], j, levels[j])
-                for i, j in zip(cell, slot, strict=True)]
-    return out
+def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) -> list[tuple]:
+    """Brackets of every ramp-edge crossing on each member's grid (:mod:`reference.crossings`), with
+    the member's position: ``(member position, t_a, t_b, f_a, f_b, column, level)``."""
+    owner = np.repeat(np.asarray(members, int), [g.size for g in grids])
+    values = np.split(stack.ramp_speeds(owner, np.concatenate(grids)),
+                      np.cumsum([g.size for g in grids])[:-1])
+    found, grazing = [], []
+    for k, (m, grid, v) in enumerate(zip(members, grids, values, strict=True)):
+        for levels in (-stack.ramp_bands[m], stack.ramp_bands[m]):
+            found += [(k, *br) for br in sign_change_brackets(grid, v, levels)]
+            grazing += [(k, levels, c) for c in grazing_candidates(grid, v, levels)]
+    if grazing:  # every scene's vertices in one evaluation
+        at = stack.ramp_speeds(np.array([members[k] for k, _, _ in grazing], int),
+                               np.array([c[0] for _, _, c in grazing]))
+        for row, (k, levels, c) in enumerate(grazing):
+            pair = grazing_brackets(grids[k], values[k], levels, [c], at[row, c[2]:c[2] + 1])
+            found += [(k, *br) for br in pair]
+    return found
 
 
 def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
@@ -45,12 +57,8 @@ def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
     grids = []
     for m, a, b in zip(members, t_a, t_b, strict=True):
         turned = abs(stack.speed[m] * b - stack.speed[m] * a)
-        grids.append(np.linspace(a, b, max(64, int(BREAKPOINT_GRID * turned / (2.0 * math.pi))) + 1))
-    owner = np.repeat(np.asarray(members, int), [g.size for g in grids])
-    values = np.split(stack.ramp_speeds(owner, np.concatenate(grids)),
-                      np.cumsum([g.size for g in grids])[:-1])
-    found = [(k, *br) for k, (m, g, v) in enumerate(zip(members, grids, values, strict=True))
-             for br in _brackets(v, g, stack.ramp_bands[m])]
+        grids.append(np.linspace(a, b, max(64, int(SCAN_PER_REVOLUTION * turned / (2.0 * math.pi))) + 1))
+    found = _scan(stack, members, grids)
     if not found:
         return empty
     k, a, b, f_a, f_b, j, level = (np.array(v) for v in zip(*found, strict=True))

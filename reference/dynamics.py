@@ -39,11 +39,10 @@ eqs. (3), (5) (friction from the reactions) and eq. (18) (instantaneous efficien
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from reference.bands import sign_bands
+from reference.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
 from reference.friction import friction_magnitudes, pair_power_loss, regularised_sign
 from reference.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
 from reference.joint_motion import JointMotion, joint_motion
@@ -268,24 +267,9 @@ class FrictionLaw:
         """
         return friction_law_values(x, self.index, signs, self.k_force, self.k_moment)
 
-
-def friction_law_values(x: np.ndarray, index: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
-                        k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:meth:`FrictionLaw.__call__` with its coefficients given: ``index`` (K, 4) the columns of
-    ``x`` holding each slot's fx, fy, mx, my; ``k_force`` [m or -] and ``k_moment`` [-, 1/m]
-    the law's factors of ``|F|`` and ``|M|``, shape (K,) or one row per sample (n, K)."""
-    c = x[:, index]  # (n, K, 4): fx, fy, mx, my
-    force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
-    norms = np.stack([force, force, moment, moment], -1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(norms > 0, c / norms, 0.0)
-    s = -signs
-    values = s * (k_force * force + k_moment * moment)
-    gains = np.stack([k_force, k_force, k_moment, k_moment], -1)
-    jacobian = np.zeros(x.shape[:1] + index.shape[:1] + x.shape[1:])
-    rows = np.arange(index.shape[0])[:, None]
-    jacobian[:, rows, index] = s[..., None] * gains * unit
-    return values, jacobian
+    def reduced(self, c: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`reduced_law_values` of the slots' reaction components ``c`` = ``x[:, index]``."""
+        return reduced_law_values(c, signs, self.k_force, self.k_moment)
 
 
 def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
@@ -358,96 +342,6 @@ def ramp_bands(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
     """Ramp widths [m/s] of :func:`ramp_speeds`, shape (K',)."""
     bands = slot_bands(scene, slots)
     return np.concatenate([bands, bands]) if scene.friction.law == "resultant" else bands
-
-
-@dataclass
-class FixedPoint:
-    """Outcome of the friction fixed point, per sample.
-
-    Attributes
-    ----------
-    x : ndarray, shape (n, 18)
-        Reactions and the drive unknown, :func:`unknowns` order.
-    friction : ndarray, shape (n, K)
-        Friction values of :func:`friction_slots`.
-    converged : ndarray of bool, shape (n,)
-        Newton converged to the relative tolerance.
-    loop_gain : ndarray, shape (n,)
-        Spectral radius of ``dG/dphi`` at the solution (0 without friction); where the
-        infinity norm of ``dG/dphi`` is below 0.5 that norm is reported instead (an upper bound,
-        enough to tell that the sample does not lock); infinite where Newton found no solution.
-    iterations : int
-        Newton iterations of the slowest sample.
-    """
-
-    x: np.ndarray
-    friction: np.ndarray
-    converged: np.ndarray
-    loop_gain: np.ndarray
-    iterations: int
-
-    @property
-    def self_locking(self) -> np.ndarray:
-        """Per sample: no converged fixed point, or a loop gain of 1 or more (bool array)."""
-        return ~self.converged | ~(self.loop_gain < 1.0)
-
-
-def solve_friction(law: FrictionLaw, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
-                   tolerance: float = 1e-13, max_iterations: int = 50,
-                   exact_gain: float = 0.5) -> FixedPoint:
-    """Solve ``phi = G(x0 - S phi)`` for every sample by Newton's method.
-
-    Parameters
-    ----------
-    law : FrictionLaw
-        ``G`` and its Jacobian.
-    x0 : ndarray, shape (n, 18)
-        Solution without friction.
-    s : ndarray, shape (n, 18, K)
-        Response of the solution to unit friction values.
-    signs : ndarray, shape (n, K)
-        Regularised signs of the relative motions.
-    tolerance : float
-        Converged when the Newton update is at most ``tolerance`` times the largest friction
-        value of the sample (or of the frictionless estimate, whichever is larger).
-    max_iterations : int
-        Newton iterations before a sample is declared not converged.
-    exact_gain : float
-        Loop gain: the spectral radius where its norm bound reaches this, else the bound.
-    """
-    n, k = x0.shape[0], s.shape[-1]
-    if k == 0:
-        return FixedPoint(x0, np.zeros((n, 0)), np.ones(n, bool), np.zeros(n), 0)
-    phi, _ = law(x0, signs)
-    scale = np.max(np.abs(phi), -1)
-    converged = np.zeros(n, bool)
-    active = np.arange(n)
-    iterations = 0
-    for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported below)
-        x = x0[active] - np.einsum("nik,nk->ni", s[active], phi[active])
-        g, g_x = law(x, signs[active])
-        jac = np.eye(k) + g_x @ s[active]
-        with np.errstate(all="ignore"):
-            step = np.linalg.solve(jac, (phi[active] - g)[..., None])[..., 0]
-        phi[active] -= step
-        size = np.max(np.abs(step), -1)
-        scale[active] = np.maximum(scale[active], np.max(np.abs(phi[active]), -1))
-        done = size <= tolerance * np.maximum(scale[active], np.finfo(float).tiny)
-        bad = ~np.all(np.isfinite(phi[active]), -1)
-        converged[active[done & ~bad]] = True
-        active = active[~done & ~bad]
-        if active.size == 0:
-            break
-    x = x0 - np.einsum("nik,nk->ni", s, phi)
-    _, g_x = law(x, signs)
-    with np.errstate(all="ignore"):
-        gain_matrix = np.nan_to_num(g_x @ s, nan=np.inf, posinf=np.inf, neginf=-np.inf)
-    finite = np.all(np.isfinite(gain_matrix), (-2, -1))
-    gain = np.where(finite, np.max(np.sum(np.abs(gain_matrix), -1), -1), np.inf)
-    exact = finite & (gain >= exact_gain)  # the spectral radius is at most any induced norm
-    gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
-    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
-    return FixedPoint(x, phi, converged, gain, iterations)
 
 
 def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,

@@ -28,6 +28,12 @@ from typing import Any
 import numpy as np
 
 from reference.bands import sign_bands
+from reference.crossings import (
+    SCAN_PER_REVOLUTION,
+    grazing_brackets,
+    grazing_candidates,
+    sign_change_brackets,
+)
 from reference.dynamics import (
     dynamics_columns,
     friction_slots,
@@ -46,6 +52,7 @@ from reference.histories import run_clock
 from reference.joint import PAIR_NAMES
 from reference.joint_motion import joint_motion
 from reference.loop_closure import LoopClosureError
+from reference.periodic import period_rows, repeat_period
 from reference.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.schema import (
     OptionsError,
@@ -247,13 +254,24 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np
     return {"t": np.asarray(t, float), **cols}
 
 
+def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`columns_at` on the table's instants ``t`` [s]. Summary only (no table recorded): a
+    periodic motion's first period, repeated (:mod:`reference.periodic`); a recorded table is
+    evaluated row by row, so that each row's angle is the one its state was computed at."""
+    rows = period_rows(t, scene.drive.speed) if motion.periodic and not scene.record.timeseries else None
+    if rows is None:
+        return columns_at(scene, motion, t)
+    return repeat_period(columns_at(scene, motion, t[:rows]), t, scene.drive.speed)
+
+
 def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
-                     per_revolution: int = 1024) -> np.ndarray:
+                     per_revolution: int = SCAN_PER_REVOLUTION) -> np.ndarray:
     """Instants in (t_a, t_b) where a friction sign ramp starts or ends [s].
 
-    Each relative surface (or sliding) speed is sampled finely, every crossing of its ramp
+    Each relative surface (or sliding) speed is sampled on a grid, every crossing of its ramp
     edges ``+-band`` (:func:`reference.dynamics.slot_bands`; of 0 for the exact sign) is
-    bracketed and refined to rounding.
+    bracketed (:mod:`reference.crossings`: sign changes, and grazing crossings between two
+    samples) and refined to rounding.
     """
 
     slots = friction_slots(scene)
@@ -272,10 +290,12 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     bands = ramp_bands(scene, slots)
     brackets = []
     for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
-        g = values - levels
-        cell, slot = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)
-        brackets += [(grid[i], grid[i + 1], g[i, j], g[i + 1, j], j, levels[j])
-                     for i, j in zip(cell, slot, strict=True)]
+        brackets += sign_change_brackets(grid, values, levels)
+        candidates = grazing_candidates(grid, values, levels)
+        if candidates:
+            at_vertex = speeds(np.array([c[0] for c in candidates]))[np.arange(len(candidates)),
+                                                                     [c[2] for c in candidates]]
+            brackets += grazing_brackets(grid, values, levels, candidates, at_vertex)
     if not brackets:
         return np.zeros(0)
     a, b, f_a, f_b, j, level = (np.array(v) for v in zip(*brackets, strict=True))
@@ -467,7 +487,7 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
     if motion.status == Status.SELF_LOCKING:
         return None
     t = table_times(scene, motion, options)
-    columns = columns_at(scene, motion, t)
+    columns = table_columns(scene, motion, t)
     table_verdict(t, columns, summary, origin)
     if summary.success:  # the means over whole revolutions, from the works
         means_from_works(scene, work_quadrature(scene, motion, columns, options), columns, options, summary)

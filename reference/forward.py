@@ -22,7 +22,7 @@ This module takes the same equations apart instead:
   load, and the friction's response), and solves the friction fixed point ``phi = G(x0 - S phi)``
   (eqs. (3), (5)) by Newton's method on at most seven values, LAPACK's ``dgesv`` called directly,
   started from the previous call's solution (the integrator's calls are close) and stopped where
-  its quadratic convergence puts the next update below :func:`reference.dynamics.solve_friction`'s
+  its quadratic convergence puts the next update below :func:`reference.fixed_point.solve_friction`'s
   tolerance; where the loop gain comes near 1 the sample is solved again exactly as
   ``solve_friction`` does, so the self-locking verdict is the direct solve's.
 
@@ -81,13 +81,13 @@ PART_SCALE = 1024.0
 """Speed [rad/s], acceleration [rad/s^2] and load [N m] at which the system's parts are taken
 (a power of two: the divisions are exact)."""
 NEWTON_TOLERANCE = 1e-13
-"""Stopping rule of :func:`reference.dynamics.solve_friction`: a Newton update at most this
+"""Stopping rule of :func:`reference.fixed_point.solve_friction`: a Newton update at most this
 fraction of the largest friction value."""
 NEWTON_ITERATIONS = 50
 WARM_START_GAIN = 0.9
 """Newton starts from the previous call's friction (the integrator's calls are close: two or three
 iterations instead of five); where the loop gain it finds is at least this, the sample is solved
-again from :func:`reference.dynamics.solve_friction`'s start, so that a verdict near self-locking
+again from :func:`reference.fixed_point.solve_friction`'s start, so that a verdict near self-locking
 is the same as the direct solve's."""
 
 Acceleration = Callable[[float, float, float], tuple[float, bool]]
@@ -206,7 +206,7 @@ class ForwardState:
     friction : ndarray, shape (K,)
         Friction values of :func:`reference.dynamics.friction_slots` [N m or N].
     converged : bool
-        Newton converged (:func:`reference.dynamics.solve_friction`'s rule).
+        Newton converged (:func:`reference.fixed_point.solve_friction`'s rule).
     loop_gain : float
         Spectral radius of the friction loop's Jacobian, or an upper bound (its infinity norm
         over the active slots) where that is below :data:`WARM_START_GAIN` (0.5 when solved from
@@ -236,7 +236,7 @@ def _spectral_radius(matrix: np.ndarray) -> float:
 
 
 def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
-    """:func:`reference.dynamics.solve_friction`'s loop gain of one sample: the spectral radius,
+    """:func:`reference.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
     or the infinity norm (an upper bound) where that is below ``exact_from``."""
     norm = float(np.abs(matrix).sum(1).max())
     if not math.isfinite(norm):
@@ -246,7 +246,7 @@ def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
 
 def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
                     start: np.ndarray | None = None) -> tuple[np.ndarray, bool, float, int]:
-    """The friction fixed point of one sample, as :func:`reference.dynamics.solve_friction`.
+    """The friction fixed point of one sample, as :func:`reference.fixed_point.solve_friction`.
 
     Parameters
     ----------
@@ -260,7 +260,7 @@ def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
     coupled : bool
         False: the friction of the frictionless reactions (coupling ``"uncoupled"``).
     start : ndarray, shape (K,), or None
-        None: :func:`reference.dynamics.solve_friction` exactly (first iterate the friction of the
+        None: :func:`reference.fixed_point.solve_friction` exactly (first iterate the friction of the
         frictionless reactions, stop when an update is at most :data:`NEWTON_TOLERANCE` of the
         largest value, loop gain at the solution). Else the first iterate (a close one: the
         previous call's), and Newton also stops where its quadratic convergence puts the next
