@@ -6,7 +6,9 @@
 - the extrapolated scheme's recurrence is stable for every loop gain in (-1, 1);
 - on a scene whose friction is smooth it converges at second order, against the reference engine;
 - it agrees with the converged scheme where the loop gain is high, and reports a joint that
-  locks as the reference does.
+  locks as the reference does;
+- the hot path's fused evaluation (``LawTable``, ``PairReader``) gives, to the last bit, what
+  the scalar law and the plain reads give.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import pytest
 
 from cardan_exudyn import engines
 from cardan_exudyn.model import friction_io as io
+from cardan_exudyn.model.friction_law import LawTable, PairLaw, magnitude_loads
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
 from reference.joint import PAIR_BODIES
@@ -130,3 +133,71 @@ def test_locking_joint_is_reported_as_locking():
     assert reference.status == "self_locking"
     s = engines.run(_at_steps(scene, 200), "exudyn", OPTIONS).summary
     assert s.status == "self_locking", (s.status, s.reason)
+
+
+@pytest.mark.parametrize("law", ["paper", "resultant"])
+def test_batch_law_is_the_scalar_law_to_the_bit(law):
+    """``LawTable.loads`` (the hot path: every pair in one pass, on extrapolated inputs) gives
+    exactly what ``magnitude_loads`` gives pair by pair on the same inputs: inside and outside
+    the sign ramps, at a zero band (exact sign), for pairs that slide and pairs that do not."""
+    kinds = [(True, 0.42, 0.005, 0.006), (False, 0.2, 0.02, 0.01), (True, 0.3, 0.01, 0.02)]
+    laws = [PairLaw(c, f, d, lever, law == "resultant") for c, f, d, lever in kinds]
+    bands = [(1e-3, 2e-6, 1e-3), (0.0, 0.0, 0.0), (5e-4, 1e-5, 5e-4)]
+    slides = [True, False, False]
+    table = LawTable(laws, bands, slides)
+    rng = np.random.default_rng(19)
+    for _ in range(300):
+        now = [(float(rng.uniform(0, 50)), float(rng.uniform(0, 2)), float(rng.normal(0, 0.3)),
+                float(rng.normal(0, 3e-6))) for _ in laws]
+        old = [(float(rng.uniform(0, 50)), float(rng.uniform(0, 2)), float(rng.normal(0, 0.3)),
+                float(rng.normal(0, 3e-6))) for _ in laws]
+        for older, a, b in ((None, 1.0, 0.0), (old, 1.5, 0.5), (old, 2.0, 1.0)):
+            friction, regime, sliding, size = table.loads(now, older, a, b)
+            rows = now if older is None else [tuple(a * x - b * y for x, y in zip(p, q, strict=True))
+                                              for p, q in zip(now, old, strict=True)]
+            expected, sides = [], []
+            for lw, (band, slide_band, resultant), slide, (fn, mn, w, v) in zip(laws, bands, slides, rows,
+                                                                                strict=True):
+                torque, force, scale = magnitude_loads(lw, fn, mn, w, v, band, slide_band, resultant)
+                expected.append((torque, force if slide else 0.0, scale))
+                surface = 0.5 * lw.d * w
+                sides += [(surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band)]
+            assert friction == tuple(x for e in expected for x in e[:2])
+            assert regime == tuple(sides)
+            assert sliding == max(0.0, *(e[2] for e in expected))  # extrapolated |F| can be < 0
+            assert size == max(abs(x) for x in friction)
+
+
+def test_pair_reader_is_the_plain_reads_to_the_bit():
+    """At every solve of a run with mounting errors (sliding pairs, joints to ground), the fused
+    reader gives exactly the reactions' magnitudes of ``read_reactions`` and the BDF2 speeds of
+    ``pair_coordinates`` / ``bdf2_speeds`` over the accepted steps."""
+    scene = _at_steps(named_scene("rig-matched-errors"), 50, revolutions=1)
+    checked = []
+
+    def tweak(model, settings):
+        coupling = model.friction
+        update = coupling.post_newton
+        history = []
+
+        def compare(mbs, t):
+            if not history or history[-1][0] != t:  # a new step: the last coordinates accepted
+                history.append((t, None))
+            read = io.read_reactions(mbs, coupling.channels)
+            coords = io.pair_coordinates(mbs, coupling.channels)
+            result = update(mbs, t)
+            inputs = coupling.reader.read(t) if len(history) > 2 else None
+            if inputs is not None:
+                (t1, c1), (t2, c2) = history[-2], history[-3]
+                speeds = io.bdf2_speeds(coords, t - t1, c1, t1 - t2, c2)
+                expected = [(math.hypot(fx, fy), math.hypot(mx, my), w, v)
+                            for (fx, fy, mx, my), (w, v) in zip(read, speeds, strict=True)]
+                checked.append(inputs == expected)
+            history[-1] = (t, coords)
+            return result
+
+        model.mbs.SetPostNewtonUserFunction(compare)
+
+    solved = solve(replace(scene, **{"friction.coupling": "lagged"}), OPTIONS, reactions=False, tweak=tweak)
+    assert solved.status == "ok"
+    assert len(checked) > 20 and all(checked)

@@ -19,7 +19,11 @@ One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, 
 solve, the law's inputs -- per pair the magnitudes of the reaction force normal to the axis and of
 the bending moment (from the Lagrange multipliers, read once), and the relative angular and
 sliding speeds (BDF2 of the joint's own angle and slide outputs) -- computes the friction and sets
-the loads (:mod:`cardan_exudyn.model.friction_io`: plain floats, no small arrays). Before the first
+the loads (:mod:`cardan_exudyn.model.friction_io`: plain floats, no small arrays). On the one-solve
+path each evaluation is one pass over the pairs to read (:class:`~cardan_exudyn.model.friction_io.PairReader`,
+which also gives the sides of the sign ramps) and one to extrapolate and evaluate the law
+(:class:`~cardan_exudyn.model.friction_law.LawTable`); the friction is carried as one flat tuple
+``(M_z, F_z)`` per pair, which the log keeps without copying. Before the first
 step the friction is iterated to consistency with the initial state (``FrictionCoupling.initialise``),
 so no scheme starts frictionless.
 
@@ -71,7 +75,7 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.model import friction_io as io
-from cardan_exudyn.model.friction_law import PairLaw, magnitude_loads
+from cardan_exudyn.model.friction_law import LawTable, PairLaw
 from reference.bands import sign_bands
 from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.schema import Status
@@ -146,15 +150,21 @@ class FrictionCoupling:
             axes.append(model.pair_frames[name][:, 2].copy())
         self.loads = io.BodyLoads(self.mbs, contributions, axes, [p.slides for p in self.pairs])
         self.n = len(self.pairs)
+        self.table = LawTable([p.law for p in self.pairs], [p.bands for p in self.pairs],
+                              [p.slides for p in self.pairs])
+        self._flat_weight = tuple(w for p in self.pairs for w in (1.0, p.weight))
         self.channels: list[io.PairChannel] = []
-        self.applied = np.zeros((self.n, 2))
+        self.reader: io.PairReader | None = None
+        self.applied: tuple = (0.0,) * (2 * self.n)  # flat (M_z, F_z) per pair, in effect
+        self._applied_size = 0.0                     # the largest of its magnitudes
         self.log = FrictionLog()
         self.initial: np.ndarray | None = None  # friction consistent with the initial state
         self._accepted: list[np.ndarray] = []
         self._step_t = None
         self._step_iter = 0
-        self._xs: list[np.ndarray] = []
-        self._gs: list[np.ndarray] = []
+        self._xs: list[np.ndarray] = []    # converged iteration of a step: friction in (masked)
+        self._gs: list[tuple] = []         # friction out (flat)
+        self._rs: list[np.ndarray] = []    # residual out - in (masked)
         self._step_gain = 0.0
         self._gains: list[float] = []
         self._broyden_b = None
@@ -164,17 +174,12 @@ class FrictionCoupling:
         self.escalated_at: float | None = None
         self._iterating = False            # extrapolated scheme: this step is iterated (reversal)
         self.iterated_steps = 0
-        self._regimes: list = []           # the regimes of self._inputs
-        self._current_regime: list = []    # of the inputs of the step's first solve
-        self._predicted_regime: list = []
+        self._regimes: list = []           # the regimes of self._inputs (PairReader.regime)
+        self._predicted_regime: tuple = ()
         self._last_inputs: list = []
-        mask = np.zeros((self.n, 2), dtype=bool)
-        self._weight = np.ones((self.n, 2))
-        for k, p in enumerate(self.pairs):
-            mask[k, 0] = True
-            mask[k, 1] = p.slides
-            self._weight[k, 1] = p.weight
-        self._mask = mask.ravel()
+        self._weight = np.array(self._flat_weight).reshape(self.n, 2)
+        self._mask = np.array([m for p in self.pairs for m in (True, p.slides)])  # loads that can act
+        self._mask_index = tuple(int(i) for i in np.flatnonzero(self._mask))
         self.unconverged_steps = 0
         self.status, self.reason = Status.OK, ""
         self.error: Exception | None = None  # raised inside the user function (see post_newton)
@@ -185,8 +190,8 @@ class FrictionCoupling:
         """Look up the multipliers (after ``mbs.Assemble``) and register the user function."""
         self.channels = [io.pair_channel(self.mbs, p.joint, PAIR_BODIES[p.name][0] == "ground",
                                          self.model.pair_frames[p.name], p.slides) for p in self.pairs]
-        self._history = [(self.model.start_time, io.pair_coordinates(self.mbs, self.channels))]
-        self._coords = self._history[0][1]
+        self.reader = io.PairReader(self.mbs, self.channels, self.model.start_time,
+                                    [(p.weight, *p.bands[:2]) for p in self.pairs])
         self.mbs.SetPostNewtonUserFunction(self.post_newton)
         self.model.user_functions.append(self.post_newton)
 
@@ -202,36 +207,20 @@ class FrictionCoupling:
 
     def _read_inputs(self, t: float | None) -> list[tuple[float, float, float, float]]:
         """Per pair the law's inputs ``(|F|, |M|, omega_rel, slide_rel)`` at the current state
-        (``t`` None: the initial state, with velocity-level speeds); keeps the coordinates."""
-        reactions = io.read_reactions(self.mbs, self.channels)
-        if t is None:
-            speeds = io.initial_speeds(self.mbs, self.channels)
-        else:
-            self._coords = io.pair_coordinates(self.mbs, self.channels)
-            (t1, c1) = self._history[-1]
-            if len(self._history) < 2:
-                speeds = io.bdf2_speeds(self._coords, t - t1, c1)
-            else:
-                t2, c2 = self._history[-2]
-                speeds = io.bdf2_speeds(self._coords, t - t1, c1, t1 - t2, c2)
-        self._last_inputs = [(math.hypot(fx, fy), math.hypot(mx, my), w, v)
-                             for (fx, fy, mx, my), (w, v) in zip(reactions, speeds, strict=True)]
+        (``t`` None: the initial state, with velocity-level speeds)."""
+        self._last_inputs = self.reader.read(t)
         return self._last_inputs
 
-    def _law(self, inputs: list) -> list[list[float]]:
-        """Friction ``[M_z, F_z]`` of each pair for the law's ``inputs``; sets :attr:`scale_floor`."""
-        friction, sliding = [], 0.0
-        for p, (force_n, moment_n, omega, slide) in zip(self.pairs, inputs, strict=True):
-            torque, force, scale = magnitude_loads(p.law, force_n, moment_n, omega, slide, *p.bands)
-            friction.append([torque, force if p.slides else 0.0])
-            sliding = max(sliding, scale)
+    def _law(self, inputs: list) -> tuple[float, ...]:
+        """Friction, flat ``(M_z, F_z)`` per pair, for the law's ``inputs``; sets :attr:`scale_floor`."""
+        friction, _, sliding, _ = self.table.loads(inputs)
         self.scale_floor = REST_FLOOR * sliding
         return friction
 
-    def evaluate(self, t: float | None) -> np.ndarray:
-        """Friction (M_z, F_z on body b) of each pair at the current state, shape (n, 2) (``t``
-        None: the initial state, with velocity-level speeds)."""
-        return np.array(self._law(self._read_inputs(t))).reshape(self.n, 2)
+    def evaluate(self, t: float | None) -> tuple[float, ...]:
+        """Friction at the current state, flat ``(M_z, F_z)`` on body b of each pair [N m, N]
+        (``t`` None: the initial state, with velocity-level speeds)."""
+        return self._law(self._read_inputs(t))
 
     def initialise(self, solver: Any, settings: Any, max_iterations: int = 60) -> None:
         """Friction consistent with the initial reactions, before the first step.
@@ -254,9 +243,9 @@ class FrictionCoupling:
             if scale == 0.0 or weighted.max() <= self.settings.tolerance * scale:
                 self.apply(friction)
                 solver.InitializeSolverInitialConditions(self.mbs, settings)
-                self._accepted = [friction.copy()]
+                self._accepted = [tuple(friction.ravel().tolist())]
                 self._inputs = [inputs]
-                self._predicted_regime = self._regime(inputs)
+                self._predicted_regime = self.reader.regime
                 self._regimes = [self._predicted_regime]
                 self.initial = friction.copy()
                 return
@@ -276,11 +265,13 @@ class FrictionCoupling:
         self.reason = (f"no consistent friction state at the start: the fixed-point iteration "
                        f"did not converge in {max_iterations} iterations (loop gain >= 1)")
 
-    def apply(self, friction: Any) -> None:
-        """Set every friction load from ``friction`` (per pair ``(M_z, F_z)``, list or array)."""
-        values = friction.tolist() if isinstance(friction, np.ndarray) else friction
+    def apply(self, friction: Any, size: float | None = None) -> None:
+        """Set every friction load from ``friction``: flat ``(M_z, F_z)`` per pair, or an array
+        of shape (n, 2); ``size``: its largest magnitude, when known."""
+        values = tuple(friction.ravel().tolist()) if isinstance(friction, np.ndarray) else friction
         self.loads.apply(values)
         self.applied = values
+        self._applied_size = max(map(abs, values)) if size is None else size
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
         """Exudyn's post-Newton user function: update the friction, return the change as the
@@ -302,17 +293,18 @@ class FrictionCoupling:
     def _new_step(self, t: float) -> bool:
         """Bookkeeping at each evaluation; True at the first evaluation of a step (the one before
         was then accepted: its coordinates join the BDF2 history)."""
+        log = self.log
         if t == self._step_t:
             self._step_iter += 1
-            self.log.applied[-1] = list(self.applied)
-            self.log.iterations[-1] = self._step_iter + 1
+            log.applied[-1] = self.applied
+            log.iterations[-1] = self._step_iter + 1
             return False
         if self._step_t is not None:
-            self._history = [self._history[-1], (self._step_t, self._coords)]
+            self.reader.accept(self._step_t)
         self._step_t, self._step_iter = t, 0
-        self.log.t.append(t)
-        self.log.applied.append(list(self.applied))
-        self.log.iterations.append(1)
+        log.t.append(t)
+        log.applied.append(self.applied)
+        log.iterations.append(1)
         return True
 
     def _extrapolated(self, t: float) -> list[float]:
@@ -322,10 +314,11 @@ class FrictionCoupling:
         first = self._new_step(t)
         if self._iterating:
             return self._update(t, counted=True)
-        inputs = self._read_inputs(t)
+        inputs = self._last_inputs = self.reader.read(t)
+        regime = self.reader.regime
         if first:
             self._accepted_steps += 1
-            if self._reversed(inputs):
+            if self._reversed(inputs, regime):
                 self._iterating = True
                 self.iterated_steps += 1
                 return self._update(t, counted=True)
@@ -338,170 +331,162 @@ class FrictionCoupling:
             self._finish_probe(t, self._law(inputs))
             if self.escalated_at is not None:
                 return self._update(t, counted=True)
-        self._predict(inputs, self._current_regime if first else None)
+        self._predict(inputs, regime)
         return [0.0, -1.0]
 
-    def _reversed(self, inputs: list) -> bool:
+    def _reversed(self, inputs: list, regime: tuple) -> bool:
         """Whether a pair's motion crossed its sign ramp in fewer than :data:`RAMP_STEPS` steps
-        (from one side to the other or into it) between ``inputs`` and the steps the
-        extrapolation through them would use, or against the prediction this step was solved
+        (from one side to the other or into it) between ``inputs`` (of ``regime``) and the steps
+        the extrapolation through them would use, or against the prediction this step was solved
         with: its friction then jumps, and so do the reactions (the friction feeds back), which a
         line through the jump would carry into the next steps as an error of order one. The step
         is then solved to its fixed point (about three steps per reversal). A ramp resolved by the
         step is crossed smoothly and needs nothing (iterating there mixes fixed-point and
         extrapolated states in the stencil, which measured worse)."""
-        regime = self._current_regime = self._regime(inputs)
-        others = [self._predicted_regime, *self._regimes]
-        if all(regime == other for other in others):
+        others = (self._predicted_regime, *self._regimes)
+        for other in others:
+            if other != regime:
+                break
+        else:
             return False
         last = self._inputs[-1] if self._inputs else inputs
         for k, p in enumerate(self.pairs):
             for j, scale in ((0, p.weight), (1, 1.0)):
-                if all(other[k][j] == regime[k][j] for other in others):
+                if all(other[2 * k + j] == regime[2 * k + j] for other in others):
                     continue
                 if abs(inputs[k][2 + j] - last[k][2 + j]) * scale * RAMP_STEPS > p.bands[j]:
                     return True
         return False
 
-    def _regime(self, inputs: list) -> list[tuple[int, int]]:
-        """Per pair the side of its sign ramps each motion is on: -1, 0 (inside), +1."""
-        out = []
-        for p, (_, _, w, v) in zip(self.pairs, inputs, strict=True):
-            surface, band, slide_band = w * p.weight, p.bands[0], p.bands[1]
-            out.append(((surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band)))
-        return out
-
-    def _predict(self, inputs: list, regime: list | None = None) -> None:
-        """Accept the step's ``inputs`` (``regime``: theirs, when known) and apply the friction of
-        the law on the inputs extrapolated to the end of the next step (``1.5 x_n - 0.5 x_{n-2}``,
-        module doc)."""
+    def _predict(self, inputs: list, regime: tuple) -> None:
+        """Accept the step's ``inputs`` (of ``regime``) and apply the friction of the law on the
+        inputs extrapolated to the end of the next step (``1.5 x_n - 0.5 x_{n-2}``, module doc)."""
         hist, regimes = self._inputs, self._regimes
         hist.append(inputs)
-        regimes.append(self._regime(inputs) if regime is None else regime)
+        regimes.append(regime)
         if len(hist) > 3:
-            hist.pop(0)
-            regimes.pop(0)
+            del hist[0], regimes[0]
         if len(hist) == 3:
-            predicted = [(1.5 * f - 0.5 * f2, 1.5 * m - 0.5 * m2, 1.5 * w - 0.5 * w2, 1.5 * v - 0.5 * v2)
-                         for (f, m, w, v), (f2, m2, w2, v2) in zip(inputs, hist[0], strict=True)]
+            friction, self._predicted_regime, sliding, size = self.table.loads(inputs, hist[0], 1.5, 0.5)
         elif len(hist) == 2:
-            predicted = [(2.0 * f - f1, 2.0 * m - m1, 2.0 * w - w1, 2.0 * v - v1)
-                         for (f, m, w, v), (f1, m1, w1, v1) in zip(inputs, hist[0], strict=True)]
+            friction, self._predicted_regime, sliding, size = self.table.loads(inputs, hist[0], 2.0, 1.0)
         else:
-            predicted = inputs
-        self._predicted_regime = self._regime(predicted)
-        friction = self._law(predicted)
-        self._watch_growth(friction)
-        self.apply(friction)
+            friction, self._predicted_regime, sliding, size = self.table.loads(inputs)
+        self.scale_floor = REST_FLOOR * sliding
+        self._watch_growth(size)
+        self.apply(friction, size)
 
-    def _change(self, friction: list, before: list) -> float:
-        """Largest change between two friction states, forces weighted by ``d / 2`` [N m]."""
-        return max((max(abs(a[0] - b[0]), p.weight * abs(a[1] - b[1]))
-                    for p, a, b in zip(self.pairs, friction, before, strict=True)), default=0.0)
+    def _change(self, friction: tuple, before: tuple) -> float:
+        """Largest change between two flat friction states, forces weighted by ``d / 2`` [N m]."""
+        return max((w * abs(a - b) for w, a, b in zip(self._flat_weight, friction, before, strict=True)),
+                   default=0.0)
 
     def _finish_probe(self, t: float, friction: list) -> None:
         """Second solve of a probe step: the loop gain from the two changes; escalation."""
         first, change0 = self._probe
         self._probe = None
-        size = self._change(friction, [(0.0, 0.0)] * self.n)
+        size = self._change(friction, (0.0,) * (2 * self.n))
         if change0 <= PROBE_NOISE * max(size, self.scale_floor):
             return
         gain = self._change(friction, first) / change0
         self._gains.append(gain)
         if gain > ESCALATE_GAIN:
             self.escalated_at = t
-            self._xs, self._gs = [], []  # the converged iteration takes over within this step
+            self._xs, self._gs, self._rs = [], [], []  # the converged iteration takes over
 
     def _update(self, t: float, counted: bool = False) -> list[float]:
         """One evaluation of the converged or lagged scheme (``counted``: :meth:`_new_step` was
         already called for it)."""
         if not counted:
             self._new_step(t)
-        friction = self.evaluate(t)
-        applied = np.asarray(self.applied, dtype=float).reshape(self.n, 2)
+        friction, applied = self.evaluate(t), self.applied
         # forces enter as the torque they make at the journal radius, so one relative measure
         # covers both kinds of load
-        weighted = np.abs(friction) * self._weight
-        scale = max(float(weighted.max()), self.scale_floor)
-        change = float((np.abs(friction - applied) * self._weight).max())
+        weights = self._flat_weight
+        scale = max(max([w * abs(f) for w, f in zip(weights, friction, strict=True)]), self.scale_floor)
+        change = max([w * abs(f - a) for w, f, a in zip(weights, friction, applied, strict=True)])
         error = change / scale if scale > 0.0 else 0.0
         if self.mode == "lagged":
-            self._watch_growth(friction)
-            self.apply(friction)
+            size = max(map(abs, friction))
+            self._watch_growth(size)
+            self.apply(friction, size)
             return [0.0, -1.0]
         if self._step_iter == 0:
-            self._xs, self._gs = [], []
-        self._xs.append(applied.ravel().copy())
-        self._gs.append(friction.ravel().copy())
-        residuals = [g - x for x, g in zip(self._xs, self._gs, strict=True)]
-        if len(residuals) == 2:  # after one plain update: the contraction of the map
-            r0, r1 = np.linalg.norm(residuals[0]), np.linalg.norm(residuals[1])
-            if r0 > 1e-7 * max(float(np.abs(friction).max()), 1e-300):
+            self._xs, self._gs, self._rs = [], [], []
+        xs, rs = self._xs, self._rs
+        index = self._mask_index
+        x = np.array([applied[i] for i in index])
+        xs.append(x)
+        self._gs.append(friction)
+        rs.append(np.array([friction[i] for i in index]) - x)
+        if len(rs) == 2:  # after one plain update: the contraction of the map
+            r0, r1 = math.sqrt(rs[0] @ rs[0]), math.sqrt(rs[1] @ rs[1])
+            if r0 > 1e-7 * max(max(map(abs, friction)), 1e-300):
                 self._step_gain = r1 / r0
         if error <= self.settings.tolerance:
             self._accept(friction)
             return [0.0, -1.0]
-        if len(residuals) >= self.settings.max_iterations:
+        if len(rs) >= self.settings.max_iterations:
             self.unconverged_steps += 1
-            shrink = np.linalg.norm(residuals[-1]) / max(np.linalg.norm(residuals[0]), 1e-300)
+            shrink = math.sqrt(rs[-1] @ rs[-1]) / max(math.sqrt(rs[0] @ rs[0]), 1e-300)
             if shrink >= STALL_RATIO:
                 self.status = Status.SELF_LOCKING
                 self.reason = (f"no consistent friction state at t = {t:.6g} s: the fixed-point "
                                f"iteration stalled (residual ratio {shrink:.3g} after "
-                               f"{len(residuals)} iterations, contraction of the plain map "
+                               f"{len(rs)} iterations, contraction of the plain map "
                                f"{self._step_gain:.3g}); the loop gain of the friction feedback "
                                "is >= 1" + self._band_hint())
             self._accept(friction)
             return [0.0, -1.0]
-        self.apply(self._broyden(residuals).reshape(friction.shape))
+        self.apply(self._broyden())
         return [error, -1.0]
 
-    def _broyden(self, residuals: list[np.ndarray]) -> np.ndarray:
-        """Next friction guess: Broyden's quasi-Newton method on ``r(x) = Phi(x) - x``.
+    def _broyden(self) -> tuple[float, ...]:
+        """Next friction guess (flat): Broyden's quasi-Newton method on ``r(x) = Phi(x) - x``.
 
         The map friction -> reactions -> friction is nearly linear within a step (signs fixed)
         and changes slowly from step to step, so the secant approximation ``B`` of ``dr/dx`` is
         kept across steps (it starts as ``-I``, i.e. a plain fixed-point update, and is updated
         with every pair of iterates of the same step). After the first steps an accepted step
         typically needs two or three evaluations where the plain iteration contracts only with
-        the loop gain (0.6-0.9 at 10-35 deg).
+        the loop gain (0.6-0.9 at 10-35 deg). Works on the loads that can be non-zero
+        (:attr:`_mask_index`); the others stay 0.
         """
-        mask = self._mask
-        x = self._xs[-1][mask]
-        r = residuals[-1][mask]
+        xs, rs = self._xs, self._rs
+        x, r = xs[-1], rs[-1]
         if self._broyden_b is None:
-            self._broyden_b = -np.eye(mask.sum())
-        if len(residuals) >= 2:
-            dx = x - self._xs[-2][mask]
-            dr = r - residuals[-2][mask]
+            self._broyden_b = -np.eye(x.size)
+        if len(rs) >= 2:
+            dx = x - xs[-2]
+            dr = r - rs[-2]
             norm = float(dx @ dx)
             if norm > 0.0:
-                self._broyden_b += np.outer(dr - self._broyden_b @ dx, dx) / norm
+                self._broyden_b += (dr - self._broyden_b @ dx)[:, None] * dx / norm  # outer product
         try:
             step = np.linalg.solve(self._broyden_b, -r)
         except np.linalg.LinAlgError:
-            self._broyden_b = -np.eye(mask.sum())
+            self._broyden_b = -np.eye(x.size)
             step = r
-        out = self._gs[-1].copy()
-        out[mask] = x + step
-        return out
+        out = list(self._gs[-1])
+        for i, value in zip(self._mask_index, (x + step).tolist(), strict=True):
+            out[i] = value
+        return tuple(out)
 
-    def _accept(self, friction: np.ndarray) -> None:
-        """Step accepted: record the loop gain; predict the next step's friction by extrapolating
-        the last three steps.
+    def _accept(self, friction: tuple) -> None:
+        """Step accepted (``friction``: flat): record the loop gain; predict the next step's
+        friction by extrapolating the last three steps.
 
         Loop gain: the spectral radius of the Broyden approximation of d(friction out)/d(friction
         in), ``B + I``, i.e. the contraction of the plain fixed-point map friction -> reactions ->
         friction at this step (exact for the directions the iterations have explored).
 
         Quadratic extrapolation on the step grid (error O(h^3)) puts the first evaluation of the
-        next step within
-        about 1e-4 of its fixed point at the default step sizes, so one Broyden correction
-        usually meets the tolerance. It only sets the starting guess.
+        next step within about 1e-4 of its fixed point at the default step sizes, so one Broyden
+        correction usually meets the tolerance. It only sets the starting guess.
         """
         if self.mode == "extrapolated" and self.escalated_at is None:  # back to one solve per step
             self._iterating = False
-            self._predict(self._last_inputs)
+            self._predict(self._last_inputs, self.reader.regime)
             return
         self._accepted_steps += 1
         # the eigenvalues cost as much as a friction evaluation: every GAIN_EVERY-th step
@@ -509,13 +494,13 @@ class FrictionCoupling:
             g = self._broyden_b + np.eye(self._broyden_b.shape[0])
             self._gains.append(float(np.max(np.abs(np.linalg.eigvals(g)))))
         hist = self._accepted
-        hist.append(friction.copy())
+        hist.append(friction)
         if len(hist) > 3:
-            hist.pop(0)
+            del hist[0]
         if len(hist) == 3:
-            prediction = 3.0 * hist[2] - 3.0 * hist[1] + hist[0]
+            prediction = tuple(3.0 * c - 3.0 * b + a for a, b, c in zip(*hist, strict=True))
         elif len(hist) == 2:
-            prediction = 2.0 * hist[1] - hist[0]
+            prediction = tuple(2.0 * b - a for a, b in zip(*hist, strict=True))
         else:
             prediction = friction
         self.apply(prediction)
@@ -526,9 +511,10 @@ class FrictionCoupling:
         return (" (with a sign band of 0 the exact sign of rounding-level relative speeds decides "
                 "the direction of friction in pairs that do not move; use a positive band)")
 
-    def _watch_growth(self, friction: Any) -> None:
-        size = max(abs(v) for row in friction for v in row)
-        before = max(abs(v) for row in self.applied for v in row)
+    def _watch_growth(self, size: float) -> None:
+        """Self-locking watch of the one-solve schemes; ``size``: the largest magnitude of the
+        friction about to be applied."""
+        before = self._applied_size
         if before > 0.0 and size > before:
             if self._growth_steps == 0:  # growth out of rounding noise (pairs at rest) is no locking
                 self._growth_start = max(before, self.scale_floor)
@@ -577,7 +563,7 @@ class FrictionCoupling:
             return out
         # the initial row (no step yet): the initial friction, else that of the first step
         t_log = np.asarray(self.log.t)
-        applied = np.asarray(self.log.applied)
+        applied = np.asarray(self.log.applied).reshape(len(self.log.applied), self.n, 2)
         index = np.searchsorted(t_log, times - 1e-12 * max(1.0, abs(times[-1])))
         index[0] = 0 if times[0] < t_log[0] else index[0]
         valid = (index < len(t_log))

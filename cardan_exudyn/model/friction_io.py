@@ -3,6 +3,10 @@
 The friction coupling (:mod:`cardan_exudyn.model.coupling`) evaluates the law after every Newton
 solve; on this model numpy on three-vectors costs more than the law itself, so everything here is
 float arithmetic on values read once per evaluation.
+The coupling's hot path reads through :class:`PairReader` (one pass over the pairs; the
+functions below are the same reads one quantity at a time, for the initial state and the tests).
+About half of an evaluation is Exudyn's: one ``GetObjectOutput`` per pair angle and slide
+(1.2-1.4 us each) and one ``SetLoadParameter`` per load (0.9 us).
 
 Reactions
 ---------
@@ -46,12 +50,13 @@ import numpy as np
 from cardan_exudyn.model.friction_law import bdf2_weights
 
 __all__ = ["PairChannel", "pair_channel", "read_reactions", "pair_coordinates", "bdf2_speeds",
-           "initial_speeds", "BodyLoads"]
+           "initial_speeds", "PairReader", "BodyLoads"]
 
 _ROTATION = exu.OutputVariableType.Rotation
 _DISPLACEMENT = exu.OutputVariableType.DisplacementLocal
 _ANGULAR_VELOCITY = exu.OutputVariableType.AngularVelocityLocal
 _VELOCITY = exu.OutputVariableType.VelocityLocal
+_CURRENT = exu.ConfigurationType.Current
 _PI, _TWO_PI = math.pi, 2.0 * math.pi
 
 
@@ -139,6 +144,102 @@ def initial_speeds(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, f
              float(get(c.joint, _VELOCITY)[2]) if c.slides else 0.0) for c in channels]
 
 
+class PairReader:
+    """The law's inputs of every pair after a Newton solve, in one pass (the coupling's hot path).
+
+    Gives what :func:`read_reactions`, :func:`pair_coordinates` and :func:`bdf2_speeds` (or
+    :func:`initial_speeds`) give together, to the last bit, and keeps the coordinates of the last
+    two accepted steps for the backward differences. In the same pass it sets :attr:`regime`, the
+    side of its sign ramps each pair's motion is on (as
+    :meth:`cardan_exudyn.model.friction_law.LawTable.loads` gives it for the inputs it evaluates).
+
+    Parameters
+    ----------
+    mbs : exudyn MainSystem
+        Assembled.
+    channels : list of PairChannel
+    start_time : float
+        Time of the initial state, whose coordinates start the history [s].
+    sides : list of (float, float, float)
+        Per pair the journal radius [m] and the widths of the rotation's and the sliding's sign
+        ramps [m/s].
+    """
+
+    def __init__(self, mbs: Any, channels: list[PairChannel], start_time: float,
+                 sides: list[tuple[float, float, float]]) -> None:
+        self.mbs = mbs
+        self.channels = list(channels)
+        self._get = mbs.GetObjectOutput
+        self._multipliers = mbs.systemData.GetAECoordinates
+        self._rows = [(c.joint, c.ae, c.force_rows, c.slides, *side)
+                      for c, side in zip(self.channels, sides, strict=True)]
+        self.regime: tuple[int, ...] = ()
+        self.coords = pair_coordinates(mbs, self.channels)
+        self._t1, self._c1 = start_time, self.coords
+        self._t2 = self._c2 = None
+        self._back: list | None = None  # per pair (a1, s1, d2, s1 - s2) of the accepted steps
+        self._steps = self._weights = (None, None)
+
+    def accept(self, t: float) -> None:
+        """The coordinates read last are those of the step accepted at ``t`` [s]."""
+        self._t2, self._c2 = self._t1, self._c1
+        self._t1, self._c1 = t, self.coords
+        self._back = [(a1, s1, (a1 - a2 + _PI) % _TWO_PI - _PI, s1 - s2)
+                      for (a1, s1), (a2, s2) in zip(self._c1, self._c2, strict=True)]
+
+    def read(self, t: float | None) -> list[tuple[float, float, float, float]]:
+        """Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])`` at the current
+        state (``t`` None: the initial state, with velocity-level speeds; else BDF2 over the
+        accepted steps, and the coordinates are kept as :attr:`coords`)."""
+        if t is None or self._back is None:
+            return self._read_plain(t)
+        h1, h2 = t - self._t1, self._t1 - self._t2
+        if (h1, h2) != self._steps:
+            w1, w2 = bdf2_weights(h1, h2)
+            self._steps, self._weights = (h1, h2), (w1 / h1, w2 / h1)
+        w1, w2 = self._weights
+        ae = self._multipliers(_CURRENT, False).tolist()
+        get, hypot = self._get, math.hypot
+        coords, out, regime = [], [], []
+        for (joint, i, rows, slides, radius, band, slide_band), (a1, s1, d2, e2) in zip(
+                self._rows, self._back, strict=True):
+            a = float(get(joint, _ROTATION)[2])
+            if slides:
+                s = float(get(joint, _DISPLACEMENT)[2])
+                v = w1 * (s - s1) - w2 * e2
+            else:
+                s = v = 0.0
+            coords.append((a, s))
+            if rows is None:
+                fx, fy = ae[i], ae[i + 1]
+            else:
+                (ra, rb, rd), (re, rf, rg) = rows
+                gx, gy, gz = ae[i], ae[i + 1], ae[i + 2]
+                fx, fy = ra * gx + rb * gy + rd * gz, re * gx + rf * gy + rg * gz
+            w = w1 * ((a - a1 + _PI) % _TWO_PI - _PI) - w2 * d2
+            out.append((hypot(fx, fy), hypot(ae[i + 3], ae[i + 4]), w, v))
+            surface = radius * w
+            regime += ((surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band))
+        self.coords, self.regime = coords, tuple(regime)
+        return out
+
+    def _read_plain(self, t: float | None) -> list[tuple[float, float, float, float]]:
+        reactions = read_reactions(self.mbs, self.channels)
+        if t is None:
+            speeds = initial_speeds(self.mbs, self.channels)
+        else:
+            self.coords = pair_coordinates(self.mbs, self.channels)
+            speeds = bdf2_speeds(self.coords, t - self._t1, self._c1)
+        out = [(math.hypot(fx, fy), math.hypot(mx, my), w, v)
+               for (fx, fy, mx, my), (w, v) in zip(reactions, speeds, strict=True)]
+        regime: list[int] = []
+        for (*_, radius, band, slide_band), (_, _, w, v) in zip(self._rows, out, strict=True):
+            surface = radius * w
+            regime += ((surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band))
+        self.regime = tuple(regime)
+        return out
+
+
 class BodyLoads:
     """The merged friction loads of the moving bodies (see the module doc).
 
@@ -154,12 +255,12 @@ class BodyLoads:
         for k, (parts, axis, slide) in enumerate(zip(contributions, axes, slides, strict=True)):
             for body, point, role in parts:
                 entry = bodies.setdefault(body, {"torque": [], "force": []})
-                entry["torque"].append((k, 0, *(role * float(c) for c in axis)))
+                entry["torque"].append((2 * k, *(role * float(c) for c in axis)))
                 if slide:
                     arm = np.cross(point, axis)
-                    entry["torque"].append((k, 1, *(role * float(c) for c in arm)))
-                    entry["force"].append((k, 1, *(role * float(c) for c in axis)))
-        self._loads = []  # (load number, [(pair, column, x, y, z)])
+                    entry["torque"].append((2 * k + 1, *(role * float(c) for c in arm)))
+                    entry["force"].append((2 * k + 1, *(role * float(c) for c in axis)))
+        self._loads = []  # (load number, [(index in the flat friction, x, y, z)])
         self.kinds: list[str] = []  # "torque" or "force", per load added
         for body, entry in bodies.items():
             marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
@@ -169,13 +270,14 @@ class BodyLoads:
                     self._loads.append((load, entry[kind]))
                     self.kinds.append(kind)
 
-    def apply(self, friction: list) -> None:
-        """Set every load from ``friction``, per pair ``(torque, force)`` on body b [N m, N]."""
+    def apply(self, friction: tuple) -> None:
+        """Set every load from ``friction``, flat ``(torque_0, force_0, torque_1, ...)`` on body b
+        of each pair [N m, N]."""
         set_load = self.mbs.SetLoadParameter
         for load, terms in self._loads:
             x = y = z = 0.0
-            for k, j, ax, ay, az in terms:
-                value = friction[k][j]
+            for index, ax, ay, az in terms:
+                value = friction[index]
                 x += value * ax
                 y += value * ay
                 z += value * az

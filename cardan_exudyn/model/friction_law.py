@@ -40,7 +40,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-__all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "magnitude_loads", "bdf2_weights"]
+__all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "magnitude_loads", "bdf2_weights",
+           "LawTable"]
 
 
 @dataclass(frozen=True)
@@ -168,3 +169,95 @@ def bdf2_weights(h1: float, h2: float) -> tuple[float, float]:
     """
     w = h1 / h2
     return (1.0 + 2.0 * w) / (1.0 + w), w * w / (1.0 + w)
+
+
+class LawTable:
+    """The laws of a coupling's pairs, evaluated together on the law's inputs (the hot path).
+
+    Gives, to the last bit, what :func:`magnitude_loads` gives pair by pair (the same operations in
+    the same order), and in the same pass each pair's regime and the largest loads.
+
+    Parameters
+    ----------
+    laws : list of PairLaw
+    bands : list of (float, float, float)
+        Per pair the widths of the sign ramps: rotation, sliding, resultant [m/s].
+    slides : list of bool
+        Per pair whether its axial force acts (else it is 0, whatever the law gives).
+    """
+
+    def __init__(self, laws: list[PairLaw], bands: list[tuple[float, float, float]],
+                 slides: list[bool]) -> None:
+        self.laws = list(laws)
+        self.bands = [tuple(float(b) for b in band) for band in bands]
+        self.slides = list(slides)
+        self._rows = [(law, 0.5 * law.d, law.f * law.d, law.lever, law.f * (0.5 * law.d), law.f,
+                       law.cylindrical, slide, band, band > 0.0, slide_band, slide_band > 0.0,
+                       resultant if law.resultant else None)
+                      for law, (band, slide_band, resultant), slide in zip(self.laws, self.bands,
+                                                                           self.slides, strict=True)]
+
+    def loads(self, inputs: list, older: list | None = None, a: float = 1.0,
+              b: float = 0.0) -> tuple[tuple[float, ...], tuple[int, ...], float, float]:
+        """The friction on the law's ``inputs`` or, with ``older``, on ``a x - b x_older``.
+
+        Parameters
+        ----------
+        inputs, older : list of (float, float, float, float)
+            Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])``.
+        a, b : float
+            Weights of the extrapolation through ``inputs`` and ``older`` [-].
+
+        Returns
+        -------
+        friction : tuple of float
+            Flat ``(M_z_0, F_z_0, M_z_1, ...)`` on body b of each pair [N m, N].
+        regime : tuple of int
+            Per pair the side of its two sign ramps the motion the law was evaluated on is on
+            (-1, 0 inside, +1), flat: ``(rotation_0, sliding_0, rotation_1, ...)``.
+        sliding : float
+            The largest ``sliding_scale`` of the pairs [N m].
+        size : float
+            The largest ``|M_z|`` or ``|F_z|`` [N m or N].
+        """
+        friction: list[float] = []
+        regime: list[int] = []
+        sliding = size = 0.0
+        for row, x, y in zip(self._rows, inputs, inputs if older is None else older, strict=True):
+            law, radius, fd, lever, fr, f, cylindrical, slide, band, ramp, slide_band, slide_ramp, res = row
+            force_n, moment_n, omega, slide_rel = x
+            if older is not None:
+                force_n, moment_n = a * force_n - b * y[0], a * moment_n - b * y[1]
+                omega, slide_rel = a * omega - b * y[2], a * slide_rel - b * y[3]
+            surface = radius * omega
+            turn = (surface > band) - (surface < -band)
+            axial_side = (slide_rel > slide_band) - (slide_rel < -slide_band)
+            regime += (turn, axial_side)
+            if res is not None:
+                torque, axial, scale = magnitude_loads(law, force_n, moment_n, omega, slide_rel,
+                                                       band, slide_band, res)
+                if not slide:
+                    axial = 0.0
+            else:
+                torque = fd * moment_n / lever + fr * force_n
+                axial = 0.0
+                if cylindrical:
+                    magnitude = f * (force_n + 2.0 * moment_n / lever)
+                    scale = radius * magnitude
+                    if not scale > torque:
+                        scale = torque
+                    if slide:
+                        side = axial_side if axial_side or not slide_ramp else slide_rel / slide_band
+                        axial = -side * magnitude
+                else:
+                    scale = torque
+                torque = -(turn if turn or not ramp else surface / band) * torque
+            if scale > sliding:
+                sliding = scale
+            friction += (torque, axial)
+            torque, axial = abs(torque), abs(axial)
+            if torque > size:
+                size = torque
+            if axial > size:
+                size = axial
+        return tuple(friction), tuple(regime), sliding, size
