@@ -62,6 +62,7 @@ from reference.dynamics import (
     slot_speeds,
     solve_dynamics,
 )
+from reference.fixed_point import power_bound
 from reference.joint_motion import joint_motion
 from reference.loop_closure import LoopClosureError
 from reference.scene import Scene
@@ -237,11 +238,15 @@ def _spectral_radius(matrix: np.ndarray) -> float:
 
 def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
     """:func:`reference.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
-    or the infinity norm (an upper bound) where that is below ``exact_from``."""
+    or an upper bound (the infinity norm, :func:`reference.fixed_point.power_bound`) where that is
+    below ``exact_from``."""
     norm = float(np.abs(matrix).sum(1).max())
     if not math.isfinite(norm):
         return math.inf
-    return norm if norm < exact_from else _spectral_radius(matrix)
+    if norm < exact_from:
+        return norm
+    bound = float(power_bound(matrix[None], np.array([norm]))[0])
+    return bound if bound < exact_from else _spectral_radius(matrix)
 
 
 def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
