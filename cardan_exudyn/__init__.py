@@ -18,13 +18,14 @@ from __future__ import annotations
 from reference.lazy import lazy_face
 
 __all__ = [
-    "run", "make_options", "options_class", "ENGINES", "EngineUnavailable",
+    "run", "run_batch", "make_options", "options_class", "ENGINES", "EngineUnavailable",
     "ExudynOptions", "compare", "Comparison", "sweep",
     "Result", "Summary", "Status", "OptionsError",
 ]
 
 _LAZY = {
     "run": "cardan_exudyn.engines",
+    "run_batch": "cardan_exudyn.engines",
     "make_options": "cardan_exudyn.engines",
     "options_class": "cardan_exudyn.engines",
     "ENGINES": "cardan_exudyn.engines",

@@ -200,7 +200,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         spec = sweep_spec_from_args(args)
         summary = run_sweep(spec, args.out, workers=args.workers, scheduler=args.scheduler,
                             restart=args.restart, retry_failed=args.retry_failed,
-                            progress=False if args.quiet else None)
+                            progress=False if args.quiet else None, batch_size=args.batch_size)
     except SweepError as exc:
         raise BadInput(str(exc)) from None
     except SweepIncomplete as exc:
@@ -273,6 +273,10 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
                        help="local processes (default: all cores; 1 runs in this process)")
     where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                        help="run on this Dask distributed scheduler instead")
+    p.add_argument("--batch-size", type=count("--batch-size"), metavar="N",
+                   help="most cases per batch of an engine with a batched pass (the reference engine; "
+                        "default 1000, fewer when each worker would get under four batches; 1: every "
+                        "case on its own)")
     p.add_argument("--restart", action="store_true", help="discard the records in --out and start over")
     p.add_argument("--retry-failed", action="store_true", help="rerun the cases recorded as failed")
     p.add_argument("--quiet", action="store_true", help="no progress bar, no closing line")

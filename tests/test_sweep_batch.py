@@ -236,3 +236,27 @@ def test_tolerance_study_runs_in_batches_and_equals_single_runs(tmp_path, batche
         single = engines.run(replace(scene, **record["overrides"]), "reference").summary
         assert record["mean_efficiency"] == pytest.approx(single.mean_efficiency, abs=AGREEMENT)
         assert set(record["overrides"]) == set(default_distributions())
+
+
+def test_cli_batch_size_caps_the_batches(tmp_path, batches):
+    """``cardan sweep --batch-size N`` reaches the runner: 12 cases (which would run as four
+    batches of 3 in one process) in batches of at most 2, and ``--batch-size 1`` runs each case
+    on its own."""
+    import json
+
+    from cardan_exudyn.cli import main
+
+    spec = tmp_path / "spec.toml"
+    torques_ = ", ".join(str(1.0 + 0.25 * i) for i in range(12))
+    spec.write_text('engine = "reference"\nscene = "paper-literal-10deg"\n'
+                    '[fixed]\n"record.timeseries" = false\n'
+                    f'[grid]\n"load.torque" = [{torques_}]\n', encoding="utf-8")
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "two"), "--workers", "1", "--quiet",
+                 "--batch-size", "2"]) == 0
+    assert batches == [2] * 6
+    batching = json.loads((tmp_path / "two" / "sweep.json").read_text(encoding="utf-8"))["batching"]
+    assert batching == {"batches": 6, "batched_cases": 12, "largest_batch": 2}
+    batches.clear()
+    assert main(["sweep", str(spec), "--out", str(tmp_path / "one"), "--workers", "1", "--quiet",
+                 "--batch-size", "1"]) == 0
+    assert batches == []
