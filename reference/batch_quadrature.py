@@ -18,6 +18,7 @@ import numpy as np
 from reference.batch_model import SceneStack
 from reference.crossings import (
     SCAN_PER_REVOLUTION,
+    distinct_instants,
     grazing_brackets,
     grazing_candidates,
     sign_change_brackets,
@@ -75,7 +76,7 @@ def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
         active &= np.bincount(k, (~converged).astype(float), len(members)) > 0
         if not np.any(active):
             break
-    return [np.unique(b[k == i]) for i in range(len(members))]
+    return [distinct_instants(b[k == i], t_b[i] - t_a[i]) for i in range(len(members))]
 
 
 def _gauss(integrand: Callable, rules: dict, nodes: np.ndarray, owner: np.ndarray, lo: np.ndarray,

@@ -18,10 +18,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SCAN_PER_REVOLUTION", "sign_change_brackets", "grazing_candidates", "grazing_brackets"]
+__all__ = ["SCAN_PER_REVOLUTION", "MERGE", "sign_change_brackets", "grazing_candidates", "grazing_brackets",
+           "distinct_instants"]
 
 SCAN_PER_REVOLUTION = 256
 """Samples per input revolution of the scan (at least 64 per scan)."""
+MERGE = 1e-12
+"""Refined crossings closer than this share of the scanned span are one (two slots with the same
+crossing, e.g. the two spider pairs, converge to instants a few ulp apart)."""
 
 
 def sign_change_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray) -> list[tuple]:
@@ -70,3 +74,11 @@ def grazing_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray,
         f_lo, f_hi = values[lo, col] - levels[col], values[hi, col] - levels[col]
         out += [(grid[lo], t_v, f_lo, f_v, col, levels[col]), (t_v, grid[hi], f_v, f_hi, col, levels[col])]
     return out
+
+
+def distinct_instants(instants: np.ndarray, span: float) -> np.ndarray:
+    """Sorted ``instants`` [s] with those within ``MERGE * span`` of the one before dropped."""
+    t = np.unique(instants)
+    if t.size < 2:
+        return t
+    return t[np.concatenate([[True], np.diff(t) > MERGE * span])]

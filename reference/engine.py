@@ -30,6 +30,7 @@ import numpy as np
 from reference.bands import sign_bands
 from reference.crossings import (
     SCAN_PER_REVOLUTION,
+    distinct_instants,
     grazing_brackets,
     grazing_candidates,
     sign_change_brackets,
@@ -308,7 +309,7 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
         b, f_b = c, f_c
         if np.all((np.abs(b - a) <= 1e-15) | (f_b == 0.0)):
             break
-    return np.unique(b)
+    return distinct_instants(b, t_b - t_a)
 
 
 def _time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> float:

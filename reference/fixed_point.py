@@ -75,9 +75,10 @@ class FixedPoint:
         Newton converged to the relative tolerance.
     loop_gain : ndarray, shape (n,)
         Spectral radius of ``dG/dphi`` at the solution (0 without friction); where an upper
-        bound -- its infinity norm, or :func:`power_bound` -- is below ``exact_gain`` (0.5 or
-        1), that bound is reported instead (enough to tell that the sample does not lock);
-        infinite where Newton found no solution.
+        bound is below ``exact_gain``, that bound is reported instead (enough to tell that the
+        sample does not lock): the infinity norm, and with ``exact_gain`` >= 1 (the verdict
+        only, as the quadrature asks) also :func:`power_bound`; infinite where Newton found no
+        solution.
     iterations : int
         Newton iterations of the slowest sample.
     """
@@ -170,8 +171,9 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
     finite = np.all(np.isfinite(gain_matrix), (-2, -1))
     gain = np.where(finite, np.max(np.sum(np.abs(gain_matrix), -1), -1), np.inf)
     exact = finite & (gain >= exact_gain)  # the spectral radius is at most any induced norm
-    gain[exact] = power_bound(gain_matrix[exact], gain[exact])
-    exact &= gain >= exact_gain
+    if exact_gain >= 1.0:  # only the verdict is asked for: a sharper bound may settle it
+        gain[exact] = power_bound(gain_matrix[exact], gain[exact])
+        exact &= gain >= exact_gain
     gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
     gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
     return FixedPoint(x, phi, converged, gain, iterations)

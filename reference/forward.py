@@ -238,15 +238,18 @@ def _spectral_radius(matrix: np.ndarray) -> float:
 
 def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
     """:func:`reference.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
-    or an upper bound (the infinity norm, :func:`reference.fixed_point.power_bound`) where that is
-    below ``exact_from``."""
+    or an upper bound where that is below ``exact_from`` (the infinity norm; for ``exact_from`` >= 1
+    also :func:`reference.fixed_point.power_bound`)."""
     norm = float(np.abs(matrix).sum(1).max())
     if not math.isfinite(norm):
         return math.inf
     if norm < exact_from:
         return norm
-    bound = float(power_bound(matrix[None], np.array([norm]))[0])
-    return bound if bound < exact_from else _spectral_radius(matrix)
+    if exact_from >= 1.0:  # the verdict only
+        bound = float(power_bound(matrix[None], np.array([norm]))[0])
+        if bound < exact_from:
+            return bound
+    return _spectral_radius(matrix)
 
 
 def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,

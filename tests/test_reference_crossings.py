@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from reference.crossings import grazing_brackets, grazing_candidates, sign_change_brackets
+from reference.crossings import distinct_instants, grazing_brackets, grazing_candidates, sign_change_brackets
 from reference.engine import run
 from reference.paper import named_scene, rig_scene
 from reference.periodic import period_rows, repeat_period
@@ -57,6 +57,12 @@ def test_no_candidates_without_an_extremum_near_the_level():
     grid = np.linspace(0.0, 1.0, 11)
     values = np.column_stack([np.cos(2 * math.pi * grid) + 3.0, grid])
     assert grazing_candidates(grid, values, np.zeros(2)) == []
+
+
+def test_crossings_a_few_ulp_apart_are_one():
+    t = np.array([0.3, 0.25011515372109666, 0.1, 0.2501151537210966, 0.25011515372109666])
+    assert distinct_instants(t, 1.0).tolist() == [0.1, 0.2501151537210966, 0.3]
+    assert distinct_instants(np.array([0.1, 0.1 + 1e-9]), 1.0).size == 2  # distinct crossings stay
 
 
 def test_period_rows():
