@@ -48,8 +48,9 @@ from reference.joint import PAIR_NAMES
 from reference.joint_motion import joint_motion
 from reference.scene import AngleDrive, Scene
 
-__all__ = ["PROFILE_SAMPLES", "SPEED_FLOOR", "PairBands", "PairSpeeds",
-           "characteristic_speeds", "nominal_speed", "sign_bands"]
+__all__ = ["PROFILE_SAMPLES", "SPEED_FLOOR", "PairBands", "PairSpeeds", "characteristic_speeds",
+           "profile_angles", "speeds_from_profile", "needs_speeds", "bands_from_speeds", "nominal_speed",
+           "sign_bands"]
 
 SPEED_FLOOR = 1e-3
 """A pair's characteristic speed is taken as at least this fraction of the scene's largest [-]."""
@@ -109,16 +110,52 @@ def characteristic_speeds(scene: Scene) -> dict[str, PairSpeeds]:
     reference.loop_closure.LoopClosureError
         The joint's mounting errors keep the loop from closing at some angle.
     """
-    theta = np.linspace(0.0, 2.0 * math.pi, PROFILE_SAMPLES, endpoint=False)
-    motion = joint_motion(scene.joint, theta, 1.0, 0.0)
+    motion = joint_motion(scene.joint, profile_angles(), 1.0, 0.0)
+    return speeds_from_profile(scene, motion.omega_rel, motion.slide_rel)
+
+
+def profile_angles() -> np.ndarray:
+    """The input angles [rad] of the speed profile: :data:`PROFILE_SAMPLES` over one turn."""
+    return np.linspace(0.0, 2.0 * math.pi, PROFILE_SAMPLES, endpoint=False)
+
+
+def speeds_from_profile(scene: Scene, omega_rel: dict[str, np.ndarray],
+                        slide_rel: dict[str, np.ndarray]) -> dict[str, PairSpeeds]:
+    """:func:`characteristic_speeds` from the pairs' relative angular [rad/s] and sliding [m/s]
+    speeds at the :func:`profile_angles` for an input turning at 1 rad/s (per pair, shape (360,))."""
     w = nominal_speed(scene)
 
     def rms(v: np.ndarray) -> float:
         return float(w * np.sqrt(np.mean(np.square(v))))
 
-    return {p: PairSpeeds(rms(0.5 * getattr(scene.joint.pairs, p).journal_diameter * motion.omega_rel[p]),
-                          rms(motion.slide_rel[p]))
+    return {p: PairSpeeds(rms(0.5 * getattr(scene.joint.pairs, p).journal_diameter * omega_rel[p]),
+                          rms(slide_rel[p]))
             for p in PAIR_NAMES}
+
+
+def needs_speeds(scene: Scene) -> bool:
+    """Whether the scene's bands are relative to its characteristic speeds (else they are given)."""
+    return scene.friction.sign_band is None and scene.friction.relative_band != 0.0
+
+
+def bands_from_speeds(scene: Scene, speeds: dict[str, PairSpeeds] | None) -> dict[str, PairBands]:
+    """:func:`sign_bands` from the characteristic speeds (None where :func:`needs_speeds` is
+    False): the rule of that function, for a caller that computed the speeds itself."""
+    return dict(zip(PAIR_NAMES, _from_speeds(scene, speeds), strict=True))
+
+
+def _from_speeds(scene: Scene, speeds: dict[str, PairSpeeds] | None) -> tuple[PairBands, ...]:
+    settings = scene.friction
+    if settings.sign_band is not None:
+        return tuple(PairBands(settings.sign_band, settings.sign_band, settings.sign_band)
+                     for _ in PAIR_NAMES)
+    relative = settings.relative_band
+    if relative == 0.0:
+        return tuple(PairBands(0.0, 0.0, 0.0) for _ in PAIR_NAMES)
+    floor = SPEED_FLOOR * max(max(s) for s in speeds.values())
+    return tuple(PairBands(relative * max(speeds[p].rotation, floor),
+                           relative * max(speeds[p].sliding, floor),
+                           relative * max(math.hypot(*speeds[p]), floor)) for p in PAIR_NAMES)
 
 
 def sign_bands(scene: Scene) -> dict[str, PairBands]:
@@ -140,15 +177,4 @@ def sign_bands(scene: Scene) -> dict[str, PairBands]:
 @functools.lru_cache(maxsize=64)
 def _bands(scene: Scene) -> tuple[PairBands, ...]:
     # cached per scene (frozen, hashable): engines ask for the bands at every evaluation
-    settings = scene.friction
-    if settings.sign_band is not None:
-        return tuple(PairBands(settings.sign_band, settings.sign_band, settings.sign_band)
-                     for _ in PAIR_NAMES)
-    relative = settings.relative_band
-    if relative == 0.0:
-        return tuple(PairBands(0.0, 0.0, 0.0) for _ in PAIR_NAMES)
-    speeds = characteristic_speeds(scene)
-    floor = SPEED_FLOOR * max(max(s) for s in speeds.values())
-    return tuple(PairBands(relative * max(speeds[p].rotation, floor),
-                           relative * max(speeds[p].sliding, floor),
-                           relative * max(math.hypot(*speeds[p]), floor)) for p in PAIR_NAMES)
+    return _from_speeds(scene, characteristic_speeds(scene) if needs_speeds(scene) else None)

@@ -29,7 +29,6 @@ from collections.abc import Hashable, Sequence
 
 import numpy as np
 
-from reference.bands import sign_bands
 from reference.batch_model import SceneStack
 from reference.batch_quadrature import work_quadratures
 from reference.dynamics import friction_slots
@@ -44,9 +43,7 @@ from reference.engine import (
     table_times,
     table_verdict,
 )
-from reference.loop_closure import LoopClosureError
 from reference.periodic import period_rows, repeat_period
-from reference.rccc import DHParameters, solve_positions
 from reference.scene import Scene, SpeedDrive, scene_to_dict
 from reference.schema import OptionsError, Result, Status, Summary, result_table
 from reference.validation import SceneError, check_steps, require_scene
@@ -113,37 +110,24 @@ def _summary(scene: Scene, options: ReferenceOptions) -> Summary:
                    options={k: getattr(options, k) for k in options.__dataclass_fields__})
 
 
-def _closes(scene: Scene) -> bool:
-    """The checks the engine's first steps make: the sign bands (a joint motion over one
-    revolution, which also checks the loop's windings) or, without friction, the loop at 0."""
-    try:
-        if scene.has_friction:
-            sign_bands(scene)
-        elif scene.joint.errors.any:
-            solve_positions(DHParameters.of_joint(scene.joint), np.zeros(1))
-    except LoopClosureError:
-        return False
-    return True
-
-
 def _run_chunk(scenes: list[Scene], options: ReferenceOptions) -> list[Result]:
     """Results of scenes sharing one batch key (see the module documentation)."""
     start = time.perf_counter()
-    alone = {i for i, scene in enumerate(scenes) if not _closes(scene)}
-    members = [i for i in range(len(scenes)) if i not in alone]
+    # the checks the engine's first steps make (the loop at 0, its windings, its closure on the
+    # sign bands' profile) for all at once; the scenes that pass are evaluated together
+    stack = SceneStack(scenes)
+    members = [k for k in range(len(scenes)) if k not in stack.failed]
+    if stack.failed and members:
+        stack = SceneStack([scenes[k] for k in members], [stack.sign_bands[k] for k in members])
     results: dict[int, Result] = {}
     if members:
-        stack = SceneStack([scenes[i] for i in members])
         tables = _tables(stack, options)
-        for k, i in enumerate(members):
-            if k not in stack.failed:
-                results[i] = tables[k]
-        alone.update(members[k] for k in stack.failed)
+        results = {k: tables[j] for j, k in enumerate(members) if j not in stack.failed}
     share = (time.perf_counter() - start) / max(1, len(results))
     for result in results.values():
         result.summary.wall_time_s = share
-    results.update({i: run(scenes[i], options) for i in sorted(alone)})
-    return [results[i] for i in range(len(scenes))]
+    results.update({k: run(scenes[k], options) for k in range(len(scenes)) if k not in results})
+    return [results[k] for k in range(len(scenes))]
 
 
 def _tables(stack: SceneStack, options: ReferenceOptions) -> list[Result]:
@@ -162,7 +146,7 @@ def _tables(stack: SceneStack, options: ReferenceOptions) -> list[Result]:
     for k, scene in enumerate(stack.scenes):
         summary = _summary(scene, options)
         if scene.has_friction:
-            summary.extras["sign_bands_m_s"] = {p: list(b) for p, b in sign_bands(scene).items()}
+            summary.extras["sign_bands_m_s"] = {p: list(b) for p, b in stack.sign_bands[k].items()}
         table_verdict(times[k], tables[k], summary)
         summaries.append(summary)
     ok = [k for k, s in enumerate(summaries) if s.success]

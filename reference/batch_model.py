@@ -22,6 +22,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from reference import kinematics, rccc
+from reference.bands import (
+    PairBands,
+    PairSpeeds,
+    bands_from_speeds,
+    needs_speeds,
+    profile_angles,
+    speeds_from_profile,
+)
 from reference.dual import Dual
 from reference.dynamics import (
     DRIVE_ROW,
@@ -107,11 +115,16 @@ class SceneStack:
     Parameters
     ----------
     scenes : sequence of Scene
-        Constant speed, constant load; their sign bands (:func:`reference.bands.sign_bands`)
-        must be computable (the loop closes on its profile grid).
+        Constant speed, constant load (:func:`reference.batch.batch_key`).
+    sign_bands : sequence of dict, optional
+        Each scene's :func:`reference.bands.sign_bands`, known from an earlier stack of the same
+        scenes (then the windings are not checked again); None: computed here for all scenes at
+        once, with the checks the engine makes on the way (:meth:`_sign_bands`). A scene that
+        fails a check is in :attr:`failed` and its bands are placeholders: evaluate a stack of
+        the others (a scene whose loop does not close makes the Newton-Euler matrices singular).
     """
 
-    def __init__(self, scenes: Sequence[Scene]) -> None:
+    def __init__(self, scenes: Sequence[Scene], sign_bands: Sequence[dict] | None = None) -> None:
         self.scenes = list(scenes)
         first = self.scenes[0]
         self.first, self.slots = first, friction_slots(first)
@@ -125,13 +138,16 @@ class SceneStack:
             self.mass[name] = tuple(np.array([p[k] for p in props], float) for k in range(3))
         coefficients = np.array([_slot_coefficients(s, self.slots) for s in self.scenes])
         self.diameter, self.k_force, self.k_moment = np.moveaxis(coefficients, -1, 0)
-        # sign_bands (a joint motion over a revolution) only for scenes with friction, as the engine
-        self.bands = np.array([slot_bands(s, self.slots) if self.slots else np.zeros(0)
-                               for s in self.scenes]).reshape(len(self.scenes), -1)
-        self.ramp_bands = np.array([ramp_bands(s, self.slots) if self.slots else np.zeros(0)
-                                    for s in self.scenes]).reshape(len(self.scenes), -1)
         self.failed: set[int] = set()
         self._geometry()
+        # sign_bands (a joint motion over a revolution) only for scenes with friction, as the engine
+        self.sign_bands = self._sign_bands() if sign_bands is None else list(sign_bands)
+        self.bands = np.array([slot_bands(s, self.slots, b) if self.slots else np.zeros(0)
+                               for s, b in zip(self.scenes, self.sign_bands, strict=True)]
+                              ).reshape(len(self.scenes), -1)
+        self.ramp_bands = np.array([ramp_bands(s, self.slots, b) if self.slots else np.zeros(0)
+                                    for s, b in zip(self.scenes, self.sign_bands, strict=True)]
+                                   ).reshape(len(self.scenes), -1)
 
     def _geometry(self) -> None:
         joints = [s.joint for s in self.scenes]
@@ -149,6 +165,54 @@ class SceneStack:
                              "the reference input angle", strict=False)
         self.failed.update(np.flatnonzero(~np.all(np.isfinite(zero.re), -1)).tolist())
         self.zero_angle, self.zero_slide = np.nan_to_num(zero.re), np.nan_to_num(zero.du)
+
+    def _check_windings(self) -> None:
+        """The windings check of :func:`reference.rccc.solve_positions` for every scene at once
+        (:data:`reference.rccc.WINDING_SAMPLES` input angles each): a scene whose joint angles
+        jump, or whose loop does not close at one of them, is added to :attr:`failed` (run on its
+        own, the engine reports why)."""
+        live = np.array([k for k in range(len(self.scenes)) if k not in self.failed], int)
+        if live.size == 0:
+            return
+        theta1 = np.linspace(0.0, 2.0 * np.pi, rccc.WINDING_SAMPLES + 1)
+        idx = np.repeat(live, theta1.size)
+        raw = solve_wrapped(Dual(self.alpha[idx], self.offset[idx]), self.s1[idx], np.tile(theta1, live.size),
+                            HOOKE, "input angles", strict=False).re.reshape(live.size, theta1.size, 4)
+        with np.errstate(invalid="ignore"):
+            jumps = np.any(rccc.winding_jumps(raw, self.zero_angle[live], theta1), (-2, -1))
+        self.failed.update(live[jumps | ~np.all(np.isfinite(raw), (-2, -1))].tolist())
+
+    def _sign_bands(self) -> list[dict[str, PairBands]]:
+        """:func:`reference.bands.sign_bands` of every scene, the characteristic speeds of all in
+        one pass (with mounting errors after :meth:`_check_windings`); a failed scene's (run on its
+        own) are placeholders."""
+        if not self.ideal:
+            self._check_windings()
+        need = [k for k, s in enumerate(self.scenes)
+                if self.slots and needs_speeds(s) and k not in self.failed]
+        speeds: dict[int, dict] = {}
+        if need:
+            theta = profile_angles()
+            idx = np.repeat(need, theta.size)
+            omega_rel, slide_rel = self._unit_speeds(idx, np.tile(theta, len(need)))
+            for j, k in enumerate(need):
+                part = slice(j * theta.size, (j + 1) * theta.size)
+                speeds[k] = speeds_from_profile(self.scenes[k], {p: v[part] for p, v in omega_rel.items()},
+                                                {p: v[part] for p, v in slide_rel.items()})
+        zero = {p: PairSpeeds(0.0, 0.0) for p in PAIR_NAMES}
+        return [bands_from_speeds(s, speeds.get(k, zero) if needs_speeds(s) else None)
+                for k, s in enumerate(self.scenes)]
+
+    def _unit_speeds(self, idx: np.ndarray, theta: np.ndarray) -> tuple[dict, dict]:
+        """Per pair the relative angular [rad/s] and sliding [m/s] speeds at input angles ``theta``
+        [rad] turning at 1 rad/s, of the scenes ``idx``."""
+        one, zero = np.ones_like(theta), np.zeros_like(theta)
+        if self.ideal:
+            motion = self.motion(idx, theta, one, zero)
+            return motion.omega_rel, motion.slide_rel
+        rates = self._loop_rates(idx, theta, one, zero)[2]
+        return ({p: rates.theta_t[..., k] for k, p in enumerate(PAIR_NAMES)},
+                {p: rates.s_t[..., k] for k, p in enumerate(PAIR_NAMES)})
 
     def motion(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray,
                theta_tt: np.ndarray) -> JointMotion:

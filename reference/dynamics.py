@@ -287,13 +287,14 @@ def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str,
     return np.stack(out, -1)
 
 
-def slot_bands(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
-    """Width of each slot's sign ramp [m/s] (:func:`reference.bands.sign_bands`), shape (K,).
+def slot_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = None) -> np.ndarray:
+    """Width of each slot's sign ramp [m/s] (``bands``, or :func:`reference.bands.sign_bands`),
+    shape (K,).
 
     Under the resultant-slip law (``scene.friction.law``) both slots of a pair share the ramp of
     its resultant slip speed.
     """
-    bands = sign_bands(scene)
+    bands = sign_bands(scene) if bands is None else bands
     if scene.friction.law == "resultant":
         return np.array([bands[pair].resultant for pair, _ in slots], dtype=float)
     return np.array([bands[pair].rotation if kind == "torque" else bands[pair].sliding
@@ -338,9 +339,9 @@ def ramp_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str,
     return np.concatenate([speeds, slip_speeds(slots, speeds)], -1)
 
 
-def ramp_bands(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
-    """Ramp widths [m/s] of :func:`ramp_speeds`, shape (K',)."""
-    bands = slot_bands(scene, slots)
+def ramp_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = None) -> np.ndarray:
+    """Ramp widths [m/s] of :func:`ramp_speeds`, shape (K',) (``bands`` as for :func:`slot_bands`)."""
+    bands = slot_bands(scene, slots, bands)
     return np.concatenate([bands, bands]) if scene.friction.law == "resultant" else bands
 
 

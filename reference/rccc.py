@@ -323,15 +323,22 @@ def _check_windings(params: DHParameters, branch: str) -> None:
         raw = _solve(params, theta1, branch, "input angles").re
     except LoopClosureError:  # reported by the caller's own solve, at the caller's angles
         return
-    nominal = reference + _WINDING * theta1[:, None]
-    deviation = np.remainder(raw - nominal + np.pi, 2.0 * np.pi) - np.pi
-    jumps = np.abs(np.diff(deviation[:, 1:], axis=0)) > 0.5 * np.pi
+    jumps = winding_jumps(raw, reference, theta1)
     if np.any(jumps):
         at = theta1[1:][np.any(jumps, -1)]
         raise LoopClosureError(
             "with these mounting errors the loop is not a Cardan joint's double crank: a joint "
             "angle does not follow the input turn for turn (it jumps by a full turn near input "
             f"angle(s) {angle_listing(at)})", at)
+
+
+def winding_jumps(raw: np.ndarray, reference: np.ndarray, theta1: np.ndarray) -> np.ndarray:
+    """Joint angles jumping a quarter turn or more between neighbours against the Cardan joint's
+    windings, (..., m - 1, 3): ``raw`` (..., m, 4) the wrapped loop solution at the input angles
+    ``theta1`` (m,) [rad], ``reference`` (..., 4) its value at 0 (any True: not a double crank)."""
+    nominal = reference[..., None, :] + _WINDING * theta1[:, None]
+    deviation = np.remainder(raw - nominal + np.pi, 2.0 * np.pi) - np.pi
+    return np.abs(np.diff(deviation[..., 1:], axis=-2)) > 0.5 * np.pi
 
 
 def solve_positions(params: DHParameters, theta1: ArrayLike, branch: str = "hooke") -> LoopPositions:
