@@ -218,3 +218,19 @@ def test_without_error_estimate_one_run_and_no_estimate():
     assert alone.summary.efficiency_error_estimate is None and "accuracy" not in alone.summary.extras
     assert full.summary.efficiency_error_estimate is not None
     assert full.summary.extras["accuracy"]["companion_dt"] == 4e-4  # the companion the other skips
+
+
+@pytest.mark.parametrize("coupling", ["converged", "extrapolated"])
+def test_automatic_step_without_error_estimate_meets_the_accuracy(coupling):
+    """With ``error_estimate`` off an automatic step is still planned for the mean efficiency
+    (the pilot's losses, and for the extrapolated coupling its loop gain), not for the speed ratio
+    alone: at 30 deg the speed ratio's 100 steps per revolution read the efficiency 1.7e-3 off."""
+    from cardan_exudyn.model.options import ExudynOptions
+
+    scene = replace(named_scene("paper-literal-30deg"),
+                    **{"numerics.accuracy": 1e-4, "friction.coupling": coupling, "record.timeseries": False})
+    summary = run(scene, options=ExudynOptions(error_estimate=False)).summary
+    truth = run(scene, engine="reference").summary.mean_efficiency
+    assert summary.success and "mean efficiency" in summary.dt_choice
+    assert "no error estimate" in summary.dt_choice
+    assert abs(summary.mean_efficiency - truth) <= 1e-4
