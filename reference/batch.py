@@ -140,8 +140,10 @@ def _tables(stack: SceneStack, options: ReferenceOptions) -> list[Result]:
     owner = np.repeat(np.arange(len(times)), rows)
     columns = stack.columns(owner, np.concatenate([t[:n] for t, n in zip(times, rows, strict=True)]))
     bounds = np.cumsum([0, *rows])
-    tables = [repeat_period({key: value[bounds[k]:bounds[k + 1]] for key, value in columns.items()},
-                            times[k], stack.speed[k]) for k in range(len(times))]
+    tables = [{key: value[bounds[k]:bounds[k + 1]] for key, value in columns.items()}
+              for k in range(len(times))]
+    tables = [repeat_period(table, t, speed) if n < t.size else table
+              for table, t, speed, n in zip(tables, times, stack.speed, rows, strict=True)]
     summaries = []
     for k, scene in enumerate(stack.scenes):
         summary = _summary(scene, options)

@@ -289,14 +289,14 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     grid = np.linspace(t_a, t_b, n + 1)
     values = speeds(grid)
     bands = ramp_bands(scene, slots)
-    brackets = []
+    brackets, grazing = [], []
     for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
         brackets += sign_change_brackets(grid, values, levels)
-        candidates = grazing_candidates(grid, values, levels)
-        if candidates:
-            at_vertex = speeds(np.array([c[0] for c in candidates]))[np.arange(len(candidates)),
-                                                                     [c[2] for c in candidates]]
-            brackets += grazing_brackets(grid, values, levels, candidates, at_vertex)
+        grazing += [(levels, c) for c in grazing_candidates(grid, values, levels)]
+    if grazing:  # every vertex in one evaluation
+        at = speeds(np.array([c[0] for _, c in grazing]))
+        for row, (levels, c) in enumerate(grazing):
+            brackets += grazing_brackets(grid, values, levels, [c], at[row, c[2]:c[2] + 1])
     if not brackets:
         return np.zeros(0)
     a, b, f_a, f_b, j, level = (np.array(v) for v in zip(*brackets, strict=True))

@@ -31,25 +31,18 @@ def friction_law_values(x: np.ndarray, index: np.ndarray, signs: np.ndarray, k_f
     """:meth:`FrictionLaw.__call__` with its coefficients given: ``index`` (K, 4) the columns of
     ``x`` holding each slot's fx, fy, mx, my; ``k_force`` [m or -] and ``k_moment`` [-, 1/m]
     the law's factors of ``|F|`` and ``|M|``, shape (K,) or one row per sample (n, K)."""
-    c = x[:, index]  # (n, K, 4): fx, fy, mx, my
-    force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
-    norms = np.stack([force, force, moment, moment], -1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(norms > 0, c / norms, 0.0)
-    s = -signs
-    values = s * (k_force * force + k_moment * moment)
-    gains = np.stack([k_force, k_force, k_moment, k_moment], -1)
+    values, slopes = reduced_law_values(x[:, index], signs, k_force, k_moment)
     jacobian = np.zeros(x.shape[:1] + index.shape[:1] + x.shape[1:])
-    rows = np.arange(index.shape[0])[:, None]
-    jacobian[:, rows, index] = s[..., None] * gains * unit
+    jacobian[:, np.arange(index.shape[0])[:, None], index] = slopes
     return values, jacobian
 
 
 def reduced_law_values(c: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
                        k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`friction_law_values` on the components it reads: ``c`` (n, K, 4) each slot's fx,
+    """The law of eqs. (3) and (5) on the components it reads: ``c`` (n, K, 4) each slot's fx,
     fy, mx, my. Returns the values (n, K) and their derivatives with respect to ``c`` (n, K, 4)
-    (the zero subgradient where a norm is exactly zero)."""
+    (the zero subgradient where a norm is exactly zero); :func:`friction_law_values` scatters
+    them into ``dG/dx``."""
     force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
     per_force, per_moment = -signs * k_force, -signs * k_moment
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -23,7 +23,7 @@ import numpy as np
 
 __all__ = ["period_rows", "repeat_period"]
 
-SHIFTED = {"theta_in": 1.0, "theta_out": 1.0}
+SHIFTED = ("theta_in", "theta_out")
 """Columns that advance by one turn per period (times the sign of the speed); ``t`` advances by
 the period; every other column repeats."""
 

@@ -255,9 +255,7 @@ def _planned_run(scene: Scene, options: ExudynOptions) -> Result:
     main = run_once(replace(scene, **{"numerics.dt": revolution_period(scene) / steps}), options)
     main.summary.scene = scene_to_dict(scene)
     main.summary.dt_choice = why + "; no error estimate (ExudynOptions.error_estimate is off)"
-    main.summary.extras.setdefault("accuracy", {})["pilot"] = {
-        "dt": pilot.summary.dt, "mean_efficiency": pilot.summary.mean_efficiency,
-        "wall_time_s": pilot.summary.wall_time_s, "is_companion": False}
+    _record_pilot(main, pilot, is_companion=False)
     return main
 
 
@@ -284,10 +282,15 @@ def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
         _report_accuracy(main, coarse, scene, options)
         why += f"; refined to {steps} after an estimated error of {first:.2g} at {steps // 2}"
     main.summary.scene, main.summary.dt_choice = scene_to_dict(scene), why
+    _record_pilot(main, pilot, is_companion=coarse is pilot)
+    return main
+
+
+def _record_pilot(main: Result, pilot: Result, is_companion: bool) -> None:
+    """The pilot run's step, efficiency and cost in ``main``'s ``extras["accuracy"]["pilot"]``."""
     main.summary.extras.setdefault("accuracy", {})["pilot"] = {
         "dt": pilot.summary.dt, "mean_efficiency": pilot.summary.mean_efficiency,
-        "wall_time_s": pilot.summary.wall_time_s, "is_companion": coarse is pilot}
-    return main
+        "wall_time_s": pilot.summary.wall_time_s, "is_companion": is_companion}
 
 
 def _kinematic_steps(scene: Scene, options: ExudynOptions) -> float:
