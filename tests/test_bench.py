@@ -17,6 +17,7 @@ import pytest
 
 from cardan_exudyn import engines
 from cardan_exudyn.cli import main
+from cardan_exudyn.studies.bench import steps_or_auto
 from cardan_exudyn.studies.bench_audit import skip_audit, solution_file, solve_only
 from cardan_exudyn.studies.bench_configs import (
     EXUDYN_TUNED,
@@ -28,12 +29,14 @@ from cardan_exudyn.studies.bench_configs import (
 )
 from cardan_exudyn.studies.bench_ladders import run_errors, yardstick
 from cardan_exudyn.studies.bench_report import bench_command
-from cardan_exudyn.studies.bench_result import check_inputs
+from cardan_exudyn.studies.bench_result import BenchError, check_inputs, check_paper
 from cardan_exudyn.studies.bench_targets import (
     EFFICIENCY_TARGET,
     STARTUP_TARGET_MS,
     evaluate_targets,
     friction_ladders,
+    paper_exudyn_scene,
+    paper_scenes,
     paper_scenes_timing,
 )
 from reference.paper import named_scene
@@ -234,6 +237,7 @@ def test_solve_only_is_the_engine_solve_with_the_tweak(tmp_path):
     (["--repeats", "0"], "--repeats"),
     (["--paper-coupling", "implicit"], "--paper-coupling"),
     (["--paper-steps", "0"], "--paper-steps"),
+    (["--paper-steps", "fast"], "--paper-steps"),
 ])
 def test_bad_input_is_exit_2_with_one_line(args, message, capsys, tmp_path):
     try:
@@ -253,6 +257,7 @@ def test_paper_scene_timing_reports_errors_against_the_tight_reference():
     part = paper_scenes_timing(repeats=1, exudyn_steps=100)
     assert len(part["exudyn"]["errors"]) == 11
     assert "extrapolated coupling, 100 steps/rev" in part["exudyn"]["config"]
+    assert part["exudyn"]["steps_per_revolution"] == [100] * 11
     assert part["exudyn"]["max_error"] > EFFICIENCY_TARGET
     assert part["reference"]["max_error"] < 1e-6
     assert part["reference"]["failed"] == 0
@@ -337,6 +342,20 @@ def test_friction_scenes_bring_their_frictionless_twins():
                     "friction-35deg"]
     assert (engines_, repeats) == (["exudyn"], 1)
     assert check_inputs(None, ["exudyn"], 2, False)[0] == list(SCENES)
+
+
+def test_paper_scenes_run_at_their_own_step_or_the_given_one():
+    scene = paper_scenes()[0]
+    auto = paper_exudyn_scene(scene, "auto", "converged")
+    assert auto.numerics.dt is None and auto.numerics.accuracy == EFFICIENCY_TARGET
+    assert auto.friction.coupling == "converged"
+    fixed = paper_exudyn_scene(scene, 400, "extrapolated")
+    assert fixed.numerics.dt == pytest.approx(2.0 * math.pi / scene.drive.max_speed() / 400, rel=1e-15)
+    assert fixed.friction.coupling == "extrapolated"
+    assert steps_or_auto("Auto") == "auto" and steps_or_auto("300") == 300
+    check_paper("auto", "extrapolated")
+    with pytest.raises(BenchError, match="--paper-steps"):
+        check_paper("fast", "extrapolated")
 
 
 def test_bench_command_repeats_the_settings():

@@ -123,8 +123,14 @@ def paper_section(paper: Mapping[str, Any]) -> str:
         out += (f"- {engine} ({part['config']}): {part['wall_s']:.2f} s (median of "
                 f"{part['repeats']}; all: {', '.join(f'{w:.2f}' for w in part['walls_s'])}), "
                 f"largest mean-efficiency error {number(part['max_error'], '.2g')}, not ok: "
-                f"{part['failed']}\n")
+                f"{part['failed']}" + _steps(part) + "\n")
     return out
+
+
+def _steps(part: Mapping[str, Any]) -> str:
+    """``; steps/rev: ...`` per scene where the scenes' steps differ (an automatic step)."""
+    steps = [s for s in part.get("steps_per_revolution") or [] if s is not None]
+    return f"; steps/rev: {', '.join(str(s) for s in steps)}" if len(set(steps)) > 1 else ""
 
 
 def ladders_section(rows: pd.DataFrame) -> str:

@@ -110,16 +110,16 @@ def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
     return keys, engines, repeats
 
 
-def check_paper(steps: int, coupling: str) -> None:
-    """Check the paper timing's Exudyn steps per revolution and coupling.
+def check_paper(steps: int | str, coupling: str) -> None:
+    """Check the paper timing's Exudyn steps per revolution (or ``"auto"``) and coupling.
 
     Raises
     ------
     BenchError
         Steps that are not a positive integer, or an unknown coupling.
     """
-    if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
-        raise BenchError(f"`--paper-steps` must be a positive integer, got {steps!r}")
+    if steps != "auto" and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1):
+        raise BenchError(f"`--paper-steps` must be a positive integer or 'auto', got {steps!r}")
     if coupling not in COUPLINGS:
         raise BenchError(f"`--paper-coupling` must be one of {list(COUPLINGS)}, got {coupling!r}")
 
@@ -127,7 +127,7 @@ def check_paper(steps: int, coupling: str) -> None:
 def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[str] | None = None,
               engines: Iterable[str] = ENGINE_NAMES, audit: bool = True, paper: bool = True,
               progress: Progress | None = None, startup: bool = True,
-              paper_steps: int = PAPER_EXUDYN_STEPS,
+              paper_steps: int | str = PAPER_EXUDYN_STEPS,
               paper_coupling: str = PAPER_EXUDYN_COUPLING) -> BenchResult:
     """The whole bench: work-precision runs, the paper scenes' timing, the import cost of
     ``cardan run``, the skip audit, and the targets from all of them.
@@ -146,8 +146,9 @@ def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[
         Run the skip audit, the paper scenes' timing, the import-cost measurement.
     progress : callable, optional
         Called with one line of text per finished piece of work.
-    paper_steps : int
-        Exudyn's steps per revolution in the paper scenes' timing.
+    paper_steps : int or "auto"
+        Exudyn's steps per revolution in the paper scenes' timing (``"auto"``: each scene's own
+        step for the target accuracy).
     paper_coupling : str
         Exudyn's friction coupling there (one of :data:`reference.scene.COUPLINGS`).
 
