@@ -205,6 +205,9 @@ def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any =
         ``scenes`` is not a sequence, or one of them not a Scene (the message names its index).
     EngineUnavailable, OptionsError
         As in :func:`run`; raised before any scene runs.
+    SceneError
+        A scene the engine's batched pass refuses before running (a table beyond the step
+        limit), named by its index in ``scenes``; raised before any scene runs.
     """
     if isinstance(scenes, (Scene, str, bytes)) or not isinstance(scenes, Sequence):
         raise TypeError(f"`scenes` must be a sequence of Scene, got {type(scenes).__name__} {scenes!r:.80}")
@@ -213,6 +216,8 @@ def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any =
     engine, options = resolve(engine, options, **option_values)
     entry, run_function = _entry(engine), get_engine(engine)
     module = _import(engine, entry.batch) if entry.batch else None
+    if module is not None:  # every scene, before any group runs, named by its index in `scenes`
+        module.check_scenes(scenes, options)
     groups: dict[Hashable, list[int]] = {}
     for i, scene in enumerate(scenes):
         key = module.batch_key(scene) if module is not None else None

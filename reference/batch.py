@@ -48,7 +48,7 @@ from reference.scene import Scene, SpeedDrive, scene_to_dict
 from reference.schema import OptionsError, Result, Status, Summary, result_table
 from reference.validation import SceneError, check_steps, require_scene
 
-__all__ = ["BATCH_SCENES", "batch_key", "run_batch"]
+__all__ = ["BATCH_SCENES", "batch_key", "check_scenes", "run_batch"]
 
 BATCH_SCENES = 32
 """Scenes evaluated together at most: bounds the memory (their time tables are held at once).
@@ -68,17 +68,9 @@ def batch_key(scene) -> Hashable | None:
 def run_batch(scenes: Sequence, options: ReferenceOptions | None = None) -> list[Result]:
     """One :class:`Result` per scene, in order (see the module's contract)."""
     scenes = list(scenes)
-    for i, scene in enumerate(scenes):
-        require_scene(scene, f"scenes[{i}]")
-    if options is not None and not isinstance(options, ReferenceOptions):
-        raise OptionsError(f"`options` must be ReferenceOptions or None, got {type(options).__name__}")
-    options = options or ReferenceOptions()
+    options = check_scenes(scenes, options)
     groups: dict[Hashable, list[int]] = {}
     for i, scene in enumerate(scenes):
-        try:  # a table too long for the step limit is refused before anything runs
-            _check_steps(scene, options)
-        except SceneError as exc:
-            raise SceneError(f"scenes[{i}]: {exc}") from None
         groups.setdefault(batch_key(scene), []).append(i)
     results: list[Result | None] = [None] * len(scenes)
     for key, members in groups.items():
@@ -91,6 +83,28 @@ def run_batch(scenes: Sequence, options: ReferenceOptions | None = None) -> list
             for i, result in zip(chunk, _run_chunk([scenes[i] for i in chunk], options), strict=True):
                 results[i] = result
     return results
+
+
+def check_scenes(scenes: Sequence, options: ReferenceOptions | None = None) -> ReferenceOptions:
+    """Refuse, before anything runs, what :func:`run_batch` would refuse: a non-scene, options
+    that are not :class:`ReferenceOptions`, a scene whose table or integration exceeds the step
+    limit (each message names the scene's index in ``scenes``). Returns the options in effect.
+
+    Raises
+    ------
+    TypeError, OptionsError, SceneError
+    """
+    for i, scene in enumerate(scenes):
+        require_scene(scene, f"scenes[{i}]")
+    if options is not None and not isinstance(options, ReferenceOptions):
+        raise OptionsError(f"`options` must be ReferenceOptions or None, got {type(options).__name__}")
+    options = options or ReferenceOptions()
+    for i, scene in enumerate(scenes):
+        try:
+            _check_steps(scene, options)
+        except SceneError as exc:
+            raise SceneError(f"scenes[{i}]: {exc}") from None
+    return options
 
 
 def _check_steps(scene: Scene, options: ReferenceOptions) -> None:

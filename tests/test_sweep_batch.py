@@ -20,6 +20,7 @@ from cardan_exudyn.sweep import Batch, CaseFunction, expand_cases, plan_tasks, r
 from cardan_exudyn.sweep.spec import spec_from_mapping
 from reference.paper import named_scene
 from reference.scene import replace
+from reference.validation import SceneError
 
 TESTS = Path(__file__).parent
 # the reference engine at one revolution without a time table: ~0.05 s per case
@@ -108,6 +109,26 @@ def test_engines_run_batch_equals_run_in_order():
     with pytest.raises(engines.EngineUnavailable, match="`engine` must be one of"):
         engines.run_batch([base], "nope")
     assert engines.batch_key(base, "exudyn") is None and not engines.has_batch("mujoco")
+
+
+def test_engines_run_batch_refuses_a_long_scene_by_its_index_before_running(monkeypatch):
+    """An over-long scene behind scenes of other keys (a torque drive runs on its own) is named by
+    its index in the caller's list, and nothing runs first (it was named by its index within its
+    group, after the other groups had run)."""
+    ran = []
+
+    def chunk(scenes, options):
+        ran.append(scenes)
+        return [None] * len(scenes)
+
+    monkeypatch.setattr(reference.batch, "_run_chunk", chunk)
+    base = named_scene("paper-10deg")
+    scenes = [named_scene("rig-errors"),
+              replace(base, drive={"kind": "torque", "torque": 2.0, "initial_speed": 209.0}),
+              base, replace(base, **{"numerics.dt": 1e-10})]
+    with pytest.raises(SceneError, match=r"^scenes\[3\]: "):
+        engines.run_batch(scenes, "reference")
+    assert ran == []
 
 
 def test_a_failing_case_in_a_batch_records_only_itself(tmp_path, batches, monkeypatch):

@@ -37,8 +37,9 @@ so no scheme starts frictionless.
   (-1, 1) (``tests/test_coupling_lean.py`` checks the roots and runs at gains near -1 and +1).
   Extrapolating the friction itself instead of the inputs stays first order (a sign ramp crossed
   in a step is not predicted), and ``2 x_n - x_{n-1}`` is unstable for ``g < -1/3``. The first
-  two steps extrapolate with what exists (constant, then linear through two steps). Every
-  :data:`PROBE_EVERY`-th step is solved twice, the second time with the friction of the first
+  two steps extrapolate with what exists (constant, then linear through two steps). A step at
+  least :data:`PROBE_EVERY` steps after the last probe, and not itself a reversal step (solved to
+  its fixed point instead), is solved twice, the second time with the friction of the first
   solve's state: the ratio of the two friction changes estimates the loop gain
   (``loop_gain_estimate``). A probe above :data:`ESCALATE_GAIN` switches the run to the converged
   scheme (near self-locking the extrapolation amplifies its error by ``1 / (1 - g)``, and only the
@@ -94,7 +95,14 @@ GAIN_EVERY = 4
 # stalled and was reported as self-locking)
 REST_FLOOR = 1e-6
 PROBE_EVERY = 25
-"""Extrapolated scheme: every this many steps one step is solved twice to estimate the loop gain."""
+"""Extrapolated scheme: every this many steps one step is solved twice to estimate the loop gain
+(the next step that is not a reversal step: at 50 steps per revolution and 10 deg every 25th
+step fell on a spider pair's reversal, and a pilot run measured no gain at all); more often at
+coarse steps, :data:`PROBES_PER_REVOLUTION` at least."""
+PROBES_PER_REVOLUTION = 8
+"""Extrapolated scheme: probes per input revolution at least (the gain varies over a revolution:
+a pilot at 50 steps per revolution probing twice a revolution read 0.02 where the run reached
+1.0; its planned step then read the mean efficiency 1.5e-4 off at accuracy 1e-4)."""
 ESCALATE_GAIN = 0.95
 """Extrapolated scheme: a probed loop gain above this switches the run to the converged scheme."""
 RAMP_STEPS = 4
@@ -169,6 +177,8 @@ class FrictionCoupling:
         self._gains: list[float] = []
         self._broyden_b = None
         self._accepted_steps = 0
+        # extrapolated scheme: steps since the last probe, probes done, steps between (initialise)
+        self._since_probe, self.probes, self._probe_every = 0, 0, PROBE_EVERY
         self._inputs: list[list] = []      # extrapolated scheme: law inputs of the last 3 steps
         self._probe: tuple | None = None   # (friction of the first solve, its change) in a probe
         self.escalated_at: float | None = None
@@ -230,6 +240,10 @@ class FrictionCoupling:
         so that the first recorded row, the first step and, in the lagged scheme, the friction
         of the first step all include friction. Call after ``solver.InitializeSolver``.
         """
+        ti = settings.timeIntegration
+        period = 2.0 * math.pi / self.model.scene.drive.max_speed()  # one input revolution [s]
+        steps = period * ti.numberOfSteps / max(ti.endTime - ti.startTime, 1e-300)
+        self._probe_every = int(min(PROBE_EVERY, max(2, steps // PROBES_PER_REVOLUTION)))
         b = None
         x_prev = r_prev = None
         x = np.zeros(int(self._mask.sum()))
@@ -318,11 +332,13 @@ class FrictionCoupling:
         regime = self.reader.regime
         if first:
             self._accepted_steps += 1
+            self._since_probe += 1
             if self._reversed(inputs, regime):
                 self._iterating = True
                 self.iterated_steps += 1
                 return self._update(t, counted=True)
-            if self._accepted_steps % PROBE_EVERY == 0:
+            if self._since_probe >= self._probe_every:
+                self._since_probe = 0
                 friction = self._law(inputs)
                 self._probe = (friction, self._change(friction, self.applied))
                 self.apply(friction)
@@ -385,6 +401,7 @@ class FrictionCoupling:
         """Second solve of a probe step: the loop gain from the two changes; escalation."""
         first, change0 = self._probe
         self._probe = None
+        self.probes += 1
         size = self._change(friction, (0.0,) * (2 * self.n))
         if change0 <= PROBE_NOISE * max(size, self.scale_floor):
             return
@@ -552,6 +569,9 @@ class FrictionCoupling:
             # step (see _accept); the median is robust to the start-up steps
             "loop_gain_estimate": float(np.median(self._gains)) if self._gains else None,
             "loop_gain_estimate_max": float(np.max(self._gains)) if self._gains else None,
+            # extrapolated scheme: probe steps solved twice; a probe whose friction did not move
+            # beyond rounding (PROBE_NOISE) gives no gain
+            "gain_probes": self.probes,
         }
 
     def columns(self, times: np.ndarray) -> dict[str, np.ndarray]:

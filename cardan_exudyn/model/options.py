@@ -43,8 +43,9 @@ class ExudynOptions:
     error_estimate : bool
         With friction, run the pilot and companion that choose the step and estimate the mean
         efficiency's error (:func:`cardan_exudyn.model.solve.run`). False: one run at the given
-        ``numerics.dt`` or at the speed-ratio step, no estimate (for a caller that estimates the
-        error itself, such as step halving, which would otherwise repeat the run it halves).
+        ``numerics.dt``, or a pilot run and one run at the step it plans for ``numerics.accuracy``
+        (:func:`cardan_exudyn.model.solve._planned_run`), no estimate (for a caller that estimates
+        the error itself, such as step halving, which would otherwise repeat the run it halves).
     """
 
     spectral_radius: float = 0.6

@@ -167,11 +167,19 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
         raise friction.error
     if friction is not None and friction.status != Status.OK:
         status, reason = friction.status, friction.reason
-    if status == Status.INTEGRATION_FAILURE and scene.drive.kind == "torque" and scene.numerics.dt is None:
-        reason += (f" (the step was sized for the torque drive's initial speed, "
-                   f"{abs(scene.drive.initial_speed):.3g} rad/s; a joint that speeds up beyond it "
-                   f"needs `numerics.dt` for its top speed)")
+    if status == Status.INTEGRATION_FAILURE and scene.numerics.dt is None:
+        reason += torque_step_hint(scene)
     return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
+
+
+def torque_step_hint(scene: Scene) -> str:
+    """What to add to an integration failure at an automatic step of a torque drive (the step
+    was sized for its initial speed), else ``""``."""
+    if scene.drive.kind != "torque":
+        return ""
+    return (f" (the step was sized for the torque drive's initial speed, "
+            f"{abs(scene.drive.initial_speed):.3g} rad/s; a joint that speeds up beyond it "
+            f"needs `numerics.dt` for its top speed)")
 
 
 def reusable(model: ExudynModel, reactions: bool) -> bool:
@@ -201,26 +209,23 @@ def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     """
     options = options or ExudynOptions()
     wall_start = time.perf_counter()
-    if scene.numerics.richardson:
-        why = two_step.refusal(scene)
-        if why is not None:
-            raise SceneError(why)
-        result = _richardson_run(scene, options)
+    if scene.numerics.richardson and (why := two_step.refusal(scene)) is not None:
+        raise SceneError(why)
+    if scene.numerics.richardson or not scene.has_friction:
+        result = _richardson_run(scene, options) if scene.numerics.richardson else run_once(scene, options)
         _report_accuracy(result, None, scene, options)
         return result
-    if not scene.has_friction:
-        result = run_once(scene, options)
-        _report_accuracy(result, None, scene, options)
-        return result
-    if not options.error_estimate:
-        return run_once(scene, options) if scene.numerics.dt is not None else _planned_run(scene, options)
     if scene.numerics.dt is not None:
+        if not options.error_estimate:
+            return run_once(scene, options)
         coarse = run_once(_companion(scene, 2.0 * scene.numerics.dt), options)
         main = run_once(scene, options)
         _report_accuracy(main, coarse, scene, options)
     else:
-        main = _automatic_runs(scene, options)
-    main.summary.wall_time_s = time.perf_counter() - wall_start
+        main = _automatic_runs(scene, options) if options.error_estimate else _planned_run(scene, options)
+        if main.summary.status == Status.INTEGRATION_FAILURE:
+            main.summary.reason += torque_step_hint(scene)
+    main.summary.wall_time_s = time.perf_counter() - wall_start  # the pilot and companions too
     return main
 
 
@@ -233,6 +238,9 @@ def _pilot_plan(scene: Scene, options: ExudynOptions) -> tuple[Result, int, int,
     pilot = run_once(_companion(scene, period / pilot_steps), options)
     cost = pilot.summary.wall_time_s / max(pilot.summary.steps or 1, 1)
     steps, why = plan_steps(scene, loss_fraction(pilot), options.node_type, cost)
+    if not pilot.success:
+        why += (f" (the pilot at {pilot_steps} steps per revolution ended {pilot.summary.status}: "
+                f"its loss fraction taken as 1, the most a joint can lose)")
     return pilot, pilot_steps, max(steps, 2 * pilot_steps), why
 
 
@@ -245,18 +253,34 @@ def _planned_run(scene: Scene, options: ExudynOptions) -> Result:
     coupling the planned steps grow by ``sqrt(1 / (1 - g))`` (the pilot's loop gain ``g``): without
     it the paper's 30 and 35 deg scenes read 1.7e-4 and 2.7e-4 off at 1e-4 (``docs/accuracy.md``)."""
     pilot, _, steps, why = _pilot_plan(scene, options)
-    gain = pilot.summary.max_friction_loop_gain
-    if scene.friction.coupling == "extrapolated" and gain is not None and math.isfinite(gain) and gain > 0.0:
+    if scene.friction.coupling == "extrapolated":
         # no estimate will catch an under-read: the extrapolation's error grows as 1 / (1 - g)
         # with the friction loop gain g (the coupling's module doc), which the model leaves out
-        factor = math.sqrt(1.0 / (1.0 - min(gain, EXTRAPOLATION_GAIN_CAP)))
+        g, said = _pilot_gain(pilot)
+        factor = math.sqrt(1.0 / (1.0 - g))
         steps = math.ceil(steps * factor / 2.0) * 2
-        why += f"; x{factor:.2f} for the extrapolated coupling at loop gain {gain:.2f}"
+        why += f"; x{factor:.2f} for the extrapolated coupling at {said}"
+        refuse(scene, steps, f"a mean-efficiency error of {scene.numerics.accuracy:g} with the "
+                             f"extrapolated coupling")
     main = run_once(replace(scene, **{"numerics.dt": revolution_period(scene) / steps}), options)
     main.summary.scene = scene_to_dict(scene)
     main.summary.dt_choice = why + "; no error estimate (ExudynOptions.error_estimate is off)"
     _record_pilot(main, pilot, is_companion=False)
     return main
+
+
+def _pilot_gain(pilot: Result) -> tuple[float, str]:
+    """The loop gain the planned step allows for (in [0, :data:`EXTRAPOLATION_GAIN_CAP`]) and
+    how it was found: the pilot's largest probe; 0 where its probes saw the friction not move
+    (no feedback to amplify); the cap where no probe finished or the pilot failed."""
+    gain = pilot.summary.max_friction_loop_gain
+    if pilot.success and gain is not None and math.isfinite(gain):
+        return min(max(gain, 0.0), EXTRAPOLATION_GAIN_CAP), f"loop gain {gain:.2f}"
+    probes = (pilot.summary.extras.get("friction") or {}).get("gain_probes") or 0
+    if pilot.success and probes > 0:
+        return 0.0, f"no loop gain ({probes} probes saw the friction not move)"
+    return EXTRAPOLATION_GAIN_CAP, (f"loop gain {EXTRAPOLATION_GAIN_CAP:g}, where the coupling escalates "
+                                    f"(the pilot measured none)")
 
 
 def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
@@ -275,12 +299,15 @@ def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
         coarse = run_once(_companion(scene, 2.0 * period / steps), options)
     main = run_once(replace(scene, **{"numerics.dt": period / steps}), options)
     _report_accuracy(main, coarse, scene, options)
-    if main.summary.accuracy_met is False and 2 * steps <= MAX_STEPS_PER_REVOLUTION:
+    unverified = main.success and main.summary.accuracy_met is None  # the companion failed
+    if (main.summary.accuracy_met is False or unverified) and 2 * steps <= MAX_STEPS_PER_REVOLUTION:
         first = main.summary.efficiency_error_estimate
         coarse, steps = main, 2 * steps
         main = run_once(replace(scene, **{"numerics.dt": period / steps}), options)
         _report_accuracy(main, coarse, scene, options)
-        why += f"; refined to {steps} after an estimated error of {first:.2g} at {steps // 2}"
+        why += (f"; refined to {steps} after an estimated error of {first:.2g} at {steps // 2}"
+                if first is not None else
+                f"; refined to {steps}: the companion of the run at {steps // 2} failed")
     main.summary.scene, main.summary.dt_choice = scene_to_dict(scene), why
     _record_pilot(main, pilot, is_companion=coarse is pilot)
     return main
@@ -340,16 +367,28 @@ def _report_accuracy(main: Result, coarse: Result | None, scene: Scene, options:
         estimate, info["method"] = 0.0, "no friction: nothing is lost, the efficiency is 1"
     else:
         estimate = _estimate(main, coarse, scene, options, info)
-    s.efficiency_error_estimate, s.accuracy_met = estimate, bool(estimate <= target)
     s.extras["accuracy"] = info
+    if estimate is None:  # no claim either way
+        s.warn(f"no error estimate: {info['method']}; the accuracy {target:g} is not verified "
+               f"(give a smaller --dt, or --accuracy for an automatic step)")
+        return
+    s.efficiency_error_estimate, s.accuracy_met = estimate, bool(estimate <= target)
     if not s.accuracy_met:
         s.warn(f"accuracy not met: estimated mean-efficiency error {estimate:.2g} > target {target:g} "
                f"(refine --dt or --accuracy)")
 
 
-def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions, info: dict) -> float:
+def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions,
+              info: dict) -> float | None:
     """Richardson from ``coarse`` (at first order at least :data:`MODEL_FLOOR` of the a-priori
-    model); the model when the companion failed or is too coarse. How, into ``info``."""
+    model; at least the model when the companion is too coarse); None when the companion failed.
+    How, into ``info``.
+
+    A failed companion gives no estimate, not the model: the run it should check is then close
+    to what fails at the coarser step (a friction loop near self-locking, where the model does
+    not hold). Falling back to the model called ``paper-literal`` at 40 deg with friction 0.3
+    (its companion self-locked) "accuracy met" at an estimated 9.7e-4 with a true error of
+    1.4e-2."""
     s = main.summary
     steps, loss = revolution_period(scene) / s.dt, loss_fraction(main)
     order = convergence_order(scene)
@@ -361,8 +400,9 @@ def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions
                 companion_wall_time_s=coarse.summary.wall_time_s)
     eta_c = coarse.summary.mean_efficiency
     if not (coarse.success and eta_c is not None and math.isfinite(eta_c)):
-        info["method"] = f"a-priori model (the companion run ended {coarse.summary.status})"
-        return model
+        info["method"] = (f"the companion run at {coarse.summary.dt:.3g} s ended {coarse.summary.status}"
+                          if coarse.summary.dt else f"the companion run ended {coarse.summary.status}")
+        return None
     ratio = coarse.summary.dt / s.dt
     info["richardson"] = richardson(s.mean_efficiency, eta_c, ratio, order)
     floored = order == 1 or bool(reversing_parts(scene))
