@@ -241,9 +241,10 @@ class FrictionCoupling:
         of the first step all include friction. Call after ``solver.InitializeSolver``.
         """
         ti = settings.timeIntegration
-        period = 2.0 * math.pi / self.model.scene.drive.max_speed()  # one input revolution [s]
-        steps = period * ti.numberOfSteps / max(ti.endTime - ti.startTime, 1e-300)
-        self._probe_every = int(min(PROBE_EVERY, max(2, steps // PROBES_PER_REVOLUTION)))
+        speed, duration = self.model.scene.drive.max_speed(), ti.endTime - ti.startTime
+        if speed > 0.0 and duration > 0.0:  # steps per input revolution at the drive's top speed
+            steps = 2.0 * math.pi / speed * ti.numberOfSteps / duration
+            self._probe_every = int(min(PROBE_EVERY, max(2, steps // PROBES_PER_REVOLUTION)))
         b = None
         x_prev = r_prev = None
         x = np.zeros(int(self._mask.sum()))
