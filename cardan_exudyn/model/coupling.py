@@ -37,10 +37,10 @@ so no scheme starts frictionless.
   (-1, 1) (``tests/test_coupling_lean.py`` checks the roots and runs at gains near -1 and +1).
   Extrapolating the friction itself instead of the inputs stays first order (a sign ramp crossed
   in a step is not predicted), and ``2 x_n - x_{n-1}`` is unstable for ``g < -1/3``. The first
-  two steps extrapolate with what exists (constant, then linear through two steps). A step at
-  least :data:`PROBE_EVERY` steps after the last probe, and not itself a reversal step (solved to
-  its fixed point instead), is solved twice, the second time with the friction of the first
-  solve's state: the ratio of the two friction changes estimates the loop gain
+  two steps extrapolate with what exists (constant, then linear through two steps). Every
+  :data:`PROBE_EVERY`-th step (more often at coarse steps) that is not a reversal step is solved
+  twice, the second time with the friction of the first solve's state: the ratio of the two
+  friction changes estimates the loop gain
   (``loop_gain_estimate``). A probe above :data:`ESCALATE_GAIN` switches the run to the converged
   scheme (near self-locking the extrapolation amplifies its error by ``1 / (1 - g)``, and only the
   fixed-point iteration tells a joint that locks).
@@ -96,9 +96,11 @@ GAIN_EVERY = 4
 REST_FLOOR = 1e-6
 PROBE_EVERY = 25
 """Extrapolated scheme: every this many steps one step is solved twice to estimate the loop gain
-(the next step that is not a reversal step: at 50 steps per revolution and 10 deg every 25th
-step fell on a spider pair's reversal, and a pilot run measured no gain at all); more often at
-coarse steps, :data:`PROBES_PER_REVOLUTION` at least."""
+(a reversal step is solved to its fixed point instead). At coarse steps more often, at least
+:data:`PROBES_PER_REVOLUTION` times a revolution: a pilot at 50 steps per revolution and 10 deg
+probing every 25th step fell on a spider pair's reversal every time and measured no gain at all.
+Probes deferred past reversals instead landed just after them, read the transition rather than
+the loop (1.2 with sliding pairs whose gain is below 0.6) and escalated those runs."""
 PROBES_PER_REVOLUTION = 8
 """Extrapolated scheme: probes per input revolution at least (the gain varies over a revolution:
 a pilot at 50 steps per revolution probing twice a revolution read 0.02 where the run reached
@@ -177,8 +179,8 @@ class FrictionCoupling:
         self._gains: list[float] = []
         self._broyden_b = None
         self._accepted_steps = 0
-        # extrapolated scheme: steps since the last probe, probes done, steps between (initialise)
-        self._since_probe, self.probes, self._probe_every = 0, 0, PROBE_EVERY
+        # extrapolated scheme: probes done, steps between probes (initialise sets it for the step)
+        self.probes, self._probe_every = 0, PROBE_EVERY
         self._inputs: list[list] = []      # extrapolated scheme: law inputs of the last 3 steps
         self._probe: tuple | None = None   # (friction of the first solve, its change) in a probe
         self.escalated_at: float | None = None
@@ -333,13 +335,11 @@ class FrictionCoupling:
         regime = self.reader.regime
         if first:
             self._accepted_steps += 1
-            self._since_probe += 1
             if self._reversed(inputs, regime):
                 self._iterating = True
                 self.iterated_steps += 1
                 return self._update(t, counted=True)
-            if self._since_probe >= self._probe_every:
-                self._since_probe = 0
+            if self._accepted_steps % self._probe_every == 0:
                 friction = self._law(inputs)
                 self._probe = (friction, self._change(friction, self.applied))
                 self.apply(friction)
