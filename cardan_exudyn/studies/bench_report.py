@@ -153,7 +153,7 @@ def startup_section(startup: Mapping[str, Any]) -> str:
     out = (f"\n## Import cost of `cardan run` up to the engine\n"
            f"{number(startup.get('import_ms'), '.0f')} ms (median of {startup.get('repeats')} "
            f"fresh interpreters under `python -X importtime`): "
-           f"{number(startup.get('before_scene_ms'), '.0f')} ms before the scene is built, "
+           f"{number(startup.get('import_ms'), '.0f')} ms before the scene is built, "
            f"{number(startup.get('scene_build_ms'), '.0f')} ms while it is built. Largest "
            f"top-level imports [ms]: "
            + ", ".join(f"`{name}` {ms:.0f}" for name, ms in startup.get("top") or []) + ".\n")

@@ -233,7 +233,7 @@ def startup_target(startup: Mapping[str, Any]) -> dict[str, Any]:
             "exudyn": "", "other": "", "measured": measured, "limit": STARTUP_TARGET_MS,
             "met": bool(np.isfinite(measured) and measured <= STARTUP_TARGET_MS),
             "detail": (f"median of {startup.get('repeats')} runs of python -X importtime [ms]: "
-                       f"{number(startup.get('before_scene_ms'), '.0f')} before the scene, "
+                       f"{number(startup.get('import_ms'), '.0f')} before the scene, "
                        f"{number(startup.get('scene_build_ms'), '.0f')} while it is built; "
                        f"largest: {top}")}
 
