@@ -299,7 +299,8 @@ def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
         coarse = run_once(_companion(scene, 2.0 * period / steps), options)
     main = run_once(replace(scene, **{"numerics.dt": period / steps}), options)
     _report_accuracy(main, coarse, scene, options)
-    unverified = main.success and main.summary.accuracy_met is None  # the companion failed
+    # no estimate because the companion failed (not because the main run has no efficiency)
+    unverified = main.summary.accuracy_met is None and _failed(coarse) and not _failed(main)
     if (main.summary.accuracy_met is False or unverified) and 2 * steps <= MAX_STEPS_PER_REVOLUTION:
         first = main.summary.efficiency_error_estimate
         coarse, steps = main, 2 * steps
@@ -335,10 +336,7 @@ def _companion(scene: Scene, dt: float) -> Scene:
 
 def loss_fraction(result: Result) -> float:
     """``1 - mean_efficiency`` of a run [-]; 1 (the most a joint can lose) without one."""
-    eta = result.summary.mean_efficiency
-    if not result.success or eta is None or not math.isfinite(eta):
-        return 1.0
-    return min(abs(1.0 - eta), 1.0)
+    return 1.0 if _failed(result) else min(abs(1.0 - result.summary.mean_efficiency), 1.0)
 
 
 EXTRAPOLATION_GAIN_CAP = 0.95
@@ -359,7 +357,7 @@ def _report_accuracy(main: Result, coarse: Result | None, scene: Scene, options:
     """The mean-efficiency error estimate of ``main`` into its summary (:func:`_estimate`; 0
     without friction), ``accuracy_met`` and a warning when the estimate exceeds the target."""
     s = main.summary
-    if not s.success or s.mean_efficiency is None or not math.isfinite(s.mean_efficiency):
+    if _failed(main):
         return
     target = scene.numerics.accuracy
     info: dict = {"target": target}
@@ -376,6 +374,12 @@ def _report_accuracy(main: Result, coarse: Result | None, scene: Scene, options:
     if not s.accuracy_met:
         s.warn(f"accuracy not met: estimated mean-efficiency error {estimate:.2g} > target {target:g} "
                f"(refine --dt or --accuracy)")
+
+
+def _failed(run: Result) -> bool:
+    """Whether a run gave no usable mean efficiency (not ``ok``, or none, or not finite)."""
+    eta = run.summary.mean_efficiency
+    return not (run.success and eta is not None and math.isfinite(eta))
 
 
 def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions,
@@ -398,13 +402,12 @@ def _estimate(main: Result, coarse: Result, scene: Scene, options: ExudynOptions
                 companion_status=str(coarse.summary.status),
                 companion_mean_efficiency=coarse.summary.mean_efficiency,
                 companion_wall_time_s=coarse.summary.wall_time_s)
-    eta_c = coarse.summary.mean_efficiency
-    if not (coarse.success and eta_c is not None and math.isfinite(eta_c)):
+    if _failed(coarse):
         info["method"] = (f"the companion run at {coarse.summary.dt:.3g} s ended {coarse.summary.status}"
                           if coarse.summary.dt else f"the companion run ended {coarse.summary.status}")
         return None
     ratio = coarse.summary.dt / s.dt
-    info["richardson"] = richardson(s.mean_efficiency, eta_c, ratio, order)
+    info["richardson"] = richardson(s.mean_efficiency, coarse.summary.mean_efficiency, ratio, order)
     floored = order == 1 or bool(reversing_parts(scene))
     estimate = max(info["richardson"], MODEL_FLOOR * model if floored else 0.0)
     info["method"] = (f"Richardson, companion at {ratio:.3g} x the step, order {order}"
