@@ -194,7 +194,8 @@ class SceneStack:
         if need:
             theta = profile_angles()
             idx = np.repeat(need, theta.size)
-            omega_rel, slide_rel = self._unit_speeds(idx, np.tile(theta, len(need)))
+            angles = np.tile(theta, len(need))
+            omega_rel, slide_rel = self._pair_speeds(idx, angles, np.ones_like(angles))
             for j, k in enumerate(need):
                 part = slice(j * theta.size, (j + 1) * theta.size)
                 speeds[k] = speeds_from_profile(self.scenes[k], {p: v[part] for p, v in omega_rel.items()},
@@ -203,14 +204,15 @@ class SceneStack:
         return [bands_from_speeds(s, speeds.get(k, zero) if needs_speeds(s) else None)
                 for k, s in enumerate(self.scenes)]
 
-    def _unit_speeds(self, idx: np.ndarray, theta: np.ndarray) -> tuple[dict, dict]:
-        """Per pair the relative angular [rad/s] and sliding [m/s] speeds at input angles ``theta``
-        [rad] turning at 1 rad/s, of the scenes ``idx``."""
-        one, zero = np.ones_like(theta), np.zeros_like(theta)
+    def _pair_speeds(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray) -> tuple[dict, dict]:
+        """Per pair the relative angular [rad/s] and sliding [m/s] speeds of the scenes ``idx`` at
+        input angles ``theta`` [rad] and speeds ``theta_t`` [rad/s] (speeds need no accelerations;
+        with mounting errors the loop's rates are all they need: no frames, no body motions)."""
+        zero = np.zeros_like(theta)
         if self.ideal:
-            motion = self.motion(idx, theta, one, zero)
+            motion = self.motion(idx, theta, theta_t, zero)
             return motion.omega_rel, motion.slide_rel
-        rates = self._loop_rates(idx, theta, one, zero)[2]
+        rates = self._loop_rates(idx, theta, theta_t, zero)[2]
         return ({p: rates.theta_t[..., k] for k, p in enumerate(PAIR_NAMES)},
                 {p: rates.s_t[..., k] for k, p in enumerate(PAIR_NAMES)})
 
@@ -303,14 +305,7 @@ class SceneStack:
 
     def _ramp_speeds(self, idx: np.ndarray, t: np.ndarray) -> np.ndarray:
         w = self.speed[idx]
-        theta, theta_t, theta_tt = w * t, w + 0.0, np.zeros_like(t)  # speeds need no accelerations
-        if self.ideal:
-            motion = self.motion(idx, theta, theta_t, theta_tt)
-            omega_rel, slide_rel = motion.omega_rel, motion.slide_rel
-        else:  # the loop's rates are all the speeds need (no frames, no body motions)
-            rates = self._loop_rates(idx, theta, theta_t, theta_tt)[2]
-            omega_rel = {p: rates.theta_t[..., k] for k, p in enumerate(PAIR_NAMES)}
-            slide_rel = {p: rates.s_t[..., k] for k, p in enumerate(PAIR_NAMES)}
+        omega_rel, slide_rel = self._pair_speeds(idx, w * t, w + 0.0)
         speeds = self.slot_speeds(idx, omega_rel, slide_rel)
         if self.first.friction.law != "resultant":
             return speeds
