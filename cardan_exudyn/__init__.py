@@ -33,10 +33,10 @@ _LAZY = {
     "ExudynOptions": "cardan_exudyn.model.options",
     "compare": "cardan_exudyn.comparison",
     "Comparison": "cardan_exudyn.comparison",
-    "Result": "reference.schema",
-    "Summary": "reference.schema",
-    "Status": "reference.schema",
-    "OptionsError": "reference.schema",
+    "Result": "reference.results.schema",
+    "Summary": "reference.results.schema",
+    "Status": "reference.results.schema",
+    "OptionsError": "reference.results.schema",
     "sweep": "cardan_exudyn.sweep",
 }
 

@@ -24,10 +24,10 @@ else:  # Python 3.10
     import tomli as tomllib
 
 from cardan_exudyn.io import OutputError, check_output_folder
-from reference.paper import named_scene
-from reference.scene import Scene, replace
-from reference.scene_files import load_scene
-from reference.validation import DEG, RPM, SceneError
+from reference.paper.paper import named_scene
+from reference.scene.scene import Scene, replace
+from reference.scene.files import load_scene
+from reference.scene.validation import DEG, RPM, SceneError
 
 __all__ = ["EXIT_OK", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_INCOMPLETE", "EXIT_INACCURATE",
            "EXIT_INTERRUPTED",

@@ -50,9 +50,9 @@ from cardan_exudyn.io import (
 )
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies import COMMANDS
-from reference.scene import Scene, scene_to_dict
-from reference.schema import OptionsError, Status, Summary
-from reference.validation import SceneError
+from reference.scene.scene import Scene, scene_to_dict
+from reference.results.schema import OptionsError, Status, Summary
+from reference.scene.validation import SceneError
 
 if TYPE_CHECKING:
     from cardan_exudyn.sweep import SweepSpec
@@ -293,8 +293,8 @@ def add_scene_parser(sub: argparse._SubParsersAction) -> None:
 
 def _add_study_commands(sub: argparse._SubParsersAction) -> None:
     """The subcommands the study modules register (:data:`cardan_exudyn.studies.COMMANDS`)."""
-    for name in COMMANDS:
-        importlib.import_module(f"cardan_exudyn.studies.{name}").register(sub)
+    for module in COMMANDS.values():
+        importlib.import_module(f"cardan_exudyn.studies.{module}").register(sub)
 
 
 def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:

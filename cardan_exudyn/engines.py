@@ -1,12 +1,12 @@
-"""The one engine dispatch: every engine takes a :class:`reference.scene.Scene` and options, and
-returns a :class:`reference.schema.Result` with the same columns and summary fields.
+"""The one engine dispatch: every engine takes a :class:`reference.scene.scene.Scene` and options, and
+returns a :class:`reference.results.schema.Result` with the same columns and summary fields.
 
 Like scipy's ``solve_ivp(method=...)`` over its ``METHODS`` table: callers name an engine (or
 pass options of an engine's class) and never import an engine module themselves. Engines are
 imported on first use, so a missing optional engine (MuJoCo) costs nothing until asked for.
 
 Many scenes at once: :func:`run_batch`. An engine with a batched pass (the reference engine's
-:mod:`reference.batch`) runs the scenes of equal :func:`batch_key` together; the others, and
+:mod:`reference.engine.batch.solve`) runs the scenes of equal :func:`batch_key` together; the others, and
 scenes whose key is None, run one at a time as :func:`run` would.
 """
 
@@ -17,9 +17,9 @@ from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from reference.scene import Scene
-from reference.schema import OptionsError, Result
-from reference.validation import require_scene
+from reference.scene.scene import Scene
+from reference.results.schema import OptionsError, Result
+from reference.scene.validation import require_scene
 
 
 @dataclass(frozen=True)
@@ -42,10 +42,10 @@ class Engine:
 ENGINES: dict[str, Engine] = {
     "exudyn": Engine("exudyn", "cardan_exudyn.model.solve", "cardan_exudyn.model.options:ExudynOptions",
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
-    "reference": Engine("reference", "reference.engine", "reference.engine:ReferenceOptions",
+    "reference": Engine("reference", "reference.engine.solve", "reference.engine.solve:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "
-                        "minimal-coordinate dynamics, adaptive work quadrature", batch="reference.batch"),
-    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco_engine", "cardan_exudyn.mujoco_engine:MujocoOptions",
+                        "minimal-coordinate dynamics, adaptive work quadrature", batch="reference.engine.batch.solve"),
+    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco.engine", "cardan_exudyn.mujoco.engine:MujocoOptions",
                      "MuJoCo (optional extra): frictionless scenes with a constant load only"),
 }
 
@@ -145,7 +145,7 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
     Raises
     ------
     TypeError
-        ``scene`` is not a Scene (:class:`reference.validation.SceneTypeError`), or ``engine``
+        ``scene`` is not a Scene (:class:`reference.scene.validation.SceneTypeError`), or ``engine``
         not a string.
     EngineUnavailable
         Unknown or uninstalled engine, or a scene the engine cannot express.
@@ -187,7 +187,7 @@ def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any =
               **option_values: Any) -> list[Result]:
     """Run many scenes with one engine: one :class:`Result` per scene, in order, each equal to
     ``run(scene, engine, options)`` (to rounding, or to the quadrature tolerance where the batched
-    pass adapts differently: :mod:`reference.batch`).
+    pass adapts differently: :mod:`reference.engine.batch.solve`).
 
     Scenes of equal :func:`batch_key` run in one pass of the engine's batched evaluation (a scene
     that locks or fails gets its own failed Result); the others, and every scene of an engine

@@ -26,7 +26,7 @@ from typing import IO, Any
 import numpy as np
 
 from cardan_exudyn.interrupts import deferred_signals
-from reference.schema import Result, Summary
+from reference.results.schema import Result, Summary
 
 
 class OutputError(ValueError):

@@ -30,14 +30,14 @@ from __future__ import annotations
 from reference.lazy import lazy_face
 
 _HOMES = {
-    "reference.validation": ("SceneError", "DEG", "RPM"),
-    "reference.joint": ("PAIR_NAMES", "Body", "Geometry", "Pair", "Pairs", "MountingErrors", "Joint"),
-    "reference.scene": ("Scene", "SpeedDrive", "AngleDrive", "TorqueDrive", "Load", "Numerics",
+    "reference.scene.validation": ("SceneError", "DEG", "RPM"),
+    "reference.scene.joint": ("PAIR_NAMES", "Body", "Geometry", "Pair", "Pairs", "MountingErrors", "Joint"),
+    "reference.scene.scene": ("Scene", "SpeedDrive", "AngleDrive", "TorqueDrive", "Load", "Numerics",
                         "FrictionSettings", "Record", "replace", "scene_to_dict", "scene_from_dict"),
-    "reference.scene_files": ("load_scene", "scene_from_mapping"),
-    "reference.paper": ("named_scene", "paper_scene", "rig_scene"),
-    "reference.schema": ("Status", "Result", "Summary", "OptionsError"),
-    "reference.engine": ("ReferenceOptions", "run"),
+    "reference.scene.files": ("load_scene", "scene_from_mapping"),
+    "reference.paper.paper": ("named_scene", "paper_scene", "rig_scene"),
+    "reference.results.schema": ("Status", "Result", "Summary", "OptionsError"),
+    "reference.engine.solve": ("ReferenceOptions", "run"),
 }
 _LAZY = {name: module for module, names in _HOMES.items() for name in names}
 

@@ -31,7 +31,7 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.interpolate import PchipInterpolator, make_smoothing_spline
 from scipy.optimize import minimize_scalar
 
-from reference.kinematics import speed_ratio
+from reference.physics.kinematics import speed_ratio
 from rigdata.record import SHAFTS, RigDataError, RigRecord
 from rigdata.units import check_magnitudes
 

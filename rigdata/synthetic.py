@@ -27,11 +27,11 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.interpolate import CubicSpline
 
 from cardan_exudyn import engines
-from reference.engine import ReferenceOptions, columns_at, input_motion
-from reference.paper import named_scene
-from reference.scene import AngleDrive, Load, Scene
-from reference.scene import replace as replace_field
-from reference.schema import Result
+from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.paper.paper import named_scene
+from reference.scene.scene import AngleDrive, Load, Scene
+from reference.scene.scene import replace as replace_field
+from reference.results.schema import Result
 from rigdata import files
 from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
@@ -48,7 +48,7 @@ class RigSettings:
     Attributes
     ----------
     scene : str
-        Named scene of the joint (``reference.paper.named_scene``); its drive and load are
+        Named scene of the joint (``reference.paper.paper.named_scene``); its drive and load are
         replaced by the motor and brake below.
     shaft_angle_deg : float or None
         The joint's shaft angle [deg]; None: the scene's (15 for the rig).

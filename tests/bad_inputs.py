@@ -3,7 +3,7 @@
 Every entry point must reject bad input with one clear line naming what is wrong: the ``cardan``
 command line (every subcommand, ``cardan rig ...`` included) exits with status 2, one line on
 stderr, nothing on stdout, no traceback, and leaves an output folder it was given as it was; the
-Python API raises a documented exception (:class:`~reference.scene.SceneError`,
+Python API raises a documented exception (:class:`~reference.scene.scene.SceneError`,
 :class:`~cardan_exudyn.sweep.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
 :class:`~cardan_exudyn.io.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
 one-line message. A run that fails is not bad input: it exits with status 3 and a status line
@@ -30,13 +30,13 @@ from cardan_exudyn.comparison import compare
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
-from reference.engine import ReferenceOptions
-from reference.joint import Body
-from reference.paper import named_scene
-from reference.scene import Load, Scene, replace, scene_from_dict
-from reference.scene_files import load_scene
-from reference.schema import OptionsError, Result, Status, Summary
-from reference.validation import SceneError
+from reference.engine.solve import ReferenceOptions
+from reference.scene.joint import Body
+from reference.paper.paper import named_scene
+from reference.scene.scene import Load, Scene, replace, scene_from_dict
+from reference.scene.files import load_scene
+from reference.results.schema import OptionsError, Result, Status, Summary
+from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
 from rigdata.readers import read
 from rigdata.record import ChannelSource, RigDataError, RigRecord
@@ -145,12 +145,12 @@ _RIG_FILE = {"rig.csv": _rig_csv()}
 
 
 def _api_load_missing(d: Path) -> Any:
-    """reference.scene_files.load_scene("missing.toml")"""
+    """reference.scene.files.load_scene("missing.toml")"""
     return load_scene(d / "missing.toml")
 
 
 def _api_empty_dict(d: Path) -> Any:
-    """reference.scene.scene_from_dict({})"""
+    """reference.scene.scene.scene_from_dict({})"""
     return scene_from_dict({})
 
 
@@ -175,7 +175,7 @@ def _api_load_text(d: Path) -> Any:
 
 
 def _api_named_unknown(d: Path) -> Any:
-    """reference.paper.named_scene("nope")"""
+    """reference.paper.paper.named_scene("nope")"""
     return named_scene("nope")
 
 
@@ -280,7 +280,7 @@ def _api_compare_skip_all(d: Path) -> Any:
 
 
 def _api_replace_none(d: Path) -> Any:
-    """reference.scene.replace(None, revolutions=2)"""
+    """reference.scene.scene.replace(None, revolutions=2)"""
     return replace(None, revolutions=2.0)
 
 
@@ -291,12 +291,12 @@ def _api_scene_load_type(d: Path) -> Any:
 
 
 def _api_named_scene_list(d: Path) -> Any:
-    """reference.paper.named_scene(["paper-literal"])"""
+    """reference.paper.paper.named_scene(["paper-literal"])"""
     return named_scene(["paper-literal"])
 
 
 def _api_load_scene_none(d: Path) -> Any:
-    """reference.scene_files.load_scene(None)"""
+    """reference.scene.files.load_scene(None)"""
     return load_scene(None)
 
 

@@ -19,7 +19,7 @@ from cardan_exudyn.model.stepsize import (
     reversing_parts,
     richardson,
 )
-from cardan_exudyn.studies.accuracy_grid import (
+from cardan_exudyn.studies.accuracy.compute import (
     REFERENCE_TIGHT,
     cell_scene,
     grid_cells,
@@ -27,10 +27,10 @@ from cardan_exudyn.studies.accuracy_grid import (
     run_cell,
     run_cell_limited,
 )
-from reference.paper import named_scene
-from reference.scene import replace
-from reference.schema import Status
-from reference.validation import SceneError
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
+from reference.results.schema import Status
+from reference.scene.validation import SceneError
 
 ONE_REVOLUTION = {"revolutions": 1.0, "record.timeseries": False}
 
@@ -53,7 +53,7 @@ def test_efficiency_model_falls_with_the_step_and_scales_with_the_loss():
 
 
 def test_order_is_two_unless_friction_lags():
-    """Friction's sign jumps at reversals are integrated across (reference.quadrature), so the
+    """Friction's sign jumps at reversals are integrated across (reference.results.quadrature), so the
     mean efficiency converges at second order with reversing friction too, at any step; the
     lagged coupling (friction one step late) at first order."""
     scene = named_scene("paper-literal-10deg")

@@ -17,9 +17,9 @@ import pytest
 
 from cardan_exudyn import engines
 from cardan_exudyn.cli import main
-from cardan_exudyn.studies.bench import steps_or_auto
-from cardan_exudyn.studies.bench_audit import skip_audit, solution_file, solve_only
-from cardan_exudyn.studies.bench_configs import (
+from cardan_exudyn.studies.bench.command import steps_or_auto
+from cardan_exudyn.studies.bench.audit import skip_audit, solution_file, solve_only
+from cardan_exudyn.studies.bench.configs import (
     EXUDYN_TUNED,
     SCENES,
     Config,
@@ -27,10 +27,10 @@ from cardan_exudyn.studies.bench_configs import (
     configurations,
     frictionless_twin_config,
 )
-from cardan_exudyn.studies.bench_ladders import run_errors, yardstick
-from cardan_exudyn.studies.bench_report import bench_command
-from cardan_exudyn.studies.bench_result import BenchError, check_inputs, check_paper
-from cardan_exudyn.studies.bench_targets import (
+from cardan_exudyn.studies.bench.ladders import run_errors, yardstick
+from cardan_exudyn.studies.bench.report import bench_command
+from cardan_exudyn.studies.bench.result import BenchError, check_inputs, check_paper
+from cardan_exudyn.studies.bench.targets import (
     EFFICIENCY_TARGET,
     STARTUP_TARGET_MS,
     evaluate_targets,
@@ -39,9 +39,9 @@ from cardan_exudyn.studies.bench_targets import (
     paper_scenes,
     paper_scenes_timing,
 )
-from reference.paper import named_scene
-from reference.scene import replace
-from reference.schema import Result, Status, Summary
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
+from reference.results.schema import Result, Status, Summary
 
 
 def tuned_errors(scene, steps) -> list[dict]:
@@ -207,7 +207,7 @@ def test_skip_audit_measures_each_item_side_by_side():
     # (median 1.37) over 40 such audits on 2 loaded cores, while items of no effect ranged 0.95 to
     # 1.16 (5-95 %); in wall time (the default clock) they ranged 0.46 to 2.0 there. The Python
     # drive function, 1.66 when the angle history was a CubicSpline call (15 us), measures 1.10 to
-    # 1.14 (medians) since histories evaluate in plain floats (reference.histories, about 1 us):
+    # 1.14 (medians) since histories evaluate in plain floats (reference.scene.histories, about 1 us):
     # within the noise.
     row = audit[audit["item"] == "solution file"].iloc[0]
     assert row["with_over_without"] > 1.1
@@ -383,7 +383,7 @@ def test_batch_bench_reports_the_torque_drive_target():
     """`cardan bench --only batch`'s torque-drive target: the reference engine's torque-driven
     paper scene runs to status ok with the friction losses of a 10 deg joint, and the target row
     compares the measured time with its limit (the time itself is a benchmark, not asserted)."""
-    from cardan_exudyn.studies.bench_batch import TORQUE_TARGET_S, batch_targets, torque_drive
+    from cardan_exudyn.studies.bench.batch import TORQUE_TARGET_S, batch_targets, torque_drive
 
     torque = torque_drive(repeats=1)
     assert torque["status"] == Status.OK and 0.9 < torque["mean_efficiency"] < 1.0

@@ -11,10 +11,10 @@ import pytest
 
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
-from cardan_exudyn.studies.calibrate import calibrate, case_rows, fit, fit_statistics, residuals
-from cardan_exudyn.studies.envelope import envelope_study
-from cardan_exudyn.studies.fitting import CaseModel, Space, cases_named, set_space
-from reference.paper import (
+from cardan_exudyn.studies.calibrate.compute import calibrate, case_rows, fit, fit_statistics, residuals
+from cardan_exudyn.studies.calibrate.envelope import envelope_study
+from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, cases_named, set_space
+from reference.paper.paper import (
     envelope,
     paper_cases,
     paper_scene,
@@ -23,7 +23,7 @@ from reference.paper import (
     plausible_box,
     set_values,
 )
-from reference.scene import replace
+from reference.scene.scene import replace
 
 ECCENTRIC = Space(("input_eccentricity",), (0.0,), (0.001,), (False,))
 """A one-parameter box: the input's unbalance 0-1 mm."""
@@ -142,7 +142,7 @@ def test_bad_input_in_the_api():
 def test_parameter_tables_against_the_plausible_box():
     """Every physical value lies inside its plausible range; the matched set's values outside
     theirs are reported as outside (its levers as the dimensions they stand for)."""
-    from cardan_exudyn.studies.reproduce_report import parameter_rows
+    from cardan_exudyn.studies.reproduce.report import parameter_rows
 
     for row in parameter_table("physical"):
         if row["name"] != "friction_law":  # a law, not a dimension: no plausible range

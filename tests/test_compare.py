@@ -7,7 +7,7 @@ be at most ``(omega h)^2`` (the dimensionless
 step squared) for the mean efficiency, halving the step must divide the differences by about
 four, and Richardson extrapolation of two Exudyn runs must land on the reference. These claims
 hold where the friction sign ramps are resolved by the step: the default ramp (1e-3 of each
-pair's characteristic speed, ``reference.bands``) spans about 1.5e-3 rad of input angle and makes
+pair's characteristic speed, ``reference.physics.bands``) spans about 1.5e-3 rad of input angle and makes
 the mean-efficiency error first order at any affordable step (``docs/accuracy.md``), so the
 friction scenes here use a ramp of ``RAMP_RELATIVE`` (0.1 rad wide, four steps at 200 steps per
 revolution): both engines solve the same regularised model. The
@@ -28,11 +28,11 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.comparison import Comparison, compare, join_on_input_angle
 from cardan_exudyn.engines import run
 from cardan_exudyn.io import dumps
-from reference.engine import ReferenceOptions
-from reference.joint import PAIR_NAMES
-from reference.paper import named_scene
-from reference.scene import replace
-from reference.schema import OptionsError, Status
+from reference.engine.solve import ReferenceOptions
+from reference.scene.joint import PAIR_NAMES
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
+from reference.results.schema import OptionsError, Status
 
 SKIP = 0.25  # revolutions left out of the steady statistics
 RAMP_RELATIVE = 0.1  # sign ramp resolved by the step (see the module docstring)

@@ -9,8 +9,8 @@ import pytest
 from conftest import balanced_scene
 
 from cardan_exudyn import run
-from reference.paper import named_scene
-from reference.scene import AngleDrive, replace
+from reference.paper.paper import named_scene
+from reference.scene.scene import AngleDrive, replace
 
 
 def balance_residual(result) -> tuple[float, float]:

@@ -1,6 +1,6 @@
-"""Fast forward dynamics (reference.forward): the series right-hand side against the direct solve.
+"""Fast forward dynamics (reference.engine.forward): the series right-hand side against the direct solve.
 
-The direct solve (:func:`reference.dynamics.solve_dynamics` per sample) is the reference engine's
+The direct solve (:func:`reference.engine.dynamics.solve_dynamics` per sample) is the reference engine's
 right-hand side before the series; it stays reachable as ``method="direct"``. Both build the
 same Newton-Euler equations, so they must agree to rounding, friction and the self-locking
 verdict included. The direct solve's own rounding is about 1e-12 of the acceleration (its
@@ -17,7 +17,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import cardan_exudyn
-from reference.dynamics import (
+from reference.engine.dynamics import (
     FrictionLaw,
     friction_matrix,
     friction_slots,
@@ -27,11 +27,11 @@ from reference.dynamics import (
     slot_speeds,
     solve_dynamics,
 )
-from reference.forward import ForwardDynamics, fit_periodic, right_hand_side
-from reference.joint import PAIR_NAMES
-from reference.joint_motion import joint_motion
-from reference.paper import named_scene
-from reference.scene import replace
+from reference.engine.forward import ForwardDynamics, fit_periodic, right_hand_side
+from reference.scene.joint import PAIR_NAMES
+from reference.physics.joint_motion import joint_motion
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
 
 SPEED = 209.44  # 2000 rpm [rad/s], the paper's speed
 AGREE = 1e-10

@@ -14,11 +14,11 @@ import pytest
 
 from cardan_exudyn import run
 from cardan_exudyn.model.build import build_model
-from reference.bands import characteristic_speeds, sign_bands
-from reference.friction import friction_from_columns, pair_friction, regularised_sign
-from reference.joint import PAIR_KIND, PAIR_NAMES, Pair
-from reference.paper import named_scene
-from reference.scene import replace
+from reference.physics.bands import characteristic_speeds, sign_bands
+from reference.physics.friction import friction_from_columns, pair_friction, regularised_sign
+from reference.scene.joint import PAIR_KIND, PAIR_NAMES, Pair
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
 
 
 def _scene(coupling: str, **changes):
@@ -70,7 +70,7 @@ def test_regularised_sign_per_slot():
 
 
 # relative speeds the Exudyn model evaluates and those its table records differ by rounding,
-# about 1e-13 of the scene's fastest characteristic speed (reference/bands.py; measured here
+# about 1e-13 of the scene's fastest characteristic speed (reference/physics/bands.py; measured here
 # 2.4e-14: 5e-14 m/s against the frame journals' 2.1 m/s)
 SPEED_ROUNDING = 1e-13
 
@@ -215,7 +215,7 @@ def test_sign_band_does_not_change_the_0deg_result():
     The ideal joint's cylindrical pairs get no axial friction (they cannot slide); before, the
     exact sign of their solver-noise slide speeds switched the full axial force and the run
     stopped as self-locking."""
-    from cardan_exudyn.studies.friction_numerics import sign_band_study
+    from cardan_exudyn.studies.study.compute import sign_band_study
 
     rows = sign_band_study(["paper-0deg"], [0.0, 1e-6, 1e-3, 1e-1])
     etas = [r["mean_efficiency"] for r in rows]
@@ -231,7 +231,7 @@ def test_converged_coupling_beats_lagged_at_every_step():
     converged one fell by 7.8 over the ladder while the table's trapezoid was first order across
     friction's sign jumps; integrated across them, what is left at 200-800 steps is the dip of
     this 1 mm/s ramp, which the steps only partly resolve: 3.6e-4 at 800, 6.8e-7 at 1600.)"""
-    from cardan_exudyn.studies.friction_numerics import COUPLING_QUICK, coupling_study
+    from cardan_exudyn.studies.study.compute import COUPLING_QUICK, coupling_study
 
     rows = coupling_study(COUPLING_QUICK["names"], COUPLING_QUICK["ladder"])
     err = {(r["coupling"], r["steps_per_revolution"]): abs(r["error"]) for r in rows}

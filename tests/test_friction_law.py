@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads, ramp_sign
-from reference.friction import pair_friction
+from reference.physics.friction import pair_friction
 
 SPIDER = PairLaw(cylindrical=True, f=0.42, d=0.005, lever=0.006)  # the paper's spider pairs
 
@@ -52,9 +52,9 @@ finite = st.floats(-1e3, 1e3, allow_nan=False)
        band=st.sampled_from([0.0, 1e-4, 1e-3]), slide_band=st.sampled_from([None, 0.0, 1e-6, 1e-2]),
        cylindrical=st.booleans())
 def test_agrees_with_the_reference_law(fx, fy, mx, my, omega, slide, band, slide_band, cylindrical):
-    """Same torque and force as reference.friction.pair_friction, written independently, with
+    """Same torque and force as reference.physics.friction.pair_friction, written independently, with
     the rotation's and the sliding's own bands."""
-    from reference.joint import Pair
+    from reference.scene.joint import Pair
 
     pair = Pair(friction_coefficient=0.42, journal_diameter=0.005, moment_lever=0.006)
     law = PairLaw(cylindrical, 0.42, 0.005, 0.006)

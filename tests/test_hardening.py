@@ -20,7 +20,7 @@ from bad_inputs import CASES, DIRECTORY, ENTRY_POINTS, MARKER, Case
 from cardan_exudyn import io as cio
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
-from reference.schema import Result, Status, Summary
+from reference.results.schema import Result, Status, Summary
 
 #: Non-finite numbers as a command would print them (``nan``, ``inf``, ``-inf``, ``infinity``).
 NON_FINITE = re.compile(r"(?<![\w.])[-+]?(nan|inf|infinity)(?![\w])", re.IGNORECASE)
@@ -234,7 +234,7 @@ def test_run_out_interrupted_keeps_previous(tmp_path, monkeypatch, stop):
 
 def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
     """`cardan compare --out`: interrupted while drawing the plots, after the tables."""
-    import cardan_exudyn.studies.compare as compare
+    import cardan_exudyn.studies.compare.command as compare
 
     out = tmp_path / "cmp"
     _previous(out)
@@ -252,7 +252,7 @@ def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
 
 def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
     """`cardan study --out`: the plot fails after the CSV and JSON are written."""
-    import cardan_exudyn.studies.friction_numerics as studies
+    import cardan_exudyn.studies.study.compute as studies
 
     out = tmp_path / "study"
     _previous(out)
@@ -269,7 +269,7 @@ def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
 def test_tolerance_out_failure_keeps_previous_study(tmp_path, monkeypatch):
     """`cardan tolerance montecarlo`: the report fails after the samples table is written; the
     previous study folder stays, the sweep records (resumable by design) are kept."""
-    import cardan_exudyn.studies.tolerance as tolerance
+    import cardan_exudyn.studies.tolerance.compute as tolerance
 
     out = tmp_path / "mc"
     _previous(out / "study")
@@ -357,7 +357,7 @@ def test_forced_failure_prints_status_not_nan(tmp_path, monkeypatch, capsys):
 
     real = engines.get_engine
     monkeypatch.setitem(engines.ENGINES, "fake", engines.Engine(
-        "fake", "reference.engine", "reference.engine:ReferenceOptions", "test double"))
+        "fake", "reference.engine.solve", "reference.engine.solve:ReferenceOptions", "test double"))
     monkeypatch.setattr(engines, "get_engine",
                         lambda name: _nan_engine("integration_failure") if name == "fake" else real(name))
     assert main(["run", "--engine", "fake", "--out", str(tmp_path / "r")]) == 3
@@ -378,7 +378,7 @@ def test_zero_input_work_prints_undefined(monkeypatch, capsys):
 
     real = engines.get_engine
     monkeypatch.setitem(engines.ENGINES, "fake", engines.Engine(
-        "fake", "reference.engine", "reference.engine:ReferenceOptions", "test double"))
+        "fake", "reference.engine.solve", "reference.engine.solve:ReferenceOptions", "test double"))
     monkeypatch.setattr(engines, "get_engine",
                         lambda name: _nan_engine("ok") if name == "fake" else real(name))
     assert main(["run", "--engine", "fake"]) == 0
@@ -410,7 +410,7 @@ def test_compare_with_failed_engines_prints_no_number(capsys):
 
 def test_calibrate_failed_case_prints_status(monkeypatch, capsys):
     """`cardan calibrate`: a held-out case whose run failed shows its status, exit 3."""
-    import cardan_exudyn.studies.calibrate as calibrate
+    import cardan_exudyn.studies.calibrate.compute as calibrate
 
     rows = [{"case": "table2:0:2000", "used_in_fit": True, "paper": 0.99, "model": 0.98,
              "difference": -0.01, "status": "ok", "reason": ""},
@@ -432,8 +432,8 @@ def test_reference_zero_input_work_finishes():
     """No load, no friction, no gravity: the input work cancels to ~0; the quadrature used to
     split its panels 40 times (2^40 panels: out of memory). Now it closes at once, and the
     efficiency of a joint that transmits and loses nothing is undefined (it was 1, issue 18)."""
-    from reference.paper import named_scene
-    from reference.scene import replace
+    from reference.paper.paper import named_scene
+    from reference.scene.scene import replace
 
     for angle in (0.0, 10.0):
         scene = replace(named_scene("paper-literal-frictionless"), revolutions=1, gravity=[0.0, 0.0, 0.0],
@@ -446,7 +446,7 @@ def test_reference_zero_input_work_finishes():
 
 def test_scene_file_switches_drive_kind(tmp_path):
     """A scene file on a speed-driven base may give an angle drive (it replaces the base's)."""
-    from reference.scene_files import load_scene
+    from reference.scene.files import load_scene
 
     path = tmp_path / "s.toml"
     path.write_text('base = "paper-literal-frictionless"\n[drive]\nkind = "angle"\n'

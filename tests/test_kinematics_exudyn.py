@@ -9,7 +9,7 @@ import pytest
 from conftest import balanced_scene
 
 from cardan_exudyn import run
-from reference.kinematics import output_angle, speed_ratio
+from reference.physics.kinematics import output_angle, speed_ratio
 
 
 def ratio_error(result) -> float:

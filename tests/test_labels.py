@@ -9,9 +9,9 @@ import pytest
 
 from cardan_exudyn.arguments import override_name, scene_from_args
 from cardan_exudyn.cli import build_parser, main
-from reference.paper import named_scene
-from reference.scene_files import scene_from_mapping
-from reference.validation import SceneError
+from reference.paper.paper import named_scene
+from reference.scene.files import scene_from_mapping
+from reference.scene.validation import SceneError
 
 
 def _scene(*argv: str):

@@ -2,7 +2,7 @@
 
 Each check runs in a fresh interpreter, so that what this test session has imported already
 (pandas, scipy, Exudyn, ...) cannot hide an import. The timing itself is a benchmark figure
-(:func:`cardan_exudyn.studies.bench_startup.import_cost`), not a test.
+(:func:`cardan_exudyn.studies.bench.startup.import_cost`), not a test.
 """
 
 from __future__ import annotations
@@ -17,13 +17,13 @@ import pytest
 
 from cardan_exudyn.arguments import DEFAULT_SCENE
 from cardan_exudyn.studies import COMMANDS
-from cardan_exudyn.studies.bench_startup import SCENE_MARKER, import_cost, parse_importtime
-from reference.paper import named_scene
+from cardan_exudyn.studies.bench.startup import SCENE_MARKER, import_cost, parse_importtime
+from reference.paper.paper import named_scene
 
 HEAVY = ("pandas", "matplotlib", "scipy", "dask", "distributed", "mujoco", "exudyn", "tqdm")
 """Third-party packages a run loads only when it needs them (tables, plots, the engines)."""
 JOBS = ("cardan_exudyn.studies.", "cardan_exudyn.sweep", "cardan_exudyn.model", "cardan_exudyn.comparison",
-        "cardan_exudyn.mujoco_engine", "cardan_exudyn.report.plots", "rigdata")
+        "cardan_exudyn.mujoco.engine", "cardan_exudyn.report.plots", "rigdata")
 """Modules of this project that ``cardan run`` has no use for before its engine runs."""
 
 PROBE = f"""
@@ -140,7 +140,7 @@ def test_window_times_agree_with_brentq(t0, ripple):
     lets the speed dip to 1.2 rad/s."""
     from scipy.optimize import brentq
 
-    import reference.engine as engine
+    import reference.engine.solve as engine
 
     motion = RippledMotion(t0, ripple)
     rtol = 4 * np.finfo(float).eps  # brentq's settings in the engine before, xtol 1e-15 s
@@ -158,8 +158,8 @@ import time:       900 |       1000 | site
 import time:       500 |      50000 |   numpy
 import time:       200 |      60000 | cardan_exudyn.cli
 {SCENE_MARKER}
-import time:       300 |       7000 |     reference.rccc
-import time:       400 |      12000 | reference.engine
+import time:       300 |       7000 |     reference.physics.rccc
+import time:       400 |      12000 | reference.engine.solve
 import time:        50 |         50 | numpy.ma
 """
 
@@ -169,7 +169,7 @@ def test_parse_importtime_sums_top_level_entries_per_phase():
     marker; the header line is skipped."""
     before, after = parse_importtime(SAMPLE)
     assert before == {"site": 1000, "cardan_exudyn.cli": 60000}
-    assert after == {"reference.engine": 12000, "numpy.ma": 50}
+    assert after == {"reference.engine.solve": 12000, "numpy.ma": 50}
     assert parse_importtime(SAMPLE.replace(SCENE_MARKER, "other line"))[1] == {}
 
 
@@ -178,7 +178,7 @@ def test_import_cost_measures_cardan_run():
     cost = import_cost(1)
     assert cost["import_ms"] == cost["runs_ms"][0] > 0
     assert "cardan_exudyn.cli" in [name for name, _ in cost["top"]]
-    assert "reference.engine" in [name for name, _ in cost["scene_top"]]
+    assert "reference.engine.solve" in [name for name, _ in cost["scene_top"]]
     assert 0 < cost["baseline_ms"] and cost["through_scene_ms"] > cost["import_ms"]
     assert cost["target_ms"] == 150.0 and cost["repeats"] == 1
 

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import run
-from reference.paper import named_scene
-from reference.scene import AngleDrive, Load, scene_from_dict, scene_to_dict
-from reference.scene_files import load_scene
-from reference.validation import SceneError
+from reference.paper.paper import named_scene
+from reference.scene.scene import AngleDrive, Load, scene_from_dict, scene_to_dict
+from reference.scene.files import load_scene
+from reference.scene.validation import SceneError
 
 SPEED = 6.0
 SPAN = 2 * np.pi * 2.2 / SPEED

@@ -1,8 +1,8 @@
-"""Long runs (``cardan_exudyn.studies.longrun``): drift over thousands of revolutions with
+"""Long runs (``cardan_exudyn.studies.stress.longrun``): drift over thousands of revolutions with
 friction, and energy conservation of the free-spinning frictionless joint.
 
 The library measures; the verdicts are here: :data:`TOLERANCES` holds each tolerance with its
-reason (measured values with a margin, see ``cardan_exudyn/studies/longrun.py``), and every
+reason (measured values with a margin, see ``cardan_exudyn/studies/stress/longrun.py``), and every
 verdict test runs on each variant of the study: a short one in the default suite (5 revolutions
 with friction for each node type, 8 free-spinning revolutions at 35 deg, the reference engine
 for 1; about 8 s), the quick one of ``cardan stress --quick`` and the full one (2000 / 1000
@@ -25,8 +25,8 @@ import pytest
 from cardan_exudyn import ExudynOptions
 from cardan_exudyn.model.options import NODE_TYPES
 from cardan_exudyn.model.stepsize import MIN_STEPS_PER_REVOLUTION
-from cardan_exudyn.studies.longrun import LongRuns, long_runs, simulate
-from cardan_exudyn.studies.longrun_measures import (
+from cardan_exudyn.studies.stress.longrun import LongRuns, long_runs, simulate
+from cardan_exudyn.studies.stress.longrun_measures import (
     algorithmic_damping,
     at_revolutions,
     damping_coefficient,
@@ -35,7 +35,7 @@ from cardan_exudyn.studies.longrun_measures import (
     per_revolution_max,
     revolution_index,
 )
-from cardan_exudyn.studies.longrun_plan import (
+from cardan_exudyn.studies.stress.longrun_plan import (
     DEFAULT_RHO,
     DISSIPATION_MODEL,
     DRIFT_SCENE,
@@ -49,9 +49,9 @@ from cardan_exudyn.studies.longrun_plan import (
     energy_plan,
     model_loss,
 )
-from cardan_exudyn.studies.longrun_report import markdown, write_long
-from reference.paper import named_scene
-from reference.scene import replace
+from cardan_exudyn.studies.stress.longrun_report import markdown, write_long
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
 
 
 class Tolerance(NamedTuple):

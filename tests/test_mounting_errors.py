@@ -14,14 +14,14 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 import cardan_exudyn
-from reference import kinematics, rccc
-from reference.dynamics import dynamics_columns
-from reference.friction import friction_from_columns
-from reference.joint import ERROR_NAMES, PAIR_NAMES
-from reference.joint_motion import ideal_pair_origins, joint_motion
-from reference.paper import named_scene, paper_errors
-from reference.scene import replace, scene_from_dict, scene_to_dict
-from reference.validation import SceneError
+from reference.physics import kinematics, rccc
+from reference.engine.dynamics import dynamics_columns
+from reference.physics.friction import friction_from_columns
+from reference.scene.joint import ERROR_NAMES, PAIR_NAMES
+from reference.physics.joint_motion import ideal_pair_origins, joint_motion
+from reference.paper.paper import named_scene, paper_errors
+from reference.scene.scene import replace, scene_from_dict, scene_to_dict
+from reference.scene.validation import SceneError
 
 CYLINDRICAL = ("input_spider", "spider_output", "output_frame")
 # one error at a time, large enough to matter; offsets [m], twists [rad]

@@ -4,7 +4,7 @@ Tolerances come from docs/mujoco.md. With the recommended settings (RK4, constra
 constant 20 steps, impedance 0.9999) at dt = 1e-4 s (300 steps per revolution at 2000 rpm):
 
 - the speed-ratio error is bounded by the documented error model
-  (:func:`cardan_exudyn.mujoco_engine.speed_ratio_error_model`), which over-estimates the
+  (:func:`cardan_exudyn.mujoco.engine.speed_ratio_error_model`), which over-estimates the
   measured values (3.9e-9 at 10 deg, 2.4e-8 at 30 deg) by 2-40x;
 - every constraint force, the drive torque included, misses a fraction of about ``1 - d = 1e-4``
   (MuJoCo caps the impedance d at 0.9999): the measured torque and spider-moment errors are
@@ -20,18 +20,19 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from cardan_exudyn import engines, mujoco_engine  # noqa: E402 (after the optional-import skip)
-from cardan_exudyn.mujoco_engine import MujocoOptions, speed_ratio_error_model  # noqa: E402
-from cardan_exudyn.studies.mujoco_settings import (  # noqa: E402
+from cardan_exudyn import engines
+from cardan_exudyn.mujoco import engine as mujoco_engine  # noqa: E402 (after the optional-import skip)
+from cardan_exudyn.mujoco.engine import MujocoOptions, speed_ratio_error_model  # noqa: E402
+from cardan_exudyn.studies.mujoco_settings.compute import (  # noqa: E402
     MUJOCO_DEFAULTS,
     accuracy,
     settings_study,
     study_cases,
 )
-from reference.dynamics import inverse_dynamics  # noqa: E402
-from reference.paper import named_scene  # noqa: E402
-from reference.scene import Numerics, Scene, TorqueDrive, replace  # noqa: E402
-from reference.schema import OptionsError, Result, Status, table_columns  # noqa: E402
+from reference.engine.dynamics import inverse_dynamics  # noqa: E402
+from reference.paper.paper import named_scene  # noqa: E402
+from reference.scene.scene import Numerics, Scene, TorqueDrive, replace  # noqa: E402
+from reference.results.schema import OptionsError, Result, Status, table_columns  # noqa: E402
 
 DT = 1e-4
 STEPS_PER_REVOLUTION = 300  # 2000 rpm at DT

@@ -8,8 +8,8 @@ import math
 import pytest
 
 from cardan_exudyn import run
-from reference.joint import GEOMETRY_LEVER, Pair
-from reference.paper import (
+from reference.scene.joint import GEOMETRY_LEVER, Pair
+from reference.paper.paper import (
     DEFAULT_PARAMETER_SET,
     PARAMETER_SETS,
     apply_parameters,
@@ -21,8 +21,8 @@ from reference.paper import (
     rig_scene,
     set_values,
 )
-from reference.scene import replace, scene_from_dict, scene_to_dict
-from reference.validation import SceneError
+from reference.scene.scene import replace, scene_from_dict, scene_to_dict
+from reference.scene.validation import SceneError
 
 
 def test_names_spell_out_the_set():

@@ -17,9 +17,9 @@ from cardan_exudyn.accuracy import SAFETY_FACTOR, AccuracyError, error_estimate
 from cardan_exudyn.engines import get_engine, make_options
 from cardan_exudyn.testing import CachingRunner, CardanToleranceWarning, make_scene
 from cardan_exudyn.testing.assertions import MAX_RELATIVE_ERROR, Limit, tolerance
-from reference.scene import scene_to_dict
-from reference.schema import Result, Status, Summary
-from reference.validation import SceneError
+from reference.scene.scene import scene_to_dict
+from reference.results.schema import Result, Status, Summary
+from reference.scene.validation import SceneError
 
 pytest_plugins = ["pytester"]
 
@@ -72,7 +72,7 @@ def test_cardan_scene_builds_named_and_file_scenes(pytester):
     pytester.makefile(".toml", joint=f'base = "{SMALL}"\nrevolutions = 1.5\n')
     source = f"""
         import math
-        from reference.scene import Scene
+        from reference.scene.scene import Scene
 
         def test_named(cardan_scene):
             scene = cardan_scene("{SMALL}", revolutions=1.0, numerics__accuracy=1e-4,
@@ -261,7 +261,7 @@ def test_bad_calls_raise_and_are_not_cached():
     counting = Counting()
     runner = CachingRunner(counting)
     scene = make_scene(SMALL, revolutions=1.0)
-    with pytest.raises(TypeError, match="must be a reference.scene.Scene"):
+    with pytest.raises(TypeError, match="must be a reference.scene.scene.Scene"):
         runner("paper-literal-10deg")
     with pytest.raises(ValueError, match="not both"):
         runner(scene, options=make_options("exudyn"), node_type="EP")

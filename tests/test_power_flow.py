@@ -31,15 +31,15 @@ from hypothesis import strategies as st
 
 from cardan_exudyn import run as run_engine
 from cardan_exudyn.cli import main
-from cardan_exudyn.studies.stress_map import cell_class
+from cardan_exudyn.studies.stress.map import cell_class
 from cardan_exudyn.sweep.records import scalar_summary
 from cardan_exudyn.testing.assertions import check_flow
-from reference.engine import ReferenceOptions
-from reference.paper import named_scene
-from reference.power_flow import PowerFlow, classify_works, sign_changes
-from reference.scene import replace
-from reference.schema import SCHEMA_VERSION, Result, Status, Summary
-from reference.validation import DEG, RPM
+from reference.engine.solve import ReferenceOptions
+from reference.paper.paper import named_scene
+from reference.results.power_flow import PowerFlow, classify_works, sign_changes
+from reference.scene.scene import replace
+from reference.results.schema import SCHEMA_VERSION, Result, Status, Summary
+from reference.scene.validation import DEG, RPM
 
 MIRROR = np.diag([1.0, 1.0, -1.0])
 REFERENCE_TOL = 10 * ReferenceOptions().quadrature_rtol

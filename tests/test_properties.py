@@ -109,11 +109,11 @@ from test_energy import balance_residual
 from cardan_exudyn import run as run_engine
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step, error_coefficient
-from reference.engine import ReferenceOptions
-from reference.joint import PAIR_KIND, PAIR_NAMES
-from reference.paper import named_scene
-from reference.scene import COUPLINGS, Numerics, replace
-from reference.validation import DEG, RPM
+from reference.engine.solve import ReferenceOptions
+from reference.scene.joint import PAIR_KIND, PAIR_NAMES
+from reference.paper.paper import named_scene
+from reference.scene.scene import COUPLINGS, Numerics, replace
+from reference.scene.validation import DEG, RPM
 
 # --------------------------------------------------------------------------- contract
 

@@ -1,4 +1,4 @@
-"""reference.batch: many constant-speed scenes in one pass give the single engine's results
+"""reference.engine.batch.solve: many constant-speed scenes in one pass give the single engine's results
 (a reference package test: it calls the engine directly, as tests/test_architecture.py allows)."""
 
 from __future__ import annotations
@@ -9,12 +9,12 @@ import math
 import numpy as np
 import pytest
 
-from reference.batch import batch_key, run_batch
-from reference.engine import ReferenceOptions, run
-from reference.paper import named_scene, rig_scene
-from reference.scene import TorqueDrive, replace
-from reference.schema import OptionsError, Status
-from reference.validation import SceneError
+from reference.engine.batch.solve import batch_key, run_batch
+from reference.engine.solve import ReferenceOptions, run
+from reference.paper.paper import named_scene, rig_scene
+from reference.scene.scene import TorqueDrive, replace
+from reference.results.schema import OptionsError, Status
+from reference.scene.validation import SceneError
 
 # Same samples, same arithmetic per sample: the tables agree to rounding. The works are sums of
 # the same panel integrals in another order, and a panel at its closing threshold may split

@@ -1,4 +1,4 @@
-"""reference.crossings and reference.periodic: the breakpoint scan's brackets (sign changes and
+"""reference.engine.crossings and reference.engine.periodic: the breakpoint scan's brackets (sign changes and
 grazing crossings between two samples) and the summary-only table built from its first period
 (a reference package test: it calls the engine directly, as tests/test_architecture.py allows)."""
 
@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from reference.crossings import distinct_instants, grazing_brackets, grazing_candidates, sign_change_brackets
-from reference.engine import run
-from reference.paper import named_scene, rig_scene
-from reference.periodic import period_rows, repeat_period
-from reference.scene import replace
+from reference.engine.crossings import distinct_instants, grazing_brackets, grazing_candidates, sign_change_brackets
+from reference.engine.solve import run
+from reference.paper.paper import named_scene, rig_scene
+from reference.engine.periodic import period_rows, repeat_period
+from reference.scene.scene import replace
 
 
 def _dip(t):
@@ -98,7 +98,7 @@ def test_summary_only_run_repeats_the_first_period(scene):
 
 
 def test_summary_only_run_evaluates_one_period(monkeypatch):
-    import reference.engine as engine
+    import reference.engine.solve as engine
 
     sizes, columns_at = [], engine.columns_at
     monkeypatch.setattr(engine, "columns_at", lambda s, m, t: sizes.append(np.size(t)) or columns_at(s, m, t))

@@ -1,4 +1,4 @@
-"""RCCC loop in dual numbers (reference.rccc) against Hooke's closed forms and its own closure."""
+"""RCCC loop in dual numbers (reference.physics.rccc) against Hooke's closed forms and its own closure."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from reference import dual, kinematics, rccc
-from reference.dual import Dual
-from reference.joint import PAIR_BODIES, PAIR_NAMES
-from reference.loop_closure import LoopClosureError
+from reference.physics import dual, kinematics, rccc
+from reference.physics.dual import Dual
+from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
+from reference.physics.loop_closure import LoopClosureError
 
 EPS = np.finfo(float).eps
 DEG = math.pi / 180.0
@@ -161,7 +161,7 @@ def test_ideal_joint_reproduces_hooke(beta_deg, branch):
 
 @pytest.mark.parametrize("beta_deg", [0.0, 30.0, 85.0], ids=["0deg", "30deg", "85deg"])
 def test_ideal_joint_bodies_and_pairs_match_kinematics(beta_deg):
-    """Body frames, angular motion, pair axes and relative speeds equal reference.kinematics."""
+    """Body frames, angular motion, pair axes and relative speeds equal reference.physics.kinematics."""
     beta = beta_deg * DEG
     motion = input_motion(TIMES)
     params = rccc.DHParameters.ideal(beta)

@@ -1,4 +1,4 @@
-"""Frictionless inverse dynamics (reference.dynamics) against statics by hand and balance laws."""
+"""Frictionless inverse dynamics (reference.engine.dynamics) against statics by hand and balance laws."""
 
 from __future__ import annotations
 
@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 from test_reference_kinematics import derivative
 
-from reference import engine
-from reference.dynamics import inverse_dynamics, reaction_system
-from reference.joint import Body, Geometry, Joint
-from reference.joint_motion import joint_motion
-from reference.kinematics import body_motions, speed_ratio
-from reference.paper import named_scene
-from reference.scene import Load, Scene, SpeedDrive, replace
-from reference.schema import Status, table_columns
+from reference.engine import solve as engine
+from reference.engine.dynamics import inverse_dynamics, reaction_system
+from reference.scene.joint import Body, Geometry, Joint
+from reference.physics.joint_motion import joint_motion
+from reference.physics.kinematics import body_motions, speed_ratio
+from reference.paper.paper import named_scene
+from reference.scene.scene import Load, Scene, SpeedDrive, replace
+from reference.results.schema import Status, table_columns
 
 EPS = np.finfo(float).eps
 M_IN, M_SPIDER, M_OUT = 0.9, 0.05, 0.8  # [kg]

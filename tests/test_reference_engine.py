@@ -11,13 +11,13 @@ import pytest
 from test_reference_dynamics import EPS, energy_rate, external_wrench, momentum
 from test_reference_kinematics import derivative
 
-from reference.dynamics import reaction_system
-from reference.engine import EXTRA_COLUMNS, ReferenceOptions, run
-from reference.friction import friction_from_columns
-from reference.joint_motion import joint_motion
-from reference.paper import named_scene, paper_scene
-from reference.scene import AngleDrive, Scene, TorqueDrive, replace
-from reference.schema import Status, table_columns
+from reference.engine.dynamics import reaction_system
+from reference.engine.solve import EXTRA_COLUMNS, ReferenceOptions, run
+from reference.physics.friction import friction_from_columns
+from reference.physics.joint_motion import joint_motion
+from reference.paper.paper import named_scene, paper_scene
+from reference.scene.scene import AngleDrive, Scene, TorqueDrive, replace
+from reference.results.schema import Status, table_columns
 
 FRICTION_SCENES = ["paper-literal-10deg", "paper-literal-35deg", "paper-matched-20deg"]
 
@@ -28,7 +28,7 @@ def one_revolution(name: str, **changes) -> Scene:
 
 @pytest.mark.parametrize("name", FRICTION_SCENES)
 def test_applied_friction_is_the_law_of_the_reported_reactions(name):
-    """Every sample's friction equals eqs. (3), (5) (reference.friction, written separately)
+    """Every sample's friction equals eqs. (3), (5) (reference.physics.friction, written separately)
     applied to the reactions and speeds the engine reports: the fixed point is solved."""
     table = run(one_revolution(name), ReferenceOptions(samples_per_revolution=90)).table
     law = friction_from_columns(named_scene(name), table)
@@ -181,7 +181,7 @@ def test_torque_drive_reverses_and_stops_after_the_turn():
 @pytest.mark.slow
 def test_torque_drive_with_friction_converges_with_the_tolerance():
     """With friction the ODE tolerance controls the mean efficiency: tighter tolerances agree
-    and the energy balance closes to the tolerance (about 1.4 s with reference/forward.py's
+    and the energy balance closes to the tolerance (about 1.4 s with reference/engine/forward.py's
     right-hand side; 10 s with the direct solve at every evaluation)."""
     scene = torque_scene(8.0, 60.0)
     s = [run(scene, ReferenceOptions(ode_rtol=rt, ode_atol=rt)).summary for rt in (1e-8, 1e-10)]

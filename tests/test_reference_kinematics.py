@@ -1,4 +1,4 @@
-"""Closed-form Cardan kinematics (reference.kinematics) against independent constructions."""
+"""Closed-form Cardan kinematics (reference.physics.kinematics) against independent constructions."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from reference.joint import PAIR_BODIES, PAIR_NAMES
-from reference.kinematics import (
+from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
+from reference.physics.kinematics import (
     body_motions,
     output_angle,
     output_motion,

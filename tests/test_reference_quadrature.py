@@ -1,4 +1,4 @@
-"""The window integral across friction's sign jumps (reference/quadrature.py)."""
+"""The window integral across friction's sign jumps (reference/results/quadrature.py)."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from reference.engine import ReferenceOptions, run
-from reference.paper import named_scene
-from reference.quadrature import jump_breaks, segment_integrals
-from reference.scene import replace
-from reference.schema import whole_revolution_window, window_integral
+from reference.engine.solve import ReferenceOptions, run
+from reference.paper.paper import named_scene
+from reference.results.quadrature import jump_breaks, segment_integrals
+from reference.scene.scene import replace
+from reference.results.schema import whole_revolution_window, window_integral
 
 
 def _columns(t, w, y):

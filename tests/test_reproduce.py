@@ -13,13 +13,13 @@ import pytest
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run as engine_run
 from cardan_exudyn.report import plots
-from cardan_exudyn.studies import reproduce as rep
-from cardan_exudyn.studies import reproduce_report as report
+from cardan_exudyn.studies.reproduce import compute as rep
+from cardan_exudyn.studies.reproduce import report as report
 from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
-from reference.joint import PAIR_NAMES
-from reference.paper import PARAMETER_SETS, paper_scene, parameter_set
-from reference.scene import replace
-from reference.schema import Result, Status, Summary
+from reference.scene.joint import PAIR_NAMES
+from reference.paper.paper import PARAMETER_SETS, paper_scene, parameter_set
+from reference.scene.scene import replace
+from reference.results.schema import Result, Status, Summary
 
 QUICK_IDS = [f"{p}-{c}" for p in ("physical", "literal", "matched")
              for c in ("table2-0deg-2000rpm", "table2-10deg-2000rpm", "speed-10deg-500rpm")]

@@ -15,13 +15,13 @@ import cardan_exudyn
 from cardan_exudyn.arguments import scene_from_args
 from cardan_exudyn.cli import build_parser
 from cardan_exudyn.model.friction_law import PairLaw, pair_loads
-from reference.bands import characteristic_speeds, sign_bands
-from reference.friction import friction_from_columns, pair_friction
-from reference.joint import PAIR_NAMES, Pair
-from reference.paper import RENAMED_SETS, named_scene
-from reference.scene import replace, scene_from_dict, scene_to_dict
-from reference.scene_files import load_scene
-from reference.validation import SceneError
+from reference.physics.bands import characteristic_speeds, sign_bands
+from reference.physics.friction import friction_from_columns, pair_friction
+from reference.scene.joint import PAIR_NAMES, Pair
+from reference.paper.paper import RENAMED_SETS, named_scene
+from reference.scene.scene import replace, scene_from_dict, scene_to_dict
+from reference.scene.files import load_scene
+from reference.scene.validation import SceneError
 
 # the set fitted to the paper's numbers (formerly "calibrated"): its rig case with the stated
 # errors runs under both laws (the literal set self-locks there under both)

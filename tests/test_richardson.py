@@ -12,11 +12,11 @@ import pytest
 from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.cli import main
 from cardan_exudyn.model import richardson
-from reference.engine import ReferenceOptions, columns_at, input_motion
-from reference.paper import named_scene
-from reference.scene import replace
-from reference.scene_files import load_scene
-from reference.validation import SceneError
+from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
+from reference.scene.files import load_scene
+from reference.scene.validation import SceneError
 
 SCENE = "paper-literal-35deg-frictionless"
 

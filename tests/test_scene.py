@@ -10,11 +10,11 @@ import pytest
 import tomli_w
 
 import reference
-from reference.joint import Body, Geometry
-from reference.paper import assumption_register, named_scene, paper_cases, stated_values, table1_body
-from reference.scene import SpeedDrive, replace, scene_from_dict, scene_to_dict
-from reference.scene_files import load_scene
-from reference.validation import SceneError
+from reference.scene.joint import Body, Geometry
+from reference.paper.paper import assumption_register, named_scene, paper_cases, stated_values, table1_body
+from reference.scene.scene import SpeedDrive, replace, scene_from_dict, scene_to_dict
+from reference.scene.files import load_scene
+from reference.scene.validation import SceneError
 
 DIAG = [[1e-3, 0, 0], [0, 1e-3, 0], [0, 0, 1e-3]]
 
@@ -142,8 +142,8 @@ def test_public_face_is_lazy():
     code = "import sys, reference; print(sorted(m for m in sys.modules if m.startswith('reference')))"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert loaded.stdout.strip() == "['reference', 'reference.lazy']"
-    assert reference.Scene is reference.scene.Scene and reference.load_scene is load_scene
-    assert reference.run is reference.engine.run and reference.SceneError is SceneError
+    assert reference.Scene is reference.scene.scene.Scene and reference.load_scene is load_scene
+    assert reference.run is reference.engine.solve.run and reference.SceneError is SceneError
     assert set(reference.__all__) <= set(dir(reference))
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         reference.nope  # noqa: B018

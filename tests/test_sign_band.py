@@ -1,4 +1,4 @@
-"""The friction sign ramp scales with the scene (``reference.bands``): relative band by default,
+"""The friction sign ramp scales with the scene (``reference.physics.bands``): relative band by default,
 the same bands in every engine, the mean efficiency at its sharp-sign limit at every speed."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import engines
-from reference.bands import SPEED_FLOOR, characteristic_speeds, nominal_speed, sign_bands
-from reference.joint import PAIR_NAMES
-from reference.paper import named_scene
-from reference.scene import (
+from reference.physics.bands import SPEED_FLOOR, characteristic_speeds, nominal_speed, sign_bands
+from reference.scene.joint import PAIR_NAMES
+from reference.paper.paper import named_scene
+from reference.scene.scene import (
     DEFAULT_SIGN_BAND_RELATIVE,
     AngleDrive,
     FrictionSettings,
@@ -21,7 +21,7 @@ from reference.scene import (
     scene_from_dict,
     scene_to_dict,
 )
-from reference.validation import SceneError
+from reference.scene.validation import SceneError
 
 
 def efficiency(scene, **changes) -> float:
@@ -115,7 +115,7 @@ def test_default_band_gives_the_sharp_sign_limit(name):
 
 def test_both_engines_use_the_same_bands():
     """Exudyn's friction coupling and the reference engine report the bands of
-    ``reference.bands.sign_bands`` for the pairs with friction."""
+    ``reference.physics.bands.sign_bands`` for the pairs with friction."""
     from cardan_exudyn import engines
 
     # 60 rpm: one revolution per second, 120 steps (the bands do not depend on the step)

@@ -14,10 +14,10 @@ from cardan_exudyn import ExudynOptions
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
 from cardan_exudyn.model.stepsize import error_coefficient
-from cardan_exudyn.studies import stress_map
-from cardan_exudyn.studies.stress_map import Panel, base_scene, classify, efficiency_promise, measure_cell
-from reference.kinematics import speed_ratio
-from reference.scene import replace
+from cardan_exudyn.studies.stress import map as stress_map
+from cardan_exudyn.studies.stress.map import Panel, base_scene, classify, efficiency_promise, measure_cell
+from reference.physics.kinematics import speed_ratio
+from reference.scene.scene import replace
 
 
 def record(**changes):

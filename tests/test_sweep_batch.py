@@ -13,21 +13,21 @@ from pathlib import Path
 import pytest
 from processes import wait_for
 
-import reference.batch
-import reference.engine
+import reference.engine.batch.solve
+import reference.engine.solve
 from cardan_exudyn import engines
 from cardan_exudyn.sweep import Batch, CaseFunction, expand_cases, plan_tasks, read_records, run_sweep
 from cardan_exudyn.sweep.spec import spec_from_mapping
-from reference.paper import named_scene
-from reference.scene import replace
-from reference.validation import SceneError
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
+from reference.scene.validation import SceneError
 
 TESTS = Path(__file__).parent
 # the reference engine at one revolution without a time table: ~0.05 s per case
 BASE = {"scene": "paper-literal-10deg", "engine": "reference",
         "fixed": {"revolutions": 1, "record.timeseries": False}}
 # what may differ between a batched and a single run: wall times, and the quadrature's own
-# counters and error estimates where the batched pass adapts differently (reference/batch.py)
+# counters and error estimates where the batched pass adapts differently (reference/engine/batch/solve.py)
 COSTS = ("case_wall_s", "wall_time_s", "quadrature.")
 # the quadrature accepts each work integral to 1e-9 of the input work (ReferenceOptions); an
 # efficiency 1 - W_loss / W_in carries both errors
@@ -42,9 +42,9 @@ def torques(n: int, **extra) -> dict:
 def batches(monkeypatch):
     """Sizes of the reference engine's batched runs in this process. Scenes the contract lets run
     on their own (key None, as today's loop says of every scene) are given a common key, so that
-    they do run through ``reference.batch.run_batch``."""
+    they do run through ``reference.engine.batch.solve.run_batch``."""
     sizes: list[int] = []
-    real_key, real_run = reference.batch.batch_key, reference.batch.run_batch
+    real_key, real_run = reference.engine.batch.solve.batch_key, reference.engine.batch.solve.run_batch
 
     def key(scene):
         k = real_key(scene)
@@ -54,8 +54,8 @@ def batches(monkeypatch):
         sizes.append(len(scenes))
         return real_run(scenes, options)
 
-    monkeypatch.setattr(reference.batch, "batch_key", key)
-    monkeypatch.setattr(reference.batch, "run_batch", run)
+    monkeypatch.setattr(reference.engine.batch.solve, "batch_key", key)
+    monkeypatch.setattr(reference.engine.batch.solve, "run_batch", run)
     return sizes
 
 
@@ -121,7 +121,7 @@ def test_engines_run_batch_refuses_a_long_scene_by_its_index_before_running(monk
         ran.append(scenes)
         return [None] * len(scenes)
 
-    monkeypatch.setattr(reference.batch, "_run_chunk", chunk)
+    monkeypatch.setattr(reference.engine.batch.solve, "_run_chunk", chunk)
     base = named_scene("paper-10deg")
     scenes = [named_scene("rig-errors"),
               replace(base, drive={"kind": "torque", "torque": 2.0, "initial_speed": 209.0}),
@@ -134,7 +134,7 @@ def test_engines_run_batch_refuses_a_long_scene_by_its_index_before_running(monk
 def test_a_failing_case_in_a_batch_records_only_itself(tmp_path, batches, monkeypatch):
     """An exception inside a batch (here: load torque 2.0 makes the engine raise) reruns the
     batch's cases one by one: the case that raises is recorded as an error, its batch-mate ok."""
-    real_batch, real_run = reference.batch.run_batch, reference.engine.run
+    real_batch, real_run = reference.engine.batch.solve.run_batch, reference.engine.solve.run
 
     def raising(scene, options=None):
         if scene.load.torque == 2.0:
@@ -146,8 +146,8 @@ def test_a_failing_case_in_a_batch_records_only_itself(tmp_path, batches, monkey
             raise RuntimeError("engine failure in this batch")
         return real_batch(scenes, options)
 
-    monkeypatch.setattr(reference.batch, "run_batch", batch)
-    monkeypatch.setattr(reference.engine, "run", raising)
+    monkeypatch.setattr(reference.engine.batch.solve, "run_batch", batch)
+    monkeypatch.setattr(reference.engine.solve, "run", raising)
     summary = run_sweep(torques(8), tmp_path / "out", workers=1)
     records = read_records(tmp_path / "out" / "cases.jsonl")
     assert summary["failed_ids"] == ["0004"] and summary["ok"] == 7
@@ -185,7 +185,7 @@ def test_custom_functions_and_other_engines_are_not_batched():
 
 INTERRUPTED = """
 import json, sys, time
-import reference.batch as rb
+import reference.engine.batch.solve as rb
 real_key, real_run = rb.batch_key, rb.run_batch
 rb.batch_key = lambda s: real_key(s) or ("test",)
 def slow(scenes, options=None):
@@ -246,7 +246,7 @@ def test_dask_cluster_runs_batches_with_the_local_results(tmp_path):
 def test_tolerance_study_runs_in_batches_and_equals_single_runs(tmp_path, batches):
     """`cardan tolerance montecarlo`'s study goes through the sweep's batches, and its samples
     equal the single-scene engine's."""
-    from cardan_exudyn.studies.tolerance import default_distributions, monte_carlo
+    from cardan_exudyn.studies.tolerance.compute import default_distributions, monte_carlo
 
     scene = replace(named_scene("rig-matched"), revolutions=1)
     summary = monte_carlo(scene, "reference", 8, 1, out=tmp_path / "mc", workers=1, progress=False)

@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from cardan_exudyn.cli import main
-from cardan_exudyn.studies.tolerance import (
+from cardan_exudyn.studies.tolerance.compute import (
     MATCH_FACTOR,
     correlation_ratio,
     law_verdicts,
@@ -16,8 +16,8 @@ from cardan_exudyn.studies.tolerance import (
     sensitivities,
     verdict_line,
 )
-from reference.paper import RENAMED_SETS, named_scene
-from reference.scene import replace
+from reference.paper.paper import RENAMED_SETS, named_scene
+from reference.scene.scene import replace
 
 # the set fitted to the paper's numbers (formerly "calibrated"), whose measurements these tests hold
 MATCHED = RENAMED_SETS["calibrated"]
@@ -62,7 +62,7 @@ def test_monte_carlo_draws_reproducibly_and_reports(small_study, tmp_path):
     m = summary["mean_efficiency"]
     assert m["p5"] <= m["p50"] <= m["p95"] and m["max"] <= summary["ideal_mean_efficiency"] + 1e-12
     # the spider offset a2 dominates (sliding friction). With the sign ramp relative to each pair's
-    # speed (reference.bands), any sliding gets the full Coulomb force of eqs. (3), (5), so the
+    # speed (reference.physics.bands), any sliding gets the full Coulomb force of eqs. (3), (5), so the
     # loss jumps at a2 = 0 and then grows slowly with |a2|: the rank correlation with |a2| is
     # weak (measured -0.48), the correlation ratio (any dependence) carries it (measured 0.97,
     # alpha3 0.25)

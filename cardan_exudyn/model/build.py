@@ -17,7 +17,7 @@ Modelling choices
   user function). Prescribed angle: the same connector at position level with an offset user
   function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``. A load history: a
   ``LoadTorqueVector`` with a user function. Both user functions find the sample interval by
-  bisection and evaluate one piece in plain floats (:mod:`reference.histories`): O(log n) per
+  bisection and evaluate one piece in plain floats (:mod:`reference.scene.histories`): O(log n) per
   call, so a long measured history costs what a short one does. The model's clock starts at 0
   whatever time the histories start at (``ExudynModel.time_origin``).
 - Gravity loads and the output load only when they are non-zero; friction loads and their user
@@ -25,7 +25,7 @@ Modelling choices
 - Mounting errors (``scene.joint.errors``): each pair's marker frames are displaced and rotated
   to the joint's Denavit-Hartenberg geometry (the pair axes no longer meet at one point, so the
   cylindrical pairs slide). The marker frames and the initial assembled state are taken from
-  :mod:`reference.rccc` at the start; from there on the motion is Exudyn's own (its constraints
+  :mod:`reference.physics.rccc` at the start; from there on the motion is Exudyn's own (its constraints
   keep the loop closed; the tests compare it with the reference engine). The ideal joint keeps
   the closed form below, written independently of ``reference``. In both cases the reference
   configuration (node axes = global axes) is the assembled joint at input angle 0.
@@ -43,10 +43,10 @@ import numpy as np
 
 from cardan_exudyn.model.coupling import FrictionCoupling
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES, TWO_PI, RotationCoordinates, WholeTurns
-from reference import rccc
-from reference.histories import run_clock
-from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
-from reference.scene import AngleDrive, Scene, SpeedDrive
+from reference.physics import rccc
+from reference.scene.histories import run_clock
+from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.scene.scene import AngleDrive, Scene, SpeedDrive
 
 CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
 
@@ -70,7 +70,7 @@ def _rot_x(angle: float) -> np.ndarray:
 
 
 def _loop_motion(scene: Scene, theta: float, omega: float) -> dict[str, rccc.BodyMotion]:
-    """Body motions of the joint with mounting errors at one input state (reference.rccc)."""
+    """Body motions of the joint with mounting errors at one input state (reference.physics.rccc)."""
     params = rccc.DHParameters.of_joint(scene.joint)
     positions, rates = rccc.solve_motion(params, np.array([theta]), omega, 0.0)
     return {name: rccc.BodyMotion(*(np.asarray(v)[0] for v in (m.rotation, m.origin, m.omega,
@@ -114,10 +114,10 @@ def assembled_state(scene: Scene, theta: float, omega: float) -> dict[str, dict[
     about the joint centre).
 
     Ideal joint: closed-form vector geometry (written here independently of
-    ``reference.kinematics``): the output yoke axis is normal to the output shaft axis and the
+    ``reference.physics.kinematics``): the output yoke axis is normal to the output shaft axis and the
     input yoke axis; the relative rates follow from the velocity loop
     ``omega e_x + gamma_t u1 = theta2_t a2 + phi_t u2``. With mounting errors:
-    :mod:`reference.rccc`.
+    :mod:`reference.physics.rccc`.
     """
     axes = node_axes_in_canonical(scene)
     if scene.joint.errors.any:
@@ -171,7 +171,7 @@ class ExudynModel:
     rotations: dict[str, RotationCoordinates] = field(default_factory=dict)
     # whole revolutions taken out of the input's angle coordinate (_wrap_rotations)
     input_turns: WholeTurns = field(default_factory=WholeTurns)
-    # the scene's time at the model's t = 0 [s] (reference.histories.run_clock): model.scene's
+    # the scene's time at the model's t = 0 [s] (reference.scene.histories.run_clock): model.scene's
     # histories start at 0, the results' time column adds this back
     time_origin: float = 0.0
 
@@ -389,7 +389,7 @@ def _add_drive(model: ExudynModel, ground) -> None:
         connector = eii.ObjectConnectorCoordinate(markerNumbers=[m_ground, m_angle],
                                                   velocityLevel=True, offset=drive.speed)
     else:
-        angle = drive.evaluator()  # O(log n) per call in plain floats (reference.histories)
+        angle = drive.evaluator()  # O(log n) per call in plain floats (reference.scene.histories)
         turns = model.input_turns  # the coordinate is the angle less these (_wrap_rotations)
 
         def angle_offset(mbs_, t, item, offset):
@@ -405,7 +405,7 @@ def _add_loads(model: ExudynModel) -> None:
     mbs, scene = model.mbs, model.scene
     axis = model.pair_frames["output_frame"][:, 2]  # the output axis, fixed in the ground
     if not scene.load.constant:  # a measured history: interpolated at each instant
-        torque = scene.load.evaluator()  # O(log n) per call in plain floats (reference.histories)
+        torque = scene.load.evaluator()  # O(log n) per call in plain floats (reference.scene.histories)
         ax, ay, az = (-float(c) for c in axis)
 
         def load_history(mbs_, t, load_vector):

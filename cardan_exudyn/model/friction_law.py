@@ -1,6 +1,6 @@
 """The friction law of the Exudyn model as pure functions: floats in, floats out, no Exudyn.
 
-Written separately from :mod:`reference.friction` on purpose (the reference exists to catch
+Written separately from :mod:`reference.physics.friction` on purpose (the reference exists to catch
 mistakes here; neither calls the other). Plain ``float`` arithmetic, because the coupling calls
 it once per pair after every Newton solve and numpy on scalars costs more than the law itself.
 
@@ -19,7 +19,7 @@ Body ``b`` of the pair receives ``-s(v_rot) T`` about the axis and ``-s(v_slide)
 body ``a`` the opposite, where ``s`` is the sign of the relative surface speed of ``b`` with
 respect to ``a``, regularised by a linear ramp of width ``band`` [m/s] (the rotation's; the
 sliding has its own, ``slide_band``); for the rotation the surface speed is ``omega_rel d / 2``.
-The widths are scene data, the same for every engine (:func:`reference.bands.sign_bands`).
+The widths are scene data, the same for every engine (:func:`reference.physics.bands.sign_bands`).
 
 That is the paper's law (``FrictionSettings.law = "paper"``). Since ``T = (d / 2) A``, both are
 one Coulomb force ``A`` at the journal surface; the resultant-slip law (``"resultant"``) lets that
@@ -71,7 +71,7 @@ class PairLaw:
 
     @classmethod
     def of(cls, kind: str, pair: Any, law: str = "paper") -> PairLaw:
-        """The law of a scene's pair (:class:`reference.joint.Pair`, its ``moment_lever``
+        """The law of a scene's pair (:class:`reference.scene.joint.Pair`, its ``moment_lever``
         resolved to a number) of ``kind`` ("revolute" or "cylindrical") under the friction
         ``law`` ("paper" or "resultant", ``FrictionSettings.law``)."""
         if law not in ("paper", "resultant"):

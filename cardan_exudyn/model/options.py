@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from reference.scene import Scene
-from reference.schema import OptionsError
+from reference.scene.scene import Scene
+from reference.results.schema import OptionsError
 
 __all__ = ["ExudynOptions", "NODE_TYPES", "SENSOR_SCOPES"]
 

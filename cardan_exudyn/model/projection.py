@@ -38,7 +38,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from reference.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 
 __all__ = ["BODIES", "cross_rows", "constraint_jacobian", "project_velocities"]
 

@@ -43,9 +43,9 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from reference.joint import PAIR_NAMES
-from reference.scene import Scene, replace
-from reference.schema import Summary, instantaneous_efficiency
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.scene import Scene, replace
+from reference.results.schema import Summary, instantaneous_efficiency
 
 __all__ = ["EXTRAPOLATED", "FROM_FINE", "FILTERED", "smooth", "extrapolate", "combine", "refusal",
            "run_pair"]

@@ -1,5 +1,5 @@
 """Run a scene with Exudyn: the one solve sequence (step choice, solver settings, friction set-up,
-stop function) and the run that turns it into the common result (:class:`reference.schema.Result`).
+stop function) and the run that turns it into the common result (:class:`reference.results.schema.Result`).
 """
 
 from __future__ import annotations
@@ -31,17 +31,17 @@ from cardan_exudyn.model.stepsize import (
     revolution_period,
     richardson,
 )
-from reference.joint import PAIR_NAMES
-from reference.loop_closure import LoopClosureError
-from reference.scene import AngleDrive, Scene, replace, scene_to_dict
-from reference.schema import (
+from reference.scene.joint import PAIR_NAMES
+from reference.physics.loop_closure import LoopClosureError
+from reference.scene.scene import AngleDrive, Scene, replace, scene_to_dict
+from reference.results.schema import (
     REACTION_SUFFIXES,
     Result,
     Status,
     Summary,
     result_table,
 )
-from reference.validation import SceneError, check_steps
+from reference.scene.validation import SceneError, check_steps
 
 ENGINE_NAME = "exudyn"
 

@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import math
 
-from reference.joint import PAIR_NAMES
-from reference.scene import AngleDrive, Scene, SpeedDrive
-from reference.validation import SceneError
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.scene import AngleDrive, Scene, SpeedDrive
+from reference.scene.validation import SceneError
 
 __all__ = ["ERROR_CONSTANT", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS_PER_REVOLUTION", "NODE_ERROR",
            "EFFICIENCY_FIRST_ORDER", "EFFICIENCY_FIRST_ORDER_ERRORS", "EFFICIENCY_SECOND_ORDER",
@@ -152,7 +152,7 @@ def convergence_order(scene: Scene) -> int:
 
     Friction's sign jumps at reversals used to make it 1 until the steps resolved the sign ramps:
     the table's trapezoid put each jump in the middle of its step. The window integral now
-    integrates each side of a jump on its own (:mod:`reference.quadrature`): on the reference
+    integrates each side of a jump on its own (:mod:`reference.results.quadrature`): on the reference
     engine's own rows of ``paper-literal-10deg`` the error fell from 1.1e-3, 5.3e-4, 2.5e-4 to
     1.1e-4, 3.7e-5, 1.9e-6 at 200, 400, 800 steps per revolution, and Exudyn's (converged
     coupling) from 1.0e-3, 5.2e-4, 2.5e-4 to 2.1e-5, 2.0e-5, -1.9e-6."""

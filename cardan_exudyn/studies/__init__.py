@@ -18,6 +18,9 @@ from __future__ import annotations
 
 __all__ = ["COMMANDS"]
 
-COMMANDS: tuple[str, ...] = ("reproduce", "bench", "stress", "friction_numerics", "calibrate",
-                             "compare", "tolerance", "accuracy_grid")
+COMMANDS: dict[str, str] = {
+    "reproduce": "reproduce.compute", "bench": "bench.command", "stress": "stress.command",
+    "study": "study.compute", "calibrate": "calibrate.compute", "compare": "compare.command",
+    "tolerance": "tolerance.compute", "accuracy": "accuracy.compute",
+}
 """Modules of this package that register a subcommand, in the order ``cardan --help`` lists them."""

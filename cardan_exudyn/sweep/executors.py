@@ -29,7 +29,7 @@ from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.sweep.records import error_record
 from cardan_exudyn.sweep.spec import CaseFunction, SweepError
 from cardan_exudyn.sweep.tasks import Batch, Task, run_case, run_task, task_cases, task_key
-from reference.scene import Scene
+from reference.scene.scene import Scene
 
 __all__ = ["SweepIncomplete", "SweepInterrupted", "Emit", "default_workers", "run_case", "run_in_process",
            "run_pool", "ignore_interrupts", "connect", "run_dask"]

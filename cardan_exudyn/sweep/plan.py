@@ -26,10 +26,10 @@ from cardan_exudyn.sweep.spec import (
     resolve_function,
     spec_from_mapping,
 )
-from reference.paper import named_scene
-from reference.scene import Scene, replace, scene_to_dict
-from reference.scene_files import load_scene, scene_from_mapping
-from reference.validation import SceneError
+from reference.paper.paper import named_scene
+from reference.scene.scene import Scene, replace, scene_to_dict
+from reference.scene.files import load_scene, scene_from_mapping
+from reference.scene.validation import SceneError
 
 __all__ = ["PLAN_FORMAT", "Case", "Plan", "expand_cases", "base_scene", "make_plan", "plan_difference"]
 

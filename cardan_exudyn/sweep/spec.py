@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.io import to_jsonable
-from reference.scene import Scene, scene_to_dict
-from reference.scene_files import read_toml
+from reference.scene.scene import Scene, scene_to_dict
+from reference.scene.files import read_toml
 
 __all__ = ["SweepError", "Distribution", "RandomSpec", "SweepSpec", "CaseFunction",
            "DEFAULT_FUNCTION", "grid_values", "function_name", "resolve_function", "flatten_paths",
@@ -242,7 +242,7 @@ class SweepSpec:
     Attributes
     ----------
     scene : str, dict or Scene
-        Named scene (``reference.paper.named_scene``), path to a scene TOML, a scene table, or a
+        Named scene (``reference.paper.paper.named_scene``), path to a scene TOML, a scene table, or a
         scene.
     engine : str
         Engine of :data:`cardan_exudyn.engines.ENGINES` (a grid or a case may set ``engine``).

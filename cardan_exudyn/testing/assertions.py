@@ -32,8 +32,8 @@ from cardan_exudyn.comparison import COMPARED, check_request, join_on_input_angl
 from cardan_exudyn.comparison import run_engines as comparison_runs  # with the session cache
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.report.format import is_number, markdown_table, number
-from reference.scene import Scene
-from reference.schema import Result, after_revolutions
+from reference.scene.scene import Scene
+from reference.results.schema import Result, after_revolutions
 
 __all__ = ["MAX_RELATIVE_ERROR", "ROUNDING", "DEFAULT_COLUMNS", "CardanToleranceWarning", "Limit",
            "Check", "assert_efficiency", "assert_engines_agree", "tolerance"]

@@ -24,7 +24,7 @@ import pytest
 
 if TYPE_CHECKING:
     from cardan_exudyn.testing.runner import CachingRunner
-    from reference.scene import Scene
+    from reference.scene.scene import Scene
 
 __all__ = ["SceneFactory", "RUNNER", "MARKER", "cardan_scene", "cardan_run"]
 
@@ -71,7 +71,7 @@ class SceneFactory:
         # pytest imports this module at every start, in suites that never use it too: the
         # harness (numpy, the scene model, the engines) is imported when a fixture is first used
         from cardan_exudyn.testing.scenes import make_scene
-        from reference.validation import SceneError
+        from reference.scene.validation import SceneError
 
         try:
             return make_scene(source, self.root, **changes)

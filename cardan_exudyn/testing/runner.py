@@ -16,8 +16,8 @@ from typing import Any
 from cardan_exudyn.accuracy import ErrorEstimate, error_estimate
 from cardan_exudyn.engines import resolve
 from cardan_exudyn.engines import run as run_engine
-from reference.scene import Scene
-from reference.schema import Result, Status
+from reference.scene.scene import Scene
+from reference.results.schema import Result, Status
 
 __all__ = ["RunRecord", "CachingRunner"]
 
@@ -93,12 +93,12 @@ class CachingRunner:
         Raises
         ------
         TypeError
-            ``scene`` is not a :class:`reference.scene.Scene`.
+            ``scene`` is not a :class:`reference.scene.scene.Scene`.
         OptionsError
             Both ``options`` and option keywords, or options of another engine's class.
         """
         if not isinstance(scene, Scene):
-            raise TypeError(f"`scene` must be a reference.scene.Scene, got {type(scene).__name__}")
+            raise TypeError(f"`scene` must be a reference.scene.scene.Scene, got {type(scene).__name__}")
         engine, options = resolve(engine, options, **option_values)
         return scene, engine, options
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from reference.paper import named_scene
-from reference.scene import Scene, replace
-from reference.scene_files import load_scene
-from reference.validation import SceneError
+from reference.paper.paper import named_scene
+from reference.scene.scene import Scene, replace
+from reference.scene.files import load_scene
+from reference.scene.validation import SceneError
 
 __all__ = ["make_scene"]
 
@@ -20,12 +20,12 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
     ----------
     source : str, pathlib.Path or Scene
         A named scene (``"paper-10deg"``, ``"rig-frictionless"``, see
-        :func:`reference.paper.named_scene`), a TOML scene file (a ``Path``, or a string ending
+        :func:`reference.paper.paper.named_scene`), a TOML scene file (a ``Path``, or a string ending
         in ``.toml`` or holding a ``/``), or a scene to change.
     root : str or pathlib.Path, optional
         The folder a relative file path is taken from (the current folder by default).
     **changes
-        Scene fields by dotted path, as :func:`reference.scene.replace` takes them; a double
+        Scene fields by dotted path, as :func:`reference.scene.scene.replace` takes them; a double
         underscore stands for the dot, so ``numerics__accuracy=1e-4`` is
         ``**{"numerics.accuracy": 1e-4}``. Unit-suffixed names work (``shaft_angle_deg``).
 

@@ -1,0 +1,191 @@
+"""The paper's numbers as bounds: for each of its eleven mean efficiencies, the lowest and highest
+value the model gives over the plausible box (``[plausible]`` of ``reference/paper/data/paper.toml``),
+``cardan calibrate --envelope``.
+
+Method: every combination of the box's discrete options, and the continuous box by its corners
+(all of them, each run once for every case); then, per case and direction, a bounded local
+optimisation (``scipy.optimize.minimize``, L-BFGS-B, finite-difference gradient) started from the
+best corner. It is a local search: an extreme inside the box that no corner leads to can be
+missed, so a stored ``lowest`` may be too high and a ``highest`` too low. For a number outside
+the envelope, the parameters at a bound of the box at the closest plausible point say what would
+have to change, with the slope of the efficiency against each of them there.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from cardan_exudyn.report.format import markdown_table
+from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, box_space
+from reference.paper.paper import case_key, paper_cases
+
+METHOD = ("every combination of the discrete options; the continuous box by its 2^n corners, then "
+          "a bounded local optimisation (scipy.optimize.minimize, L-BFGS-B, forward-difference "
+          "gradient, step 1e-6 of each range) from the best corner per case and direction; a local "
+          "search that can miss an extreme inside the box")
+ENVELOPE_COLUMNS = ["case", "paper", "lowest", "highest", "reachable", "closest", "limited by"]
+ENVELOPE_FORMATS = {"paper": ".3f", "lowest": ".4f", "highest": ".4f", "closest": ".4f"}
+BOUND_TOL = 1e-6
+"""A parameter within this share of its range from a bound is at the bound."""
+
+__all__ = ["METHOD", "envelope_study", "envelope_text"]
+
+
+def corner_scan(model: CaseModel, space: Space, combinations: list[dict[str, str]],
+                cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Every corner of ``space`` under every combination: ``u``, ``choices`` and the mean
+    efficiency of each case (NaN where the run failed)."""
+    points = []
+    for choices in combinations:
+        for u in space.corners():
+            values = {**choices, **space.values(u)}
+            points.append({"u": u, "choices": choices,
+                           "eta": np.asarray([model.efficiency(c, values) for c in cases])})
+    return points
+
+
+def refine(model: CaseModel, space: Space, case: Mapping[str, Any], point: Mapping[str, Any],
+           sign: float) -> tuple[float, np.ndarray]:
+    """Bounded local optimisation of ``sign * eta`` of ``case`` from a corner ``point``; the
+    extreme efficiency [-] and its ``u``."""
+    from scipy.optimize import minimize  # import cost: this module is behind a CLI command
+
+    choices = point["choices"]
+
+    def objective(u: np.ndarray) -> float:
+        eta = model.efficiency(case, {**choices, **space.values(u)})
+        return sign * eta if np.isfinite(eta) else 10.0  # a locked run: worse than any efficiency
+
+    solution = minimize(objective, np.asarray(point["u"], dtype=float), method="L-BFGS-B",
+                        bounds=[(0.0, 1.0)] * len(space.names),
+                        options={"eps": 1e-6, "maxiter": 30, "ftol": 1e-12, "gtol": 1e-9})
+    best_corner = sign * objective(np.asarray(point["u"], dtype=float))
+    eta = sign * float(solution.fun)
+    if sign * eta > sign * best_corner:  # never worse than the corner it started from
+        return best_corner, np.asarray(point["u"], dtype=float)
+    return eta, np.clip(solution.x, 0.0, 1.0)
+
+
+def at_bounds(model: CaseModel, space: Space, case: Mapping[str, Any], u: np.ndarray,
+              choices: Mapping[str, str]) -> list[dict[str, Any]]:
+    """The parameters at a bound of the box at ``u``: name, bound, value [m] and the slope of
+    the efficiency [1/m] moving outwards (extrapolated from a step 1e-3 of the range inwards)."""
+    base = model.efficiency(case, {**choices, **space.values(u)})
+    out = []
+    for i, name in enumerate(space.names):
+        for bound, edge, inward in (("lower", 0.0, 1.0), ("upper", 1.0, -1.0)):
+            if abs(u[i] - edge) > BOUND_TOL:
+                continue
+            v = u.copy()
+            v[i] = edge + inward * 1e-3
+            step = (space.upper[i] - space.lower[i]) * 1e-3
+            slope = (base - model.efficiency(case, {**choices, **space.values(v)})) / step
+            out.append({"name": name, "bound": bound, "value": space.values(u)[name],
+                        "slope_outwards": float(slope)})
+    return out
+
+
+def envelope_study(engine: str = "reference", progress: Callable[[str], None] | None = None,
+                   space: Space | None = None, combinations: list[dict[str, str]] | None = None,
+                   cases: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+    """The lowest and highest mean efficiency of each of the paper's cases over the plausible box.
+
+    Parameters
+    ----------
+    engine : {"reference", "exudyn"}
+        Engine of every run.
+    progress : callable, optional
+        Called with a line of text as the study proceeds.
+    space, combinations, cases : optional
+        A smaller box, other choices or fewer cases than the data file's (for tests).
+
+    Returns
+    -------
+    dict
+        ``method``, ``engine``, ``cases`` (per case: ``case``, ``paper``, ``lowest``, ``highest``,
+        ``lowest_at``, ``highest_at`` (parameter values), ``reachable``, ``closest`` and, when not
+        reachable, ``limiting`` (:func:`at_bounds` at the closest point)), ``corners``, ``runs``,
+        ``failed_runs`` and ``wall_time_s`` [s].
+    """
+    start = time.perf_counter()
+    model = CaseModel(engine, progress)
+    if space is None or combinations is None:
+        default_space, default_combinations = box_space()
+        space = default_space if space is None else space
+        combinations = default_combinations if combinations is None else combinations
+    cases = paper_cases() if cases is None else cases
+    points = corner_scan(model, space, combinations, cases)
+    if progress:
+        progress(f"{len(points)} corners x {len(cases)} cases: {model.runs} runs, "
+                 f"{time.perf_counter() - start:.0f} s; refining")
+    rows = [case_envelope(model, space, points, k, case) for k, case in enumerate(cases)]
+    failed = sorted({k for k, (eta, _, _) in model.cache.items() if not np.isfinite(eta)}, key=str)
+    return {"method": METHOD, "engine": engine, "cases": rows, "corners": len(points),
+            "box": {n: [lo, hi] for n, lo, hi in zip(space.names, space.lower, space.upper, strict=True)},
+            "choices": combinations, "runs": model.runs, "failed_runs": [str(f) for f in failed],
+            "wall_time_s": time.perf_counter() - start}
+
+
+def case_envelope(model: CaseModel, space: Space, points: list[dict[str, Any]], k: int,
+                  case: Mapping[str, Any]) -> dict[str, Any]:
+    """One case's envelope from the corner scan ``points`` (case index ``k``), refined."""
+    row: dict[str, Any] = {"case": case_key(case), "paper": case["paper_mean_efficiency"]}
+    where = {}
+    for key, sign in (("lowest", 1.0), ("highest", -1.0)):
+        finite = [p for p in points if np.isfinite(p["eta"][k])]
+        corner = min(finite, key=lambda p: sign * p["eta"][k])
+        eta, u = refine(model, space, case, corner, sign)
+        row[key] = eta
+        row[f"{key}_at"] = {**corner["choices"], **space.values(u)}
+        where[key] = (u, corner["choices"])
+    paper = row["paper"]
+    row["reachable"] = row["lowest"] <= paper <= row["highest"]
+    row["closest"] = min(max(paper, row["lowest"]), row["highest"])
+    if not row["reachable"]:
+        u, choices = where["lowest" if paper < row["lowest"] else "highest"]
+        row["limiting"] = at_bounds(model, space, case, u, choices)
+    return row
+
+
+def envelope_text(result: Mapping[str, Any]) -> str:
+    """The report of :func:`envelope_study`: the table, what to paste into ``[envelope]`` of the
+    data file, and what would have to change for each number outside the envelope."""
+    rows = [{**r, "reachable": "yes" if r["reachable"] else "no",
+             "limited by": "; ".join(map(_limit, r.get("limiting", []))) + _choices(r)}
+            for r in result["cases"]]
+    lines = [f"engine {result['engine']}; method: {result['method']}", "",
+             markdown_table(rows, ENVELOPE_COLUMNS, ENVELOPE_FORMATS).rstrip(),
+             "", "paste into reference/paper/data/paper.toml:", "[envelope]",
+             'command = "cardan calibrate --envelope"', f'method = "{result["method"]}"']
+    for r in result["cases"]:
+        lines.append(f'[envelope.cases."{r["case"]}"]')
+        lines.append(f"lowest = {r['lowest']:.6f}")
+        lines.append(f"highest = {r['highest']:.6f}")
+        for key in ("lowest_at", "highest_at"):
+            lines.append(f"{key} = {{ " + ", ".join(f"{n} = {_toml(v)}" for n, v in r[key].items()) + " }")
+    lines.append(f"\n{result['corners']} corners, {result['runs']} engine runs, "
+                 f"{result['wall_time_s']:.0f} s")
+    return "\n".join(lines) + "\n"
+
+
+def _limit(x: Mapping[str, Any]) -> str:
+    if x["bound"] == "lower" and x["value"] == 0.0:  # a distance: zero is a physical limit
+        return f"{x['name']} at zero (a distance, cannot go lower)"
+    return (f"{x['name']} at its {x['bound']} bound ({x['value']:.4g}; d eta/d x outwards "
+            f"{x['slope_outwards']:+.3g} /m)")
+
+
+def _choices(row: Mapping[str, Any]) -> str:
+    if row.get("reachable", True) or "limiting" not in row:
+        return ""
+    at = row["lowest_at"] if row["paper"] < row["lowest"] else row["highest_at"]
+    picked = {k: v for k, v in at.items() if isinstance(v, str)}
+    return (" [" + ", ".join(f"{k} = {v}" for k, v in picked.items()) + "]") if picked else ""
+
+
+def _toml(v: Any) -> str:
+    return f'"{v}"' if isinstance(v, str) else f"{v:.6g}"

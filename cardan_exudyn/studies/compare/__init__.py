@@ -1,0 +1,13 @@
+"""``cardan compare``."""
+
+from __future__ import annotations
+
+from reference.lazy import lazy_face
+
+_LAZY = {
+    "command": "cardan_exudyn.studies.compare.command",
+}
+
+__all__ = list(_LAZY)
+
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)

@@ -1,0 +1,172 @@
+"""The friction fixed point of the inverse (and forward) dynamics, for many samples at once.
+
+With the friction values ``phi`` (one per slot of :func:`reference.engine.dynamics.friction_slots`) the
+reactions are ``x = x0 - S phi`` (``x0`` the frictionless solution, ``S`` its response to unit
+friction), and the law of eqs. (3) and (5) gives ``phi = G(x)``. :func:`solve_friction` solves
+``phi = G(x0 - S phi)`` by Newton's method per sample; the law reads four components of ``x`` per
+slot (the normal force and the bending moment in the pair frame), so the iteration runs on those,
+(n, K, 4) and (n, K, 4, K), never on all of ``x``. Its loop gain -- the spectral radius of
+``dG/dphi`` at the solution -- tells a joint that self-locks (gain >= 1: no consistent friction).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["FixedPoint", "friction_law_values", "reduced_law_values", "solve_friction", "power_bound",
+           "POWER_SQUARINGS"]
+
+POWER_SQUARINGS = 6
+"""Squarings of :func:`power_bound`: the bound of ``||G^64||^(1/64)``. Measured on rig samples with
+mounting errors (loop gains 0.6-0.9, infinity norms above 1 at every sample): after 5 squarings the
+bound is within 1.12 of the spectral radius and below 1 at every sample, at 0.45 us per sample
+against 3.8 us for the eigenvalues."""
+
+
+def friction_law_values(x: np.ndarray, index: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
+                        k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`FrictionLaw.__call__` with its coefficients given: ``index`` (K, 4) the columns of
+    ``x`` holding each slot's fx, fy, mx, my; ``k_force`` [m or -] and ``k_moment`` [-, 1/m]
+    the law's factors of ``|F|`` and ``|M|``, shape (K,) or one row per sample (n, K)."""
+    values, slopes = reduced_law_values(x[:, index], signs, k_force, k_moment)
+    jacobian = np.zeros(x.shape[:1] + index.shape[:1] + x.shape[1:])
+    jacobian[:, np.arange(index.shape[0])[:, None], index] = slopes
+    return values, jacobian
+
+
+def reduced_law_values(c: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
+                       k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The law of eqs. (3) and (5) on the components it reads: ``c`` (n, K, 4) each slot's fx,
+    fy, mx, my. Returns the values (n, K) and their derivatives with respect to ``c`` (n, K, 4)
+    (the zero subgradient where a norm is exactly zero); :func:`friction_law_values` scatters
+    them into ``dG/dx``."""
+    force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
+    per_force, per_moment = -signs * k_force, -signs * k_moment
+    with np.errstate(invalid="ignore", divide="ignore"):
+        along_force = np.where(force > 0, per_force / force, 0.0)
+        along_moment = np.where(moment > 0, per_moment / moment, 0.0)
+    slopes = np.empty(np.broadcast_shapes(c.shape, along_force.shape + (4,)))
+    np.multiply(c[..., :2], along_force[..., None], out=slopes[..., :2])
+    np.multiply(c[..., 2:], along_moment[..., None], out=slopes[..., 2:])
+    return per_force * force + per_moment * moment, slopes
+
+
+@dataclass
+class FixedPoint:
+    """Outcome of the friction fixed point, per sample.
+
+    Attributes
+    ----------
+    x : ndarray, shape (n, 18)
+        Reactions and the drive unknown, :func:`unknowns` order.
+    friction : ndarray, shape (n, K)
+        Friction values of :func:`friction_slots`.
+    converged : ndarray of bool, shape (n,)
+        Newton converged to the relative tolerance.
+    loop_gain : ndarray, shape (n,)
+        Spectral radius of ``dG/dphi`` at the solution (0 without friction); where an upper
+        bound is below ``exact_gain``, that bound is reported instead (enough to tell that the
+        sample does not lock): the infinity norm, and with ``exact_gain`` >= 1 (the verdict
+        only, as the quadrature asks) also :func:`power_bound`; infinite where Newton found no
+        solution.
+    iterations : int
+        Newton iterations of the slowest sample.
+    """
+
+    x: np.ndarray
+    friction: np.ndarray
+    converged: np.ndarray
+    loop_gain: np.ndarray
+    iterations: int
+
+    @property
+    def self_locking(self) -> np.ndarray:
+        """Per sample: no converged fixed point, or a loop gain of 1 or more (bool array)."""
+        return ~self.converged | ~(self.loop_gain < 1.0)
+
+
+def power_bound(g: np.ndarray, norm: np.ndarray) -> np.ndarray:
+    """Upper bounds of the spectral radii of the matrices ``g`` (n, K, K), from their infinity
+    norms ``norm`` (n,) (positive): ``rho(G) = rho(G^m)^(1/m) <= ||G^m||^(1/m)`` (Gelfand), with
+    ``m = 2^POWER_SQUARINGS`` by squaring ``G / ||G||`` (whose powers cannot overflow). The
+    bound falls towards ``rho`` as ``m`` grows; where it stays at or above a threshold the caller
+    computes the eigenvalues."""
+    p = g / norm[:, None, None]
+    for _ in range(POWER_SQUARINGS):
+        p = p @ p
+    return np.minimum(norm, norm * np.max(np.sum(np.abs(p), -1), -1) ** (1.0 / 2 ** POWER_SQUARINGS))
+
+
+def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
+                   tolerance: float = 1e-13, max_iterations: int = 50,
+                   exact_gain: float = 0.5) -> FixedPoint:
+    """Solve ``phi = G(x0 - S phi)`` for every sample by Newton's method.
+
+    Parameters
+    ----------
+    law : reference.engine.dynamics.FrictionLaw or alike
+        ``G``: its ``index`` (K, 4), the columns of ``x`` each slot reads, and ``reduced(c, signs)``,
+        the values and derivatives of :func:`reduced_law_values`.
+    x0 : ndarray, shape (n, 18)
+        Solution without friction.
+    s : ndarray, shape (n, 18, K)
+        Response of the solution to unit friction values.
+    signs : ndarray, shape (n, K)
+        Regularised signs of the relative motions.
+    tolerance : float
+        Converged when the Newton update is at most ``tolerance`` times the largest friction
+        value of the sample (or of the frictionless estimate, whichever is larger).
+    max_iterations : int
+        Newton iterations before a sample is declared not converged.
+    exact_gain : float
+        Loop gain: the spectral radius where its norm bound reaches this, else the bound.
+    """
+    n, k = x0.shape[0], s.shape[-1]
+    if k == 0:
+        return FixedPoint(x0, np.zeros((n, 0)), np.ones(n, bool), np.zeros(n), 0)
+    # the law reads 4 components per slot: Newton on those, (n, K, 4) and (n, K, 4, K), not on x
+    index = law.index
+    c0, s_c = x0[:, index], s[:, index, :]
+    phi, _ = law.reduced(c0, signs)
+    scale = np.max(np.abs(phi), -1)
+    converged = np.zeros(n, bool)
+    active = np.arange(n)
+    # the unconverged samples' data, compacted as samples converge
+    c_a, s_a, signs_a, phi_a, scale_a = c0, s_c, signs, phi.copy(), scale.copy()
+    iterations, eye = 0, np.eye(k)
+    for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported below)
+        shift = (s_a.reshape(s_a.shape[0], 4 * k, k) @ phi_a[..., None]).reshape(c_a.shape)
+        g, g_c = law.reduced(c_a - shift, signs_a)
+        jac = eye + (g_c[:, :, None, :] @ s_a)[:, :, 0, :]  # I + d(G(x0 - S phi))/dphi
+        with np.errstate(all="ignore"):
+            step = np.linalg.solve(jac, (phi_a - g)[..., None])[..., 0]
+        phi_a -= step
+        scale_a = np.maximum(scale_a, np.max(np.abs(phi_a), -1))
+        done = np.max(np.abs(step), -1) <= tolerance * np.maximum(scale_a, np.finfo(float).tiny)
+        bad = ~np.all(np.isfinite(phi_a), -1)
+        stop = done | bad
+        phi[active] = phi_a
+        converged[active[done & ~bad]] = True
+        if np.all(stop):
+            break
+        if np.any(stop):
+            keep = ~stop
+            active, c_a, s_a, signs_a = active[keep], c_a[keep], s_a[keep], signs_a[keep]
+            phi_a, scale_a = phi_a[keep], scale_a[keep]
+    x = x0 - np.einsum("nik,nk->ni", s, phi)
+    _, g_c = law.reduced(x[:, index], signs)
+    with np.errstate(all="ignore"):
+        gain_matrix = np.nan_to_num((g_c[:, :, None, :] @ s_c)[:, :, 0, :], nan=np.inf, posinf=np.inf,
+                                    neginf=-np.inf)
+    finite = np.all(np.isfinite(gain_matrix), (-2, -1))
+    gain = np.where(finite, np.max(np.sum(np.abs(gain_matrix), -1), -1), np.inf)
+    exact = finite & (gain >= exact_gain)  # the spectral radius is at most any induced norm
+    if exact_gain >= 1.0:  # only the verdict is asked for: a sharper bound may settle it
+        gain[exact] = power_bound(gain_matrix[exact], gain[exact])
+        exact &= gain >= exact_gain
+    gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
+    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
+    return FixedPoint(x, phi, converged, gain, iterations)

@@ -1,0 +1,517 @@
+"""Forward dynamics of a torque-driven scene at one state in microseconds, not milliseconds.
+
+A torque drive is integrated in time (:func:`reference.engine.solve.input_motion`); every call of the
+integrator's right-hand side needs the input acceleration at one state ``(t, theta, theta_t)``.
+Solving the Newton-Euler system for that one sample (:func:`reference.engine.dynamics.solve_dynamics`,
+kept here as :func:`direct_acceleration`) costs milliseconds of Python overhead on tiny arrays.
+This module takes the same equations apart instead:
+
+- in forward dynamics the system ``K(theta) x = R0(theta) + theta_t^2 R2(theta) + T_load U(theta)
+  - T_in e - W(theta) phi`` has a matrix (the acceleration's column included) and friction
+  wrenches ``W`` that depend on the input angle only, and a right-hand side that is linear in
+  ``theta_t^2``, the load torque ``T_load`` and the drive torque ``T_in`` (one degree of freedom:
+  every velocity is ``theta_t`` times a function of the angle, every acceleration ``theta_tt``
+  times one plus ``theta_t^2`` times another); the slot speeds whose signs the friction law takes
+  are ``theta_t`` times functions of the angle;
+- so ``K^-1 R0``, ``K^-1 R2``, ``K^-1 U``, ``K^-1 e``, ``K^-1 W`` and the unit slot speeds,
+  restricted to the rows the friction law and the acceleration need, are computed once, in one
+  vectorised pass over an equispaced grid of one input revolution (they are periodic in the
+  angle: the geometry is constant), and represented by their Fourier series, truncated where the
+  harmonics fall below rounding (the grid is doubled until they do);
+- a call evaluates the series (one product gives the frictionless solution at this speed and
+  load, and the friction's response), and solves the friction fixed point ``phi = G(x0 - S phi)``
+  (eqs. (3), (5)) by Newton's method on at most seven values, LAPACK's ``dgesv`` called directly,
+  started from the previous call's solution (the integrator's calls are close) and stopped where
+  its quadratic convergence puts the next update below :func:`reference.engine.fixed_point.solve_friction`'s
+  tolerance; where the loop gain comes near 1 the sample is solved again exactly as
+  ``solve_friction`` does, so the self-locking verdict is the direct solve's.
+
+The parts are taken at a large speed, acceleration and load (:data:`PART_SCALE`), so their
+differences keep all digits; the direct solve takes the acceleration's column as the difference
+of two right-hand sides at accelerations 0 and 1 and loses about three digits to gravity and the
+centrifugal terms. Measured: the two agree to 2e-12 of the acceleration (random states, with
+friction, mounting errors, both friction laws), and the series' acceleration and friction satisfy
+the Newton-Euler equations and the friction law to 3e-14 (drive torque) where the direct solve's
+do to 4e-12, and to 1e-9 near self-locking (``tests/test_forward_dynamics.py``). Where the grid
+cannot be built (the loop with mounting errors does not close at some angle) or no grid of
+:data:`GRID_SIZES` resolves the series, :func:`right_hand_side` falls back to the direct solve.
+
+References
+----------
+Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
+experimental validation": Section 3 (Newton-Euler of the RCCC model), eqs. (3), (5) (friction).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg.lapack import dgeev, dgesv  # LAPACK direct: 1 us, np.linalg.solve 12 us
+
+from reference.engine.dynamics import (
+    DRIVE_ROW,
+    FrictionLaw,
+    friction_matrix,
+    friction_slots,
+    reaction_system,
+    slot_bands,
+    slot_signs,
+    slot_speeds,
+    solve_dynamics,
+)
+from reference.engine.fixed_point import power_bound
+from reference.physics.joint_motion import joint_motion
+from reference.physics.loop_closure import LoopClosureError
+from reference.scene.scene import Scene
+
+__all__ = ["METHODS", "ForwardDynamics", "ForwardState", "TrigSeries", "angle_functions",
+           "direct_acceleration", "fit_periodic", "friction_newton", "right_hand_side"]
+
+TAU = 2.0 * math.pi
+GRID_SIZES = (64, 128, 256, 512, 1024, 2048)
+"""Grid points per revolution tried in turn until the series is resolved."""
+RESOLVED_TOLERANCE, KEEP_TOLERANCE = 1e-14, 1e-15
+"""Relative to each group's largest value on the grid (the solution's parts, the friction
+response, the speeds): the upper half of the grid's harmonics must stay below the first, and
+harmonics are kept up to the last one above the second (the samples' rounding noise is about
+1e-17 of that scale, :data:`PART_SCALE`)."""
+PART_SCALE = 1024.0
+"""Speed [rad/s], acceleration [rad/s^2] and load [N m] at which the system's parts are taken
+(a power of two: the divisions are exact)."""
+NEWTON_TOLERANCE = 1e-13
+"""Stopping rule of :func:`reference.engine.fixed_point.solve_friction`: a Newton update at most this
+fraction of the largest friction value."""
+NEWTON_ITERATIONS = 50
+WARM_START_GAIN = 0.9
+"""Newton starts from the previous call's friction (the integrator's calls are close: two or three
+iterations instead of five); where the loop gain it finds is at least this, the sample is solved
+again from :func:`reference.engine.fixed_point.solve_friction`'s start, so that a verdict near self-locking
+is the same as the direct solve's."""
+
+Acceleration = Callable[[float, float, float], tuple[float, bool]]
+"""``(t [s], theta [rad], theta_t [rad/s]) -> (theta_tt [rad/s^2], self_locking)``."""
+
+
+@dataclass(frozen=True)
+class TrigSeries:
+    """Real Fourier series of many periodic functions of the input angle, evaluated in one product.
+
+    ``f(theta) = sum_k a_k cos(k theta) + b_k sin(k theta)``, k = 0..H.
+
+    Attributes
+    ----------
+    frequencies : ndarray, shape (2 (H + 1),)
+        ``k`` twice: cosine rows, then sine rows.
+    phases : ndarray, shape (2 (H + 1),)
+        0 for the cosine rows, pi/2 for the sine rows (``sin x = cos(x - pi/2)``).
+    table : ndarray, shape (2 (H + 1), M)
+        The coefficients ``a_k`` then ``b_k`` of the M functions.
+    grid : int
+        Grid points per revolution the series was fitted on.
+    """
+
+    frequencies: np.ndarray
+    phases: np.ndarray
+    table: np.ndarray
+    grid: int
+
+    def __call__(self, theta: float) -> np.ndarray:
+        """The M functions at one input angle [rad], shape (M,)."""
+        return np.cos(self.frequencies * (theta % TAU) - self.phases) @ self.table
+
+
+def fit_periodic(values: np.ndarray, scale: np.ndarray) -> TrigSeries | None:
+    """The Fourier series of functions sampled on ``n`` equispaced angles ``2 pi j / n``.
+
+    Parameters
+    ----------
+    values : ndarray, shape (n, M)
+        Samples; n even.
+    scale : ndarray, shape (M,)
+        Each function's scale: its group's largest sample (a function that is zero up to
+        rounding has rounding-level harmonics, judged against its group, not against itself).
+
+    Returns
+    -------
+    TrigSeries or None
+        Harmonics kept up to the last one above :data:`KEEP_TOLERANCE` times the scale; None when
+        some harmonic from ``n / 4`` on exceeds :data:`RESOLVED_TOLERANCE` (not resolved).
+    """
+    n = values.shape[0]
+    c = np.fft.rfft(values, axis=0) / n  # (n/2 + 1, M)
+    a, b = 2.0 * c.real, -2.0 * c.imag
+    a[0] *= 0.5
+    size = np.hypot(a, b) / np.maximum(scale, np.finfo(float).tiny)
+    if np.any(size[n // 4:] > RESOLVED_TOLERANCE):
+        return None
+    kept = np.nonzero(np.any(size > KEEP_TOLERANCE, 1))[0]
+    h = int(kept[-1]) + 1 if kept.size else 1
+    k = np.arange(h, dtype=float)
+    return TrigSeries(np.concatenate([k, k]), np.concatenate([np.zeros(h), np.full(h, 0.5 * math.pi)]),
+                      np.concatenate([a[:h], b[:h]]), n)
+
+
+def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[str, np.ndarray]:
+    """The angle-only parts of the forward-dynamics system on ``n`` angles ``2 pi j / n``.
+
+    Returns
+    -------
+    dict
+        ``x0``, ``x2``, ``xu``, ``xd`` (n, 18): ``K^-1`` times the right-hand side at rest, its
+        share per ``theta_t^2`` [1/s^2], per unit load torque and per unit drive torque
+        (:func:`reference.engine.dynamics.unknowns` order, the input acceleration last); ``s`` (n, 18, K):
+        ``K^-1 W``, the solution's response to unit friction values; ``v`` (n, K): slot speeds
+        per unit input speed [m/rad] (:func:`reference.engine.dynamics.slot_speeds`).
+
+    Raises
+    ------
+    reference.physics.loop_closure.LoopClosureError
+        The loop with the joint's mounting errors does not close at some angle.
+    """
+    theta = TAU * np.arange(n) / n
+    # four blocks: at rest, then a speed, an acceleration and a load so large that their parts
+    # dominate the rest's (gravity) and survive the difference to rounding
+    big = np.array([PART_SCALE ** 2, PART_SCALE, PART_SCALE])
+    speed = np.repeat([0.0, PART_SCALE, 0.0, 0.0], n)
+    accel = np.repeat([0.0, 0.0, PART_SCALE, 0.0], n)
+    load = np.repeat([0.0, 0.0, 0.0, PART_SCALE], n)
+    motion = joint_motion(scene.joint, np.tile(theta, 4), speed, accel)
+    matrix, rhs = reaction_system(scene, motion, load)
+    rest, parts = rhs[:n], (rhs.reshape(4, n, 18)[1:] - rhs[:n]) / big[:, None, None]
+    matrix = matrix[:n].copy()
+    matrix[:, :, -1] = -parts[1]  # the acceleration's share moves to the left, as in solve_dynamics
+    drive = np.zeros((n, 18))
+    drive[:, DRIVE_ROW] = 1.0
+    wrenches = friction_matrix(motion, slots)[:n]
+    columns = np.concatenate([np.stack([rest, parts[0], parts[2], drive], -1), wrenches], -1)
+    solved = np.linalg.solve(matrix, columns)
+    unit = slice(n, 2 * n)
+    v = (slot_speeds(scene, slots, {p: w[unit] for p, w in motion.omega_rel.items()},
+                     {p: w[unit] for p, w in motion.slide_rel.items()}) / PART_SCALE
+         if slots else np.zeros((n, 0)))
+    return {"x0": solved[..., 0], "x2": solved[..., 1], "xu": solved[..., 2], "xd": solved[..., 3],
+            "s": solved[..., 4:], "v": v}
+
+
+@dataclass(frozen=True)
+class ForwardState:
+    """The forward dynamics at one state.
+
+    Attributes
+    ----------
+    acceleration : float
+        Input acceleration [rad/s^2].
+    friction : ndarray, shape (K,)
+        Friction values of :func:`reference.engine.dynamics.friction_slots` [N m or N].
+    converged : bool
+        Newton converged (:func:`reference.engine.fixed_point.solve_friction`'s rule).
+    loop_gain : float
+        Spectral radius of the friction loop's Jacobian, or an upper bound (its infinity norm
+        over the active slots) where that is below :data:`WARM_START_GAIN` (0.5 when solved from
+        ``solve_friction``'s start); infinite when Newton did not converge.
+    iterations : int
+        Newton iterations.
+    """
+
+    acceleration: float
+    friction: np.ndarray
+    converged: bool
+    loop_gain: float
+    iterations: int
+
+    @property
+    def self_locking(self) -> bool:
+        """No converged fixed point, or a loop gain of 1 or more."""
+        return not (self.converged and self.loop_gain < 1.0)
+
+
+_TINY = np.finfo(float).tiny  # n + tiny is n for every normal n, and keeps 0 / 0 away
+
+
+def _spectral_radius(matrix: np.ndarray) -> float:
+    wr, wi, _, _, info = dgeev(matrix, compute_vl=0, compute_vr=0)
+    return float(np.max(np.hypot(wr, wi))) if info == 0 else math.inf
+
+
+def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
+    """:func:`reference.engine.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
+    or an upper bound where that is below ``exact_from`` (the infinity norm; for ``exact_from`` >= 1
+    also :func:`reference.engine.fixed_point.power_bound`)."""
+    norm = float(np.abs(matrix).sum(1).max())
+    if not math.isfinite(norm):
+        return math.inf
+    if norm < exact_from:
+        return norm
+    if exact_from >= 1.0:  # the verdict only
+        bound = float(power_bound(matrix[None], np.array([norm]))[0])
+        if bound < exact_from:
+            return bound
+    return _spectral_radius(matrix)
+
+
+def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
+                    start: np.ndarray | None = None) -> tuple[np.ndarray, bool, float, int]:
+    """The friction fixed point of one sample, as :func:`reference.engine.fixed_point.solve_friction`.
+
+    Parameters
+    ----------
+    sxa : ndarray, shape (4 K, K + 1)
+        Row ``4 j + i``: pair component i (fx, fy, mx, my [N, N m]) of slot j's pair, its
+        response to unit friction values (columns ``:K``) and its value without friction (column
+        K): ``c = sxa @ [-phi, 1]``.
+    ks : ndarray, shape (2 K,)
+        Factors of ``|F|`` and ``|M|`` in each friction value, signs included
+        (``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``).
+    coupled : bool
+        False: the friction of the frictionless reactions (coupling ``"uncoupled"``).
+    start : ndarray, shape (K,), or None
+        None: :func:`reference.engine.fixed_point.solve_friction` exactly (first iterate the friction of the
+        frictionless reactions, stop when an update is at most :data:`NEWTON_TOLERANCE` of the
+        largest value, loop gain at the solution). Else the first iterate (a close one: the
+        previous call's), and Newton also stops where its quadratic convergence puts the next
+        update below that tolerance, with the loop gain of the last Jacobian (about the update's
+        relative size off, and the infinity norm where that is below :data:`WARM_START_GAIN`;
+        callers re-solve with ``start=None`` where the verdict is close).
+
+    Returns
+    -------
+    phi, converged, loop_gain, iterations
+    """
+    k = sxa.shape[1] - 1
+    ops = _OPERATORS[k]
+    strict = start is None or not coupled
+    if strict:
+        c0 = sxa[:, k]
+        phi = ops.slots @ (ks * np.sqrt(ops.norms @ (c0 * c0)))
+        if not coupled:
+            return phi, True, 0.0, 0
+    else:
+        phi = start
+    values = phi.tolist()
+    scale = max(map(abs, values))  # warm: the start's size, close to the solution's
+    before, p = 0.0, np.ones(k + 1)
+    for iterations in range(1, NEWTON_ITERATIONS + 1):
+        # G is homogeneous in the pair components: G = W c with W the unit components times
+        # their factors, so Newton's iterate is (I + W sx)^-1 W c0 (one product gives both)
+        p[:k] = -phi
+        both = _products(sxa @ p, ks, sxa, ops)
+        gm = both[:, :k]
+        _, _, phi, info = dgesv(gm + ops.eye, both[:, k])
+        last, values = values, phi.tolist()
+        size, top = max(abs(a - b) for a, b in zip(values, last, strict=True)), max(map(abs, values))
+        if info or not math.isfinite(size + sum(values)):
+            break
+        scale = max(scale, top)
+        if size <= NEWTON_TOLERANCE * scale:
+            if strict:
+                p[:k] = -phi
+                gm = _products(sxa @ p, ks, sxa, ops)[:, :k]
+            return phi, True, _gain(gm, 0.5 if strict else WARM_START_GAIN), iterations
+        if not strict and size ** 3 <= 0.01 * NEWTON_TOLERANCE * scale * before ** 2:
+            return phi, True, _gain(gm, WARM_START_GAIN), iterations
+        before = size
+    return phi, False, math.inf, iterations
+
+
+@dataclass(frozen=True)
+class _Operators:
+    """0/1 matrices of :func:`friction_newton` for K slots: ``norms`` (2 K, 4 K) squared
+    components to squared norms, ``spread`` (4 K, 2 K) back, ``slots`` (K, 2 K) per-norm terms to
+    friction values, ``blocks`` (K, 4 K) rows to their slot; ``eye`` (K, K)."""
+
+    norms: np.ndarray
+    spread: np.ndarray
+    slots: np.ndarray
+    blocks: np.ndarray
+    eye: np.ndarray
+
+    @classmethod
+    def of(cls, k: int) -> _Operators:
+        norms = np.kron(np.eye(2 * k), np.ones(2))
+        return cls(norms, norms.T.copy(), np.kron(np.eye(k), np.ones(2)), np.kron(np.eye(k), np.ones(4)),
+                   np.eye(k))
+
+
+_OPERATORS = [_Operators.of(k) for k in range(8)]  # at most seven friction values
+
+
+def _products(c: np.ndarray, ks: np.ndarray, sxa: np.ndarray, ops: _Operators) -> np.ndarray:
+    """``W @ sxa``, shape (K, K + 1): the loop's Jacobian ``-dG/dphi`` and ``W c0``, with ``W``
+    (K, 4 K) block-diagonal, the unit pair components of ``c`` (4 K,) times their factors (zero
+    where a norm vanishes: there ``c`` is zero)."""
+    w = c * (ops.spread @ (ks / (np.sqrt(ops.norms @ (c * c)) + _TINY)))
+    return (ops.blocks * w) @ sxa
+
+
+class ForwardDynamics:
+    """The input acceleration of a torque-driven scene at one state, from precomputed series.
+
+    Build with :meth:`of_scene`; call as the integrator's ``(t, theta, theta_t) ->
+    (theta_tt, self_locking)`` or :meth:`solve` for the whole state. Not thread-safe (it keeps
+    the last call's friction as Newton's next start).
+
+    Attributes
+    ----------
+    series : TrigSeries
+        The fit: per active slot and pair component the friction response and the solution, the
+        acceleration's, the unit slot speeds (:func:`_layout`), for the base, per ``theta_t^2``
+        [s^2] and per load torque (a history) side by side.
+    active : ndarray of int
+        The friction slots that can rub (a slot whose speed is zero at every angle, the axial
+        friction of the ideal joint, has none).
+    """
+
+    def __init__(self, scene: Scene, series: TrigSeries, active: np.ndarray, parts: int) -> None:
+        slots = friction_slots(scene)
+        law = FrictionLaw(scene, slots)
+        k = active.size
+        self.scene, self.slots, self.active, self.series = scene, slots, active, series
+        self._frequencies, self._phases = series.frequencies, series.phases
+        # the series of the parts per unit theta_t^2 (and load) stacked under the base's
+        self._table = np.concatenate(np.split(series.table, parts, 1))
+        self._cut = (4 * k * (k + 1), 4 * k * (k + 1) + k + 1)
+        self._factors = -np.stack([law.k_force, law.k_moment], -1)[active].ravel()
+        self._bands = slot_bands(scene, slots)
+        self._coupled = scene.friction.coupling != "uncoupled"
+        self._history = scene.load.evaluator()
+        self._start: np.ndarray | None = None  # the last call's friction: Newton's warm start
+        bands, pair = self._bands[active], [slots[j][0] for j in active]
+        # the signs on the active slots without the general code's checks (all bands > 0)
+        self._inverse_band = 1.0 / bands if np.all(bands > 0.0) else None
+        self._same_pair = np.array([[p == q for q in pair] for p in pair], dtype=float)
+        self._resultant = scene.friction.law == "resultant"
+        # the paper's law with ramps: each friction value's factor is clip(theta_t v / band), so
+        # the series gives v / band, once per norm the value multiplies
+        self._ramps = not self._resultant and self._inverse_band is not None
+        if self._ramps:
+            speed = self._table[:, self._cut[1]:] * self._inverse_band
+            self._table = np.concatenate([self._table[:, :self._cut[1]], np.repeat(speed, 2, 1)], 1)
+        self._basis = np.empty(self._table.shape[0])
+
+    @classmethod
+    def of_scene(cls, scene: Scene, torque_in: float) -> ForwardDynamics | None:
+        """Fit the series for ``scene`` under the drive torque ``torque_in`` [N m]; None where
+        the loop does not close at some angle or no grid of :data:`GRID_SIZES` resolves them."""
+        slots = friction_slots(scene)
+        index = FrictionLaw(scene, slots).index
+        for n in GRID_SIZES:
+            try:
+                f = angle_functions(scene, slots, n)
+            except LoopClosureError:
+                return None
+            # a slot whose speed is zero at every angle (no sliding in the ideal joint) never rubs
+            active = np.nonzero(np.any(f["v"] != 0.0, 0))[0]
+            parts = _layout(scene, torque_in, f, index[active], active)
+            series = fit_periodic(np.concatenate(parts, 1), np.concatenate(
+                [np.full(p.shape[1], np.max(np.abs(p), initial=0.0)) for p in parts]))
+            if series is not None:
+                return cls(scene, series, active, len(parts))
+        return None
+
+    def _friction(self, theta: float, theta_t: float, load: float | None) -> tuple:
+        """``(theta_tt, phi, converged, loop_gain, iterations)`` on the active slots."""
+        u, m = self._basis, self._frequencies.size
+        np.cos(self._frequencies * (theta % TAU) - self._phases, out=u[:m])
+        np.multiply(u[:m], theta_t * theta_t, out=u[m:2 * m])
+        if self._history is not None:
+            np.multiply(u[:m], load, out=u[2 * m:])
+        f = u @ self._table
+        k = self.active.size
+        last = f[self._cut[0]:self._cut[1]]
+        if k == 0:
+            return float(last[0]), np.zeros(0), True, 0.0, 0
+        if self._ramps:
+            ks = np.clip(theta_t * f[self._cut[1]:], -1.0, 1.0) * self._factors
+        else:
+            ks = np.repeat(self._signs(theta_t * f[self._cut[1]:]), 2) * self._factors
+        sxa = f[:self._cut[0]].reshape(4 * k, k + 1)
+        phi, converged, gain, iterations = friction_newton(sxa, ks, self._coupled, self._start)
+        if self._start is not None and not gain < WARM_START_GAIN:  # near locking: as solve_friction
+            phi, converged, gain, iterations = friction_newton(sxa, ks, self._coupled)
+        if not self._coupled:  # as solve_dynamics: the frictionless solution, friction beside it
+            return float(last[k]), phi, converged, gain, iterations
+        self._start = phi if converged else None
+        return float(last[k] - last[:k] @ phi), phi, converged, gain, iterations
+
+    def solve(self, theta: float, theta_t: float, load: float | None = None) -> ForwardState:
+        """The forward dynamics at input angle ``theta`` [rad] and speed ``theta_t`` [rad/s] under
+        the output load ``load`` [N m] (None: the scene's constant load; needed for a history)."""
+        if self._history is not None and load is None:
+            raise ValueError("the scene's load is a torque history: pass `load` [N m]")
+        accel, phi, converged, gain, iterations = self._friction(theta, theta_t, load)
+        friction = np.zeros(len(self.slots))
+        friction[self.active] = phi
+        return ForwardState(accel, friction, converged, gain, iterations)
+
+    def _signs(self, speed: np.ndarray) -> np.ndarray:
+        """:func:`reference.engine.dynamics.slot_signs` on the active slots (speeds [m/s], shape (K,))."""
+        if self._inverse_band is None:
+            speeds = np.zeros(len(self.slots))
+            speeds[self.active] = speed
+            return slot_signs(self.scene, self.slots, speeds, self._bands)[self.active]
+        if self._resultant:  # the slot's component of its pair's regularised unit slip vector
+            return speed / np.maximum(np.sqrt((speed * speed) @ self._same_pair), 1.0 / self._inverse_band)
+        return np.clip(speed * self._inverse_band, -1.0, 1.0)
+
+    def __call__(self, t: float, theta: float, theta_t: float) -> tuple[float, bool]:
+        """``(theta_tt [rad/s^2], self_locking)`` at time ``t`` [s] (the load history's time)."""
+        accel, _, converged, gain, _ = self._friction(
+            theta, theta_t, None if self._history is None else self._history(t))
+        return accel, not (converged and gain < 1.0)
+
+
+def _layout(scene: Scene, torque_in: float, f: dict[str, np.ndarray], rows: np.ndarray,
+            active: np.ndarray) -> list[np.ndarray]:
+    """The grid functions in :class:`ForwardDynamics`' column order, one array (n, M) per part:
+    the base (drive torque and a constant load folded in), per ``theta_t^2``, per load torque (a
+    history only). Columns: per active slot and pair component ``[S row, x]`` (K, 4, K + 1), the
+    acceleration's ``[S row, x]`` (K + 1), the unit slot speeds (K)."""
+    n, k = f["x0"].shape[0], active.size
+    last = f["x0"].shape[1] - 1
+    constant = scene.load.constant
+    base = f["x0"] - torque_in * f["xd"] + (float(scene.load.torque) * f["xu"] if constant else 0.0)
+    s = f["s"][..., active]
+
+    def columns(x: np.ndarray, response: np.ndarray, speeds: np.ndarray) -> np.ndarray:
+        slot_part = np.concatenate([response[:, rows], x[:, rows, None]], -1).reshape(n, -1)
+        return np.concatenate([slot_part, response[:, last], x[:, last, None], speeds], 1)
+
+    zero = np.zeros_like(s)
+    out = [columns(base, s, f["v"][:, active]), columns(f["x2"], zero, np.zeros((n, k)))]
+    if not constant:
+        out.append(columns(f["xu"], zero, np.zeros((n, k))))
+    return out
+
+
+def direct_acceleration(scene: Scene, torque_in: float, t: float, theta: float, theta_t: float,
+                        bands: np.ndarray | None = None) -> tuple[float, bool]:
+    """``(theta_tt [rad/s^2], self_locking)`` from :func:`reference.engine.dynamics.solve_dynamics` on
+    one sample (the reference engine's right-hand side before the series; milliseconds)."""
+    _, fixed = solve_dynamics(scene, np.array([theta]), np.array([theta_t]), torque_in=torque_in,
+                              load_torque=scene.load.at(np.array([t])), bands=bands)
+    return float(fixed.x[0, -1]), bool(fixed.self_locking[0])
+
+
+METHODS = ("auto", "series", "direct")
+
+
+def right_hand_side(scene: Scene, torque_in: float, method: str = "auto") -> Acceleration:
+    """The input acceleration as a function ``(t, theta, theta_t) -> (theta_tt, self_locking)``.
+
+    ``method``: ``"series"`` (:class:`ForwardDynamics`; ValueError where it cannot be built),
+    ``"direct"`` (:func:`direct_acceleration`) or ``"auto"`` (the series, else the direct solve).
+    """
+    if method not in METHODS:
+        raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")
+    if method != "direct":
+        fast = ForwardDynamics.of_scene(scene, torque_in)
+        if fast is not None:
+            return fast
+        if method == "series":
+            raise ValueError("the forward dynamics' series cannot be built for this scene (the loop "
+                             "does not close at some angle, or the grid does not resolve it)")
+    bands = slot_bands(scene, friction_slots(scene))  # once: one sample per call
+    return lambda t, theta, theta_t: direct_acceleration(scene, torque_in, t, theta, theta_t, bands)

@@ -1,0 +1,222 @@
+"""Closed-form kinematics of the ideal Cardan (Hooke's) joint, vectorised over time.
+
+Conventions are those of :mod:`reference.scene.joint`: input axis global x, output axis
+``a2 = (cos b, sin b, 0)``; at input angle 0 the input yoke's trunnions lie along global y and
+the output yoke's along global z. With these conventions the canonical body frames are
+
+- input: ``Rx(theta)``;
+- spider: ``Rx(theta) Ry(gamma)`` with ``gamma = atan2(sin b sin theta, cos b)``, so its y axis
+  stays on the input yoke and its z axis on the output yoke;
+- output: ``Rz(b) Rx(theta_out)`` with ``tan(theta_out) = tan(theta) / cos b``.
+
+Every function takes arrays of any (common) shape; rotation matrices get two trailing axes of
+length 3 and vectors one. Angles are in radians, times in seconds.
+
+See also :mod:`reference.physics.rccc`: the same joint as an RCCC loop in dual numbers, with mounting errors.
+
+References
+----------
+Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
+experimental validation", Section 3 (the ideal joint is the RCCC mechanism without errors).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
+
+
+def rot_x(angle: np.ndarray) -> np.ndarray:
+    """Rotation matrices about x [-], shape ``angle.shape + (3, 3)``."""
+    c, s = np.cos(angle), np.sin(angle)
+    one, zero = np.ones_like(c), np.zeros_like(c)
+    return np.stack([np.stack([one, zero, zero], -1),
+                     np.stack([zero, c, -s], -1),
+                     np.stack([zero, s, c], -1)], -2)
+
+
+def rot_y(angle: np.ndarray) -> np.ndarray:
+    """Rotation matrices about y [-], shape ``angle.shape + (3, 3)``."""
+    c, s = np.cos(angle), np.sin(angle)
+    one, zero = np.ones_like(c), np.zeros_like(c)
+    return np.stack([np.stack([c, zero, s], -1),
+                     np.stack([zero, one, zero], -1),
+                     np.stack([-s, zero, c], -1)], -2)
+
+
+def rot_z(angle: np.ndarray) -> np.ndarray:
+    """Rotation matrices about z [-], shape ``angle.shape + (3, 3)``."""
+    c, s = np.cos(angle), np.sin(angle)
+    one, zero = np.ones_like(c), np.zeros_like(c)
+    return np.stack([np.stack([c, -s, zero], -1),
+                     np.stack([s, c, zero], -1),
+                     np.stack([zero, zero, one], -1)], -2)
+
+
+def output_angle(theta: np.ndarray, beta: float) -> np.ndarray:
+    """Output shaft angle of Hooke's joint, continuous in ``theta``.
+
+    Parameters
+    ----------
+    theta : ndarray
+        Input shaft angle [rad].
+    beta : float
+        Shaft angle between the two axes [rad], in [0, pi/2).
+
+    Returns
+    -------
+    ndarray
+        ``theta_out = atan2(sin theta, cos b cos theta)`` unwrapped [rad]: written as
+        ``theta`` plus the lag ``atan2((1 - cos b) sin theta cos theta, cos b cos^2 theta +
+        sin^2 theta)``, whose second argument is positive, so no branch jumps occur.
+    """
+    c, s, cb = np.cos(theta), np.sin(theta), np.cos(beta)
+    return theta + np.arctan2((1.0 - cb) * s * c, cb * c**2 + s**2)
+
+
+def speed_ratio(theta: np.ndarray, beta: float) -> np.ndarray:
+    """Hooke's speed ratio ``omega_out / omega_in = cos b / (1 - sin^2 b cos^2 theta)`` [-]."""
+    return np.cos(beta) / (1.0 - np.sin(beta) ** 2 * np.cos(theta) ** 2)
+
+
+def speed_ratio_slope(theta: np.ndarray, beta: float) -> np.ndarray:
+    """Derivative of :func:`speed_ratio` with respect to the input angle [1/rad]."""
+    d = 1.0 - np.sin(beta) ** 2 * np.cos(theta) ** 2
+    return -np.cos(beta) * np.sin(beta) ** 2 * np.sin(2.0 * theta) / d**2
+
+
+def output_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
+                  beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Output angle [rad], speed [rad/s] and acceleration [rad/s^2] for a given input motion.
+
+    Parameters
+    ----------
+    theta, theta_t, theta_tt : ndarray
+        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
+    beta : float
+        Shaft angle [rad].
+    """
+    ratio = speed_ratio(theta, beta)
+    return (output_angle(theta, beta), ratio * theta_t,
+            speed_ratio_slope(theta, beta) * theta_t**2 + ratio * theta_tt)
+
+
+def spider_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
+                  beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Spider angle about the input yoke axis, relative to the input, and its rates.
+
+    ``gamma = atan2(sin b sin theta, cos b)`` [rad] (``|gamma| <= b``); its rate is
+    ``h(theta) theta_t`` with ``h = sin b cos b cos theta / (1 - sin^2 b cos^2 theta)``.
+
+    Returns
+    -------
+    gamma, gamma_t, gamma_tt : ndarray
+        [rad], [rad/s], [rad/s^2].
+    """
+    sb, cb = np.sin(beta), np.cos(beta)
+    c, s = np.cos(theta), np.sin(theta)
+    d = 1.0 - sb**2 * c**2
+    h = sb * cb * c / d
+    h_theta = -sb * cb * s * (1.0 + sb**2 * c**2) / d**2
+    return np.arctan2(sb * s, cb), h * theta_t, h_theta * theta_t**2 + h * theta_tt
+
+
+@dataclass(frozen=True)
+class BodyMotion:
+    """Orientation and angular motion of one body (global components).
+
+    Attributes
+    ----------
+    rotation : ndarray, shape (..., 3, 3)
+        Columns: the canonical body axes in global coordinates [-].
+    omega : ndarray, shape (..., 3)
+        Angular velocity [rad/s].
+    alpha : ndarray, shape (..., 3)
+        Angular acceleration [rad/s^2].
+    """
+
+    rotation: np.ndarray
+    omega: np.ndarray
+    alpha: np.ndarray
+
+
+def body_motions(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
+                 beta: float) -> dict[str, BodyMotion]:
+    """Motion of ``ground``, ``input``, ``spider`` and ``output`` for a given input motion.
+
+    Parameters
+    ----------
+    theta, theta_t, theta_tt : ndarray
+        Input angle [rad], speed [rad/s] and acceleration [rad/s^2], same shape.
+    beta : float or ndarray
+        Shaft angle [rad] (an array: one per sample, broadcast with ``theta``).
+
+    Returns
+    -------
+    dict of str to BodyMotion
+        The spider's angular velocity is ``theta_t e_x + gamma_t u1`` with ``u1`` the input yoke
+        axis; its acceleration adds the transport term ``gamma_t (theta_t e_x x u1)``.
+    """
+    theta, theta_t, theta_tt = np.broadcast_arrays(*(np.asarray(v, float)
+                                                     for v in (theta, theta_t, theta_tt)))
+    e_x = np.array([1.0, 0.0, 0.0])
+    if np.ndim(beta) == 0:
+        a2 = np.array([np.cos(beta), np.sin(beta), 0.0])
+    else:
+        a2 = np.stack(np.broadcast_arrays(np.cos(beta), np.sin(beta), 0.0), -1)
+    gamma, gamma_t, gamma_tt = spider_motion(theta, theta_t, theta_tt, beta)
+    theta_out, omega_out, alpha_out = output_motion(theta, theta_t, theta_tt, beta)
+    a_in = rot_x(theta)
+    u1 = a_in[..., :, 1]
+    w_in, dw_in = theta_t[..., None] * e_x, theta_tt[..., None] * e_x
+    w_spider = w_in + gamma_t[..., None] * u1
+    dw_spider = (dw_in + gamma_tt[..., None] * u1
+                 + gamma_t[..., None] * np.cross(w_in, u1))
+    zero = np.zeros(theta.shape + (3,))
+    return {
+        "ground": BodyMotion(np.broadcast_to(np.eye(3), zero.shape + (3,)), zero, zero),
+        "input": BodyMotion(a_in, w_in, dw_in),
+        "spider": BodyMotion(a_in @ rot_y(gamma), w_spider, dw_spider),
+        "output": BodyMotion(rot_z(np.full_like(theta, beta)) @ rot_x(theta_out),
+                             omega_out[..., None] * a2, alpha_out[..., None] * a2),
+    }
+
+
+def pair_frames_in_body_a() -> dict[str, np.ndarray]:
+    """Each pair's frame (columns x, y, z; z the pair axis) in body a's canonical axes [-].
+
+    In the reference configuration these are, in global axes: ``frame_input`` (e_y, e_z, e_x),
+    ``input_spider`` (e_z, e_x, e_y), ``spider_output`` (e_x, e_y, e_z) and ``output_frame``
+    ((-sin b, cos b, 0), e_z, a2); the last one is (e_y, e_z, e_x) in the output's canonical
+    axes, which are turned by b about z.
+    """
+    e_x, e_y, e_z = np.eye(3)
+    return {
+        "frame_input": np.column_stack([e_y, e_z, e_x]),
+        "input_spider": np.column_stack([e_z, e_x, e_y]),
+        "spider_output": np.eye(3),
+        "output_frame": np.column_stack([e_y, e_z, e_x]),
+    }
+
+
+def pair_frames(motions: dict[str, BodyMotion]) -> dict[str, np.ndarray]:
+    """Pair frames moving with body a, global components, shape (..., 3, 3) [-]."""
+    local = pair_frames_in_body_a()
+    return {p: motions[PAIR_BODIES[p][0]].rotation @ local[p] for p in PAIR_NAMES}
+
+
+def relative_speeds(motions: dict[str, BodyMotion]) -> dict[str, np.ndarray]:
+    """Angular speed of body b relative to body a about each pair's axis [rad/s].
+
+    In the ideal joint the pairs do not slide, so the relative sliding speeds are all zero.
+    """
+    frames = pair_frames(motions)
+    out = {}
+    for pair in PAIR_NAMES:
+        a, b = PAIR_BODIES[pair]
+        relative = motions[b].omega - motions[a].omega
+        out[pair] = np.einsum("...i,...i->...", relative, frames[pair][..., :, 2])
+    return out
