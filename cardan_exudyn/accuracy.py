@@ -196,7 +196,7 @@ def quadrature_estimate(result: Result) -> ErrorEstimate:
     values = mean_values(s)
     means = {k: e + ode_rtol * abs(values.get(k, 0.0)) for k, e in means.items()}
     columns = {}
-    if result.table is not None:
+    if result.has_table:
         columns = {c: ode_rtol * float(np.nanmax(np.abs(result.table[c].to_numpy(float)), initial=0.0))
                    for c in result.table.columns if c != "t"}
     detail = (f"quadrature rtol {q['rtol']:g}"
@@ -223,7 +223,7 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
         options = replace_fields(options, error_estimate=False)  # no companion: it would be
         # the run being halved
     try:
-        finer = run(half_step_scene(scene, s.dt, result.table is not None), s.engine, options)
+        finer = run(half_step_scene(scene, s.dt, result.has_table), s.engine, options)
     except SceneError as exc:
         raise AccuracyError(f"cannot rerun at half the step: {exc}") from None
     if not finer.success:
@@ -233,7 +233,7 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
     coarse, fine = mean_values(s), mean_values(finer.summary)
     means = {k: factor * abs(v - fine[k]) for k, v in coarse.items() if k in fine}
     columns = {}
-    if result.table is not None and finer.table is not None:
+    if result.has_table and finer.has_table:
         changes = row_changes(result.table, finer.table, s.dt, skip_revolutions)
         columns = {c: factor * d for c, d in changes.items()}
     detail = f"step halving: dt = {s.dt:.4g} s and {0.5 * s.dt:.4g} s, order {order}"

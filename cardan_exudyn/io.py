@@ -385,7 +385,7 @@ def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
 def result_files(result: Result) -> list[str]:
     """The files :func:`write_result_files` writes for ``result``: ``timeseries.csv`` only when a
     table was recorded (``record.timeseries``), then ``summary.json``."""
-    return (["timeseries.csv"] if result.table is not None else []) + ["summary.json"]
+    return (["timeseries.csv"] if result.has_table else []) + ["summary.json"]
 
 
 def write_result_files(result: Result, folder: Path) -> None:

@@ -187,3 +187,26 @@ def test_import_cost_measures_cardan_run():
 def test_import_cost_refuses_bad_repeats(repeats):
     with pytest.raises(ValueError, match="`repeats` must be a positive integer"):
         import_cost(repeats)
+
+
+WHOLE_RUN = """
+import sys
+import cardan_exudyn.cli as cli
+status = cli.main(sys.argv[1:])
+print("pandas" in sys.modules, status)
+"""
+
+
+@pytest.mark.parametrize("engine", ["exudyn", "reference"])
+def test_a_run_without_out_builds_no_table(engine, tmp_path):
+    """``cardan run`` without ``--out`` never imports pandas (nobody reads its time table); with
+    ``--out`` the table is built and written."""
+    base = ["run", "--engine", engine, "--revolutions", "1"]
+    bare = subprocess.run([sys.executable, "-c", WHOLE_RUN, *base], capture_output=True, text=True,
+                          timeout=300)
+    assert bare.stdout.splitlines()[-1] == "False 0", bare.stderr
+    out = tmp_path / "out"
+    written = subprocess.run([sys.executable, "-c", WHOLE_RUN, *base, "--out", str(out)],
+                             capture_output=True, text=True, timeout=300)
+    assert written.stdout.splitlines()[-1] == "True 0", written.stderr
+    assert (out / "timeseries.csv").stat().st_size > 0

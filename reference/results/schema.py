@@ -322,20 +322,64 @@ class Summary:
                       "is not reported: it may span a reversal of the power flow")
 
 
-@dataclass
+class DeferredTable:
+    """The columns of a time table, turned into a pandas DataFrame only when someone reads it.
+
+    Why: importing pandas costs about 0.4 s, ten times a short run's solve; a run whose table
+    nobody writes or returns should not pay it.
+    """
+
+    def __init__(self, columns: Mapping[str, np.ndarray], every: int, names: list[str]) -> None:
+        self._columns = {c: columns[c][::every] for c in names}
+
+    def build(self) -> Any:
+        """The table as a pandas DataFrame, every ``every``-th row."""
+        import pandas as pd  # import cost: see the class docstring
+
+        return pd.DataFrame(self._columns)
+
+
 class Result:
     """What every engine returns: a time table (or None) and a :class:`Summary`.
 
-    Attributes
+    Parameters
     ----------
-    table : pandas.DataFrame or None
+    table : pandas.DataFrame, DeferredTable or None
         The columns of :func:`table_columns` (and engine extras), every ``record.every``-th row;
-        None when the scene does not record the time series or the run failed.
+        None when the scene does not record the time series or the run failed. A
+        :class:`DeferredTable` is built on first access of :attr:`table`.
     summary : Summary
     """
 
-    table: Any  # pandas.DataFrame or None
-    summary: Summary
+    __slots__ = ("_table", "summary")
+
+    def __init__(self, table: Any, summary: Summary) -> None:
+        self._table = table
+        self.summary = summary
+
+    def __repr__(self) -> str:
+        return f"Result(status={self.summary.status.value!r}, table={self.has_table})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Result):
+            return NotImplemented
+        return self.summary == other.summary and self.table is other.table
+
+    @property
+    def table(self) -> Any:
+        """The time table (pandas.DataFrame) or None."""
+        if isinstance(self._table, DeferredTable):
+            self._table = self._table.build()
+        return self._table
+
+    @table.setter
+    def table(self, value: Any) -> None:
+        self._table = value
+
+    @property
+    def has_table(self) -> bool:
+        """True when the run recorded a time table (without building it)."""
+        return self._table is not None
 
     @property
     def status(self) -> Status:
@@ -357,13 +401,10 @@ class Result:
         return self.summary.mean_efficiency
 
 
-
 def result_table(columns: Mapping[str, np.ndarray], every: int, extra: tuple[str, ...] = ()) -> Any:
     """The time table of a result: the schema's columns (and an engine's ``extra`` ones), every
-    ``every``-th row, as a pandas DataFrame."""
-    import pandas as pd  # pandas takes ~0.5 s to import; only a recorded table needs it
-
-    return pd.DataFrame({c: columns[c][::every] for c in table_columns() + list(extra)})
+    ``every``-th row, built as a pandas DataFrame when first read (:class:`DeferredTable`)."""
+    return DeferredTable(columns, every, table_columns() + list(extra))
 
 
 def after_revolutions(theta_in: np.ndarray, skip_revolutions: float) -> np.ndarray:
