@@ -132,13 +132,60 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return found
 
 
+def docstring_lines(path: Path) -> tuple[int, int]:
+    """(docstring lines, code lines) of a module: docstrings of the module, classes and functions
+    (and attribute docstrings, string statements) against every other non-blank, non-comment line."""
+    text = path.read_text(encoding="utf-8")
+    doc_rows: set[int] = set()
+    for node in ast.walk(ast.parse(text)):
+        if (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+                and isinstance(node.value.value, str)):
+            doc_rows.update(range(node.lineno, node.end_lineno + 1))
+    code = 0
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if stripped and not stripped.startswith("#") and number not in doc_rows:
+            code += 1
+    return len(doc_rows), code
+
+
+def packed_assignments(path: Path) -> list[int]:
+    """Lines assigning a literal tuple of two or more expressions to as many names
+    (``a, b = f(x), g(y)``): statements packed onto one line."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if (isinstance(node, ast.Assign) and len(node.targets) == 1
+                and isinstance(node.targets[0], ast.Tuple) and isinstance(node.value, ast.Tuple)
+                and len(node.value.elts) >= 2):
+            found.append(node.lineno)
+    return found
+
+
+def figures(root: Path = ROOT) -> dict[str, float]:
+    """The headline figures of the product code: modules, lines, docstring lines per 100 code
+    lines, functions over 30 lines, packed tuple assignments."""
+    files = product_files(root)
+    docs = [docstring_lines(p) for p in files]
+    lengths = [f.length for p in files for f in functions(p, root)]
+    return {
+        "modules": len(files),
+        "lines": sum(module_lines(root).values()),
+        "docstring_lines_per_100_code": round(100 * sum(d for d, _ in docs) / sum(c for _, c in docs), 1),
+        "functions": len(lengths),
+        "functions_over_30": sum(n > 30 for n in lengths),
+        "packed_assignments": sum(len(packed_assignments(p)) for p in files),
+    }
+
+
 def report(root: Path = ROOT) -> str:
     sizes = module_lines(root)
     lengths = [f.length for p in product_files(root) for f in functions(p, root)]
     deciles = statistics.quantiles(lengths, n=10)
     over_60 = sorted((f for p in product_files(root) for f in functions(p, root) if f.length > 60),
                      key=lambda f: -f.length)
+    headline = figures(root)
     lines = [
+        "figures: " + ", ".join(f"{k} {v}" for k, v in headline.items()),
         f"modules: {len(sizes)}, lines: {sum(sizes.values())}, largest: "
         + ", ".join(f"{m} {n}" for m, n in sorted(sizes.items(), key=lambda kv: -kv[1])[:5]),
         f"modules over 600 lines: {sum(n > 600 for n in sizes.values())}",
