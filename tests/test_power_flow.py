@@ -225,13 +225,24 @@ def test_aiding_load_makes_the_output_the_source(engine):
     the mirror image (the forward speed with the load reversed) flows the same way."""
     scene = replace(named_scene("paper-literal"), revolutions=1.0, gravity=(0.0, 0.0, 0.0),
                     **{"record.skip_revolutions": 0.0})
-    aiding = run_engine(replace(scene, **{"drive.speed": -scene.drive.speed}), engine)
+    aiding_scene = replace(scene, **{"drive.speed": -scene.drive.speed})
+    aiding = run_engine(aiding_scene, engine)
     s = aiding.summary
     assert s.success and s.power_flow == "output_to_input"
     assert s.input_work < 0 and s.output_work < 0
     check_efficiency_contract(s)
-    assert 0.1 < s.mean_efficiency < 0.5  # measured 0.23
+    # 0.23: the reference's value (exact to its quadrature, 1e-9) to the two digits stated; the
+    # other engine independently to Exudyn's target accuracy (numerics.accuracy, the absolute
+    # error of the mean efficiency its automatic step is chosen for; measured 1.3e-4 apart)
+    other = run_engine(aiding_scene, "exudyn" if engine == "reference" else "reference").summary
+    reference = s if engine == "reference" else other
+    assert abs(reference.mean_efficiency - 0.23) <= 0.005, reference.mean_efficiency
+    assert abs(s.mean_efficiency - other.mean_efficiency) <= scene.numerics.accuracy
     assert s.power_reversals == 0 and (aiding.table["power_out"] < 0).all()
+    mirror = run_engine(reversed_scene(aiding_scene), engine).summary
+    assert mirror.success and mirror.power_flow == "output_to_input"
+    tol = REFERENCE_TOL if engine == "reference" else 10 * scene.friction.tolerance
+    assert abs(mirror.mean_efficiency - s.mean_efficiency) <= tol
     assert sign_changes(np.array([1.0, 0.0, -2.0, -1.0, 3.0])) == 2
 
 
@@ -279,9 +290,12 @@ def test_time_average_of_eq18_not_reported_where_undefined():
     scene = replace(named_scene("paper-literal-35deg"), revolutions=1.0,
                     **{"record.skip_revolutions": 0.0, "record.timeseries": False})
     s = run_engine(scene, "reference").summary
-    assert s.success and 0.0 < s.mean_efficiency < 1.0
+    # the reference's values (exact to its quadrature, 1e-9) to the digits the docstring states
+    assert s.success and abs(s.mean_efficiency - 0.25) <= 0.005, s.mean_efficiency
     assert s.mean_instantaneous_efficiency is None
-    assert any("eq. (18)" in w for w in s.warnings)
+    [note] = [w for w in s.warnings if "eq. (18)" in w]
+    average = float(re.search(r"eq\. \(18\), (\S+), is outside \[0, 1\]", note).group(1))
+    assert abs(average - -0.83) <= 0.005, note
 
 
 @pytest.mark.parametrize("works, flow, eta", [
