@@ -5,6 +5,7 @@ a-posteriori estimate every run reports, refusals and the ``accuracy not met`` s
 from __future__ import annotations
 
 import math
+import re
 
 import pytest
 
@@ -12,7 +13,10 @@ from cardan_exudyn import run
 from cardan_exudyn.arguments import EXIT_INACCURATE
 from cardan_exudyn.cli import main
 from cardan_exudyn.model.stepsize import (
+    EFFICIENCY_FIRST_ORDER,
+    EFFICIENCY_SECOND_ORDER,
     convergence_order,
+    error_coefficient,
     efficiency_error,
     efficiency_steps,
     plan_steps,
@@ -97,7 +101,13 @@ def test_only_the_lagged_coupling_has_a_first_order_term():
     lagged = replace(scene, **{"friction.coupling": "lagged"})
     assert efficiency_error(scene, 400, 0.5) == pytest.approx(4.0 * efficiency_error(scene, 800, 0.5))
     ratio = efficiency_error(lagged, 400, 0.5) / efficiency_error(lagged, 800, 0.5)
-    assert 2.0 < ratio < 2.2  # the first-order term dominates (C1 h against (C2 + K) h^2)
+    # the closed form C1 h + S h^2 (S = C2 + K), h = 2 pi / 400, over its value at h / 2; near 2
+    # where the first-order term dominates (C1 h against S h^2)
+    h = 2.0 * math.pi / 400
+    first = EFFICIENCY_FIRST_ORDER * h
+    second = (EFFICIENCY_SECOND_ORDER + error_coefficient(scene.joint.geometry.shaft_angle)) * h * h
+    assert ratio == pytest.approx((first + second) / (first / 2 + second / 4), rel=1e-12)
+    assert 2.0 < ratio < 2.2
 
 
 def test_companion_is_two_to_three_times_the_step():
@@ -138,7 +148,13 @@ def test_frictionless_run_reports_zero_error_without_a_companion():
 def test_reference_reports_its_quadrature_estimate():
     """The reference engine reports its quadrature's estimate in the same field."""
     s = run(replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION), "reference").summary
-    assert 0.0 <= s.efficiency_error_estimate < 1e-6  # rtol 1e-9 of works of ~25 J
+    q = s.extras["quadrature"]
+    e_in, e_loss = q["input_work_error_estimate"], q["loss_work_error_estimate"]
+    # first-order propagation of the works' estimates through 1 - W_loss / W_in
+    expected = e_loss / abs(s.input_work) + abs(s.loss_work) * e_in / s.input_work ** 2
+    assert s.efficiency_error_estimate == pytest.approx(expected, rel=1e-12)
+    # each work is accepted at quadrature_rtol of the input work: the estimate is below 2 rtol
+    assert 0.0 < s.efficiency_error_estimate <= 2.0 * q["rtol"]
     assert s.accuracy_met is True
 
 
@@ -146,9 +162,13 @@ def test_given_coarse_step_is_flagged(capsys):
     """The issue's ``--dt 0.005`` (0.175 against 0.4749): warned before running, the estimate
     exceeds the target, ``accuracy_met`` is false and ``cardan run`` exits 5."""
     status = main(["run", "--name", "paper-literal-10deg", "--dt", "0.005", "--revolutions", "1"])
-    err = capsys.readouterr().err
+    out, err = capsys.readouterr()
     assert status == EXIT_INACCURATE
     assert "may miss the accuracy" in err and "accuracy not met" in err
+    estimate = float(re.search(r"\+- (\S+) \(estimated, ACCURACY NOT MET\)", out).group(1))
+    assert estimate > 1e-3, out  # the default target
+    printed = re.search(r"estimated mean-efficiency error (\S+) > target 0\.001", err)
+    assert printed and float(printed.group(1)) == estimate, err
 
 
 # small grid off the paper's: (angle deg, rpm, friction, errors, drive)
