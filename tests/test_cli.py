@@ -69,11 +69,19 @@ def test_bad_cli_input(args, message):
     assert proc.stdout == ""
 
 
-def test_scene_command_prints_toml():
+def test_scene_command_prints_toml(tmp_path):
     """`cardan scene` prints the resolved scene, which loads back."""
-    proc = cardan("scene", "--name", "paper-literal-frictionless", "--angle", "12")
+    from cardan_exudyn.arguments import scene_from_args
+    from cardan_exudyn.cli import build_parser
+    from reference import load_scene
+
+    argv = ["scene", "--name", "paper-literal-frictionless", "--angle", "12"]
+    proc = cardan(*argv)
     assert proc.returncode == 0
     assert "shaft_angle = 0.2094" in proc.stdout
+    path = tmp_path / "printed.toml"
+    path.write_text(proc.stdout)
+    assert load_scene(path) == scene_from_args(build_parser().parse_args(argv))
 
 
 def test_reproduce_quick(tmp_path):

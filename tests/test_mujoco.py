@@ -134,6 +134,9 @@ def test_columns_and_summary_follow_the_schema(runs):
         assert value is not None and value == value  # set and not NaN
     assert summary.engine == "mujoco"
     assert summary.dt == DT
+    reference = engines.run(scene, "reference").summary
+    # the keys of every engine (the reference's), but each engine's own extras
+    assert set(summary.to_dict()) - set(summary.extras) == set(reference.to_dict()) - set(reference.extras)
     assert set(summary.to_dict()) >= {"status", "reason", "max_drive_error_rad", "mean_efficiency"}
 
 
