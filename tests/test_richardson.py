@@ -13,6 +13,7 @@ from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.cli import main
 from cardan_exudyn.model import richardson
 from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.physics.kinematics import speed_ratio
 from reference.paper.paper import named_scene
 from reference.scene.scene import replace
 from reference.scene.files import load_scene
@@ -86,6 +87,10 @@ def test_extrapolated_drive_torque_is_closer_to_the_reference_than_either_run():
     assert coarse.success and fine.success and combined.success
     errors = [_steady_torque_error(base, r) for r in (coarse, fine, combined)]
     assert errors[2] < 0.5 * min(errors[:2]), errors
+    # the projected speeds are exact for the computed positions: Hooke's ratio to rounding
+    table = combined.table
+    hooke = speed_ratio(table["theta_in"].to_numpy(), base.joint.geometry.shaft_angle)
+    assert np.max(np.abs(table["omega_out"] / table["omega_in"] - hooke)) < 1e-12
     assert len(combined.table) == len(coarse.table)
     assert combined.summary.steps == coarse.summary.steps + fine.summary.steps
     info = combined.summary.extras["richardson"]
