@@ -237,5 +237,8 @@ def test_converged_coupling_beats_lagged_at_every_step():
     err = {(r["coupling"], r["steps_per_revolution"]): abs(r["error"]) for r in rows}
     for n in COUPLING_QUICK["ladder"]:
         assert err[("converged", n)] < err[("lagged", n)], n
+    # first order: the error falls by last / first over the ladder, within a factor 2 either way
+    # (order 0.5 to 1.5 over the ladder: neither flat nor second order; measured 4.5 for 4)
     first, last = COUPLING_QUICK["ladder"][0], COUPLING_QUICK["ladder"][-1]
-    assert err[("lagged", first)] > 0.5 * (last / first) * err[("lagged", last)]
+    fall = err[("lagged", first)] / err[("lagged", last)]
+    assert 0.5 * (last / first) < fall < 2.0 * (last / first), fall
