@@ -191,7 +191,9 @@ def test_exudyn_applied_loads_are_the_numpy_resultant_law(rig_runs):
             size = max(size, abs(law[name][0][k]), w * abs(law[name][1][k]))
         assert change <= 1.01 * scene.friction.tolerance * size, k
     force, full = law["input_spider"][1], paper["input_spider"][1]
-    assert np.median(np.abs(force) / np.abs(full)) < 0.5
+    # a fifth to the one digit stated (the median of the rows sampled: 0.193 here, 0.196 on the
+    # reference's rows)
+    assert abs(np.median(np.abs(force) / np.abs(full)) - 0.2) <= 0.05
 
 
 def test_law_option_validates_round_trips_and_reaches_the_cli(tmp_path):
