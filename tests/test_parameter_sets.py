@@ -108,8 +108,7 @@ def test_mean_input_reading_needs_a_constant_speed():
 
 
 def test_literal_set_keeps_its_old_numbers():
-    """The literal set is the former plain set: the same scene, field by field, up to its name
-    and set label (the old reading of Table 1 and the register)."""
+    """The literal set keeps the former plain set's reading: gravity, 2 N m, Table 1's eccentricity."""
     scene = named_scene("paper-literal-10deg")
     assert scene.gravity == (0.0, 0.0, -9.81) and scene.load.torque == 2.0
     # Table 1's 8.6 mm eccentricity, to the digits stated (the scene has 8.568 mm)
