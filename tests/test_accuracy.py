@@ -16,9 +16,9 @@ from cardan_exudyn.model.stepsize import (
     EFFICIENCY_FIRST_ORDER,
     EFFICIENCY_SECOND_ORDER,
     convergence_order,
-    error_coefficient,
     efficiency_error,
     efficiency_steps,
+    error_coefficient,
     plan_steps,
     reversing_parts,
     richardson,
@@ -149,7 +149,8 @@ def test_reference_reports_its_quadrature_estimate():
     """The reference engine reports its quadrature's estimate in the same field."""
     s = run(replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION), "reference").summary
     q = s.extras["quadrature"]
-    e_in, e_loss = q["input_work_error_estimate"], q["loss_work_error_estimate"]
+    e_in = q["input_work_error_estimate"]
+    e_loss = q["loss_work_error_estimate"]
     # first-order propagation of the works' estimates through 1 - W_loss / W_in
     expected = e_loss / abs(s.input_work) + abs(s.loss_work) * e_in / s.input_work ** 2
     assert s.efficiency_error_estimate == pytest.approx(expected, rel=1e-12)

@@ -23,8 +23,8 @@ import pandas as pd
 import pytest
 
 from cardan_exudyn import ExudynOptions
-from cardan_exudyn.model.options import NODE_TYPES
 from cardan_exudyn.engines import run as run_engine
+from cardan_exudyn.model.options import NODE_TYPES
 from cardan_exudyn.model.stepsize import MIN_STEPS_PER_REVOLUTION, efficiency_error
 from cardan_exudyn.studies.stress.longrun import LongRuns, long_runs, simulate
 from cardan_exudyn.studies.stress.longrun_measures import (
