@@ -10,12 +10,12 @@ from test_reference_kinematics import derivative
 
 from reference.engine import solve as engine
 from reference.engine.dynamics import inverse_dynamics, reaction_system
-from reference.scene.joint import Body, Geometry, Joint
+from reference.scene.joint import PAIR_NAMES, Body, Geometry, Joint
 from reference.physics.joint_motion import joint_motion
 from reference.physics.kinematics import body_motions, speed_ratio
 from reference.paper.paper import named_scene
 from reference.scene.scene import Load, Scene, SpeedDrive, replace
-from reference.results.schema import Status, table_columns
+from reference.results.schema import Status, Summary, table_columns
 
 EPS = np.finfo(float).eps
 M_IN, M_SPIDER, M_OUT = 0.9, 0.05, 0.8  # [kg]
@@ -163,6 +163,10 @@ def test_result_follows_the_schema():
     assert table["theta_in"].iloc[-1] == pytest.approx(4 * np.pi, rel=1e-15)
     assert s.status is Status.OK and s.engine == "reference" and s.scene["name"] == scene.name
     assert {"engine_version", "wall_time_s", "input_work", "mean_efficiency"} <= s.to_dict().keys()
+    # every field of the schema's summary, and beyond it only per-pair losses and the engine's extras
+    schema = set(Summary(Status.OK).to_dict())
+    pairs = {f"loss_work_{p}" for p in PAIR_NAMES} | {f"loss_work_{p}_sliding" for p in PAIR_NAMES}
+    assert schema <= s.to_dict().keys() <= schema | pairs | set(s.extras)
     # no friction, no sliding, and no axial force / torque in the cylindrical pairs
     zero_suffixes = ("_mz", "friction_torque", "friction_force", "slide_rel")
     zero_cols = [c for c in table_columns() if c.startswith("power_loss") or c.endswith(zero_suffixes)
