@@ -35,10 +35,10 @@ import cardan_exudyn
 from cardan_exudyn.arguments import scene_from_args
 from cardan_exudyn.cli import build_parser, main
 from cardan_exudyn.model.solve import MODEL_FLOOR
-from cardan_exudyn.studies.calibrate import case_rows, fit_statistics
-from cardan_exudyn.studies.fitting import CaseModel
+from cardan_exudyn.studies.calibrate.compute import case_rows, fit_statistics
+from cardan_exudyn.studies.calibrate.fitting import CaseModel
 from cardan_exudyn.testing import make_scene
-from reference.paper import envelope, paper_cases, parameter_set, set_values
+from reference.paper.paper import envelope, paper_cases, parameter_set, set_values
 
 pytest_plugins = ["pytester"]
 
