@@ -15,6 +15,7 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.model.stepsize import (
     EFFICIENCY_FIRST_ORDER,
     EFFICIENCY_SECOND_ORDER,
+    choose_step,
     convergence_order,
     efficiency_error,
     efficiency_steps,
@@ -75,6 +76,22 @@ def test_unreachable_accuracy_is_refused_before_running(accuracy, angle):
         plan_steps(scene, 0.5)
     with pytest.raises(SceneError, match="steps per input revolution"):
         run(scene)
+
+
+@pytest.mark.parametrize("changes", [{}, {"numerics.richardson": True}], ids=["plain", "richardson"])
+def test_unreachable_accuracy_without_friction_is_refused_before_running(changes, capsys):
+    """Without friction the automatic step is refused like the friction path's (never capped at
+    the limit): SceneError with the predicted steps and time from the step choice and from
+    ``run``, and ``cardan run`` exits 2 with it on stderr."""
+    scene = replace(named_scene("paper-literal-10deg-frictionless"), **changes,
+                    **{"joint.geometry.shaft_angle": math.radians(89.9)})
+    unreachable = r"speed-ratio error of 0.001 at 89.9 deg needs .* steps per input revolution .* about .* s"
+    with pytest.raises(SceneError, match=unreachable):
+        choose_step(scene)
+    with pytest.raises(SceneError, match=unreachable):
+        run(scene)
+    status = main(["run", "--name", "paper-literal-10deg-frictionless", "--angle", "89.9"])
+    assert status == 2 and re.search(unreachable, capsys.readouterr().err)
 
 
 def test_reversing_parts_follow_angle_errors_and_drive():

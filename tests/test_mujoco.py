@@ -33,6 +33,7 @@ from reference.engine.dynamics import inverse_dynamics  # noqa: E402
 from reference.paper.paper import named_scene  # noqa: E402
 from reference.scene.scene import Numerics, Scene, TorqueDrive, replace  # noqa: E402
 from reference.results.schema import OptionsError, Result, Status, table_columns  # noqa: E402
+from reference.scene.validation import SceneError  # noqa: E402
 
 DT = 1e-4
 STEPS_PER_REVOLUTION = 300  # 2000 rpm at DT
@@ -147,6 +148,18 @@ def test_friction_scene_is_refused():
         mujoco_engine.run(named_scene("paper-literal-10deg"))
     with pytest.raises(engines.EngineUnavailable, match="friction"):
         run(named_scene("paper-literal-10deg"))
+
+
+def test_unreachable_accuracy_is_refused_before_running():
+    """An automatic step needing more steps per revolution than allowed is refused with the
+    predicted steps and time (SceneError: ``cardan run`` exits 2), never capped at the limit."""
+    scene = replace(named_scene("paper-literal-10deg-frictionless"),
+                    **{"joint.geometry.shaft_angle": math.radians(89.9)})
+    unreachable = r"speed-ratio error of 0.001 at 89.9 deg needs .* steps per input revolution .* about .* s"
+    with pytest.raises(SceneError, match=unreachable):
+        mujoco_engine.choose_timestep(scene, MujocoOptions())
+    with pytest.raises(SceneError, match=unreachable):
+        run(scene)
 
 
 def test_mujoco_defaults_are_flagged():

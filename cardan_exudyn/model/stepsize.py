@@ -29,11 +29,11 @@ import math
 
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.scene import AngleDrive, Scene, SpeedDrive
-from reference.scene.validation import SceneError
+from reference.scene.validation import MAX_STEPS_PER_REVOLUTION, refuse_steps_per_revolution
 
 __all__ = ["ERROR_CONSTANT", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS_PER_REVOLUTION", "NODE_ERROR",
            "EFFICIENCY_FIRST_ORDER", "EFFICIENCY_FIRST_ORDER_ERRORS", "EFFICIENCY_SECOND_ORDER",
-           "SECONDS_PER_STEP",
+           "SECONDS_PER_STEP", "SECONDS_PER_FRICTIONLESS_STEP",
            "MIN_COMPANION_STEPS", "error_coefficient", "steps_per_revolution", "choose_step",
            "reversing_parts", "has_errors", "convergence_order",
            "efficiency_error",
@@ -43,7 +43,6 @@ __all__ = ["ERROR_CONSTANT", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS_PER_REVOLUTI
 
 ERROR_CONSTANT = 0.19
 MIN_STEPS_PER_REVOLUTION = 100
-MAX_STEPS_PER_REVOLUTION = 2_000_000
 
 
 NODE_ERROR = {"Rxyz": (0.0, 1.0), "RotVecLG": (0.0, 2.0), "EP": (0.045, 2.2)}
@@ -57,12 +56,10 @@ def error_coefficient(shaft_angle: float, node_type: str = "Rxyz") -> float:
 
 
 def steps_per_revolution(shaft_angle: float, accuracy: float, node_type: str = "Rxyz") -> int:
-    """Steps per input revolution that meet ``accuracy`` on the speed ratio."""
-    k = error_coefficient(shaft_angle, node_type)
-    if k == 0.0:
-        return MIN_STEPS_PER_REVOLUTION
-    n = math.ceil(2.0 * math.pi / math.sqrt(accuracy / k))
-    return int(min(max(n, MIN_STEPS_PER_REVOLUTION), MAX_STEPS_PER_REVOLUTION))
+    """Steps per input revolution that meet ``accuracy`` on the speed ratio, at least
+    :data:`MIN_STEPS_PER_REVOLUTION`; not capped (the caller refuses beyond
+    :data:`MAX_STEPS_PER_REVOLUTION`, :func:`refuse`): a capped step would miss the accuracy."""
+    return int(max(kinematic_steps(shaft_angle, accuracy, node_type), MIN_STEPS_PER_REVOLUTION))
 
 
 def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
@@ -70,11 +67,16 @@ def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
 
     With a constant-speed drive the step divides one revolution exactly, so that averages over
     whole revolutions need no interpolation at the window ends.
+
+    Raises :class:`SceneError` (:func:`refuse`, before anything runs) when no step is given and
+    ``numerics.accuracy`` on the speed ratio needs more than :data:`MAX_STEPS_PER_REVOLUTION`.
     """
     if scene.numerics.dt is not None:
         return scene.numerics.dt, "given"
     beta = scene.joint.geometry.shaft_angle
     n = steps_per_revolution(beta, scene.numerics.accuracy, node_type)
+    refuse(scene, n, f"a speed-ratio error of {scene.numerics.accuracy:g} at {math.degrees(beta):g} deg",
+           SECONDS_PER_STEP if scene.has_friction else SECONDS_PER_FRICTIONLESS_STEP)
     period = 2.0 * math.pi / scene.drive.max_speed()
     why = (f"auto: {n} steps per input revolution for speed-ratio error "
            f"<= {scene.numerics.accuracy:g} at {math.degrees(beta):g} deg"
@@ -103,6 +105,9 @@ EFFICIENCY_SECOND_ORDER = 3.0
 SECONDS_PER_STEP = 3e-3
 """Wall time of one Exudyn step with friction [s] on one core (measured 2.3 ms at 10 deg), for the
 predicted run time of a refused request before anything ran."""
+SECONDS_PER_FRICTIONLESS_STEP = 1e-4
+"""Wall time of one Exudyn step without friction [s] on one core (measured 61-110 us at 10 deg,
+2000-100000 steps per revolution), for the predicted run time of a refused request."""
 MIN_COMPANION_STEPS = 50
 """Fewest steps per revolution of the companion run (half :data:`MIN_STEPS_PER_REVOLUTION`)."""
 
@@ -198,13 +203,11 @@ def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_t
 
 def refuse(scene: Scene, steps: float, why: str, seconds_per_step: float = SECONDS_PER_STEP) -> None:
     """Raise :class:`SceneError` when ``steps`` per revolution exceed the limits: the predicted
-    steps and run time (at ``seconds_per_step`` [s]), in one line."""
-    if steps <= MAX_STEPS_PER_REVOLUTION:
-        return
-    total = steps * scene.revolutions * (4.0 if scene.drive.kind == "torque" else 1.0)
-    raise SceneError(f"{why} needs {steps:.3g} steps per input revolution (at most "
-                     f"{MAX_STEPS_PER_REVOLUTION:.0e}): {total:.3g} steps, about "
-                     f"{total * seconds_per_step:.3g} s; ask for a larger `accuracy`")
+    steps and run time (at ``seconds_per_step`` [s]), in one line
+    (:func:`reference.validation.refuse_steps_per_revolution`; a torque drive counted as 4 times
+    its revolutions, the time it is allowed)."""
+    revolutions = scene.revolutions * (4.0 if scene.drive.kind == "torque" else 1.0)
+    refuse_steps_per_revolution(steps, revolutions, seconds_per_step, why)
 
 
 def plan_steps(scene: Scene, loss_fraction: float, node_type: str = "Rxyz",

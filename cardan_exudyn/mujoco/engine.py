@@ -41,6 +41,7 @@ from reference.results.schema import (
     instantaneous_efficiency,
     result_table,
 )
+from reference.scene.validation import refuse_steps_per_revolution
 
 ENGINE_NAME = "mujoco"
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast", "discrete")
@@ -161,7 +162,7 @@ class MujocoOptions:
 ERROR_CONSTANT_SPEED = 1.5e-4  # C_H of speed_ratio_error_model [-]
 ERROR_CONSTANT_GRAVITY = 1e-4  # C_G of speed_ratio_error_model [1/m]
 MIN_STEPS_PER_REVOLUTION = 100
-MAX_STEPS_PER_REVOLUTION = 2_000_000
+SECONDS_PER_STEP = 1e-4  # one RK4 step on one core [s]: measured 40-81 us (docs/mujoco.md, "Cost")
 
 
 def engine_version() -> str:
@@ -193,13 +194,15 @@ def choose_timestep(scene: Scene, options: MujocoOptions) -> tuple[float, str]:
 
     Without a given step, the fewest whole steps per revolution (at the drive's highest speed),
     at least :data:`MIN_STEPS_PER_REVOLUTION`, whose :func:`speed_ratio_error_model` meets
-    ``scene.numerics.accuracy``.
+    ``scene.numerics.accuracy`` (beyond ``MAX_STEPS_PER_REVOLUTION``, 2e6, refused, never capped).
 
     Raises
     ------
     OptionsError
         When no step is given and the settings are not the ones the error model was measured
         with (another integrator or an explicit ``solref``).
+    SceneError
+        The accuracy needs more steps than allowed (the predicted steps and run time, one line).
     """
     if options.timestep is not None:
         return options.timestep, "given (engine settings)"
@@ -211,18 +214,17 @@ def choose_timestep(scene: Scene, options: MujocoOptions) -> tuple[float, str]:
                            f"{options.integrator!r} and solref {options.solref!r}")
     accuracy = scene.numerics.accuracy
     low, high = MIN_STEPS_PER_REVOLUTION, MIN_STEPS_PER_REVOLUTION
-    while speed_ratio_error_model(scene, options, high) > accuracy and high < MAX_STEPS_PER_REVOLUTION:
+    while speed_ratio_error_model(scene, options, high) > accuracy and high < 2**60:  # falls with h
         low, high = high, 2 * high
     while high - low > 1:  # the smallest count in (low, high] that meets the accuracy
         middle = (low + high) // 2
-        if speed_ratio_error_model(scene, options, middle) <= accuracy:
-            high = middle
-        else:
-            low = middle
-    n = min(high, MAX_STEPS_PER_REVOLUTION)
-    why = (f"auto: {n} steps per input revolution for a speed-ratio error <= {accuracy:g} at "
-           f"{math.degrees(scene.joint.geometry.shaft_angle):g} deg (error model of docs/mujoco.md)")
-    return 2.0 * math.pi / scene.drive.max_speed() / n, why
+        meets = speed_ratio_error_model(scene, options, middle) <= accuracy
+        low, high = (low, middle) if meets else (middle, high)
+    target = f"a speed-ratio error of {accuracy:g} at {math.degrees(scene.joint.geometry.shaft_angle):g} deg"
+    refuse_steps_per_revolution(high, scene.revolutions * (4.0 if scene.drive.kind == "torque" else 1.0),
+                                SECONDS_PER_STEP, target)
+    why = f"auto: {high} steps per input revolution for {target} at most (error model of docs/mujoco.md)"
+    return 2.0 * math.pi / scene.drive.max_speed() / high, why
 
 
 def _numbers(values: Iterable[float]) -> str:
@@ -557,6 +559,8 @@ def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
     ------
     NotImplementedError
         For scenes with friction: MuJoCo has no friction proportional to the reactions.
+    SceneError
+        ``numerics.accuracy`` needs more steps than allowed (:func:`choose_timestep`).
     """
     if scene.has_friction:
         raise NotImplementedError(

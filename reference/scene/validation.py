@@ -24,6 +24,12 @@ MAX_STEPS = 10_000_000
 before it starts: e.g. ``dt = 1e-12`` s would take days and more memory than a machine has."""
 
 
+MAX_STEPS_PER_REVOLUTION = 2_000_000
+"""Most time steps per input revolution an engine's automatic step may choose. A finer step is
+refused (:func:`refuse_steps_per_revolution`), never capped: a capped step would miss the accuracy
+it was chosen for while the run still took hours."""
+
+
 MAX_MAGNITUDE = 1e12
 """Largest magnitude of any number of a scene, in its SI unit. Far beyond every Cardan joint
 (the largest drive shafts carry about 1e7 N m and turn below 1e4 rad/s), and far enough below
@@ -198,3 +204,17 @@ def check_steps(steps: float, what: str) -> None:
     if not steps <= MAX_STEPS:
         raise SceneError(f"{what} needs {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed: give a "
                          "larger `numerics.dt` (or `numerics.accuracy`) or fewer `revolutions`")
+
+
+def refuse_steps_per_revolution(steps: float, revolutions: float, seconds_per_step: float,
+                                why: str) -> None:
+    """Raise :class:`SceneError` when ``steps`` per input revolution exceed
+    :data:`MAX_STEPS_PER_REVOLUTION`: the steps of ``revolutions`` input revolutions and their run
+    time at ``seconds_per_step`` [s], in one line; ``why`` says what needs them (e.g. "a
+    speed-ratio error of 0.001 at 89.9 deg")."""
+    if steps <= MAX_STEPS_PER_REVOLUTION:
+        return
+    total = steps * revolutions
+    raise SceneError(f"{why} needs {steps:.3g} steps per input revolution (at most "
+                     f"{MAX_STEPS_PER_REVOLUTION:.0e}): {total:.3g} steps, about "
+                     f"{total * seconds_per_step:.3g} s; ask for a larger `accuracy`")
