@@ -6,7 +6,6 @@ the file fast."""
 from __future__ import annotations
 
 import re
-import warnings
 from dataclasses import replace as dataclass_replace
 from pathlib import Path
 
@@ -15,7 +14,7 @@ import pytest
 import cardan_exudyn.testing.plugin  # noqa: F401 (imported here: see below)
 from cardan_exudyn.accuracy import SAFETY_FACTOR, AccuracyError, error_estimate
 from cardan_exudyn.engines import get_engine, make_options
-from cardan_exudyn.testing import CachingRunner, CardanToleranceWarning, make_scene
+from cardan_exudyn.testing import CachingRunner, assert_efficiency, assert_engines_agree, make_scene
 from cardan_exudyn.testing.assertions import MAX_RELATIVE_ERROR, Limit, tolerance
 from reference.scene.scene import scene_to_dict
 from reference.results.schema import Result, Status, Summary
@@ -135,7 +134,7 @@ def test_cardan_run_computes_each_run_once_and_hands_out_copies(pytester):
 def test_assert_efficiency_passes_and_fails_readably(pytester):
     source = """
         import pytest
-        from cardan_exudyn.testing import CardanToleranceWarning, assert_efficiency
+        from cardan_exudyn.testing import assert_efficiency
 
         @pytest.fixture(scope="module")
         def runs(cardan_scene, cardan_run):
@@ -149,9 +148,8 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
         def test_an_explicit_tolerance(runs, cardan_run):
             assert_efficiency(runs[0], runs[1].mean_efficiency, rtol=3e-3, run=cardan_run)
 
-        def test_too_tight_a_tolerance_warns(runs, cardan_run):
-            with pytest.warns(CardanToleranceWarning, match="cannot resolve"):
-                assert_efficiency(runs[0], runs[0].mean_efficiency, atol=1e-12, run=cardan_run)
+        def test_too_tight_a_tolerance_fails(runs, cardan_run):
+            assert_efficiency(runs[0], runs[0].mean_efficiency, atol=1e-12, run=cardan_run)
 
         def test_wrong_value(runs, cardan_run):
             assert_efficiency(runs[0], runs[0].mean_efficiency + 0.01, run=cardan_run)
@@ -161,7 +159,12 @@ def test_assert_efficiency_passes_and_fails_readably(pytester):
             assert_efficiency(result, 0.2)
     """
     result = run_project(pytester, source)
-    result.assert_outcomes(passed=3, failed=2)
+    result.assert_outcomes(passed=2, failed=3)
+    result.stdout.fnmatch_lines([
+        ">*assert_efficiency(runs?0?, runs?0?.mean_efficiency, atol=1e-12, run=cardan_run)",
+        "E*| mean_efficiency | * | * | +0.000e+00 | - | the tolerance asked, 1e-12, is below what the "
+        "runs resolve, 5 x estimated error = *: give at least that, *",
+    ])
     result.stdout.fnmatch_lines([
         ">*assert_efficiency(runs?0?, runs?0?.mean_efficiency + 0.01, run=cardan_run)",
         "E*AssertionError: mean efficiency of scene 'rig*' (exudyn) is not 0.196*:",
@@ -347,22 +350,30 @@ def test_tolerance_never_passes_by_default_without_an_estimate():
     assert tolerance(1.0, [too_large, 0.0], atol=1.0).value == 1.0  # asked for, and larger
 
 
-def test_tolerance_takes_the_larger_of_asked_and_estimated():
+def test_an_explicit_tolerance_is_used_as_given():
+    """A tolerance the test gives is the limit as given (no rounding floor either); below
+    SAFETY_FACTOR times the estimate it is a reason to fail naming both, never widened."""
     limit = tolerance(2.0, [1e-5, 1e-6], rtol=1e-3)
-    assert limit.value == 2e-3 and not limit.widened and limit.describe() == "asked"
-    limit = tolerance(2.0, [1e-5, 1e-6], atol=1e-6)
-    assert limit.value == pytest.approx(SAFETY_FACTOR * 1.1e-5) and limit.widened
-    assert tolerance(2.0, [0.0, 0.0]).value == 2e-12  # an exact run: rounding only
+    assert limit.value == 2e-3 and limit.asked == 2e-3 and limit.describe() == "asked"
+    assert tolerance(2.0, [0.0, 0.0], atol=0.0).value == 0.0
+    too_tight = tolerance(2.0, [1e-5, 1e-6], atol=1e-6)
+    assert isinstance(too_tight, str)
+    assert re.fullmatch(r"the tolerance asked, 1e-06, is below what the runs resolve, 5 x estimated "
+                        r"error = 5.5e-05 \(rtol 2.75e-05\): give at least that, or refine the runs "
+                        r"\(numerics.accuracy, dt\)", too_tight)
+    assert tolerance(2.0, [0.0, 0.0]).value == 2e-12  # no tolerance given, an exact run: rounding
 
 
-def test_a_widened_tolerance_warns_at_the_caller():
-    from cardan_exudyn.testing.assertions import Check, warn_widened
-
-    check = Check("mean_efficiency", (0.5, 0.5), 0.0, tolerance(1.0, [1e-5, 0.0], atol=1e-9))
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        warn_widened([check])
-    assert len(caught) == 1 and caught[0].category is CardanToleranceWarning
+def test_an_explicit_tolerance_below_the_runs_accuracy_fails(reference_rig):
+    """``rtol=1e-6`` on the drive torque of two engines, and ``atol=1e-15`` on the reference
+    engine's mean efficiency, are below what the runs resolve: both assertions fail naming the
+    tolerance asked and the one the runs support (never widened to pass)."""
+    scene = make_scene(SMALL, revolutions=1.0)
+    too_tight = r"the tolerance asked, .*, is below what the runs resolve, 5 x estimated error = .*"
+    with pytest.raises(AssertionError, match=r"\| mean_torque_in \| .*" + too_tight):
+        assert_engines_agree(scene, columns=["mean_torque_in"], rtol=1e-6, run=CachingRunner())
+    with pytest.raises(AssertionError, match=r"\| mean_efficiency \| .*" + too_tight):
+        assert_efficiency(reference_rig, reference_rig.mean_efficiency, atol=1e-15)
 
 
 def docs_blocks(language: str) -> list[str]:

@@ -1,11 +1,13 @@
 """Assertions for a test suite: a run's mean efficiency, and engines agreeing on a scene.
 
-Tolerances come from the runs' own accuracy (:mod:`cardan_exudyn.accuracy`): a value may differ
-by :data:`~cardan_exudyn.accuracy.SAFETY_FACTOR` times its estimated error (the sum of both
-runs' errors when two runs are compared). A tolerance the test gives (``rtol``, ``atol``) is used
-when it is larger; when the estimate is larger it wins, with a :class:`CardanToleranceWarning`
-(the run cannot resolve what was asked). A check never passes by default without an estimate,
-nor with an estimate over :data:`MAX_RELATIVE_ERROR` of the value's scale: it fails and says so.
+Without a tolerance from the test, it comes from the runs' own accuracy
+(:mod:`cardan_exudyn.accuracy`): a value may differ by
+:data:`~cardan_exudyn.accuracy.SAFETY_FACTOR` times its estimated error (the sum of both runs'
+errors when two runs are compared). A tolerance the test gives (``rtol``, ``atol``) is used as
+given, never widened: where ``SAFETY_FACTOR`` times the estimate exceeds it, the runs cannot
+resolve it and the check fails, naming the tolerance asked and the one the runs support. A check
+never passes by default without an estimate, nor with an estimate over :data:`MAX_RELATIVE_ERROR`
+of the value's scale: it fails and says so.
 A run that did not end ``ok`` fails the check with its status and reason, and so does one whose
 efficiency is undefined (its warnings say why); engines that disagree on the direction of the
 power flow (``power_flow``) disagree.
@@ -13,7 +15,6 @@ power flow (``power_flow``) disagree.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -48,7 +49,9 @@ DEFAULT_COLUMNS = ("mean_efficiency", "work_ratio", "input_work", "output_work",
 
 
 class CardanToleranceWarning(UserWarning):
-    """A run's estimated error is larger than the tolerance a test asked for, and replaced it."""
+    """Not emitted: a tolerance the test gives is used as given, and a check fails where the
+    runs cannot resolve it. Defined so that warning filters naming it
+    (``-W error::cardan_exudyn.testing.CardanToleranceWarning``) still load."""
 
 
 @dataclass(frozen=True)
@@ -58,7 +61,8 @@ class Limit:
     Attributes
     ----------
     value : float
-        The largest difference that passes (units of the value checked).
+        The largest difference that passes (units of the value checked): ``asked`` when the
+        test gave a tolerance, else the estimate (at least the rounding floor).
     asked : float or None
         ``max(atol, rtol * scale)`` when the test gave a tolerance.
     estimated : float or None
@@ -68,11 +72,6 @@ class Limit:
     value: float
     asked: float | None
     estimated: float | None
-
-    @property
-    def widened(self) -> bool:
-        """True when the estimate replaced a smaller tolerance the test asked for."""
-        return self.asked is not None and self.estimated is not None and self.estimated > self.asked
 
     def describe(self) -> str:
         """Which term set the tolerance: the one asked, the estimate, or the rounding floor."""
@@ -118,25 +117,30 @@ def tolerance(scale: float, errors: Sequence[float | None], rtol: float | None =
     errors : sequence of float or None
         Estimated errors of the values compared (None: no estimate; an exact value has 0).
     rtol, atol : float, optional
-        The test's tolerance, ``max(atol, rtol * scale)``.
+        The test's tolerance, ``max(atol, rtol * scale)``, used as given.
 
     Returns
     -------
     Limit or str
-        The tolerance, or the reason the value cannot be checked.
+        The tolerance, or the reason the value cannot be checked: among them a tolerance asked
+        below ``SAFETY_FACTOR`` times the estimate (the runs cannot resolve it; a smaller
+        difference would pass by chance, a larger one blame the physics for the numerics).
     """
     asked = None if rtol is None and atol is None else max(atol or 0.0, (rtol or 0.0) * scale)
-    estimated = None
-    if all(e is not None for e in errors):
-        estimated = SAFETY_FACTOR * float(sum(errors))
-    elif asked is None:
+    estimated = SAFETY_FACTOR * float(sum(errors)) if all(e is not None for e in errors) else None
+    if asked is not None:
+        if estimated is not None and estimated > asked:
+            relative = f" (rtol {number(estimated / scale, '.3g')})" if scale > 0.0 else ""
+            return (f"the tolerance asked, {number(asked, '.3g')}, is below what the runs resolve, "
+                    f"{SAFETY_FACTOR:g} x estimated error = {number(estimated, '.3g')}{relative}: give "
+                    f"at least that, or refine the runs (numerics.accuracy, dt)")
+        return Limit(asked, asked, estimated)
+    if estimated is None:
         return "no error estimate: give rtol or atol"
-    if estimated is not None and (asked is None or estimated > asked):
-        if not estimated <= MAX_RELATIVE_ERROR * scale:
-            return (f"{SAFETY_FACTOR:g} x estimated error = {number(estimated, '.3g')} is over "
-                    f"{MAX_RELATIVE_ERROR:g} of the value: refine the run (numerics.accuracy, dt)")
-    value = max(asked or 0.0, estimated or 0.0, ROUNDING * scale)
-    return Limit(value, asked, estimated)
+    if not estimated <= MAX_RELATIVE_ERROR * scale:
+        return (f"{SAFETY_FACTOR:g} x estimated error = {number(estimated, '.3g')} is over "
+                f"{MAX_RELATIVE_ERROR:g} of the value: refine the run (numerics.accuracy, dt)")
+    return Limit(max(estimated, ROUNDING * scale), None, estimated)
 
 
 def check_values(name: str, values: tuple[Any, Any], scale: float | None,
@@ -149,17 +153,6 @@ def check_values(name: str, values: tuple[Any, Any], scale: float | None,
     if isinstance(limit, str):
         return Check(name, (first, second), second - first, problem=limit)
     return Check(name, (first, second), second - first, limit)
-
-
-def warn_widened(checks: Sequence[Check]) -> None:
-    """A :class:`CardanToleranceWarning` for each check whose estimate replaced the tolerance
-    asked, attributed to the caller of the assertion."""
-    for check in checks:
-        if check.limit is not None and check.limit.widened:
-            warnings.warn(CardanToleranceWarning(
-                f"{check.name}: the tolerance asked ({check.limit.asked:.3g}) is below "
-                f"{SAFETY_FACTOR:g} x the estimated error ({check.limit.estimated:.3g}), which is "
-                "used instead: the run cannot resolve the tolerance asked"), stacklevel=3)
 
 
 def check_tolerances(rtol: float | None, atol: float | None) -> None:
@@ -207,8 +200,9 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
     expected : float
         The expected mean efficiency [-].
     rtol, atol : float, optional
-        A tolerance relative to ``|expected|`` [-] and an absolute one [-]. Default: from the
-        run's own accuracy alone, ``SAFETY_FACTOR`` times its estimated error.
+        A tolerance relative to ``|expected|`` [-] and an absolute one [-], used as given (the
+        check fails where ``SAFETY_FACTOR`` times the run's estimated error exceeds it). Default:
+        from the run's own accuracy alone, ``SAFETY_FACTOR`` times its estimated error.
     run : callable, optional
         ``run(scene, engine, options) -> Result`` for the rerun at half the step that estimates
         a fixed-step engine's error; pass the plugin's ``cardan_run`` to reuse its cache.
@@ -217,8 +211,9 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
     ------
     AssertionError
         The run did not end ``ok``; its error cannot be estimated and no tolerance was given;
-        or the mean efficiency differs from ``expected`` by more than the tolerance. The
-        message is a table: value, expected, difference, tolerance and its origin.
+        the tolerance given is below what the run resolves; or the mean efficiency differs
+        from ``expected`` by more than the tolerance. The message is a table: value, expected,
+        difference, tolerance and its origin.
     """
     __tracebackhide__ = True
     check_tolerances(rtol, atol)
@@ -237,7 +232,6 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
     error = estimate.of("mean_efficiency") if estimate is not None else None
     check = check_values("mean_efficiency", (expected, result.mean_efficiency), abs(expected),
                          [error, 0.0], rtol, atol)
-    warn_widened([check])
     if check.failed:
         raise AssertionError(failure_message(
             f"mean efficiency of scene {scene!r} ({engine}) is not {expected!r}:", [check],
@@ -330,8 +324,9 @@ def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "refe
         compared where the two differ most, over the rows after ``skip_revolutions``).
     rtol, atol : float, optional
         A tolerance relative to the base's value (a work: the base's input work; a column: its
-        largest magnitude) and an absolute one, in the units of each value. Default: from the
-        runs' own accuracy alone, ``SAFETY_FACTOR`` times the sum of their estimated errors.
+        largest magnitude) and an absolute one, in the units of each value; used as given (a
+        value fails where ``SAFETY_FACTOR`` times the sum of the runs' estimated errors exceeds
+        it). Default: from the runs' own accuracy alone, ``SAFETY_FACTOR`` times that sum.
     options : mapping, optional
         Engine name -> options of that engine.
     skip_revolutions : float
@@ -344,8 +339,8 @@ def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "refe
     ------
     AssertionError
         A run did not end ``ok``; or some value differs by more than its tolerance, or cannot
-        be checked. The message is a table of those values: each engine's value, difference,
-        tolerance and its origin.
+        be checked (among them: a tolerance given below what the runs resolve). The message
+        is a table of those values: each engine's value, difference, tolerance and its origin.
     ValueError
         Fewer than two engines, an engine twice, an unknown column or a bad tolerance.
     """
@@ -369,7 +364,6 @@ def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "refe
                   + check_means(means, results[base], results[other], errors, rtol, atol)
                   + check_columns(table_columns, results[base], results[other], errors, rtol, atol,
                                   skip_revolutions))
-        warn_widened(checks)
         if any(c.failed for c in checks):
             raise AssertionError(failure_message(
                 f"engine {other} disagrees with engine {base} on scene {scene.name!r}:", checks,
