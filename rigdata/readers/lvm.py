@@ -2,11 +2,14 @@
 
 Segments are joined when they continue one another (same channels, same ``Delta_X``, no gap);
 the X column, when there is one, is the time axis. lvm_read leaves NaN, silently, in cells it
-cannot read and accepts rows cut short: both are checked here against the text itself.
+cannot read and accepts rows cut short: both are checked here against the text itself. A file it
+cannot parse at all (it raises a bare ``KeyError``, ``IndexError`` or ``SyntaxError``) is read
+again here for the reason: cut short inside a header, or the header line it stumbled on.
 """
 
 from __future__ import annotations
 
+import ast
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -117,6 +120,10 @@ def _check_segment(seg: Segment, k: int, ref: Segment, path: Path) -> None:
         raise RigDataError(f"segment {k + 1} has no channels besides X_Value: its header is incomplete "
                            f"(a blank line inside it?)", file=path)
     dt = ref.dx[0]
+    bad = [d for d in seg.dx if not (d > 0.0 or math.isnan(d))]
+    if bad:
+        raise RigDataError(f"segment {k + 1} has Delta_X {bad[0]:g} s: a sampling interval must be "
+                           f"positive", file=path)
     if seg.names != ref.names:
         raise RigDataError(f"segment {k + 1} has channels {seg.names}, segment 1 {ref.names}: segments "
                            f"with different channels cannot be joined", file=path)
@@ -157,6 +164,9 @@ def data_rows(lines: list[str], sep: str, width: int, path: Path, ends_clean: bo
         n = len(lines[i].split(sep))
         if n >= width and (ends_clean or k < len(rows) - 1):
             continue
+        if k == len(rows) - 1 and n >= width:  # every field, but no line end: LabVIEW ends each row
+            raise RigDataError(f"truncated: the last line ({i + 1}) has no line end (its last value may be "
+                               f"cut short); the file seems cut short", file=path)
         if k == len(rows) - 1:
             cut = "" if ends_clean else " and no line end"
             raise RigDataError(f"truncated: the last line ({i + 1}) has {n} of {width} fields{cut}; the file "
@@ -180,13 +190,134 @@ def text_cells(lines: list[str], rows: list[int], sep: str, decimal: str,
     return cells
 
 
+END_OF_HEADER = "***End_of_Header***"
+NUMBER_TAGS = ("Samples", "X0", "Delta_X")
+"""Segment-header tags whose values lvm_read reads as Python number literals (with ``Channels``,
+a whole number)."""
+
+
+def _tagged_lines(text: str) -> tuple[list[str], list[str], str]:
+    """The text's lines, each line's first field (its tag, as lvm_read compares it: exactly) and
+    the column separator as lvm_read takes it: the character after ``Separator``
+    (``Separator<TAB>Tab``), tab without one."""
+    lines = text.splitlines()
+    tagged = [line.strip() for line in lines[:22] if line.startswith("Separator")]
+    sep = tagged[0][9] if tagged and len(tagged[0]) > 9 else "\t"
+    return lines, [line.split(sep, 1)[0] for line in lines], sep
+
+
+def _header_end(tags: list[str]) -> int | None:
+    """Index of the file header's ``***End_of_Header***`` line, None without one."""
+    return next((i for i, tag in enumerate(tags) if tag.strip() == END_OF_HEADER), None)
+
+
+def _missing_data(text: str) -> str | None:
+    """Where the text ends when a header has no data section after it (a file cut short), or
+    None when every header it starts is followed by a column-names line.
+
+    Walks the lines as lvm_read does: the file header up to its ``***End_of_Header***``, then
+    segments, each a blank line, a header and an ``X_Value`` column-names line before its rows.
+    Read from the text because lvm_read reports such a file only as an internal ``KeyError``,
+    ``IndexError`` or ``SyntaxError``.
+    """
+    lines, tags, sep = _tagged_lines(text)
+    ends = f"the file ends at line {len(lines)}"
+    end = _header_end(tags)
+    if end is None:
+        return f"truncated: header without data section ({ends}, inside the file header)"
+    segment = 0
+    state = "after header"
+    for line, tag in zip(lines[end + 1:], tags[end + 1:], strict=True):
+        if line in ("", sep):
+            state = "blank"
+        elif state == "blank":
+            segment += 1
+            state = "data" if tag.strip() == "X_Value" else "segment header"
+        elif tag.strip() == "X_Value" and state == "segment header":
+            state = "data"
+    if state == "segment header":
+        return f"truncated: header without data section ({ends}, inside the header of segment {segment})"
+    if segment == 0:
+        return f"truncated: header without data section ({ends}: nothing after the file header)"
+    return None
+
+
+def _header_problem(text: str) -> str | None:
+    """The first header line lvm_read cannot read, in words, or None when none is found: a
+    blank line inside the file header (lvm_read would start a segment there), a ``Separator``
+    tag without a value, a ``Decimal_Separator`` line that is not a tag and one value, and in a
+    segment (:func:`_segment_problem`) a missing or malformed ``X_Value`` line or a header value
+    that is not a number."""
+    lines, tags, sep = _tagged_lines(text)
+    end = _header_end(tags)
+    end = len(lines) if end is None else end
+    decimal = "."
+    for i, (line, tag) in enumerate(zip(lines[:end], tags[:end], strict=True)):
+        fields = line.split(sep)
+        if i and line in ("", sep):
+            return f"line {i + 1}: a blank line inside the file header (before its {END_OF_HEADER})"
+        if line.startswith("Separator") and len(line.strip()) <= 9:
+            return f"line {i + 1}: the Separator tag has no value"
+        if tag == "Decimal_Separator" and len(fields) != 2:
+            return (f"line {i + 1}: the Decimal_Separator line has {len(fields)} fields, the tag and "
+                    f"one value expected")
+        if tag == "Decimal_Separator":
+            decimal = fields[1]
+    return _segment_problem(lines, tags, sep, decimal, end + 1)
+
+
+def _segment_problem(lines: list[str], tags: list[str], sep: str, decimal: str,
+                     start: int) -> str | None:
+    """:func:`_header_problem` for the segments, from line index ``start`` on (``decimal``: the
+    file's decimal mark)."""
+    segment = 0
+    named = True
+    for i in range(start, len(lines)):
+        tag = tags[i]
+        if lines[i] in ("", sep):
+            if not named:
+                return (f"line {i + 1}: segment {segment} ends before its X_Value column-names "
+                        f"line (a blank line where its header or data should be)")
+            segment += 1
+            named = False
+        elif tag.strip() == "X_Value":
+            if tag != "X_Value":
+                return f"line {i + 1}: the column-names line starts with {tag!r}, not 'X_Value'"
+            named = True
+        elif not named and (tag == "Channels" or tag in NUMBER_TAGS):
+            fields = lines[i].split(sep)
+            values = fields[1:2] if tag == "Channels" else [v for v in fields[1:] if v]
+            for value in values or [""]:
+                if not _literal_number(value if tag == "Channels" else value.replace(decimal, "."),
+                                       whole=tag == "Channels"):
+                    comma = (" (a decimal comma, and no Decimal_Separator tag in the file header?)"
+                             if decimal == "." and "," in value else "")
+                    return (f"line {i + 1}: the {tag} value {value!r} of segment {segment} is not "
+                            f"{'a whole number' if tag == 'Channels' else 'a number'}{comma}")
+    return None
+
+
+def _literal_number(text: str, whole: bool) -> bool:
+    """Whether lvm_read's ``ast.literal_eval`` reads ``text`` as a number (an int when
+    ``whole``)."""
+    try:
+        value = ast.literal_eval(text)
+    except (ValueError, TypeError, SyntaxError, MemoryError, RecursionError):
+        return False
+    kinds = (int,) if whole else (int, float)
+    return isinstance(value, kinds) and not isinstance(value, bool)
+
+
 def _parse(text: str, path: Path) -> tuple[Any, dict]:
     """lvm_read's result and the file header's tags as text."""
     try:
         lvm = lvm_read.read_str(text)
     except PARSE_ERRORS as exc:  # lvm_read raises bare ValueError/KeyError/SyntaxError on bad files
-        if "no data segment" in str(exc):
-            raise RigDataError("truncated: no data segment after the LVM header", file=path) from exc
+        why = _missing_data(text) or _header_problem(text)
+        if why is not None:
+            raise RigDataError(why, file=path) from exc
+        if "no data segment" in str(exc):  # lvm_read's own sentence: the separator matches no line
+            raise RigDataError(f"cannot parse as LVM: {exc}", file=path) from exc
         raise RigDataError(f"cannot parse as LVM: {type(exc).__name__}: {exc}", file=path) from exc
     return lvm, {k: str(v) for k, v in lvm.items() if isinstance(k, str) and k != "Segments"}
 
