@@ -110,7 +110,8 @@ def layout(lines: list[str], path: Path) -> Layout:
     if not above:
         raise RigDataError(f"no header line with column names above the data (line {first + 1})", file=path)
     header, units_row = above[-1], None
-    if len(above) > 1 and _units_row(header_fields(lines[header], sep, width)):
+    units = header_fields(lines[header], sep, width)
+    if len(above) > 1 and len(units) == width and _units_row(units):
         candidate = header_fields(lines[above[-2]], sep, width)
         if len(candidate) == width and not any(map(is_number, candidate)):
             header, units_row = above[-2], above[-1]
@@ -187,7 +188,11 @@ def _frame(lines: list[str], rows: list[int], lay: Layout, path: Path) -> Any:
                            decimal=lay.decimal, header=None, names=list(range(lay.width)),
                            skip_blank_lines=False, engine="c")
     except (ValueError, OverflowError) as exc:  # pandas' ParserError (a ValueError) names no file
-        raise RigDataError(f"cannot parse the data rows: {exc}", file=path) from exc
+        quoted = [i for i in rows if lines[i].count('"') % 2]
+        if quoted:  # pandas reads on to the end of the file for the closing quote
+            raise RigDataError(f"line {quoted[0] + 1} has an unbalanced double quote ('\"'): a data "
+                               f"row cannot be read from it", file=path) from exc
+        raise RigDataError(f"cannot parse the data rows (pandas: {exc})", file=path) from exc
 
 
 def _column(series: Any, decimal: str, file_lines: list[int]) -> tuple[np.ndarray, TextCells | None]:

@@ -29,14 +29,25 @@ def file_bytes(path: Path) -> bytes:
     return data
 
 
+MAGIC = {"tdms": b"TDSm", "lvm": b"LabVIEW Measurement"}
+"""How a file of each binary-tagged format starts."""
+
+
+def _cut_in_magic(fmt: str, head: bytes) -> bool:
+    """Whether ``head``, a whole file, is a proper start of the format's :data:`MAGIC` (the file
+    was cut inside it)."""
+    start = head.lstrip(b"\xef\xbb\xbf").strip() if fmt == "lvm" else head
+    return bool(start) and len(start) < len(MAGIC[fmt]) and MAGIC[fmt].startswith(start)
+
+
 def content_format(head: bytes) -> str | None:
     """Format the first bytes show: "tdms", "lvm", or None (text of some other kind)."""
-    if head.startswith(b"TDSm"):
+    if head.startswith(MAGIC["tdms"]):
         return "tdms"
     text = head.lstrip(b"\xef\xbb\xbf")
     if text.startswith(b"\xff\xfe") or text.startswith(b"\xfe\xff"):
         text = text.decode("utf-16", errors="ignore").encode()
-    return "lvm" if text.lstrip().startswith(b"LabVIEW Measurement") else None
+    return "lvm" if text.lstrip().startswith(MAGIC["lvm"]) else None
 
 
 def choose_format(path: Path, format: str, head: bytes) -> str:
@@ -63,6 +74,9 @@ def choose_format(path: Path, format: str, head: bytes) -> str:
         name = {"tdms": "a TDMS file", "lvm": "a LabVIEW Measurement (LVM) file"}[found]
         raise RigDataError(f"content is {name} but the {said} says {wanted}; rename the file or pass "
                            f"format={found!r}", file=path)
+    if wanted in ("tdms", "lvm") and found != wanted and _cut_in_magic(wanted, head):
+        raise RigDataError(f"truncated: {len(head)} bytes, cut inside the {MAGIC[wanted].decode()!r} that "
+                           f"starts a{'' if wanted == 'tdms' else 'n'} {wanted.upper()} file", file=path)
     if wanted == "tdms" and found != "tdms":
         raise RigDataError(f"not a TDMS file: it does not start with 'TDSm' (the {said} says TDMS; "
                            f"{len(head)} bytes read: {head[:16]!r})", file=path)

@@ -30,7 +30,10 @@ __all__ = ["read_tdms"]
 DAMAGE = re.compile(r"last segment|less data|incomplete|not a multiple|cropping", re.I)
 #: What npTDMS raises on a file it cannot parse (it wraps nothing).
 PARSE_ERRORS = (ValueError, LookupError, TypeError, AttributeError, ArithmeticError, EOFError,
-                struct.error, OSError, MemoryError)
+                struct.error, OSError, MemoryError, NotImplementedError)
+LEAD_IN_BYTES = 28
+"""Size of a TDMS segment's lead-in (tag, table of contents, version, two lengths): a file
+shorter than one was cut before its first segment's metadata."""
 
 
 @contextlib.contextmanager
@@ -77,14 +80,17 @@ def channel_values(channel: Any) -> tuple[np.ndarray, TextCells | None, str | No
 def _load(data: bytes, path: Path) -> tuple[Any, list[tuple], list[str]]:
     """The TDMS file, its channels (group, channel, values, text cells, implied unit) and
     npTDMS' warnings."""
+    if len(data) < LEAD_IN_BYTES:
+        raise RigDataError(f"truncated: {len(data)} bytes, less than the {LEAD_IN_BYTES}-byte lead-in of a "
+                           f"TDMS segment", file=path)
     try:
         with nptdms_warnings() as warnings:
             tdms = nptdms.TdmsFile.read(io.BytesIO(data))
             groups = [(g.name, c) for g in tdms.groups() for c in g.channels()]
             loaded = [(g, c, *channel_values(c)) for g, c in groups]
     except PARSE_ERRORS as exc:  # npTDMS raises ValueError, KeyError, struct.error, EOFError ...
-        raise RigDataError(f"cannot read as TDMS ({type(exc).__name__}: {exc}); the file may be cut short "
-                           f"or damaged", file=path) from exc
+        raise RigDataError(f"truncated or damaged TDMS file: npTDMS cannot read its structure "
+                           f"({type(exc).__name__}: {exc})", file=path) from exc
     damage = [w for w in warnings if DAMAGE.search(w)]
     if damage:
         raise RigDataError(f"truncated or damaged TDMS file: npTDMS reports {damage[0]!r}", file=path)
