@@ -398,7 +398,46 @@ BAD = [
      "truncated or damaged TDMS file: npTDMS reports 'Last segment"),
     ("tdms-mixed-rates", "rates.tdms", lambda tmp: tdms_bytes(tmp, (DT, 2 * DT)), {},
      r"channel 'torque_out': mixed sampling rates: torque_out \('Torque Out'\) is sampled every 0.002 s"),
+    # cut short anywhere, damaged headers: one line naming what is wrong, no library internals
+    ("lvm-cut-in-segment-header", "cut.lvm", (LVM + lvm_segment(0.0, 0.001)).split("Y_Unit_Label")[0], {},
+     r"truncated: header without data section \(the file ends at line 14, inside the header of segment 1\)$"),
+    ("lvm-cut-in-file-header", "cut.lvm", LVM[:LVM.index("Separator") + len("Separator")], {},
+     r"truncated: header without data section \(the file ends at line 4, inside the file header\)$"),
+    ("lvm-cut-after-file-header", "cut.lvm", LVM, {},
+     r"truncated: header without data section \(the file ends at line 11: nothing after the file header\)$"),
+    ("lvm-cut-in-last-value", "cut.lvm", LVM + lvm_segment(0.0, 0.001)[:-3], {},
+     r"truncated: the last line \(25\) has no line end \(its last value may be cut short\)"),
+    ("lvm-cut-in-first-line", "cut.lvm", "LabVIEW Meas", {},
+     r"truncated: 12 bytes, cut inside the 'LabVIEW Measurement' that starts an LVM file$"),
+    ("lvm-blank-line-in-file-header", "blank.lvm",
+     LVM.replace("Multi_Headings\tNo\n", "\n") + lvm_segment(0.0, 0.001), {},
+     r"line 6: a blank line inside the file header \(before its \*\*\*End_of_Header\*\*\*\)$"),
+    ("lvm-separator-without-value", "sep.lvm",
+     LVM.replace("Separator\tTab", "Separator") + lvm_segment(0.0, 0.001), {},
+     r"line 4: the Separator tag has no value$"),
+    ("lvm-channels-not-a-number", "chan.lvm",
+     LVM + lvm_segment(0.0, 0.001).replace("Channels\t4", "Channels\tfour"), {},
+     r"line 13: the Channels value 'four' of segment 1 is not a whole number$"),
+    ("lvm-segment-without-column-names", "empty.lvm", LVM + "\t\n" + lvm_segment(0.0, 0.001), {},
+     r"line 13: segment 1 ends before its X_Value column-names line"),
+    ("lvm-zero-delta-x", "zero.lvm", LVM + lvm_segment(0.0, 0.0), {},
+     r"segment 1 has Delta_X 0 s: a sampling interval must be positive$"),
+    ("tdms-cut-in-tag", "cut.tdms", b"TDS", {},
+     r"truncated: 3 bytes, cut inside the 'TDSm' that starts a TDMS file$"),
+    ("tdms-cut-in-lead-in", "cut.tdms", lambda tmp: tdms_bytes(tmp)[:20], {},
+     r"truncated: 20 bytes, less than the 28-byte lead-in of a TDMS segment$"),
+    ("tdms-damaged-object-header", "bad.tdms", lambda tmp: tdms_damaged(tdms_bytes(tmp), 43, 15), {},
+     r"truncated or damaged TDMS file: npTDMS cannot read its structure \(NotImplementedError: "),
+    ("csv-unbalanced-quote", "quote.csv", edit("0.002,1.02,1.00,601,600", '0.002,1.02,1.00,",600'), {},
+     r"line 5 has an unbalanced double quote \('\"'\): a data row cannot be read from it$"),
+    ("csv-short-units-row", "units.csv", GOOD.replace("Speed Out [rpm]\n", "Speed Out\n[rpm]\n"), {},
+     r"no header line with column names above the data: line 3 \('\[rpm\]'\) has 1 fields, the data rows 5"),
 ]
+
+
+def tdms_damaged(data: bytes, offset: int, value: int) -> bytes:
+    """``data`` with the byte at ``offset`` set to ``value`` (one flipped byte)."""
+    return data[:offset] + bytes([value]) + data[offset + 1:]
 
 
 @pytest.mark.parametrize("name, content, kwargs, pattern", [case[1:] for case in BAD],
@@ -412,8 +451,9 @@ def test_bad_input(tmp_path, name, content, kwargs, pattern):
         path.write_bytes(content.encode())
     elif content is not None:
         path.write_bytes(content)
-    with pytest.raises(RigDataError, match=re.escape(str(path)) + ": " + pattern):
+    with pytest.raises(RigDataError, match=re.escape(str(path)) + ": " + pattern) as caught:
         read(path, **kwargs)
+    assert "\n" not in str(caught.value)
 
 
 @pytest.mark.parametrize("text, decimal, expected", [
