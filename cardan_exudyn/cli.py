@@ -96,18 +96,18 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _warn_given_step(scene: Scene) -> None:
-    """Before a run at a given ``--dt``: a warning on stderr when the a-priori error model of the
-    time-stepping engine (Exudyn) predicts more than the target accuracy (at the largest loss;
-    the run then measures it)."""
+    """Before a run at a given ``--dt``: a warning on stderr when the a-priori error models of the
+    time-stepping engine (Exudyn) predict more than the target accuracy, naming the quantity
+    (speed ratio; mean efficiency at the largest loss, which the run then measures)."""
     if scene.numerics.dt is None:
         return
-    from cardan_exudyn.model.stepsize import predicted_error  # the Exudyn engine's step model
+    from cardan_exudyn.model.stepsize import predicted_errors  # the Exudyn engine's step model
 
-    predicted = predicted_error(scene)
-    if predicted is not None and predicted > scene.numerics.accuracy:
+    over = [f"{what} error up to {error:.2g}" for what, error in (predicted_errors(scene) or {}).items()
+            if error > scene.numerics.accuracy]
+    if over:
         print(f"warning: dt {scene.numerics.dt:g} s may miss the accuracy (time-stepping engines) "
-              f"{scene.numerics.accuracy:g}: predicted mean-efficiency error up to {predicted:.2g}",
-              file=sys.stderr)
+              f"{scene.numerics.accuracy:g}: predicted {' and '.join(over)}", file=sys.stderr)
 
 
 def _no_work(s: Summary) -> str:

@@ -189,6 +189,23 @@ def test_given_coarse_step_is_flagged(capsys):
     assert printed and float(printed.group(1)) == estimate, err
 
 
+def test_given_step_too_coarse_for_the_speed_ratio_says_so(capsys):
+    """Without friction the mean efficiency is exact at any step (estimate 0, accuracy met): a
+    given step the speed-ratio model predicts too coarse is named as a speed-ratio error, before
+    the run (``cardan run``) and in the summary's warnings, never as a mean-efficiency error."""
+    changes = {"joint.geometry.shaft_angle": math.radians(60.0), "numerics.dt": 2e-4}
+    s = run(replace(named_scene("paper-literal-10deg-frictionless"), **ONE_REVOLUTION, **changes)).summary
+    assert s.efficiency_error_estimate == 0.0 and s.accuracy_met is True
+    assert any(re.fullmatch(r"speed ratio: its error model predicts up to \S+ at the given dt, over the "
+                            r"target 0.001 \(the accuracy estimate covers the mean efficiency only\)", w)
+               for w in s.warnings)
+    main(["run", "--name", "paper-literal-10deg-frictionless", "--angle", "60", "--dt", "2e-4",
+          "--revolutions", "1"])
+    err = capsys.readouterr().err
+    assert "may miss the accuracy (time-stepping engines) 0.001: predicted speed-ratio error up to" in err
+    assert "mean-efficiency error" not in err
+
+
 # small grid off the paper's: (angle deg, rpm, friction, errors, drive)
 SMALL_GRID = [dict(angle_deg=25.0, rpm=500.0, friction=0.3, errors=False, drive="speed"),
               dict(angle_deg=0.0, rpm=3000.0, friction=0.4, errors=False, drive="speed"),

@@ -26,6 +26,7 @@ from cardan_exudyn.model.stepsize import (
     efficiency_error,
     kinematic_steps,
     plan_steps,
+    predicted_errors,
     refuse,
     reversing_parts,
     revolution_period,
@@ -355,11 +356,17 @@ f = 0.2, angle drive: Richardson 2.0e-5 against a true 6.7e-5)."""
 
 def _report_accuracy(main: Result, coarse: Result | None, scene: Scene, options: ExudynOptions) -> None:
     """The mean-efficiency error estimate of ``main`` into its summary (:func:`_estimate`; 0
-    without friction), ``accuracy_met`` and a warning when the estimate exceeds the target."""
+    without friction), ``accuracy_met`` and a warning when the estimate exceeds the target; at a
+    given step (not combined by Richardson), a warning too when the speed-ratio model predicts
+    more than the target: the estimate and ``accuracy_met`` cover the mean efficiency only."""
     s = main.summary
     if _failed(main):
         return
     target = scene.numerics.accuracy
+    predicted = None if scene.numerics.richardson else predicted_errors(scene, options.node_type)
+    if predicted is not None and predicted["speed-ratio"] > target:
+        s.warn(f"speed ratio: its error model predicts up to {predicted['speed-ratio']:.2g} at the given "
+               f"dt, over the target {target:g} (the accuracy estimate covers the mean efficiency only)")
     info: dict = {"target": target}
     if coarse is None:
         estimate, info["method"] = 0.0, "no friction: nothing is lost, the efficiency is 1"

@@ -39,7 +39,7 @@ __all__ = ["ERROR_CONSTANT", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS_PER_REVOLUTI
            "efficiency_error",
            "efficiency_steps",
            "plan_steps", "richardson", "revolution_period", "refuse", "kinematic_steps",
-           "predicted_error"]
+           "predicted_errors"]
 
 ERROR_CONSTANT = 0.19
 MIN_STEPS_PER_REVOLUTION = 100
@@ -246,13 +246,15 @@ def richardson(fine: float, coarse: float, ratio: float, order: int) -> float:
     return abs(fine - coarse) / (ratio ** order - 1.0)
 
 
-def predicted_error(scene: Scene, node_type: str = "Rxyz") -> float | None:
-    """A-priori error [-] of a run at the scene's given ``numerics.dt``, before anything runs: the
-    larger of the speed-ratio model and the mean-efficiency model at the largest loss fraction
-    (1); None without a given step."""
+def predicted_errors(scene: Scene, node_type: str = "Rxyz") -> dict[str, float] | None:
+    """A-priori errors [-] of a run at the scene's given ``numerics.dt``, before anything runs:
+    ``{"speed-ratio": ..., "mean-efficiency": ...}``, the speed-ratio model and the
+    mean-efficiency model at the largest loss fraction (1; 0 without friction, where nothing is
+    lost); None without a given step. Named apart because a run's error estimate covers the mean
+    efficiency only: a frictionless run is exact there at any step."""
     if scene.numerics.dt is None:
         return None
     steps = revolution_period(scene) / scene.numerics.dt
     h = 2.0 * math.pi / steps
     kinematic = error_coefficient(scene.joint.geometry.shaft_angle, node_type) * h * h
-    return max(kinematic, efficiency_error(scene, steps, 1.0, node_type))
+    return {"speed-ratio": kinematic, "mean-efficiency": efficiency_error(scene, steps, 1.0, node_type)}
