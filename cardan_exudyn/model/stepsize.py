@@ -204,7 +204,7 @@ def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_t
 def refuse(scene: Scene, steps: float, why: str, seconds_per_step: float = SECONDS_PER_STEP) -> None:
     """Raise :class:`SceneError` when ``steps`` per revolution exceed the limits: the predicted
     steps and run time (at ``seconds_per_step`` [s]), in one line
-    (:func:`reference.validation.refuse_steps_per_revolution`; a torque drive counted as 4 times
+    (:func:`reference.scene.validation.refuse_steps_per_revolution`; a torque drive counted as 4 times
     its revolutions, the time it is allowed)."""
     revolutions = scene.revolutions * (4.0 if scene.drive.kind == "torque" else 1.0)
     refuse_steps_per_revolution(steps, revolutions, seconds_per_step, why)
