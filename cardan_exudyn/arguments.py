@@ -25,8 +25,9 @@ else:  # Python 3.10
 
 from cardan_exudyn.io import OutputError, check_output_folder
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
 from reference.scene.files import load_scene
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM, SceneError
 
 __all__ = ["EXIT_OK", "EXIT_BAD_INPUT", "EXIT_FAILED", "EXIT_INCOMPLETE", "EXIT_INACCURATE",

@@ -39,9 +39,10 @@ from scipy.interpolate import CubicSpline
 
 from cardan_exudyn.engines import get_engine, resolve, run
 from cardan_exudyn.report.format import is_number, markdown_table
-from reference.scene.joint import PAIR_NAMES
-from reference.scene.scene import Scene, replace
 from reference.results.schema import OptionsError, Result, Summary, after_revolutions, table_columns
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 from reference.scene.validation import require_scene
 
 __all__ = ["Comparison", "EngineDifference", "SUMMARY_KEYS", "COMPARED", "SAMPLED_ENGINES", "compare",

@@ -32,8 +32,11 @@ from reference.lazy import lazy_face
 _HOMES = {
     "reference.scene.validation": ("SceneError", "DEG", "RPM"),
     "reference.scene.joint": ("PAIR_NAMES", "Body", "Geometry", "Pair", "Pairs", "MountingErrors", "Joint"),
-    "reference.scene.scene": ("Scene", "SpeedDrive", "AngleDrive", "TorqueDrive", "Load", "Numerics",
-                        "FrictionSettings", "Record", "replace", "scene_to_dict", "scene_from_dict"),
+    "reference.scene.drives": ("SpeedDrive", "AngleDrive", "TorqueDrive"),
+    "reference.scene.load": ("Load",),
+    "reference.scene.settings": ("Numerics", "FrictionSettings", "Record"),
+    "reference.scene.scene": ("Scene",),
+    "reference.scene.mapping": ("replace", "scene_to_dict", "scene_from_dict"),
     "reference.scene.files": ("load_scene", "scene_from_mapping"),
     "reference.paper.paper": ("named_scene", "paper_scene", "rig_scene"),
     "reference.results.schema": ("Status", "Result", "Summary", "OptionsError"),

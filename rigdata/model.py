@@ -18,8 +18,10 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from cardan_exudyn import engines
-from reference.scene.scene import AngleDrive, Load, Scene
 from reference.results.schema import Result
+from reference.scene.drives import AngleDrive
+from reference.scene.load import Load
+from reference.scene.scene import Scene
 from rigdata.conditioning import Conditioned
 
 #: The margin of drive history kept after the window (so the engines find the window's end) [rev].

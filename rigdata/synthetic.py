@@ -29,9 +29,11 @@ from scipy.interpolate import CubicSpline
 from cardan_exudyn import engines
 from reference.engine.solve import ReferenceOptions, columns_at, input_motion
 from reference.paper.paper import named_scene
-from reference.scene.scene import AngleDrive, Load, Scene
-from reference.scene.scene import replace as replace_field
 from reference.results.schema import Result
+from reference.scene.drives import AngleDrive
+from reference.scene.load import Load
+from reference.scene.mapping import replace as replace_field
+from reference.scene.scene import Scene
 from rigdata import files
 from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer

@@ -3,7 +3,7 @@
 Every entry point must reject bad input with one clear line naming what is wrong: the ``cardan``
 command line (every subcommand, ``cardan rig ...`` included) exits with status 2, one line on
 stderr, nothing on stdout, no traceback, and leaves an output folder it was given as it was; the
-Python API raises a documented exception (:class:`~reference.scene.scene.SceneError`,
+Python API raises a documented exception (:class:`~reference.scene.validation.SceneError`,
 :class:`~cardan_exudyn.sweep.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
 :class:`~cardan_exudyn.io.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
 one-line message. A run that fails is not bad input: it exits with status 3 and a status line
@@ -31,11 +31,13 @@ from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
 from reference.engine.solve import ReferenceOptions
-from reference.scene.joint import Body
 from reference.paper.paper import named_scene
-from reference.scene.scene import Load, Scene, replace, scene_from_dict
-from reference.scene.files import load_scene
 from reference.results.schema import OptionsError, Result, Status, Summary
+from reference.scene.files import load_scene
+from reference.scene.joint import Body
+from reference.scene.load import Load
+from reference.scene.mapping import replace, scene_from_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
 from rigdata.readers import read
@@ -150,7 +152,7 @@ def _api_load_missing(d: Path) -> Any:
 
 
 def _api_empty_dict(d: Path) -> Any:
-    """reference.scene.scene.scene_from_dict({})"""
+    """reference.scene.mapping.scene_from_dict({})"""
     return scene_from_dict({})
 
 
@@ -280,7 +282,7 @@ def _api_compare_skip_all(d: Path) -> Any:
 
 
 def _api_replace_none(d: Path) -> Any:
-    """reference.scene.scene.replace(None, revolutions=2)"""
+    """reference.scene.mapping.replace(None, revolutions=2)"""
     return replace(None, revolutions=2.0)
 
 

@@ -6,9 +6,12 @@ import math
 
 import pytest
 
-from reference.scene.joint import Body, Geometry, Joint, Pair, Pairs
 from reference.paper.paper import named_scene
-from reference.scene.scene import Load, Numerics, Record, Scene, SpeedDrive
+from reference.scene.drives import SpeedDrive
+from reference.scene.joint import Body, Geometry, Joint, Pair, Pairs
+from reference.scene.load import Load
+from reference.scene.scene import Scene
+from reference.scene.settings import Numerics, Record
 
 M_IN, M_SPIDER, M_OUT = 0.9, 0.05, 0.8
 B_IN, B_OUT = 0.12, 0.09

@@ -33,8 +33,8 @@ from cardan_exudyn.studies.accuracy.compute import (
     run_cell_limited,
 )
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
 from reference.results.schema import Status
+from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
 ONE_REVOLUTION = {"revolutions": 1.0, "record.timeseries": False}

@@ -17,8 +17,8 @@ import pytest
 
 from cardan_exudyn import engines
 from cardan_exudyn.cli import main
-from cardan_exudyn.studies.bench.command import steps_or_auto
 from cardan_exudyn.studies.bench.audit import skip_audit, solution_file, solve_only
+from cardan_exudyn.studies.bench.command import steps_or_auto
 from cardan_exudyn.studies.bench.configs import (
     EXUDYN_TUNED,
     SCENES,
@@ -40,8 +40,8 @@ from cardan_exudyn.studies.bench.targets import (
     paper_scenes_timing,
 )
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
 from reference.results.schema import Result, Status, Summary
+from reference.scene.mapping import replace
 
 
 def tuned_errors(scene, steps) -> list[dict]:

@@ -23,7 +23,7 @@ from reference.paper.paper import (
     plausible_box,
     set_values,
 )
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 ECCENTRIC = Space(("input_eccentricity",), (0.0,), (0.001,), (False,))
 """A one-parameter box: the input's unbalance 0-1 mm."""

@@ -29,10 +29,10 @@ from cardan_exudyn.comparison import Comparison, compare, join_on_input_angle
 from cardan_exudyn.engines import run
 from cardan_exudyn.io import dumps
 from reference.engine.solve import ReferenceOptions
-from reference.scene.joint import PAIR_NAMES
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
 from reference.results.schema import OptionsError, Status
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace
 
 SKIP = 0.25  # revolutions left out of the steady statistics
 RAMP_RELATIVE = 0.1  # sign ramp resolved by the step (see the module docstring)

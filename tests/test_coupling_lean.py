@@ -24,9 +24,9 @@ from cardan_exudyn.model import friction_io as io
 from cardan_exudyn.model.friction_law import LawTable, PairLaw, magnitude_loads
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
-from reference.scene.joint import PAIR_BODIES
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.scene.joint import PAIR_BODIES
+from reference.scene.mapping import replace
 
 OPTIONS = ExudynOptions(error_estimate=False)
 

@@ -10,7 +10,8 @@ from conftest import balanced_scene
 
 from cardan_exudyn import run
 from reference.paper.paper import named_scene
-from reference.scene.scene import AngleDrive, replace
+from reference.scene.drives import AngleDrive
+from reference.scene.mapping import replace
 
 
 def balance_residual(result) -> tuple[float, float]:

@@ -16,7 +16,7 @@ from cardan_exudyn.model.postprocess import first_non_finite, postprocess
 from cardan_exudyn.model.projection import cross_rows
 from cardan_exudyn.model.solve import reusable, run_columns, solve
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 OPTIONS = ExudynOptions(modified_newton=True, jacobian_every_step=True, newton_relative_tolerance=1e-8,
                         velocity_projection=True)

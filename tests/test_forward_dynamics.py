@@ -28,10 +28,10 @@ from reference.engine.dynamics import (
     solve_dynamics,
 )
 from reference.engine.forward import ForwardDynamics, fit_periodic, right_hand_side
-from reference.scene.joint import PAIR_NAMES
-from reference.physics.joint_motion import joint_motion
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.physics.joint_motion import joint_motion
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace
 
 SPEED = 209.44  # 2000 rpm [rad/s], the paper's speed
 AGREE = 1e-10

@@ -24,7 +24,7 @@ from cardan_exudyn.sweep import read_records, run_sweep
 from cardan_exudyn.sweep.executors import SweepInterrupted
 from cardan_exudyn.sweep.records import RecordWriter
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 SIGNALS = [signal.SIGINT, signal.SIGTERM]
 STOP_WITHIN_S = 5.0  # "promptly": measured 0.1-1 s here, on 2 shared cores

@@ -9,8 +9,10 @@ import pytest
 
 from cardan_exudyn import run
 from reference.paper.paper import named_scene
-from reference.scene.scene import AngleDrive, Load, scene_from_dict, scene_to_dict
+from reference.scene.drives import AngleDrive
 from reference.scene.files import load_scene
+from reference.scene.load import Load
+from reference.scene.mapping import scene_from_dict, scene_to_dict
 from reference.scene.validation import SceneError
 
 SPEED = 6.0

@@ -52,7 +52,7 @@ from cardan_exudyn.studies.stress.longrun_plan import (
 )
 from cardan_exudyn.studies.stress.longrun_report import markdown, write_long
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 
 class Tolerance(NamedTuple):

@@ -14,13 +14,13 @@ import pytest
 from scipy.interpolate import CubicSpline
 
 import cardan_exudyn
-from reference.physics import kinematics, rccc
 from reference.engine.dynamics import dynamics_columns
-from reference.physics.friction import friction_from_columns
-from reference.scene.joint import ERROR_NAMES, PAIR_NAMES
-from reference.physics.joint_motion import ideal_pair_origins, joint_motion
 from reference.paper.paper import named_scene, paper_errors
-from reference.scene.scene import replace, scene_from_dict, scene_to_dict
+from reference.physics import kinematics, rccc
+from reference.physics.friction import friction_from_columns
+from reference.physics.joint_motion import ideal_pair_origins, joint_motion
+from reference.scene.joint import ERROR_NAMES, PAIR_NAMES
+from reference.scene.mapping import replace, scene_from_dict, scene_to_dict
 from reference.scene.validation import SceneError
 
 CYLINDRICAL = ("input_spider", "spider_output", "output_frame")

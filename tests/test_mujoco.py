@@ -31,8 +31,11 @@ from cardan_exudyn.studies.mujoco_settings.compute import (  # noqa: E402
 )
 from reference.engine.dynamics import inverse_dynamics  # noqa: E402
 from reference.paper.paper import named_scene  # noqa: E402
-from reference.scene.scene import Numerics, Scene, TorqueDrive, replace  # noqa: E402
 from reference.results.schema import OptionsError, Result, Status, table_columns  # noqa: E402
+from reference.scene.drives import TorqueDrive  # noqa: E402
+from reference.scene.mapping import replace  # noqa: E402
+from reference.scene.scene import Scene  # noqa: E402
+from reference.scene.settings import Numerics  # noqa: E402
 from reference.scene.validation import SceneError  # noqa: E402
 
 DT = 1e-4

@@ -31,9 +31,9 @@ from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.model.build import build_model
 from cardan_exudyn.model.postprocess import body_states, stored
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES
-from reference.physics.kinematics import speed_ratio
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.physics.kinematics import speed_ratio
+from reference.scene.mapping import replace
 
 NODE_TYPES = ("Rxyz", "EP", "RotVecLG")
 NODE_CLASS = {"Rxyz": "RigidBodyRxyz", "EP": "RigidBodyEP", "RotVecLG": "RigidBodyRotVecLG"}

@@ -8,7 +8,6 @@ import math
 import pytest
 
 from cardan_exudyn import run
-from reference.scene.joint import GEOMETRY_LEVER, Pair
 from reference.paper.paper import (
     DEFAULT_PARAMETER_SET,
     PARAMETER_SETS,
@@ -21,7 +20,8 @@ from reference.paper.paper import (
     rig_scene,
     set_values,
 )
-from reference.scene.scene import replace, scene_from_dict, scene_to_dict
+from reference.scene.joint import GEOMETRY_LEVER, Pair
+from reference.scene.mapping import replace, scene_from_dict, scene_to_dict
 from reference.scene.validation import SceneError
 
 

@@ -37,8 +37,8 @@ from cardan_exudyn.testing.assertions import check_flow
 from reference.engine.solve import ReferenceOptions
 from reference.paper.paper import named_scene
 from reference.results.power_flow import PowerFlow, classify_works, sign_changes
-from reference.scene.scene import replace
 from reference.results.schema import SCHEMA_VERSION, Result, Status, Summary
+from reference.scene.mapping import replace
 from reference.scene.validation import DEG, RPM
 
 MIRROR = np.diag([1.0, 1.0, -1.0])

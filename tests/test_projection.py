@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import ExudynOptions, run
-from reference.physics.kinematics import speed_ratio
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.physics.kinematics import speed_ratio
+from reference.scene.mapping import replace
 
 
 def _steps(scene, n):

@@ -12,8 +12,9 @@ import pytest
 from reference.engine.batch.solve import batch_key, run_batch
 from reference.engine.solve import ReferenceOptions, run
 from reference.paper.paper import named_scene, rig_scene
-from reference.scene.scene import TorqueDrive, replace
 from reference.results.schema import OptionsError, Status
+from reference.scene.drives import TorqueDrive
+from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
 # Same samples, same arithmetic per sample: the tables agree to rounding. The works are sums of

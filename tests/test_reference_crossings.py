@@ -9,11 +9,16 @@ import math
 import numpy as np
 import pytest
 
-from reference.engine.crossings import distinct_instants, grazing_brackets, grazing_candidates, sign_change_brackets
+from reference.engine.crossings import (
+    distinct_instants,
+    grazing_brackets,
+    grazing_candidates,
+    sign_change_brackets,
+)
+from reference.engine.periodic import period_rows, repeat_period
 from reference.engine.solve import run
 from reference.paper.paper import named_scene, rig_scene
-from reference.engine.periodic import period_rows, repeat_period
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 
 def _dip(t):

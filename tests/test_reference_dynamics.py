@@ -10,12 +10,15 @@ from test_reference_kinematics import derivative
 
 from reference.engine import solve as engine
 from reference.engine.dynamics import inverse_dynamics, reaction_system
-from reference.scene.joint import PAIR_NAMES, Body, Geometry, Joint
+from reference.paper.paper import named_scene
 from reference.physics.joint_motion import joint_motion
 from reference.physics.kinematics import body_motions, speed_ratio
-from reference.paper.paper import named_scene
-from reference.scene.scene import Load, Scene, SpeedDrive, replace
 from reference.results.schema import Status, Summary, table_columns
+from reference.scene.drives import SpeedDrive
+from reference.scene.joint import PAIR_NAMES, Body, Geometry, Joint
+from reference.scene.load import Load
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 EPS = np.finfo(float).eps
 M_IN, M_SPIDER, M_OUT = 0.9, 0.05, 0.8  # [kg]

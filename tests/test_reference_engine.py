@@ -13,11 +13,13 @@ from test_reference_kinematics import derivative
 
 from reference.engine.dynamics import reaction_system
 from reference.engine.solve import EXTRA_COLUMNS, ReferenceOptions, run
+from reference.paper.paper import named_scene, paper_scene
 from reference.physics.friction import friction_from_columns
 from reference.physics.joint_motion import joint_motion
-from reference.paper.paper import named_scene, paper_scene
-from reference.scene.scene import AngleDrive, Scene, TorqueDrive, replace
 from reference.results.schema import Status, table_columns
+from reference.scene.drives import AngleDrive, TorqueDrive
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 FRICTION_SCENES = ["paper-literal-10deg", "paper-literal-35deg", "paper-matched-20deg"]
 

@@ -10,8 +10,8 @@ import pytest
 from reference.engine.solve import ReferenceOptions, run
 from reference.paper.paper import named_scene
 from reference.results.quadrature import jump_breaks, segment_integrals
-from reference.scene.scene import replace
 from reference.results.schema import whole_revolution_window, window_integral
+from reference.scene.mapping import replace
 
 
 def _columns(t, w, y):

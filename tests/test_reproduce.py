@@ -16,10 +16,10 @@ from cardan_exudyn.report import plots
 from cardan_exudyn.studies.reproduce import compute as rep
 from cardan_exudyn.studies.reproduce import report as report
 from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
-from reference.scene.joint import PAIR_NAMES
 from reference.paper.paper import PARAMETER_SETS, paper_scene, parameter_set
-from reference.scene.scene import replace
 from reference.results.schema import Result, Status, Summary
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace
 
 QUICK_IDS = [f"{p}-{c}" for p in ("physical", "literal", "matched")
              for c in ("table2-0deg-2000rpm", "table2-10deg-2000rpm", "speed-10deg-500rpm")]

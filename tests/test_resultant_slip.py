@@ -15,12 +15,12 @@ import cardan_exudyn
 from cardan_exudyn.arguments import scene_from_args
 from cardan_exudyn.cli import build_parser
 from cardan_exudyn.model.friction_law import PairLaw, pair_loads
+from reference.paper.paper import RENAMED_SETS, named_scene
 from reference.physics.bands import characteristic_speeds, sign_bands
 from reference.physics.friction import friction_from_columns, pair_friction
-from reference.scene.joint import PAIR_NAMES, Pair
-from reference.paper.paper import RENAMED_SETS, named_scene
-from reference.scene.scene import replace, scene_from_dict, scene_to_dict
 from reference.scene.files import load_scene
+from reference.scene.joint import PAIR_NAMES, Pair
+from reference.scene.mapping import replace, scene_from_dict, scene_to_dict
 from reference.scene.validation import SceneError
 
 # the set fitted to the paper's numbers (formerly "calibrated"): its rig case with the stated

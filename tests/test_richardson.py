@@ -15,8 +15,8 @@ from cardan_exudyn.model import richardson
 from reference.engine.solve import ReferenceOptions, columns_at, input_motion
 from reference.physics.kinematics import speed_ratio
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
 from reference.scene.files import load_scene
+from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
 SCENE = "paper-literal-35deg-frictionless"

@@ -19,8 +19,8 @@ import pytest
 import rigdata
 from cardan_exudyn.engines import run
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace as replace_field
 from reference.results.schema import Status
+from reference.scene.mapping import replace as replace_field
 from rigdata import synthetic
 from rigdata.conditioning import Conditioning, condition, estimate_phase, pulse_edges
 from rigdata.efficiency import measured_efficiency, window_weights

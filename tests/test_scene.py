@@ -10,10 +10,11 @@ import pytest
 import tomli_w
 
 import reference
-from reference.scene.joint import Body, Geometry
 from reference.paper.paper import assumption_register, named_scene, paper_cases, stated_values, table1_body
-from reference.scene.scene import SpeedDrive, replace, scene_from_dict, scene_to_dict
+from reference.scene.drives import SpeedDrive
 from reference.scene.files import load_scene
+from reference.scene.joint import Body, Geometry
+from reference.scene.mapping import replace, scene_from_dict, scene_to_dict
 from reference.scene.validation import SceneError
 
 DIAG = [[1e-3, 0, 0], [0, 1e-3, 0], [0, 0, 1e-3]]

@@ -9,18 +9,12 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import engines
-from reference.physics.bands import SPEED_FLOOR, characteristic_speeds, nominal_speed, sign_bands
-from reference.scene.joint import PAIR_NAMES
 from reference.paper.paper import named_scene
-from reference.scene.scene import (
-    DEFAULT_SIGN_BAND_RELATIVE,
-    AngleDrive,
-    FrictionSettings,
-    TorqueDrive,
-    replace,
-    scene_from_dict,
-    scene_to_dict,
-)
+from reference.physics.bands import SPEED_FLOOR, characteristic_speeds, nominal_speed, sign_bands
+from reference.scene.drives import AngleDrive, TorqueDrive
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace, scene_from_dict, scene_to_dict
+from reference.scene.settings import DEFAULT_SIGN_BAND_RELATIVE, FrictionSettings
 from reference.scene.validation import SceneError
 
 

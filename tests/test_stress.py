@@ -17,7 +17,7 @@ from cardan_exudyn.model.stepsize import error_coefficient
 from cardan_exudyn.studies.stress import map as stress_map
 from cardan_exudyn.studies.stress.map import Panel, base_scene, classify, efficiency_promise, measure_cell
 from reference.physics.kinematics import speed_ratio
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 
 def record(**changes):

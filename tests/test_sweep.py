@@ -220,7 +220,7 @@ def test_reference_sweep_records_the_summary_and_writes_the_table(tmp_path):
     parameters as columns and sweep.json the statistics over the cases."""
     from cardan_exudyn import engines
     from reference.paper.paper import named_scene
-    from reference.scene.scene import replace
+    from reference.scene.mapping import replace
 
     angles = [0, 10, 20]
     summary = run_sweep({**BASE, "grid": {"joint.geometry.shaft_angle_deg": angles}}, tmp_path, workers=1)
@@ -485,7 +485,7 @@ def test_dask_cluster_gives_the_local_results(tmp_path, monkeypatch):
 def test_summary_outputs_are_scalars():
     """The default case function keeps numbers and strings, flattens small tables, drops the scene."""
     from reference.paper.paper import named_scene
-    from reference.scene.scene import replace
+    from reference.scene.mapping import replace
 
     out = summary_outputs(replace(named_scene("paper-literal-10deg"), revolutions=1), "reference")
     assert "scene" not in out and out["status"] == "ok"

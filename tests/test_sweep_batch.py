@@ -19,7 +19,7 @@ from cardan_exudyn import engines
 from cardan_exudyn.sweep import Batch, CaseFunction, expand_cases, plan_tasks, read_records, run_sweep
 from cardan_exudyn.sweep.spec import spec_from_mapping
 from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
 TESTS = Path(__file__).parent

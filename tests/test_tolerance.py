@@ -17,7 +17,7 @@ from cardan_exudyn.studies.tolerance.compute import (
     verdict_line,
 )
 from reference.paper.paper import RENAMED_SETS, named_scene
-from reference.scene.scene import replace
+from reference.scene.mapping import replace
 
 # the set fitted to the paper's numbers (formerly "calibrated"), whose measurements these tests hold
 MATCHED = RENAMED_SETS["calibrated"]

@@ -44,9 +44,10 @@ import numpy as np
 from cardan_exudyn.model.coupling import FrictionCoupling
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES, TWO_PI, RotationCoordinates, WholeTurns
 from reference.physics import rccc
+from reference.scene.drives import AngleDrive, SpeedDrive
 from reference.scene.histories import run_clock
 from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
-from reference.scene.scene import AngleDrive, Scene, SpeedDrive
+from reference.scene.scene import Scene
 
 CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
 

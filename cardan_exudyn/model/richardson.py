@@ -43,9 +43,10 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from reference.scene.joint import PAIR_NAMES
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Summary, instantaneous_efficiency
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 __all__ = ["EXTRAPOLATED", "FROM_FINE", "FILTERED", "smooth", "extrapolate", "combine", "refusal",
            "run_pair"]

@@ -32,9 +32,7 @@ from cardan_exudyn.model.stepsize import (
     revolution_period,
     richardson,
 )
-from reference.scene.joint import PAIR_NAMES
 from reference.physics.loop_closure import LoopClosureError
-from reference.scene.scene import AngleDrive, Scene, replace, scene_to_dict
 from reference.results.schema import (
     REACTION_SUFFIXES,
     Result,
@@ -42,6 +40,10 @@ from reference.results.schema import (
     Summary,
     result_table,
 )
+from reference.scene.drives import AngleDrive
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace, scene_to_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError, check_steps
 
 ENGINE_NAME = "exudyn"

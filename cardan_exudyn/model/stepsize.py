@@ -27,8 +27,9 @@ from __future__ import annotations
 
 import math
 
+from reference.scene.drives import AngleDrive, SpeedDrive
 from reference.scene.joint import PAIR_NAMES
-from reference.scene.scene import AngleDrive, Scene, SpeedDrive
+from reference.scene.scene import Scene
 from reference.scene.validation import MAX_STEPS_PER_REVOLUTION, refuse_steps_per_revolution
 
 __all__ = ["ERROR_CONSTANT", "MIN_STEPS_PER_REVOLUTION", "MAX_STEPS_PER_REVOLUTION", "NODE_ERROR",

@@ -30,9 +30,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 from reference.physics.kinematics import body_motions, pair_frames_in_body_a, rot_z
-from reference.scene.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.results.schema import (
     OptionsError,
     Result,
@@ -41,6 +39,10 @@ from reference.results.schema import (
     instantaneous_efficiency,
     result_table,
 )
+from reference.scene.drives import AngleDrive, SpeedDrive, TorqueDrive
+from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
+from reference.scene.mapping import scene_to_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import refuse_steps_per_revolution
 
 ENGINE_NAME = "mujoco"

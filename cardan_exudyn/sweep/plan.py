@@ -27,8 +27,9 @@ from cardan_exudyn.sweep.spec import (
     spec_from_mapping,
 )
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace, scene_to_dict
 from reference.scene.files import load_scene, scene_from_mapping
+from reference.scene.mapping import replace, scene_to_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 
 __all__ = ["PLAN_FORMAT", "Case", "Plan", "expand_cases", "base_scene", "make_plan", "plan_difference"]

@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.io import to_jsonable
-from reference.scene.scene import Scene, scene_to_dict
 from reference.scene.files import read_toml
+from reference.scene.mapping import scene_to_dict
+from reference.scene.scene import Scene
 
 __all__ = ["SweepError", "Distribution", "RandomSpec", "SweepSpec", "CaseFunction",
            "DEFAULT_FUNCTION", "grid_values", "function_name", "resolve_function", "flatten_paths",

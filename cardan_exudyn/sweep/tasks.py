@@ -25,8 +25,9 @@ from cardan_exudyn.io import to_jsonable
 from cardan_exudyn.sweep.plan import Case
 from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, scalar_summary
 from cardan_exudyn.sweep.spec import DEFAULT_FUNCTION, CaseFunction, flatten_paths, resolve_function
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Status
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 __all__ = ["BATCH_SIZE", "BATCHES_PER_WORKER", "Batch", "Task", "batched_function", "batch_size_for",
            "plan_tasks", "run_case", "run_batch_cases", "run_task", "task_cases", "task_key"]

@@ -6,8 +6,9 @@ from pathlib import Path
 from typing import Any
 
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
 from reference.scene.files import load_scene
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 
 __all__ = ["make_scene"]
@@ -25,7 +26,7 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
     root : str or pathlib.Path, optional
         The folder a relative file path is taken from (the current folder by default).
     **changes
-        Scene fields by dotted path, as :func:`reference.scene.scene.replace` takes them; a double
+        Scene fields by dotted path, as :func:`reference.scene.mapping.replace` takes them; a double
         underscore stands for the dot, so ``numerics__accuracy=1e-4`` is
         ``**{"numerics.accuracy": 1e-4}``. Unit-suffixed names work (``shaft_angle_deg``).
 

@@ -27,7 +27,6 @@ from typing import Any
 
 import numpy as np
 
-from reference.physics.bands import sign_bands
 from reference.engine.crossings import (
     SCAN_PER_REVOLUTION,
     distinct_instants,
@@ -49,12 +48,10 @@ from reference.engine.gauss import (
     initial_panels,
     quadrature_summary,
 )
-from reference.scene.histories import run_clock
-from reference.scene.joint import PAIR_NAMES
+from reference.engine.periodic import period_rows, repeat_period
+from reference.physics.bands import sign_bands
 from reference.physics.joint_motion import joint_motion
 from reference.physics.loop_closure import LoopClosureError
-from reference.engine.periodic import period_rows, repeat_period
-from reference.scene.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.results.schema import (
     OptionsError,
     Result,
@@ -63,6 +60,11 @@ from reference.results.schema import (
     result_table,
     whole_revolution_window,
 )
+from reference.scene.drives import AngleDrive, SpeedDrive, TorqueDrive
+from reference.scene.histories import run_clock
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import scene_to_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import check_steps, require_scene
 
 ENGINE_NAME = "reference"

@@ -45,8 +45,12 @@ from typing import Any
 
 import numpy as np
 
+from reference.scene.drives import SpeedDrive
 from reference.scene.joint import GEOMETRY_LEVER, Body, Geometry, Joint, Pair, Pairs
-from reference.scene.scene import Load, Record, Scene, SpeedDrive, replace
+from reference.scene.load import Load
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
+from reference.scene.settings import Record
 from reference.scene.validation import DEG, RPM, SceneError, SceneTypeError, finite
 
 try:

@@ -10,7 +10,7 @@ with the input speed (at 1 rpm the paper's spider pairs rub at 0.03 mm/s RMS, be
 nearly all the time, and the mean efficiency was 0.998 where the exact sign gives 0.991).
 
 So by default each band is relative (``FrictionSettings.sign_band_relative``, default 1e-3,
-:data:`reference.scene.scene.DEFAULT_SIGN_BAND_RELATIVE`): ``band = sign_band_relative * v_char``,
+:data:`reference.scene.settings.DEFAULT_SIGN_BAND_RELATIVE`): ``band = sign_band_relative * v_char``,
 where ``v_char`` is the pair's *characteristic speed*, the RMS over one input revolution of its
 surface (or sliding) speed when the input turns uniformly at the scene's :func:`nominal_speed`.
 The kinematics are linear in the input speed, so these are the speeds at 1 rad/s (closed form
@@ -44,9 +44,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from reference.scene.joint import PAIR_NAMES
 from reference.physics.joint_motion import joint_motion
-from reference.scene.scene import AngleDrive, Scene
+from reference.scene.drives import AngleDrive
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.scene import Scene
 
 __all__ = ["PROFILE_SAMPLES", "SPEED_FLOOR", "PairBands", "PairSpeeds", "characteristic_speeds",
            "profile_angles", "speeds_from_profile", "needs_speeds", "bands_from_speeds", "nominal_speed",

@@ -35,9 +35,9 @@ from typing import Any
 
 import numpy as np
 
-from reference.scene.joint import PAIR_NAMES
 from reference.results.power_flow import PowerFlow, classify_works, likely_cause, sign_changes, source_power
 from reference.results.quadrature import jump_breaks, segment_integrals
+from reference.scene.joint import PAIR_NAMES
 
 KINEMATIC_COLUMNS = ("t", "theta_in", "theta_out", "omega_in", "omega_out")
 POWER_COLUMNS = ("torque_in", "torque_out", "power_in", "power_out", "power_loss", "efficiency",
@@ -116,7 +116,7 @@ class Summary:
         Why the run did not end ``ok`` (empty when it did).
     engine, engine_version : str
     scene, options : dict
-        The scene as :func:`reference.scene.scene.scene_to_dict` gives it, and the engine's options.
+        The scene as :func:`reference.scene.mapping.scene_to_dict` gives it, and the engine's options.
     wall_time_s : float
         Wall time of the whole run [s].
     dt : float or None

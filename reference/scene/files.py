@@ -2,9 +2,9 @@
 
 A file (or a table in a sweep spec) may begin with ``base = "paper-10deg"`` (any name of
 :func:`reference.paper.paper.named_scene`) and override only what differs; the rest of the table is
-the dictionary form of :func:`reference.scene.scene.scene_from_dict`. Resolving the base needs the
+the dictionary form of :func:`reference.scene.mapping.scene_from_dict`. Resolving the base needs the
 paper's data, which itself is built from scenes, so this module sits above both
-:mod:`reference.scene.scene` and :mod:`reference.paper.paper` and neither imports it.
+:mod:`reference.scene.mapping` and :mod:`reference.paper` and neither imports it.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from reference.paper.paper import named_scene
-from reference.scene.scene import UNIT_ALIASES, Scene, scene_from_dict, scene_to_dict
+from reference.scene.mapping import UNIT_ALIASES, scene_from_dict, scene_to_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError, SceneTypeError
 
 try:
@@ -103,7 +104,7 @@ def load_scene(path: str | pathlib.Path) -> Scene:
 
 
 def scene_from_mapping(data: Mapping[str, Any]) -> Scene:
-    """Like :func:`reference.scene.scene.scene_from_dict`, resolving an optional ``base`` named scene
+    """Like :func:`reference.scene.mapping.scene_from_dict`, resolving an optional ``base`` named scene
     first.
 
     Parameters

@@ -30,7 +30,8 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM
 
 __all__ = ["ANGLES_DEG", "SPEEDS_RPM", "FRICTIONS", "DRIVES", "grid_cells", "cell_scene", "run_cell",

@@ -30,8 +30,9 @@ from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, SCENES, Progress, quiet, simulated_time
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Status
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 __all__ = ["AUDIT_SCENE", "Tweak", "Clock", "AuditItem", "run_wall", "solve_only", "audit_items",
            "skip_audit"]
@@ -180,7 +181,7 @@ def fast_module_time(scene_name: str, steps: int, revolutions: float, runs: int,
         "from cardan_exudyn.engines import run\n"
         "from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED\n"
         "from reference.paper.paper import named_scene\n"
-        "from reference.scene.scene import replace\n"
+        "from reference.scene.mapping import replace\n"
         f"s = named_scene({scene_name!r})\n"
         f"s = replace(s, **{{'numerics.dt': 2*math.pi/s.drive.speed/{steps}, "
         f"'record.timeseries': False, 'revolutions': {revolutions!r}}})\n"

@@ -44,8 +44,9 @@ from cardan_exudyn.studies.tolerance.compute import default_distributions, monte
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
 from reference.engine.solve import ReferenceOptions
 from reference.paper.paper import named_scene, rig_scene
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Status
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 __all__ = ["SIZES", "QUICK_SIZES", "MONTE_CARLO_SAMPLES", "MONTE_CARLO_TARGET_S", "PAPER_BATCH_TARGET_S",
            "DASK_SAMPLES", "TORQUE_TARGET_S", "torque_drive", "tolerance_scenes", "cost_by_batch_size",

@@ -21,8 +21,10 @@ from cardan_exudyn import engines
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from reference.engine.solve import ReferenceOptions
 from reference.paper.paper import named_scene, paper_errors
-from reference.scene.scene import COUPLINGS, Scene, replace
 from reference.results.schema import Result
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
+from reference.scene.settings import COUPLINGS
 
 __all__ = ["SCENES", "MOUNTING_ERROR_SCENES", "ENGINE_NAMES", "EXUDYN_DEFAULT", "EXUDYN_TUNED",
            "FULL_LADDER", "QUICK_LADDER", "BenchError", "Progress", "quiet", "Config", "bench_scene",
@@ -137,7 +139,7 @@ class Config:
     options : engine options or None
         Options of the engine's class; None takes the engine's defaults.
     changes : mapping or tuple of (str, value) pairs
-        Scene changes as :func:`reference.scene.scene.replace` takes them (``{"friction.coupling":
+        Scene changes as :func:`reference.scene.mapping.replace` takes them (``{"friction.coupling":
         "lagged"}``, ``{"numerics.richardson": True}``); stored as a sorted tuple of pairs.
     sets_step : bool
         True: ``steps`` sets the scene's time step; False: the options hold the resolution (the

@@ -35,8 +35,9 @@ from cardan_exudyn.studies.bench.configs import (
 )
 from reference.engine.solve import InputMotion, ReferenceOptions, columns_at, input_motion
 from reference.physics.kinematics import speed_ratio
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Result, Summary
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 __all__ = ["ERROR_KEYS", "Yardstick", "yardstick", "run_errors", "cost_counters", "Job",
            "bench_jobs", "timed_run", "work_precision"]

@@ -28,8 +28,8 @@ from cardan_exudyn.studies.bench.targets import (
     evaluate_targets,
     paper_scenes_timing,
 )
-from reference.scene.scene import COUPLINGS
 from reference.results.schema import Status
+from reference.scene.settings import COUPLINGS
 
 __all__ = ["BenchResult", "check_inputs", "check_paper", "run_bench"]
 
@@ -150,7 +150,7 @@ def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[
         Exudyn's steps per revolution in the paper scenes' timing (``"auto"``: each scene's own
         step for the target accuracy).
     paper_coupling : str
-        Exudyn's friction coupling there (one of :data:`reference.scene.scene.COUPLINGS`).
+        Exudyn's friction coupling there (one of :data:`reference.scene.settings.COUPLINGS`).
 
     Raises
     ------

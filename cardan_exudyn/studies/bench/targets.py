@@ -30,8 +30,9 @@ from cardan_exudyn.studies.bench.ladders import yardstick
 from cardan_exudyn.studies.bench.startup import IMPORT_TARGET_MS
 from reference.engine.solve import ReferenceOptions
 from reference.paper.paper import paper_cases, paper_scene
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Result, Status
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 __all__ = ["SPEED_RATIO_TARGET", "EFFICIENCY_TARGET", "FRICTION_COST_TARGET", "KINEMATICS_TARGET",
            "PAPER_EXUDYN_TARGET_S", "PAPER_REFERENCE_TARGET_S", "STARTUP_TARGET_MS", "TARGETS",

@@ -24,11 +24,11 @@ from cardan_exudyn.mujoco.engine import (
     MujocoOptions,
 )
 from reference.engine.dynamics import inverse_dynamics
-from reference.physics.kinematics import speed_ratio
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene
-from reference.scene.scene import replace as replace_scene
+from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Result
+from reference.scene.mapping import replace as replace_scene
+from reference.scene.scene import Scene
 
 __all__ = ["MUJOCO_DEFAULT_TIMESTEP", "MUJOCO_DEFAULTS", "STUDY_SCENES", "STUDY_TIMESTEPS",
            "accuracy", "study_cases", "low_speed_cases", "settings_study"]

@@ -80,10 +80,11 @@ from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, count, out_f
 from cardan_exudyn.io import atomic_directory, atomic_write, dumps
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
-from reference.scene.joint import PAIR_NAMES
 from reference.paper.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
-from reference.scene.scene import Scene, replace, scene_to_dict
 from reference.results.schema import Result, Status
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace, scene_to_dict
+from reference.scene.scene import Scene
 
 __all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_OVERRIDES",
            "PaperRun", "Reproduction", "run_numbers", "paper_case_outputs", "selected_cases",

@@ -132,8 +132,9 @@ from cardan_exudyn.studies.stress.longrun_plan import (
 )
 from cardan_exudyn.studies.stress.longrun_summary import summarise
 from reference.engine.solve import ReferenceOptions
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Status, cumulative
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 Say = Callable[[str], None]
 #: An energy case: label, function, its arguments but the label, engine, spectral radius, steps.

@@ -13,7 +13,8 @@ from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step
 from cardan_exudyn.studies.stress.longrun_measures import damping_coefficient
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 #: The engine whose long runs are measured, and the one measuring it (no time steps to drift).
 ENGINE, REFERENCE = "exudyn", "reference"

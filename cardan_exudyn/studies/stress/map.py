@@ -51,11 +51,12 @@ from cardan_exudyn.model.stepsize import error_coefficient
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import CASES_FILE, SweepSpec, read_records, run_sweep
 from reference.engine.solve import ReferenceOptions
-from reference.scene.joint import PAIR_NAMES
-from reference.physics.kinematics import speed_ratio
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
+from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Status, Summary
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM
 
 #: The engine the map tests, and the one it is tested against.

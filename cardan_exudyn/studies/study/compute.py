@@ -27,8 +27,9 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table
 from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
 from reference.results.schema import Status
+from reference.scene.mapping import replace
+from reference.scene.scene import Scene
 
 Progress = Callable[[str], None]
 

@@ -32,6 +32,7 @@ import numpy as np
 from reference.engine.batch.model import SceneStack
 from reference.engine.batch.quadrature import work_quadratures
 from reference.engine.dynamics import friction_slots
+from reference.engine.periodic import period_rows, repeat_period
 from reference.engine.solve import (
     ENGINE_NAME,
     ENGINE_VERSION,
@@ -43,9 +44,10 @@ from reference.engine.solve import (
     table_times,
     table_verdict,
 )
-from reference.engine.periodic import period_rows, repeat_period
-from reference.scene.scene import Scene, SpeedDrive, scene_to_dict
 from reference.results.schema import OptionsError, Result, Status, Summary, result_table
+from reference.scene.drives import SpeedDrive
+from reference.scene.mapping import scene_to_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError, check_steps, require_scene
 
 __all__ = ["BATCH_SCENES", "batch_key", "check_scenes", "run_batch"]

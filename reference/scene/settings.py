@@ -1,0 +1,160 @@
+"""A scene's engine-independent settings: accuracy, friction coupling and regularisation, records."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from reference.scene.validation import MAX_STEPS, SceneError, non_negative, positive, set_field
+
+__all__ = ["COUPLINGS", "DEFAULT_SIGN_BAND_RELATIVE", "FRICTION_LAWS", "MAX_ITERATIONS", "FrictionSettings",
+           "Numerics", "Record"]
+
+MAX_ITERATIONS = 10_000
+"""Most friction updates per step ``FrictionSettings.max_iterations`` may ask for."""
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """Engine-independent accuracy settings.
+
+    Attributes
+    ----------
+    dt : float or None
+        Time step [s]; None lets the engine choose it from ``accuracy`` and the scene.
+    accuracy : float
+        Target absolute error of the mean efficiency [-] (the headline number), also the target
+        relative error of omega_out/omega_in. A time-stepping engine chooses its step to meet
+        both when ``dt`` is None, and every run reports its estimated mean-efficiency error
+        (``Summary.efficiency_error_estimate``, ``accuracy_met``; ``docs/accuracy.md``).
+    richardson : bool
+        Time stepping at ``h`` and ``h / 2``, extrapolated (``docs/bench.md``); reference: ignored.
+    """
+
+    dt: float | None = None
+    accuracy: float = 1e-3
+    richardson: bool = False
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.richardson, bool):
+            raise SceneError(f"`richardson` must be true or false, got {self.richardson!r}")
+        if self.dt is not None:
+            set_field(self, "dt", positive("dt", self.dt))
+        acc = positive("accuracy", self.accuracy)
+        if acc >= 1.0:
+            raise SceneError(f"`accuracy` must be < 1, got {acc!r}")
+        set_field(self, "accuracy", acc)
+
+
+COUPLINGS = ("converged", "lagged", "uncoupled", "extrapolated")
+FRICTION_LAWS = ("paper", "resultant")
+DEFAULT_SIGN_BAND_RELATIVE = 1e-3
+"""Default ``FrictionSettings.sign_band_relative`` [-] (``docs/paper.md``, "Friction at every speed")."""
+
+
+@dataclass(frozen=True)
+class FrictionSettings:
+    """How the friction of eqs. (1)-(5) is coupled to the reactions and regularised.
+
+    Attributes
+    ----------
+    coupling : str
+        ``"extrapolated"`` (default): one Newton solve per step, the law on extrapolated inputs
+        (``cardan_exudyn.model.coupling``); ``"converged"``: within each time step, friction and
+        reactions are iterated to a fixed point (the friction of the step's own reactions);
+        ``"lagged"``: the paper's scheme (section 3.1), the reactions at the end of a step set the
+        friction applied during the next step; ``"uncoupled"``: friction is *not* applied to the
+        dynamics, eqs. (3), (5) are evaluated on the frictionless reactions and their power is
+        the loss (a first-order estimate, used to explain the paper's tolerance figure; the energy
+        balance then misses the loss). The reference solves the fixed point for the others.
+    sign_band : float or None
+        One absolute ramp width [m/s] for every pair: below it ``sign()`` of eqs. (3), (5) is
+        replaced by a linear ramp ``clip(v / sign_band, -1, 1)`` of the relative surface speed
+        ``v`` (``omega_rel d / 2`` for the rotation of a journal, the sliding speed for axial
+        friction); 0 means the exact sign. None (default): the relative band below.
+    sign_band_relative : float or None
+        Ramp width of each pair as a fraction of the pair's characteristic speed [-] (its RMS
+        surface, or sliding, speed over an input revolution at the drive's speed;
+        :func:`reference.physics.bands.sign_bands`), so that the regularisation removes the same share
+        of friction at every speed; 0 means the exact sign. None: 1e-3
+        (:data:`DEFAULT_SIGN_BAND_RELATIVE`) unless ``sign_band`` is given. Give at most
+        one of the two.
+    tolerance : float
+        Converged coupling: the fixed point is accepted when the largest change of a friction
+        load is below ``tolerance`` times the largest friction load (forces counted as the
+        torque they make at the journal radius, ``F d / 2``).
+    max_iterations : int
+        Converged coupling: friction updates per step before the step is declared not converged.
+    law : str
+        Direction of the friction of a pair that rotates and slides (a cylindrical pair of a joint
+        with mounting errors). ``"paper"`` (default): eqs. (3), (5) as written, a Coulomb torque
+        ``-s(omega_rel d/2) f (d/2) N`` about the axis and, independently, a Coulomb force
+        ``-s(v_slide) f N`` along it, ``N = |F| + 2 |M| / L`` (the full load in both directions at
+        once). ``"resultant"``: one Coulomb force ``f N`` opposing the resultant slip velocity
+        ``v = (omega_rel d/2, v_slide)`` of the contact, regularised as a vector,
+        ``-f N v / max(|v|, band)``: torque ``(d/2)`` times its circumferential, axial force its
+        axial component (:func:`reference.physics.bands.sign_bands`, ``resultant`` band). Both laws agree
+        for a revolute pair and a pair that does not slide (``docs/scenes.md``, "Friction law").
+    """
+
+    coupling: str = "extrapolated"
+    sign_band: float | None = None
+    sign_band_relative: float | None = None
+    tolerance: float = 1e-6
+    max_iterations: int = 20
+    law: str = "paper"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.coupling, str) or self.coupling not in COUPLINGS:
+            raise SceneError(f"`coupling` must be one of {list(COUPLINGS)}, got {self.coupling!r}")
+        if not isinstance(self.law, str) or self.law not in FRICTION_LAWS:
+            raise SceneError(f"`law` must be one of {list(FRICTION_LAWS)}, got {self.law!r:.80}")
+        if self.sign_band is not None and self.sign_band_relative is not None:
+            raise SceneError(
+                f"give either `sign_band` (absolute, m/s) or `sign_band_relative` (fraction of each "
+                f"pair's speed), not both; got {self.sign_band!r} and {self.sign_band_relative!r}")
+        for name in ("sign_band", "sign_band_relative"):
+            if getattr(self, name) is not None:
+                set_field(self, name, non_negative(name, getattr(self, name)))
+        tol = positive("tolerance", self.tolerance)
+        if tol >= 1.0:
+            raise SceneError(f"`tolerance` must be < 1, got {tol!r}")
+        set_field(self, "tolerance", tol)
+        if (isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int)
+                or not 2 <= self.max_iterations <= MAX_ITERATIONS):
+            raise SceneError(f"`max_iterations` must be an integer in [2, {MAX_ITERATIONS}], "
+                             f"got {self.max_iterations!r:.40}")
+
+    @property
+    def relative_band(self) -> float | None:
+        """The relative ramp width in effect [-]: ``sign_band_relative``, its default 1e-3, or
+        None when the absolute ``sign_band`` is given."""
+        if self.sign_band is not None:
+            return None
+        return DEFAULT_SIGN_BAND_RELATIVE if self.sign_band_relative is None else self.sign_band_relative
+
+
+@dataclass(frozen=True)
+class Record:
+    """What to record.
+
+    Attributes
+    ----------
+    timeseries : bool
+        Return the time table; when False only the summary is produced.
+    every : int
+        Keep every n-th step in the time table (the summary always uses every step).
+    skip_revolutions : float
+        Input revolutions at the start excluded from the mean values [-], >= 0.
+    """
+
+    timeseries: bool = True
+    every: int = 1
+    skip_revolutions: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.timeseries, bool):
+            raise SceneError(f"`timeseries` must be true or false, got {self.timeseries!r}")
+        if isinstance(self.every, bool) or not isinstance(self.every, int) \
+                or not 1 <= self.every <= MAX_STEPS:
+            raise SceneError(f"`every` must be an integer in [1, {MAX_STEPS}], got {self.every!r:.40}")
+        set_field(self, "skip_revolutions", non_negative("skip_revolutions", self.skip_revolutions))
