@@ -24,7 +24,7 @@ else:  # Python 3.10
     import tomli as tomllib
 
 from cardan_exudyn.io import OutputError, check_output_folder
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.files import load_scene
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

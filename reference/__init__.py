@@ -38,7 +38,7 @@ _HOMES = {
     "reference.scene.scene": ("Scene",),
     "reference.scene.mapping": ("replace", "scene_to_dict", "scene_from_dict"),
     "reference.scene.files": ("load_scene", "scene_from_mapping"),
-    "reference.paper.paper": ("named_scene", "paper_scene", "rig_scene"),
+    "reference.paper.scenes": ("named_scene", "paper_scene", "rig_scene"),
     "reference.results.schema": ("Status", "Result", "Summary", "OptionsError"),
     "reference.engine.solve": ("ReferenceOptions", "run"),
 }

@@ -28,7 +28,7 @@ from scipy.interpolate import CubicSpline
 
 from cardan_exudyn import engines
 from reference.engine.solve import ReferenceOptions, columns_at, input_motion
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.results.schema import Result
 from reference.scene.drives import AngleDrive
 from reference.scene.load import Load
@@ -50,7 +50,7 @@ class RigSettings:
     Attributes
     ----------
     scene : str
-        Named scene of the joint (``reference.paper.paper.named_scene``); its drive and load are
+        Named scene of the joint (``reference.paper.scenes.named_scene``); its drive and load are
         replaced by the motor and brake below.
     shaft_angle_deg : float or None
         The joint's shaft angle [deg]; None: the scene's (15 for the rig).

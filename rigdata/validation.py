@@ -24,10 +24,10 @@ import numpy as np
 
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import to_jsonable
-from reference.paper.paper import named_scene
-from reference.scene.scene import Scene
-from reference.scene.files import load_scene
+from reference.paper.scenes import named_scene
 from reference.results.schema import Status
+from reference.scene.files import load_scene
+from reference.scene.scene import Scene
 from rigdata.conditioning import Conditioned, Conditioning, condition
 from rigdata.efficiency import SQRT3, Measured, check_draws, measured_efficiency
 from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
@@ -61,7 +61,7 @@ def as_record(source: Source, **read_options: Any) -> RigRecord:
 def as_scene(scene: Scene | str | os.PathLike) -> Scene:
     """``scene`` itself when it is a scene; a scene TOML file (the user's own joint, a path or a
     name ending in ``.toml``, :func:`reference.scene.files.load_scene`); else a named scene
-    (:func:`reference.paper.paper.named_scene`). Raises ``SceneError`` naming what is wrong."""
+    (:func:`reference.paper.scenes.named_scene`). Raises ``SceneError`` naming what is wrong."""
     if isinstance(scene, Scene):
         return scene
     if not isinstance(scene, (str, os.PathLike)):
@@ -290,7 +290,7 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
         A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
     scene : Scene, str or path-like
         Joint, shaft angle, friction and numerics of the model (its drive and load are replaced):
-        a scene, a scene TOML file or a name for :func:`reference.paper.paper.named_scene`
+        a scene, a scene TOML file or a name for :func:`reference.paper.scenes.named_scene`
         (:func:`as_scene`).
     engines : tuple of str
         Engines to drive (keys of :data:`cardan_exudyn.engines.ENGINES` that take angle drives

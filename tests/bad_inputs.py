@@ -31,7 +31,7 @@ from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
 from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.results.schema import OptionsError, Result, Status, Summary
 from reference.scene.files import load_scene
 from reference.scene.joint import Body
@@ -177,7 +177,7 @@ def _api_load_text(d: Path) -> Any:
 
 
 def _api_named_unknown(d: Path) -> Any:
-    """reference.paper.paper.named_scene("nope")"""
+    """reference.paper.scenes.named_scene("nope")"""
     return named_scene("nope")
 
 
@@ -293,7 +293,7 @@ def _api_scene_load_type(d: Path) -> Any:
 
 
 def _api_named_scene_list(d: Path) -> Any:
-    """reference.paper.paper.named_scene(["paper-literal"])"""
+    """reference.paper.scenes.named_scene(["paper-literal"])"""
     return named_scene(["paper-literal"])
 
 

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.drives import SpeedDrive
 from reference.scene.joint import Body, Geometry, Joint, Pair, Pairs
 from reference.scene.load import Load

@@ -93,7 +93,7 @@ def _product_sources() -> list[tuple[str, str]]:
 def test_engine_runs_go_through_the_dispatch():
     """No engine-string dispatch and no engine's run function imported outside engines.py; the
     reference package, which cannot import cardan_exudyn, may run its own engine (the paper's
-    data solve a load with it: reference.paper.paper.mean_input_load)."""
+    data solve a load with it: reference.paper.loads.solve_mean_input_load)."""
     dispatch = re.compile(r"""(==|!=)\s*["'](exudyn|reference|mujoco)["']|"""
                           r"""in\s*\(\s*["'](exudyn|reference|mujoco)["']""")
     offenders = []

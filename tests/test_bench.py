@@ -39,7 +39,7 @@ from cardan_exudyn.studies.bench.targets import (
     paper_scenes,
     paper_scenes_timing,
 )
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.results.schema import Result, Status, Summary
 from reference.scene.mapping import replace
 

@@ -14,15 +14,9 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.studies.calibrate.compute import calibrate, case_rows, fit, fit_statistics, residuals
 from cardan_exudyn.studies.calibrate.envelope import envelope_study
 from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, cases_named, set_space
-from reference.paper.paper import (
-    envelope,
-    paper_cases,
-    paper_scene,
-    parameter_set,
-    parameter_table,
-    plausible_box,
-    set_values,
-)
+from reference.paper.cases import envelope, paper_cases
+from reference.paper.parameter_sets import parameter_set, parameter_table, plausible_box, set_values
+from reference.paper.scenes import paper_scene
 from reference.scene.mapping import replace
 
 ECCENTRIC = Space(("input_eccentricity",), (0.0,), (0.001,), (False,))

@@ -24,7 +24,7 @@ from cardan_exudyn.model import friction_io as io
 from cardan_exudyn.model.friction_law import LawTable, PairLaw, magnitude_loads
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.joint import PAIR_BODIES
 from reference.scene.mapping import replace
 

@@ -9,7 +9,7 @@ import pytest
 from conftest import balanced_scene
 
 from cardan_exudyn import run
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.drives import AngleDrive
 from reference.scene.mapping import replace
 

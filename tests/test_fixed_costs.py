@@ -15,7 +15,7 @@ from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.postprocess import first_non_finite, postprocess
 from cardan_exudyn.model.projection import cross_rows
 from cardan_exudyn.model.solve import reusable, run_columns, solve
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.mapping import replace
 
 OPTIONS = ExudynOptions(modified_newton=True, jacobian_every_step=True, newton_relative_tolerance=1e-8,

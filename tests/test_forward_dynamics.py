@@ -28,7 +28,7 @@ from reference.engine.dynamics import (
     solve_dynamics,
 )
 from reference.engine.forward import ForwardDynamics, fit_periodic, right_hand_side
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.physics.joint_motion import joint_motion
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace

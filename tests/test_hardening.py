@@ -433,7 +433,7 @@ def test_reference_zero_input_work_finishes():
     """No load, no friction, no gravity: the input work cancels to ~0; the quadrature used to
     split its panels 40 times (2^40 panels: out of memory). Now it closes at once, and the
     efficiency of a joint that transmits and loses nothing is undefined (it was 1, issue 18)."""
-    from reference.paper.paper import named_scene
+    from reference.paper.scenes import named_scene
     from reference.scene.mapping import replace
 
     for angle in (0.0, 10.0):

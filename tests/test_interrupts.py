@@ -23,7 +23,7 @@ from cardan_exudyn.interrupts import Terminated, deferred_signals, terminate_rai
 from cardan_exudyn.sweep import read_records, run_sweep
 from cardan_exudyn.sweep.executors import SweepInterrupted
 from cardan_exudyn.sweep.records import RecordWriter
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.mapping import replace
 
 SIGNALS = [signal.SIGINT, signal.SIGTERM]

@@ -9,7 +9,7 @@ import pytest
 
 from cardan_exudyn.arguments import override_name, scene_from_args
 from cardan_exudyn.cli import build_parser, main
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.files import scene_from_mapping
 from reference.scene.validation import SceneError
 

@@ -18,7 +18,8 @@ import pytest
 from cardan_exudyn.arguments import DEFAULT_SCENE
 from cardan_exudyn.studies import COMMANDS
 from cardan_exudyn.studies.bench.startup import SCENE_MARKER, import_cost, parse_importtime
-from reference.paper.paper import named_scene
+from reference.paper.data import paper_data
+from reference.paper.scenes import named_scene
 
 HEAVY = ("pandas", "matplotlib", "scipy", "dask", "distributed", "mujoco", "exudyn", "tqdm")
 """Third-party packages a run loads only when it needs them (tables, plots, the engines)."""
@@ -41,7 +42,8 @@ args = cli.parse_args(sys.argv[1:])
 after_parse = loaded()
 scene = cli.scene_from_args(args)
 print(json.dumps({{"import": after_import, "parse": after_parse, "scene": loaded(),
-                  "name": scene.name, "load": scene.load.torque}}))
+                  "name": scene.name, "load": scene.load.torque,
+                  "engine": sorted(m for m in sys.modules if m.startswith("reference.engine"))}}))
 """
 
 
@@ -54,15 +56,16 @@ def probe(*argv: str) -> dict:
 
 
 def test_cardan_run_loads_nothing_heavy_before_the_engine():
-    """Importing the CLI, parsing ``cardan run`` and building its default scene (which runs the
-    reference engine for the ``physical`` set's load) loads no heavy package and no study."""
+    """Importing the CLI, parsing ``cardan run`` and building its default scene loads no heavy
+    package, no study and no engine: the ``physical`` set's load is the stored one."""
     seen = probe("run")
     for stage in ("import", "parse", "scene"):
         assert seen[stage] == {"heavy": [], "jobs": []}, stage
     scene = named_scene(DEFAULT_SCENE)
     assert seen["name"] == scene.name
-    # the load solved for (mean input torque 2 N m) by the engine, not the 2 N m itself
-    assert seen["load"] == scene.load.torque and seen["load"] != 2.0
+    # the load for a mean input torque of 2 N m, as stored in the paper's data file
+    assert seen["load"] == scene.load.torque == paper_data()["loads"]["scenes"][seen["name"]]["torque"]
+    assert seen["engine"] == []
 
 
 def test_cardan_run_with_overrides_stays_lean():

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import run
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.drives import AngleDrive
 from reference.scene.files import load_scene
 from reference.scene.load import Load

@@ -51,7 +51,7 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     model_loss,
 )
 from cardan_exudyn.studies.stress.longrun_report import markdown, write_long
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.mapping import replace
 
 

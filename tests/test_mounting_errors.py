@@ -15,7 +15,7 @@ from scipy.interpolate import CubicSpline
 
 import cardan_exudyn
 from reference.engine.dynamics import dynamics_columns
-from reference.paper.paper import named_scene, paper_errors
+from reference.paper.scenes import named_scene, paper_errors
 from reference.physics import kinematics, rccc
 from reference.physics.friction import friction_from_columns
 from reference.physics.joint_motion import ideal_pair_origins, joint_motion

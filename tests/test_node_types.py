@@ -31,7 +31,7 @@ from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.model.build import build_model
 from cardan_exudyn.model.postprocess import body_states, stored
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
 from reference.scene.mapping import replace
 

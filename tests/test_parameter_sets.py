@@ -8,18 +8,16 @@ import math
 import pytest
 
 from cardan_exudyn import run
-from reference.paper.paper import (
+from reference.paper.apply import apply_parameters
+from reference.paper.loads import mean_input_load
+from reference.paper.parameter_sets import (
     DEFAULT_PARAMETER_SET,
     PARAMETER_SETS,
-    apply_parameters,
-    mean_input_load,
-    named_scene,
-    paper_scene,
     parameter_table,
     plausible_box,
-    rig_scene,
     set_values,
 )
+from reference.paper.scenes import named_scene, paper_scene, rig_scene
 from reference.scene.joint import GEOMETRY_LEVER, Pair
 from reference.scene.mapping import replace, scene_from_dict, scene_to_dict
 from reference.scene.validation import SceneError

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import ExudynOptions, run
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
 from reference.scene.mapping import replace
 

@@ -110,7 +110,7 @@ from cardan_exudyn import run as run_engine
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step, error_coefficient
 from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.joint import PAIR_KIND, PAIR_NAMES
 from reference.scene.mapping import replace
 from reference.scene.settings import COUPLINGS, Numerics

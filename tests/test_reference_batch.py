@@ -11,7 +11,7 @@ import pytest
 
 from reference.engine.batch.solve import batch_key, run_batch
 from reference.engine.solve import ReferenceOptions, run
-from reference.paper.paper import named_scene, rig_scene
+from reference.paper.scenes import named_scene, rig_scene
 from reference.results.schema import OptionsError, Status
 from reference.scene.drives import TorqueDrive
 from reference.scene.mapping import replace

@@ -17,7 +17,7 @@ from reference.engine.crossings import (
 )
 from reference.engine.periodic import period_rows, repeat_period
 from reference.engine.solve import run
-from reference.paper.paper import named_scene, rig_scene
+from reference.paper.scenes import named_scene, rig_scene
 from reference.scene.mapping import replace
 
 

@@ -13,7 +13,7 @@ from test_reference_kinematics import derivative
 
 from reference.engine.dynamics import reaction_system
 from reference.engine.solve import EXTRA_COLUMNS, ReferenceOptions, run
-from reference.paper.paper import named_scene, paper_scene
+from reference.paper.scenes import named_scene, paper_scene
 from reference.physics.friction import friction_from_columns
 from reference.physics.joint_motion import joint_motion
 from reference.results.schema import Status, table_columns

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reference.engine.solve import ReferenceOptions, run
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.results.quadrature import jump_breaks, segment_integrals
 from reference.results.schema import whole_revolution_window, window_integral
 from reference.scene.mapping import replace

@@ -15,7 +15,8 @@ import cardan_exudyn
 from cardan_exudyn.arguments import scene_from_args
 from cardan_exudyn.cli import build_parser
 from cardan_exudyn.model.friction_law import PairLaw, pair_loads
-from reference.paper.paper import RENAMED_SETS, named_scene
+from reference.paper.parameter_sets import RENAMED_SETS
+from reference.paper.scenes import named_scene
 from reference.physics.bands import characteristic_speeds, sign_bands
 from reference.physics.friction import friction_from_columns, pair_friction
 from reference.scene.files import load_scene

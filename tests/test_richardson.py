@@ -13,8 +13,8 @@ from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.cli import main
 from cardan_exudyn.model import richardson
 from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
-from reference.paper.paper import named_scene
 from reference.scene.files import load_scene
 from reference.scene.mapping import replace
 from reference.scene.validation import SceneError

@@ -10,7 +10,10 @@ import pytest
 import tomli_w
 
 import reference
-from reference.paper.paper import assumption_register, named_scene, paper_cases, stated_values, table1_body
+from reference.paper.cases import paper_cases
+from reference.paper.data import assumption_register, stated_values
+from reference.paper.joint import table1_body
+from reference.paper.scenes import named_scene
 from reference.scene.drives import SpeedDrive
 from reference.scene.files import load_scene
 from reference.scene.joint import Body, Geometry

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cardan_exudyn import engines
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.physics.bands import SPEED_FLOOR, characteristic_speeds, nominal_speed, sign_bands
 from reference.scene.drives import AngleDrive, TorqueDrive
 from reference.scene.joint import PAIR_NAMES

@@ -219,7 +219,7 @@ def test_reference_sweep_records_the_summary_and_writes_the_table(tmp_path):
     """Each record carries the engine's scalar summary (equal to a direct run); the table has the
     parameters as columns and sweep.json the statistics over the cases."""
     from cardan_exudyn import engines
-    from reference.paper.paper import named_scene
+    from reference.paper.scenes import named_scene
     from reference.scene.mapping import replace
 
     angles = [0, 10, 20]
@@ -484,7 +484,7 @@ def test_dask_cluster_gives_the_local_results(tmp_path, monkeypatch):
 
 def test_summary_outputs_are_scalars():
     """The default case function keeps numbers and strings, flattens small tables, drops the scene."""
-    from reference.paper.paper import named_scene
+    from reference.paper.scenes import named_scene
     from reference.scene.mapping import replace
 
     out = summary_outputs(replace(named_scene("paper-literal-10deg"), revolutions=1), "reference")
@@ -495,7 +495,7 @@ def test_summary_outputs_are_scalars():
 
 def test_sweep_spec_object_and_scene_object(tmp_path):
     """Programmatic use: a SweepSpec with a Scene and explicit cases."""
-    from reference.paper.paper import named_scene
+    from reference.paper.scenes import named_scene
 
     spec = SweepSpec(scene=named_scene("rig-literal"), engine="reference", function=cheap_case,
                      cases=({"id": "x", "load.torque": 2.0}, {"id": "y", "load.torque": 13.0}))

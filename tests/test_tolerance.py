@@ -16,7 +16,8 @@ from cardan_exudyn.studies.tolerance.compute import (
     sensitivities,
     verdict_line,
 )
-from reference.paper.paper import RENAMED_SETS, named_scene
+from reference.paper.parameter_sets import RENAMED_SETS
+from reference.paper.scenes import named_scene
 from reference.scene.mapping import replace
 
 # the set fitted to the paper's numbers (formerly "calibrated"), whose measurements these tests hold

@@ -26,7 +26,7 @@ from cardan_exudyn.sweep.spec import (
     resolve_function,
     spec_from_mapping,
 )
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.files import load_scene, scene_from_mapping
 from reference.scene.mapping import replace, scene_to_dict
 from reference.scene.scene import Scene

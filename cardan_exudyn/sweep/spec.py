@@ -243,7 +243,7 @@ class SweepSpec:
     Attributes
     ----------
     scene : str, dict or Scene
-        Named scene (``reference.paper.paper.named_scene``), path to a scene TOML, a scene table, or a
+        Named scene (``reference.paper.scenes.named_scene``), path to a scene TOML, a scene table, or a
         scene.
     engine : str
         Engine of :data:`cardan_exudyn.engines.ENGINES` (a grid or a case may set ``engine``).

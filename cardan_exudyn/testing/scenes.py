@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.files import load_scene
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
@@ -21,7 +21,7 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
     ----------
     source : str, pathlib.Path or Scene
         A named scene (``"paper-10deg"``, ``"rig-frictionless"``, see
-        :func:`reference.paper.paper.named_scene`), a TOML scene file (a ``Path``, or a string ending
+        :func:`reference.paper.scenes.named_scene`), a TOML scene file (a ``Path``, or a string ending
         in ``.toml`` or holding a ``/``), or a scene to change.
     root : str or pathlib.Path, optional
         The folder a relative file path is taken from (the current folder by default).

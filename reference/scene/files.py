@@ -1,7 +1,7 @@
 """Scenes as users write them: TOML files and tables that may start from a named scene.
 
 A file (or a table in a sweep spec) may begin with ``base = "paper-10deg"`` (any name of
-:func:`reference.paper.paper.named_scene`) and override only what differs; the rest of the table is
+:func:`reference.paper.scenes.named_scene`) and override only what differs; the rest of the table is
 the dictionary form of :func:`reference.scene.mapping.scene_from_dict`. Resolving the base needs the
 paper's data, which itself is built from scenes, so this module sits above both
 :mod:`reference.scene.mapping` and :mod:`reference.paper` and neither imports it.
@@ -13,7 +13,7 @@ import pathlib
 from collections.abc import Mapping
 from typing import Any
 
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.mapping import UNIT_ALIASES, scene_from_dict, scene_to_dict
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError, SceneTypeError

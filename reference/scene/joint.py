@@ -2,7 +2,7 @@
 
 The part of a scene that describes the mechanism; :mod:`reference.scene.scene` adds what is done with
 it (drive, load, gravity, span, numerics). Every engine and the paper's data
-(:mod:`reference.paper.paper`) build on these types, so they sit below both. SI units and radians.
+(:mod:`reference.paper`) build on these types, so they sit below both. SI units and radians.
 
 Conventions (used by every engine, documented in README "Conventions")
 -----------------------------------------------------------------------

@@ -1,7 +1,7 @@
 """Checks of user input shared by every part of a scene, and the units it may be given in.
 
 The bottom of the scene modules (:mod:`reference.scene.joint`, :mod:`reference.scene.scene`,
-:mod:`reference.paper.paper`, :mod:`reference.scene.files`): it imports none of them, so each validates
+:mod:`reference.paper`, :mod:`reference.scene.files`): it imports none of them, so each validates
 its fields with the same kind of message (the field, the rule, the value given) and raises the
 same :class:`SceneError`. Values are SI inside; :data:`DEG` and :data:`RPM` convert the units
 users may give at the boundary.

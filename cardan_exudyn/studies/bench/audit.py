@@ -29,7 +29,7 @@ from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, SCENES, Progress, quiet, simulated_time
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.results.schema import Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
@@ -180,7 +180,7 @@ def fast_module_time(scene_name: str, steps: int, revolutions: float, runs: int,
         "    import exudyn\n"
         "from cardan_exudyn.engines import run\n"
         "from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED\n"
-        "from reference.paper.paper import named_scene\n"
+        "from reference.paper.scenes import named_scene\n"
         "from reference.scene.mapping import replace\n"
         f"s = named_scene({scene_name!r})\n"
         f"s = replace(s, **{{'numerics.dt': 2*math.pi/s.drive.speed/{steps}, "

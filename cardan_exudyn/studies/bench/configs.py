@@ -20,7 +20,7 @@ from typing import Any
 from cardan_exudyn import engines
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import named_scene, paper_errors
+from reference.paper.scenes import named_scene, paper_errors
 from reference.results.schema import Result
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
@@ -43,7 +43,7 @@ SCENES = {
 The ``-errors-`` scenes get Section 4.2's mounting tolerances on top (:data:`MOUNTING_ERROR_SCENES`)."""
 
 MOUNTING_ERROR_SCENES = frozenset({"frictionless-errors-10deg", "friction-errors-10deg"})
-"""Scenes with the paper's Section 4.2 tolerances (:func:`reference.paper.paper.paper_errors`: offsets
+"""Scenes with the paper's Section 4.2 tolerances (:func:`reference.paper.scenes.paper_errors`: offsets
 ``a1 = a2 = a3 = 0.5 mm``, twist errors ``alpha1 = alpha2 = alpha3 = 6e-3 deg``), so that the
 cylindrical pairs slide. They use the physical parameter set: under the literal set these
 offsets make the reference engine report self-locking from the first instant."""

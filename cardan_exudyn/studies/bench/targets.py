@@ -29,7 +29,8 @@ from cardan_exudyn.studies.bench.configs import (
 from cardan_exudyn.studies.bench.ladders import yardstick
 from cardan_exudyn.studies.bench.startup import IMPORT_TARGET_MS
 from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import paper_cases, paper_scene
+from reference.paper.cases import paper_cases
+from reference.paper.scenes import paper_scene
 from reference.results.schema import Result, Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

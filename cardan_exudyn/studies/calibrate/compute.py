@@ -35,7 +35,8 @@ from cardan_exudyn.studies.calibrate.fitting import (
     cases_named,
     set_space,
 )
-from reference.paper.paper import case_key, in_fit, paper_cases, parameter_set
+from reference.paper.cases import case_key, in_fit, paper_cases
+from reference.paper.parameter_sets import parameter_set
 
 FIT_SETS = ("physical", "matched")
 CASE_COLUMNS = ["case", "used in fit", "paper", "model", "difference"]

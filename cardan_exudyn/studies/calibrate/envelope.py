@@ -21,7 +21,7 @@ import numpy as np
 
 from cardan_exudyn.report.format import markdown_table
 from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, box_space
-from reference.paper.paper import case_key, paper_cases
+from reference.paper.cases import case_key, paper_cases
 
 METHOD = ("every combination of the discrete options; the continuous box by its 2^n corners, then "
           "a bounded local optimisation (scipy.optimize.minimize, L-BFGS-B, forward-difference "

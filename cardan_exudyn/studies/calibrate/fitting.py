@@ -18,14 +18,10 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import run
-from reference.paper.paper import (
-    apply_parameters,
-    case_key,
-    paper_cases,
-    paper_scene,
-    parameter_set,
-    plausible_box,
-)
+from reference.paper.apply import apply_parameters
+from reference.paper.cases import case_key, paper_cases
+from reference.paper.parameter_sets import parameter_set, plausible_box
+from reference.paper.scenes import paper_scene
 from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
@@ -45,7 +41,7 @@ not held to plausible dimensions; searched on a log scale."""
 
 
 def cases_named(keys: Sequence[str]) -> list[dict[str, Any]]:
-    """The paper's cases named by ``keys`` (:func:`reference.paper.paper.case_key`), in that order."""
+    """The paper's cases named by ``keys`` (:func:`reference.paper.cases.case_key`), in that order."""
     by_key = {case_key(c): c for c in paper_cases()}
     missing = [k for k in keys if k not in by_key]
     if missing:
@@ -55,7 +51,7 @@ def cases_named(keys: Sequence[str]) -> list[dict[str, Any]]:
 
 def case_scene(case: Mapping[str, Any], values: Mapping[str, Any]):
     """The scene of ``case`` under parameter ``values`` (applied to the literal reading, as
-    :func:`reference.paper.paper.paper_scene` does), one input revolution (the motion at constant speed
+    :func:`reference.paper.scenes.paper_scene` does), one input revolution (the motion at constant speed
     is periodic in one), no time series; the mean-input load solved on that scene."""
     plain = {k: v for k, v in values.items() if k != "torque_reading"}
     scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=plain)

@@ -24,7 +24,7 @@ from cardan_exudyn.mujoco.engine import (
     MujocoOptions,
 )
 from reference.engine.dynamics import inverse_dynamics
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Result
 from reference.scene.mapping import replace as replace_scene
@@ -156,7 +156,7 @@ def settings_study(scenes: Iterable[str] = STUDY_SCENES,
     Parameters
     ----------
     scenes : iterable of str
-        Named scenes (:func:`reference.paper.paper.named_scene`), frictionless, constant speed.
+        Named scenes (:func:`reference.paper.scenes.named_scene`), frictionless, constant speed.
     cases : iterable of (str, MujocoOptions), optional
         Labelled options; default :func:`study_cases`.
     repeats : int

@@ -1,7 +1,7 @@
 """``cardan reproduce``: the paper's results with friction, under its three parameter sets, as a
 report.
 
-For each parameter set of :data:`reference.paper.paper.PARAMETER_SETS` (``physical``, the default:
+For each parameter set of :data:`reference.paper.parameter_sets.PARAMETER_SETS` (``physical``, the default:
 every open value a dimension or physical quantity inside its plausible range; ``literal``: the
 paper read literally, kept as evidence; ``matched``: fitted to the paper's numbers with values
 that are not plausible dimensions) the report has
@@ -25,7 +25,7 @@ How the runs are made
 The runs (the eleven cases under each parameter set: 33; 9 with ``--quick``) are one sweep of
 :mod:`cardan_exudyn.sweep` with an explicit case list, in ``OUT/runs/``. The base scene is
 ``paper_scene(10 deg, 2000 rpm)`` of the ``physical`` set; each case's overrides are the
-leaf-by-leaf difference between its own scene (:func:`reference.paper.paper.paper_scene`, any parameter
+leaf-by-leaf difference between its own scene (:func:`reference.paper.scenes.paper_scene`, any parameter
 set) and the base, and :func:`paper_runs` checks that the runner rebuilds exactly that scene
 (the ``physical`` set's output load, solved per case for a mean input torque of 2 N m, is one
 such leaf). Case ids read like ``matched-table2-35deg-2000rpm``. So the cases can run in worker
@@ -80,7 +80,9 @@ from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, count, out_f
 from cardan_exudyn.io import atomic_directory, atomic_write, dumps
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
-from reference.paper.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
+from reference.paper.cases import paper_cases
+from reference.paper.parameter_sets import DEFAULT_PARAMETER_SET, PARAMETER_SETS
+from reference.paper.scenes import paper_scene
 from reference.results.schema import Result, Status
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace, scene_to_dict

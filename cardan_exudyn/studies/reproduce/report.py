@@ -16,19 +16,17 @@ import pandas as pd
 
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
-from reference.scene.joint import PAIR_NAMES
-from reference.paper.paper import (
+from reference.paper.cases import envelope, in_fit
+from reference.paper.data import assumption_register, stated_values
+from reference.paper.parameter_sets import (
     DEFAULT_PARAMETER_SET,
     LEVER_DIMENSIONS,
     PARAMETER_SETS,
-    assumption_register,
-    envelope,
-    in_fit,
     parameter_set,
     parameter_table,
-    stated_values,
 )
 from reference.results.schema import Status
+from reference.scene.joint import PAIR_NAMES
 
 __all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_report",
            "draw_figures", "report_text", "error_summary", "parameter_rows", "steady_revolution"]
@@ -77,7 +75,7 @@ def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]
     case : mapping
         A paper case (``study``, ``shaft_angle_deg``, ``speed_rpm``, ``paper_mean_efficiency``).
     parameters : str
-        The parameter set, one of :data:`reference.paper.paper.PARAMETER_SETS`.
+        The parameter set, one of :data:`reference.paper.parameter_sets.PARAMETER_SETS`.
     record : mapping
         The run's sweep record (:func:`cardan_exudyn.studies.reproduce.compute.run_numbers` and status).
 
@@ -316,10 +314,10 @@ def _targets(ok: pd.DataFrame) -> str:
 
 
 def parameter_rows(parameters: str) -> list[dict[str, Any]]:
-    """A set's parameter table (:func:`reference.paper.paper.parameter_table`) for the report: the
+    """A set's parameter table (:func:`reference.paper.parameter_sets.parameter_table`) for the report: the
     plausible range as text and ``inside`` as ``yes``, ``**NO**`` (outside: not a plausible
     dimension) or ``-`` (no range). A moment lever is checked as the dimension it stands for
-    (:data:`reference.paper.paper.LEVER_DIMENSIONS`), which its reason then names."""
+    (:data:`reference.paper.parameter_sets.LEVER_DIMENSIONS`), which its reason then names."""
     out = []
     for row in parameter_table(parameters):
         plausible, inside = row["plausible"], row["plausible_value"]

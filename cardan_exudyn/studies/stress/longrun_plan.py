@@ -12,7 +12,7 @@ from typing import Any
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step
 from cardan_exudyn.studies.stress.longrun_measures import damping_coefficient
-from reference.paper.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

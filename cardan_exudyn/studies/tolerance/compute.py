@@ -46,7 +46,9 @@ from cardan_exudyn.engines import ENGINES, run
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep
-from reference.paper.paper import PARAMETER_SETS, paper_errors, rig_scene, value
+from reference.paper.data import value
+from reference.paper.parameter_sets import PARAMETER_SETS
+from reference.paper.scenes import paper_errors, rig_scene
 from reference.results.schema import Status, Summary
 from reference.scene.joint import ERROR_NAMES, PAIR_NAMES
 from reference.scene.mapping import replace
@@ -118,7 +120,7 @@ def paper_case(engines: Sequence[str] = ("reference", "exudyn"),
     ----------
     engines, parameter_sets, couplings, laws : sequence of str
         Keys of :data:`cardan_exudyn.engines.ENGINES`, parameter sets of
-        :func:`reference.paper.paper.rig_scene`, ``friction.coupling`` and ``friction.law`` values.
+        :func:`reference.paper.scenes.rig_scene`, ``friction.coupling`` and ``friction.law`` values.
     progress : callable, optional
         Called with each row as it is computed.
 
