@@ -46,7 +46,7 @@ from reference.engine.fixed_point import FixedPoint, friction_law_values, reduce
 from reference.physics.friction import friction_magnitudes, pair_power_loss, regularised_sign
 from reference.scene.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
 from reference.physics.joint_motion import JointMotion, joint_motion
-from reference.physics.rccc import BodyMotion
+from reference.physics.rccc.motion import BodyMotion
 from reference.scene.scene import Scene
 from reference.results.schema import (
     PAIR_SUFFIXES,
@@ -79,7 +79,7 @@ def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
     body : Body
         Mass properties; :meth:`Body.canonical` places them in the canonical body frame, whose
         origin is the body's frame origin (the joint centre O for the ideal joint).
-    motion : reference.physics.rccc.BodyMotion
+    motion : reference.physics.rccc.motion.BodyMotion
         Pose and motion of the body.
 
     Returns

@@ -16,8 +16,8 @@ Conventions shared by both: a body's mass properties (:meth:`reference.scene.joi
 given in its canonical frame, whose origin is the body's D-H link-frame origin (the joint centre O
 for the ideal joint). Each pair's frame is attached to body ``a`` of the pair
 (:data:`reference.scene.joint.PAIR_BODIES`), z along the pair axis; its origin, the point about which
-reaction moments are taken, is where the bearing sits (:func:`reference.physics.rccc.axial_positions`) and
-moves with body ``b`` when the pair slides (:func:`reference.physics.rccc.pair_frames`).
+reaction moments are taken, is where the bearing sits (:func:`reference.physics.rccc.frames.axial_positions`) and
+moves with body ``b`` when the pair slides (:func:`reference.physics.rccc.frames.pair_frames`).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ class JointMotion:
 
     Attributes
     ----------
-    bodies : dict of str to reference.physics.rccc.BodyMotion
+    bodies : dict of str to reference.physics.rccc.motion.BodyMotion
         ``ground``, ``input``, ``spider``, ``output``: rotation (canonical axes), frame origin and
         its velocity and acceleration, angular velocity and acceleration.
     frames : dict of str to ndarray, shape (..., 3, 3)

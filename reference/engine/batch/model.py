@@ -62,7 +62,7 @@ sample at 256, 1024, 2048, 4096, 8192, 16384 samples per call; larger calls leav
 
 class StackedLoop:
     """The loop parameters of many scenes, one row per sample; it stands in for
-    :class:`reference.physics.rccc.DHParameters` where :mod:`reference.physics.rccc` only asks for the twists.
+    :class:`reference.physics.rccc.parameters.DHParameters` where :mod:`reference.physics.rccc` only asks for the twists.
 
     Parameters
     ----------
@@ -167,8 +167,8 @@ class SceneStack:
         self.zero_angle, self.zero_slide = np.nan_to_num(zero.re), np.nan_to_num(zero.du)
 
     def _check_windings(self) -> None:
-        """The windings check of :func:`reference.physics.rccc.solve_positions` for every scene at once
-        (:data:`reference.physics.rccc.WINDING_SAMPLES` input angles each): a scene whose joint angles
+        """The windings check of :func:`reference.physics.rccc.positions.solve_positions` for every scene at once
+        (:data:`reference.physics.rccc.positions.WINDING_SAMPLES` input angles each): a scene whose joint angles
         jump, or whose loop does not close at one of them, is added to :attr:`failed` (run on its
         own, the engine reports why)."""
         live = np.array([k for k in range(len(self.scenes)) if k not in self.failed], int)
@@ -234,7 +234,7 @@ class SceneStack:
 
     def _loop_rates(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray
                     ) -> tuple[StackedLoop, rccc.LoopPositions, rccc.LoopRates]:
-        """The loop's positions and rates (:func:`reference.physics.rccc.solve_motion`) per sample."""
+        """The loop's positions and rates (:func:`reference.physics.rccc.motion.solve_motion`) per sample."""
         params = StackedLoop(self.alpha[idx], self.offset[idx], self.s1[idx])
         raw = solve_wrapped(params.twists(), params.s1, theta, HOOKE, "input angles", strict=False)
         bad = ~np.all(np.isfinite(raw.re), -1)
