@@ -17,8 +17,8 @@ from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from reference.scene.scene import Scene
 from reference.results.schema import OptionsError, Result
+from reference.scene.scene import Scene
 from reference.scene.validation import require_scene
 
 
@@ -42,7 +42,7 @@ class Engine:
 ENGINES: dict[str, Engine] = {
     "exudyn": Engine("exudyn", "cardan_exudyn.model.solve", "cardan_exudyn.model.options:ExudynOptions",
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
-    "reference": Engine("reference", "reference.engine.solve", "reference.engine.solve:ReferenceOptions",
+    "reference": Engine("reference", "reference.engine.solve", "reference.engine.options:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "
                         "minimal-coordinate dynamics, adaptive work quadrature", batch="reference.engine.batch.solve"),
     "mujoco": Engine("mujoco", "cardan_exudyn.mujoco.engine", "cardan_exudyn.mujoco.engine:MujocoOptions",

@@ -40,7 +40,8 @@ _HOMES = {
     "reference.scene.files": ("load_scene", "scene_from_mapping"),
     "reference.paper.scenes": ("named_scene", "paper_scene", "rig_scene"),
     "reference.results.schema": ("Status", "Result", "Summary", "OptionsError"),
-    "reference.engine.solve": ("ReferenceOptions", "run"),
+    "reference.engine.options": ("ReferenceOptions",),
+    "reference.engine.solve": ("run",),
 }
 _LAZY = {name: module for module, names in _HOMES.items() for name in names}
 

@@ -27,7 +27,9 @@ from scipy.integrate import cumulative_trapezoid
 from scipy.interpolate import CubicSpline
 
 from cardan_exudyn import engines
-from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.engine.motion import input_motion
+from reference.engine.options import ReferenceOptions
+from reference.engine.table import columns_at
 from reference.paper.scenes import named_scene
 from reference.results.schema import Result
 from reference.scene.drives import AngleDrive

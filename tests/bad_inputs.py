@@ -30,7 +30,7 @@ from cardan_exudyn.comparison import compare
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.results.schema import OptionsError, Result, Status, Summary
 from reference.scene.files import load_scene

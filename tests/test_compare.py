@@ -28,7 +28,7 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.comparison import Comparison, compare, join_on_input_angle
 from cardan_exudyn.engines import run
 from cardan_exudyn.io import dumps
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.results.schema import OptionsError, Status
 from reference.scene.joint import PAIR_NAMES

@@ -357,7 +357,7 @@ def test_forced_failure_prints_status_not_nan(tmp_path, monkeypatch, capsys):
 
     real = engines.get_engine
     monkeypatch.setitem(engines.ENGINES, "fake", engines.Engine(
-        "fake", "reference.engine.solve", "reference.engine.solve:ReferenceOptions", "test double"))
+        "fake", "reference.engine.solve", "reference.engine.options:ReferenceOptions", "test double"))
     monkeypatch.setattr(engines, "get_engine",
                         lambda name: _nan_engine("integration_failure") if name == "fake" else real(name))
     assert main(["run", "--engine", "fake", "--out", str(tmp_path / "r")]) == 3
@@ -378,7 +378,7 @@ def test_zero_input_work_prints_undefined(monkeypatch, capsys):
 
     real = engines.get_engine
     monkeypatch.setitem(engines.ENGINES, "fake", engines.Engine(
-        "fake", "reference.engine.solve", "reference.engine.solve:ReferenceOptions", "test double"))
+        "fake", "reference.engine.solve", "reference.engine.options:ReferenceOptions", "test double"))
     monkeypatch.setattr(engines, "get_engine",
                         lambda name: _nan_engine("ok") if name == "fake" else real(name))
     assert main(["run", "--engine", "fake"]) == 0

@@ -34,7 +34,7 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.studies.stress.map import cell_class
 from cardan_exudyn.sweep.records import scalar_summary
 from cardan_exudyn.testing.assertions import check_flow
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.results.power_flow import PowerFlow, classify_works, sign_changes
 from reference.results.schema import SCHEMA_VERSION, Result, Status, Summary

@@ -109,7 +109,7 @@ from test_energy import balance_residual
 from cardan_exudyn import run as run_engine
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step, error_coefficient
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.scene.joint import PAIR_KIND, PAIR_NAMES
 from reference.scene.mapping import replace

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from reference.engine.batch.solve import batch_key, run_batch
-from reference.engine.solve import ReferenceOptions, run
+from reference.engine.options import ReferenceOptions
+from reference.engine.solve import run
 from reference.paper.scenes import named_scene, rig_scene
 from reference.results.schema import OptionsError, Status
 from reference.scene.drives import TorqueDrive

@@ -103,7 +103,7 @@ def test_summary_only_run_repeats_the_first_period(scene):
 
 
 def test_summary_only_run_evaluates_one_period(monkeypatch):
-    import reference.engine.solve as engine
+    import reference.engine.table as engine
 
     sizes, columns_at = [], engine.columns_at
     monkeypatch.setattr(engine, "columns_at", lambda s, m, t: sizes.append(np.size(t)) or columns_at(s, m, t))

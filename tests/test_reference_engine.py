@@ -12,7 +12,9 @@ from test_reference_dynamics import EPS, energy_rate, external_wrench, momentum
 from test_reference_kinematics import derivative
 
 from reference.engine.dynamics import reaction_system
-from reference.engine.solve import EXTRA_COLUMNS, ReferenceOptions, run
+from reference.engine.options import ReferenceOptions
+from reference.engine.solve import run
+from reference.engine.table import EXTRA_COLUMNS
 from reference.paper.scenes import named_scene, paper_scene
 from reference.physics.friction import friction_from_columns
 from reference.physics.joint_motion import joint_motion

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from reference.engine.solve import ReferenceOptions, run
+from reference.engine.options import ReferenceOptions
+from reference.engine.solve import run
 from reference.paper.scenes import named_scene
 from reference.results.quadrature import jump_breaks, segment_integrals
 from reference.results.schema import whole_revolution_window, window_integral

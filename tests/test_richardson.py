@@ -12,7 +12,9 @@ import pytest
 from cardan_exudyn import ExudynOptions, run
 from cardan_exudyn.cli import main
 from cardan_exudyn.model import richardson
-from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.engine.motion import input_motion
+from reference.engine.options import ReferenceOptions
+from reference.engine.table import columns_at
 from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
 from reference.scene.files import load_scene

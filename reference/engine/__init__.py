@@ -6,7 +6,9 @@ from __future__ import annotations
 from reference.lazy import lazy_face
 
 _HOMES = {
-    "reference.engine.solve": ('ReferenceOptions', 'SelfLocking', 'run'),
+    "reference.engine.options": ("ReferenceOptions",),
+    "reference.engine.motion": ("SelfLocking",),
+    "reference.engine.solve": ("run",),
     "reference.engine.batch.solve": ('run_batch',),
 }
 _LAZY = {name: module for module, names in _HOMES.items() for name in names}

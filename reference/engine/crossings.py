@@ -1,6 +1,6 @@
 """Where sampled speeds cross the edges of friction's sign ramps: brackets for a root finder.
 
-Both reference engines (one scene, :func:`reference.engine.solve.sign_breakpoints`; many,
+Both reference engines (one scene, :func:`reference.engine.breakpoints.sign_breakpoints`; many,
 :func:`reference.engine.batch.quadrature.sign_breakpoints`) sample each ramp speed on a uniform grid of
 :data:`SCAN_PER_REVOLUTION` points per input revolution and refine every bracket to rounding.
 

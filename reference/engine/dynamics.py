@@ -41,17 +41,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.physics.bands import sign_bands
 from reference.engine.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
+from reference.physics.bands import sign_bands
 from reference.physics.friction import friction_magnitudes, pair_power_loss, regularised_sign
-from reference.scene.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
 from reference.physics.joint_motion import JointMotion, joint_motion
 from reference.physics.rccc.motion import BodyMotion
-from reference.scene.scene import Scene
 from reference.results.schema import (
     PAIR_SUFFIXES,
     instantaneous_efficiency,
 )
+from reference.scene.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
+from reference.scene.scene import Scene
 
 DRIVE_ROW = 3  # the input's moment about x (rows: per body force x, y, z, moment x, y, z)
 _COMPONENTS = {"revolute": ("fx", "fy", "fz", "mx", "my"), "cylindrical": ("fx", "fy", "mx", "my")}

@@ -1,6 +1,6 @@
 """Forward dynamics of a torque-driven scene at one state in microseconds, not milliseconds.
 
-A torque drive is integrated in time (:func:`reference.engine.solve.input_motion`); every call of the
+A torque drive is integrated in time (:func:`reference.engine.motion.input_motion`); every call of the
 integrator's right-hand side needs the input acceleration at one state ``(t, theta, theta_t)``.
 Solving the Newton-Euler system for that one sample (:func:`reference.engine.dynamics.solve_dynamics`,
 kept here as :func:`direct_acceleration`) costs milliseconds of Python overhead on tiny arrays.

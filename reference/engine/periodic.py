@@ -4,7 +4,7 @@ At a constant input speed and a constant load the joint's state is a function of
 modulo one revolution (closed-form or loop kinematics, inverse dynamics, friction): every column
 of the time table repeats with the period ``T = 2 pi / |omega|`` except the time and the two shaft
 angles, which advance by ``T`` and one turn. When the table's rows fall on the same input angles in
-every revolution (a whole number of rows per period, as :func:`reference.engine.solve.table_times` gives
+every revolution (a whole number of rows per period, as :func:`reference.engine.table.table_times` gives
 for whole revolutions), the rows of the first period are evaluated and the others are copies: the
 same values to rounding (the trigonometric functions of ``theta`` and ``theta + 2 pi k`` differ
 in the last bits only), at ``1 / revolutions`` of the cost.

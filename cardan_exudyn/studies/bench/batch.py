@@ -42,7 +42,7 @@ from cardan_exudyn.studies.bench.report import header
 from cardan_exudyn.studies.bench.targets import paper_scenes
 from cardan_exudyn.studies.tolerance.compute import default_distributions, monte_carlo
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene, rig_scene
 from reference.results.schema import Status
 from reference.scene.mapping import replace

@@ -19,7 +19,7 @@ from typing import Any
 
 from cardan_exudyn import engines
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene, paper_errors
 from reference.results.schema import Result
 from reference.scene.mapping import replace

@@ -33,7 +33,9 @@ from cardan_exudyn.studies.bench.configs import (
     quiet,
     simulated_time,
 )
-from reference.engine.solve import InputMotion, ReferenceOptions, columns_at, input_motion
+from reference.engine.motion import InputMotion, input_motion
+from reference.engine.options import ReferenceOptions
+from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Result, Summary
 from reference.scene.mapping import replace

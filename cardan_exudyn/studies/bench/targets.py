@@ -28,7 +28,7 @@ from cardan_exudyn.studies.bench.configs import (
 )
 from cardan_exudyn.studies.bench.ladders import yardstick
 from cardan_exudyn.studies.bench.startup import IMPORT_TARGET_MS
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.cases import paper_cases
 from reference.paper.scenes import paper_scene
 from reference.results.schema import Result, Status

@@ -131,7 +131,7 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     energy_scene,
 )
 from cardan_exudyn.studies.stress.longrun_summary import summarise
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.results.schema import Status, cumulative
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

@@ -50,7 +50,7 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.model.stepsize import error_coefficient
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import CASES_FILE, SweepSpec, read_records, run_sweep
-from reference.engine.solve import ReferenceOptions
+from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Status, Summary

@@ -8,7 +8,7 @@ decides the code path. :meth:`SceneStack.columns` takes, per sample, the index o
 its instant, gathers each sample's parameters and evaluates all samples of all scenes in one pass
 with the functions of :mod:`reference.physics.kinematics`, :mod:`reference.physics.rccc`,
 :mod:`reference.physics.loop_closure` and :mod:`reference.engine.dynamics`: each sample's values are those of
-``reference.engine.solve.columns_at`` for its own scene, to rounding.
+``reference.engine.table.columns_at`` for its own scene, to rounding.
 
 A sample whose loop does not close (or whose branches meet) cannot be evaluated: its scene is
 added to :attr:`SceneStack.failed` (the caller runs it on its own, which reports the error) and
@@ -21,16 +21,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from reference.physics import kinematics, rccc
-from reference.physics.bands import (
-    PairBands,
-    PairSpeeds,
-    bands_from_speeds,
-    needs_speeds,
-    profile_angles,
-    speeds_from_profile,
-)
-from reference.physics.dual import Dual
 from reference.engine.dynamics import (
     DRIVE_ROW,
     cross,
@@ -46,10 +36,20 @@ from reference.engine.dynamics import (
     wrench_columns,
 )
 from reference.engine.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
+from reference.physics import kinematics, rccc
+from reference.physics.bands import (
+    PairBands,
+    PairSpeeds,
+    bands_from_speeds,
+    needs_speeds,
+    profile_angles,
+    speeds_from_profile,
+)
+from reference.physics.dual import Dual
 from reference.physics.friction import friction_magnitudes
-from reference.scene.joint import BODY_NAMES, PAIR_NAMES
 from reference.physics.joint_motion import JointMotion, ideal_pair_origins, loop_motion
 from reference.physics.loop_closure import solve_wrapped
+from reference.scene.joint import BODY_NAMES, PAIR_NAMES
 from reference.scene.scene import Scene
 
 HOOKE = -1.0
@@ -327,7 +327,7 @@ class SceneStack:
         return solve_friction(law, both[..., 0], both[..., 1:], packed, exact_gain=exact_gain)
 
     def columns(self, idx: np.ndarray, t: np.ndarray, energy: bool = True) -> dict[str, np.ndarray]:
-        """``reference.engine.solve.columns_at`` of each sample's scene: scene indices ``idx`` and
+        """``reference.engine.table.columns_at`` of each sample's scene: scene indices ``idx`` and
         instants ``t`` [s], shape (n,) each; evaluated :data:`CHUNK_SAMPLES` at a time.
         ``energy`` False: the energy columns are left zero and the loop gain is exact only where it
         decides self-locking (the work integrands need neither)."""

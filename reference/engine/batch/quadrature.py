@@ -1,4 +1,4 @@
-"""The work quadrature of :func:`reference.engine.solve.work_quadrature` for many scenes at once.
+"""The work quadrature of :func:`reference.engine.work.work_quadrature` for many scenes at once.
 
 Each scene keeps its own window, sign breakpoints, panels, Gauss rule, scale and closing rule;
 what is shared is the integrand call: every round evaluates the open panels of all scenes in one
@@ -23,8 +23,10 @@ from reference.engine.crossings import (
     grazing_candidates,
     sign_change_brackets,
 )
-from reference.engine.solve import WORK_KEYS, InputMotion, ReferenceOptions, window_times, work_means
 from reference.engine.gauss import GROSS_SCALE, MAX_OPEN_PANELS, initial_panels, quadrature_summary
+from reference.engine.motion import InputMotion
+from reference.engine.options import ReferenceOptions
+from reference.engine.work import WORK_KEYS, window_times, work_means
 from reference.results.schema import whole_revolution_window
 
 
@@ -50,7 +52,7 @@ def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) ->
 
 def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
                      t_b: np.ndarray) -> list[np.ndarray]:
-    """:func:`reference.engine.solve.sign_breakpoints` of the scenes ``members`` of ``stack`` in their
+    """:func:`reference.engine.breakpoints.sign_breakpoints` of the scenes ``members`` of ``stack`` in their
     windows ``(t_a, t_b)`` [s]; one sorted array of instants [s] per member."""
     empty = [np.zeros(0) for _ in members]
     if not stack.slots:
@@ -150,7 +152,7 @@ def _window(scene, motion: InputMotion, table: dict[str, np.ndarray]) -> tuple[f
 
 def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequence[InputMotion],
                      tables: Sequence[dict[str, np.ndarray]], options: ReferenceOptions) -> list[dict]:
-    """:func:`reference.engine.solve.work_quadrature` of the scenes ``members`` of ``stack`` (constant
+    """:func:`reference.engine.work.work_quadrature` of the scenes ``members`` of ``stack`` (constant
     speed and load: one revolution integrated, times the revolutions), one dict per member."""
     windows = [_window(stack.scenes[m], mo, tab) for m, mo, tab in zip(members, motions, tables, strict=True)]
     live = [i for i, w in enumerate(windows) if w is not None]
@@ -188,7 +190,7 @@ def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequenc
 
 def _works(values: np.ndarray, ends: dict[str, np.ndarray], info: dict, nodes: int, kinks: int,
            options: ReferenceOptions) -> dict:
-    """The dict :func:`reference.engine.solve.work_quadrature` returns (one revolution integrated)."""
+    """The dict :func:`reference.engine.work.work_quadrature` returns (one revolution integrated)."""
     work = dict(zip(WORK_KEYS, values.tolist(), strict=True))
     out = work_means(work, ends)
     out["quadrature"] = quadrature_summary(info, nodes, options.quadrature_rtol, kinks, 0, 1)

@@ -32,18 +32,11 @@ import numpy as np
 from reference.engine.batch.model import SceneStack
 from reference.engine.batch.quadrature import work_quadratures
 from reference.engine.dynamics import friction_slots
+from reference.engine.motion import input_motion
+from reference.engine.options import ReferenceOptions
 from reference.engine.periodic import period_rows, repeat_period
-from reference.engine.solve import (
-    ENGINE_NAME,
-    ENGINE_VERSION,
-    EXTRA_COLUMNS,
-    ReferenceOptions,
-    input_motion,
-    means_from_works,
-    run,
-    table_times,
-    table_verdict,
-)
+from reference.engine.solve import ENGINE_NAME, ENGINE_VERSION, means_from_works, run
+from reference.engine.table import EXTRA_COLUMNS, table_times, table_verdict
 from reference.results.schema import OptionsError, Result, Status, Summary, result_table
 from reference.scene.drives import SpeedDrive
 from reference.scene.mapping import scene_to_dict
@@ -111,7 +104,7 @@ def check_scenes(scenes: Sequence, options: ReferenceOptions | None = None) -> R
 
 def _check_steps(scene: Scene, options: ReferenceOptions) -> None:
     """The engine's step-limit checks, without running: a torque drive's before its integration,
-    any other drive's on its time table (:func:`reference.engine.solve.table_times`)."""
+    any other drive's on its time table (:func:`reference.engine.table.table_times`)."""
     if scene.drive.kind == "torque":
         spr = options.samples_per_revolution or 360
         check_steps(scene.revolutions * spr,
@@ -150,7 +143,7 @@ def _tables(stack: SceneStack, options: ReferenceOptions) -> list[Result]:
     """Every scene of ``stack``: time table, verdict, works and means (in ``stack`` order)."""
     motions = [input_motion(scene, options) for scene in stack.scenes]
     times = [table_times(scene, motion, options) for scene, motion in zip(stack.scenes, motions, strict=True)]
-    # summary only: the first period of each table, repeated (reference.engine.solve.table_columns)
+    # summary only: the first period of each table, repeated (reference.engine.table.table_columns)
     rows = [(None if scene.record.timeseries else period_rows(t, speed)) or t.size
             for scene, t, speed in zip(stack.scenes, times, stack.speed, strict=True)]
     owner = np.repeat(np.arange(len(times)), rows)

@@ -1,0 +1,68 @@
+"""Instants where a friction sign ramp starts or ends: the kinks of the work integrands."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from reference.engine.crossings import (
+    SCAN_PER_REVOLUTION,
+    distinct_instants,
+    grazing_brackets,
+    grazing_candidates,
+    sign_change_brackets,
+)
+from reference.engine.dynamics import friction_slots, ramp_bands, ramp_speeds
+from reference.engine.motion import InputMotion
+from reference.physics.joint_motion import joint_motion
+from reference.scene.scene import Scene
+
+__all__ = ["sign_breakpoints"]
+
+
+def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
+                     per_revolution: int = SCAN_PER_REVOLUTION) -> np.ndarray:
+    """Instants in (t_a, t_b) where a friction sign ramp starts or ends [s].
+
+    Each relative surface (or sliding) speed is sampled on a grid, every crossing of its ramp
+    edges ``+-band`` (:func:`reference.engine.dynamics.slot_bands`; of 0 for the exact sign) is
+    bracketed (:mod:`reference.engine.crossings`: sign changes, and grazing crossings between two
+    samples) and refined to rounding.
+    """
+
+    slots = friction_slots(scene)
+    if not slots or t_b <= t_a:
+        return np.zeros(0)
+
+    def speeds(t: np.ndarray) -> np.ndarray:
+        theta, theta_t, _ = motion.state(t)
+        kin = joint_motion(scene.joint, theta, theta_t, 0.0)  # speeds do not need accelerations
+        return ramp_speeds(scene, slots, kin.omega_rel, kin.slide_rel)  # resultant law: slip speeds too
+
+    theta_a, theta_b = motion.angle(t_a), motion.angle(t_b)
+    n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
+    grid = np.linspace(t_a, t_b, n + 1)
+    values = speeds(grid)
+    bands = ramp_bands(scene, slots)
+    brackets, grazing = [], []
+    for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
+        brackets += sign_change_brackets(grid, values, levels)
+        grazing += [(levels, c) for c in grazing_candidates(grid, values, levels)]
+    if grazing:  # every vertex in one evaluation
+        at = speeds(np.array([c[0] for _, c in grazing]))
+        for row, (levels, c) in enumerate(grazing):
+            brackets += grazing_brackets(grid, values, levels, [c], at[row, c[2]:c[2] + 1])
+    if not brackets:
+        return np.zeros(0)
+    a, b, f_a, f_b, j, level = (np.array(v) for v in zip(*brackets, strict=True))
+    rows = np.arange(a.size)
+    for _ in range(100):  # Illinois regula falsi on all brackets at once
+        c = b - f_b * (b - a) / (f_b - f_a)
+        f_c = speeds(c)[rows, j] - level
+        same = np.sign(f_c) == np.sign(f_b)
+        a, f_a = np.where(same, a, b), np.where(same, 0.5 * f_a, f_b)
+        b, f_b = c, f_c
+        if np.all((np.abs(b - a) <= 1e-15) | (f_b == 0.0)):
+            break
+    return distinct_instants(b, t_b - t_a)

@@ -1,0 +1,151 @@
+"""The input's motion over a run for each drive kind: constant speed, angle history, torque.
+
+A prescribed motion (speed, angle history) is known in closed form or from the history's spline.
+A torque-driven scene is one degree of freedom in minimal coordinates: the input angle and speed
+are integrated with :func:`scipy.integrate.solve_ivp` (DOP853, the tolerances of
+:class:`reference.engine.options.ReferenceOptions`), the acceleration at every instant from the
+forward dynamics (:mod:`reference.engine.forward`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reference.engine.options import ReferenceOptions
+from reference.results.schema import Status
+from reference.scene.drives import AngleDrive, SpeedDrive, TorqueDrive
+from reference.scene.scene import Scene
+
+__all__ = ["InputMotion", "SelfLocking", "input_motion"]
+
+
+class SelfLocking(Exception):
+    """Friction has no finite consistent value at some instant (raised inside the integrator)."""
+
+    def __init__(self, t: float, theta: float) -> None:
+        super().__init__(t, theta)
+        self.t, self.theta = t, theta
+
+
+@dataclass
+class InputMotion:
+    """The input's motion over the run: ``state(t)`` gives angle, speed and (prescribed motion)
+    acceleration, or None for the acceleration when the dynamics must supply it (torque drive).
+
+    Attributes
+    ----------
+    t0, t_end : float
+        Span [s].
+    state : callable
+        ``t -> (theta, theta_t, theta_tt | None)``, vectorised.
+    torque_in : float or None
+        The given drive torque [N m] of a torque-driven scene.
+    knots : ndarray
+        Instants where the motion is less smooth (angle-history knots) [s].
+    status, reason : str
+        Why the span ends early, if it does.
+    ode_evaluations : int
+        Right-hand-side evaluations of the integrator (torque drive).
+    periodic : bool
+        Every input revolution takes the same time and repeats the first (constant speed and
+        constant load).
+    """
+
+    t0: float
+    t_end: float
+    state: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray | None]]
+    torque_in: float | None = None
+    knots: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    status: Status = Status.OK
+    reason: str = ""
+    ode_evaluations: int = 0
+    periodic: bool = False
+
+    def angle(self, t: float) -> float:
+        """Input angle [rad] at one instant."""
+        return float(np.asarray(self.state(np.array([t]))[0]).ravel()[0])
+
+
+def _speed_motion(scene: Scene, drive: SpeedDrive) -> InputMotion:
+    w = drive.speed
+    t_end = 2.0 * math.pi * scene.revolutions / abs(w)
+    return InputMotion(0.0, t_end, lambda t: (w * np.asarray(t, float),
+                                             np.full(np.shape(t), w),
+                                             np.zeros(np.shape(t))), periodic=scene.load.constant)
+
+
+def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
+    spline = drive.spline()
+    t0 = drive.time[0]
+    # a history shorter than the span ends first; the means say how many revolutions it holds
+    t_end = drive.time_to_turn(2.0 * math.pi * scene.revolutions)
+    return InputMotion(t0, float(t_end), lambda t: (spline(t), spline(t, 1), spline(t, 2)),
+                       knots=np.asarray(drive.time))
+
+
+def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) -> InputMotion:
+    from scipy.integrate import solve_ivp  # scipy.integrate takes ~0.5 s to import
+
+    from reference.engine.forward import right_hand_side  # scipy.linalg: imported with scipy.integrate
+
+    target = 2.0 * math.pi * scene.revolutions
+    w0 = drive.initial_speed
+    t_max = drive.time_allowed(target)  # the span every engine allows
+    count = {"n": 0}
+    acceleration = right_hand_side(scene, drive.torque)  # microseconds a call (reference.engine.forward)
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        count["n"] += 1
+        theta, theta_t = float(y[0]), float(y[1])
+        theta_tt, locked = acceleration(t, theta, theta_t)
+        if locked:
+            raise SelfLocking(t, theta)
+        return np.array([theta_t, theta_tt])
+
+    def reached(t: float, y: np.ndarray) -> float:  # turned `target` either way, as Exudyn's stop
+        return abs(y[0]) - target
+
+    reached.terminal = True
+    try:
+        sol = solve_ivp(rhs, (0.0, t_max), [0.0, w0], method="DOP853", dense_output=True,
+                        events=reached, rtol=options.ode_rtol,
+                        atol=[options.ode_atol, options.ode_atol * abs(w0)])
+    except SelfLocking as exc:
+        return InputMotion(0.0, exc.t, lambda t: (np.nan, np.nan, None), drive.torque,
+                           status=Status.SELF_LOCKING,
+                           reason=(f"friction self-locks at t = {exc.t:.6g} s, input angle "
+                                   f"{math.degrees(exc.theta):.6g} deg: no consistent friction"),
+                           ode_evaluations=count["n"])
+    if not sol.success:
+        return InputMotion(0.0, float(sol.t[-1]), sol.sol, drive.torque,
+                           status=Status.INTEGRATION_FAILURE, reason=sol.message,
+                           ode_evaluations=count["n"])
+    t_end = float(sol.t_events[0][0]) if sol.t_events[0].size else float(sol.t[-1])
+    dense = sol.sol
+
+    def state(t):
+        y = dense(np.asarray(t, float))
+        return y[0], y[1], None
+
+    motion = InputMotion(0.0, t_end, state, drive.torque, ode_evaluations=count["n"])
+    if not sol.t_events[0].size:
+        motion.status = Status.INCOMPLETE
+        motion.reason = (f"torque drive turned {abs(sol.y[0, -1]) / (2 * math.pi):.3g} of "
+                         f"{scene.revolutions:g} revolutions in the time allowed")
+    return motion
+
+
+def input_motion(scene: Scene, options: ReferenceOptions) -> InputMotion:
+    """The input's motion for the scene's drive (integrating it for a torque drive)."""
+    drive = scene.drive
+    if isinstance(drive, SpeedDrive):
+        return _speed_motion(scene, drive)
+    if isinstance(drive, AngleDrive):
+        return _angle_motion(scene, drive)
+    if isinstance(drive, TorqueDrive):
+        return _torque_motion(scene, drive, options)
+    raise NotImplementedError(f"the reference engine has no {drive.kind!r} drive")

@@ -1,0 +1,74 @@
+"""The reference engine's time table: its instants, its columns, and what it says about the run."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from reference.engine.dynamics import dynamics_columns
+from reference.engine.motion import InputMotion
+from reference.engine.options import ReferenceOptions
+from reference.engine.periodic import period_rows, repeat_period
+from reference.results.schema import Status, Summary
+from reference.scene.joint import PAIR_NAMES
+from reference.scene.scene import Scene
+from reference.scene.validation import check_steps
+
+__all__ = ["EXTRA_COLUMNS", "columns_at", "table_columns", "table_times", "table_verdict"]
+
+EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
+                 *(f"{p}_slide" for p in PAIR_NAMES),
+                 *(f"power_loss_{p}_{part}" for p in PAIR_NAMES for part in ("rotation", "sliding")))
+
+
+def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
+    """Result-schema columns at the instants ``t`` (plus :data:`EXTRA_COLUMNS`)."""
+    theta, theta_t, theta_tt = motion.state(t)
+    theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
+    theta_t = np.broadcast_to(np.asarray(theta_t, float), np.shape(t))
+    load = scene.load.at(np.asarray(t, float))
+    cols, _ = dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt, load_torque=load,  # one of the two
+                               torque_in=motion.torque_in if theta_tt is None else None)
+    return {"t": np.asarray(t, float), **cols}
+
+
+def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
+    """:func:`columns_at` on the table's instants ``t`` [s]. Summary only (no table recorded): a
+    periodic motion's first period, repeated (:mod:`reference.engine.periodic`); a recorded table is
+    evaluated row by row, so that each row's angle is the one its state was computed at."""
+    rows = period_rows(t, scene.drive.speed) if motion.periodic and not scene.record.timeseries else None
+    if rows is None:
+        return columns_at(scene, motion, t)
+    return repeat_period(columns_at(scene, motion, t[:rows]), t, scene.drive.speed)
+
+
+def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
+    span = motion.t_end - motion.t0
+    if options.samples_per_revolution is None and scene.numerics.dt is not None:
+        check_steps(span / scene.numerics.dt,
+                    f"{scene.revolutions:g} revolutions at dt = {scene.numerics.dt:.3g} s")
+        steps = max(1, math.ceil(span / scene.numerics.dt - 1e-9))  # as the Exudyn engine
+    else:
+        spr = options.samples_per_revolution or 360
+        theta_a, theta_b = motion.angle(motion.t0), motion.angle(motion.t_end)
+        check_steps(abs(theta_b - theta_a) / (2.0 * math.pi) * spr,
+                    f"{scene.revolutions:g} revolutions at {spr} samples per revolution")
+        steps = max(1, round(abs(theta_b - theta_a) / (2.0 * math.pi) * spr))
+    return np.linspace(motion.t0, motion.t_end, steps + 1)
+
+
+def table_verdict(t: np.ndarray, columns: dict[str, np.ndarray], summary: Summary,
+                  origin: float = 0.0) -> None:
+    """Step, sample count, self-locking samples, loop gain of the table at ``t`` [s] into ``summary``."""
+    locked = columns["self_locking"]
+    summary.dt, summary.steps = float(t[1] - t[0]), int(t.size - 1)
+    summary.extras["self_locking_samples"] = int(np.count_nonzero(locked))
+    summary.max_friction_loop_gain = float(np.max(columns["friction_loop_gain"]))
+    if np.any(locked) and summary.success:
+        first = int(np.argmax(locked))
+        summary.fail(Status.SELF_LOCKING, (
+            f"friction self-locks at {int(np.count_nonzero(locked))} of {locked.size} samples, "
+            f"first at t = {t[first] + origin:.6g} s, input angle "
+            f"{math.degrees(columns['theta_in'][first]):.6g} deg (loop gain "
+            f"{columns['friction_loop_gain'][first]:.3g}): no consistent friction"))
