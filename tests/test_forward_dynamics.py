@@ -17,17 +17,18 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import cardan_exudyn
-from reference.engine.dynamics import (
+from reference.engine.dynamics import solve_dynamics
+from reference.engine.forward import ForwardDynamics, right_hand_side
+from reference.engine.newton_euler import reaction_system
+from reference.engine.series import fit_periodic
+from reference.engine.slots import (
     FrictionLaw,
     friction_matrix,
     friction_slots,
-    reaction_system,
     slot_bands,
     slot_signs,
     slot_speeds,
-    solve_dynamics,
 )
-from reference.engine.forward import ForwardDynamics, fit_periodic, right_hand_side
 from reference.paper.scenes import named_scene
 from reference.physics.joint_motion import joint_motion
 from reference.scene.joint import PAIR_NAMES

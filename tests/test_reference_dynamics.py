@@ -9,7 +9,8 @@ import pytest
 from test_reference_kinematics import derivative
 
 from reference.engine import solve as engine
-from reference.engine.dynamics import inverse_dynamics, reaction_system
+from reference.engine.dynamics import inverse_dynamics
+from reference.engine.newton_euler import reaction_system
 from reference.paper.scenes import named_scene
 from reference.physics.joint_motion import joint_motion
 from reference.physics.kinematics import body_motions, speed_ratio

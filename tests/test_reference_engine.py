@@ -11,7 +11,7 @@ import pytest
 from test_reference_dynamics import EPS, energy_rate, external_wrench, momentum
 from test_reference_kinematics import derivative
 
-from reference.engine.dynamics import reaction_system
+from reference.engine.newton_euler import reaction_system
 from reference.engine.options import ReferenceOptions
 from reference.engine.solve import run
 from reference.engine.table import EXTRA_COLUMNS

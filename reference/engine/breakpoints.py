@@ -13,8 +13,8 @@ from reference.engine.crossings import (
     grazing_candidates,
     sign_change_brackets,
 )
-from reference.engine.dynamics import friction_slots, ramp_bands, ramp_speeds
 from reference.engine.motion import InputMotion
+from reference.engine.slots import friction_slots, ramp_bands, ramp_speeds
 from reference.physics.joint_motion import joint_motion
 from reference.scene.scene import Scene
 
@@ -26,7 +26,7 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     """Instants in (t_a, t_b) where a friction sign ramp starts or ends [s].
 
     Each relative surface (or sliding) speed is sampled on a grid, every crossing of its ramp
-    edges ``+-band`` (:func:`reference.engine.dynamics.slot_bands`; of 0 for the exact sign) is
+    edges ``+-band`` (:func:`reference.engine.slots.slot_bands`; of 0 for the exact sign) is
     bracketed (:mod:`reference.engine.crossings`: sign changes, and grazing crossings between two
     samples) and refined to rounding.
     """

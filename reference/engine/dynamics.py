@@ -1,28 +1,14 @@
-"""Dynamics of the Cardan joint with the paper's friction: Newton-Euler, batched over samples.
+"""Dynamics of the Cardan joint with the paper's friction: reactions, friction and the drive unknown.
 
-For a given input motion the kinematics (:func:`reference.physics.joint_motion.joint_motion`: closed
-form for the ideal joint, the dual-number loop with mounting errors) give every body's motion.
-Newton-Euler for the three moving bodies (force balance and moment balance about the global
-origin O) is then linear in the 18 unknowns
-
-- ``frame_input`` (revolute): fx, fy, fz, mx, my;
-- ``input_spider``, ``spider_output``, ``output_frame`` (cylindrical): fx, fy, mx, my;
-- the drive torque on the input about +x (inverse dynamics) or the input acceleration
-  (forward dynamics, the drive torque given),
-
-each reaction being the force and moment (about the pair origin) that body ``a`` exerts on body
-``b``, in the pair frame attached to body ``a`` (:func:`reference.physics.kinematics.pair_frames`). Body
-``b`` receives the wrench, body ``a`` its opposite.
-
-Friction (eqs. (3) and (5), :mod:`reference.physics.friction`) is an applied load that depends on the
-reactions, and the reactions depend on it. With ``phi`` the friction values (a torque per pair
-with friction, an axial force per cylindrical pair with friction), the equations are
-``K x = r - W phi`` and ``phi = G(x)``: linear in ``x``, so ``x = x0 - S phi`` with
-``x0 = K^-1 r`` and ``S = K^-1 W``, and the fixed point reduces to at most seven unknowns,
-``phi = G(x0 - S phi)``. It is solved by Newton's method with the analytic Jacobian of ``G``,
-every sample at once. A sample whose fixed point does not converge, or converges to a point where
-the loop gain (spectral radius of ``dG/dphi``) is 1 or more, is *self-locking*: friction grows
-faster than the reactions that cause it, the Coulomb problem has no unique finite solution.
+Newton-Euler (:mod:`reference.engine.newton_euler`) gives ``K x = r - W phi`` with ``phi`` the
+friction values (:mod:`reference.engine.slots`: a torque per pair with friction, an axial force
+per cylindrical pair with friction), and friction depends on the reactions, ``phi = G(x)``. Linear
+in ``x``, so ``x = x0 - S phi`` with ``x0 = K^-1 r`` and ``S = K^-1 W``, and the fixed point reduces
+to at most seven unknowns, ``phi = G(x0 - S phi)``. It is solved by Newton's method with the
+analytic Jacobian of ``G``, every sample at once (:mod:`reference.engine.fixed_point`). A sample
+whose fixed point does not converge, or converges to a point where the loop gain (spectral
+radius of ``dG/dphi``) is 1 or more, is *self-locking*: friction grows faster than the reactions
+that cause it, the Coulomb problem has no unique finite solution.
 
 Pair origins and frames come with the joint motion: in the ideal joint the origins are fixed in
 space (``frame_input`` at ``-input_bearing e_x``, the spider pairs at O, ``output_frame`` at
@@ -33,316 +19,37 @@ their axial friction does work (``power_loss_<pair>_sliding``).
 References
 ----------
 Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation": Section 3 (RCCC model, reactions in the joint frames, eqs. (8)-(9)),
-eqs. (3), (5) (friction from the reactions) and eq. (18) (instantaneous efficiency).
+experimental validation": Section 3, eqs. (3), (5) (friction from the reactions) and eq. (18)
+(instantaneous efficiency).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from reference.engine.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
-from reference.physics.bands import sign_bands
-from reference.physics.friction import friction_magnitudes, pair_power_loss, regularised_sign
-from reference.physics.joint_motion import JointMotion, joint_motion
-from reference.physics.rccc.motion import BodyMotion
-from reference.results.schema import (
-    PAIR_SUFFIXES,
-    instantaneous_efficiency,
+from reference.engine.fixed_point import FixedPoint, solve_friction
+from reference.engine.newton_euler import (
+    DRIVE_ROW,
+    constant_load,
+    mechanical_energy,
+    reaction_system,
+    unknowns,
 )
-from reference.scene.joint import BODY_NAMES, PAIR_BODIES, PAIR_KIND, PAIR_NAMES, Body
+from reference.engine.slots import (
+    FrictionLaw,
+    friction_matrix,
+    friction_slots,
+    slot_bands,
+    slot_signs,
+    slot_speeds,
+)
+from reference.physics.friction import pair_power_loss
+from reference.physics.joint_motion import JointMotion, joint_motion
+from reference.results.schema import PAIR_SUFFIXES, instantaneous_efficiency
+from reference.scene.joint import PAIR_NAMES
 from reference.scene.scene import Scene
 
-DRIVE_ROW = 3  # the input's moment about x (rows: per body force x, y, z, moment x, y, z)
-_COMPONENTS = {"revolute": ("fx", "fy", "fz", "mx", "my"), "cylindrical": ("fx", "fy", "mx", "my")}
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product over the last axis (``numpy.cross`` without its per-call overhead)."""
-    a, b = np.broadcast_arrays(a, b)
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], -1)
-
-
-def unknowns() -> list[tuple[str, str]]:
-    """The 18 unknowns in solution order: ``(pair, component)`` and ``("drive", "torque_in")``."""
-    out = [(pair, c) for pair in PAIR_NAMES for c in _COMPONENTS[PAIR_KIND[pair]]]
-    return out + [("drive", "torque_in")]
-
-
-def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
-    """Centre-of-mass position, velocity, acceleration and inertia of a body, global components.
-
-    Parameters
-    ----------
-    body : Body
-        Mass properties; :meth:`Body.canonical` places them in the canonical body frame, whose
-        origin is the body's frame origin (the joint centre O for the ideal joint).
-    motion : reference.physics.rccc.motion.BodyMotion
-        Pose and motion of the body.
-
-    Returns
-    -------
-    dict
-        ``mass`` [kg]; ``r``, ``v``, ``a``: centre of mass relative to O [m], its velocity [m/s]
-        and acceleration [m/s^2], shape (..., 3); ``inertia`` about the centre of mass
-        [kg m^2], shape (..., 3, 3).
-    """
-    return mass_kinematics(*body.canonical(), motion)
-
-
-def mass_kinematics(mass: float | np.ndarray, com: np.ndarray, inertia: np.ndarray,
-                    motion: BodyMotion) -> dict[str, np.ndarray]:
-    """:func:`body_kinematics` from the canonical mass properties (:meth:`Body.canonical`):
-    ``mass`` [kg], ``com`` (3,) [m] and ``inertia`` (3, 3) [kg m^2], or one per sample, shapes
-    (...,), (..., 3), (..., 3, 3) (many scenes in one pass, :mod:`reference.engine.batch.solve`)."""
-    rot = motion.rotation
-    c = rot @ com if np.ndim(com) == 1 else np.einsum("...ij,...j->...i", rot, com)
-    w_c = cross(motion.omega, c)
-    return {"mass": mass, "r": motion.origin + c, "v": motion.velocity + w_c,
-            "a": motion.acceleration + cross(motion.alpha, c) + cross(motion.omega, w_c),
-            "inertia": rot @ inertia @ np.swapaxes(rot, -1, -2)}
-
-
-def required_wrench(body: Body, motion: BodyMotion,
-                    gravity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Force [N] and moment about O [N m] the pairs, drive and load must apply to a body.
-
-    Newton-Euler with gravity moved to the left: ``F = m (a_c - g)``,
-    ``M_O = r_c x F + J alpha + omega x J omega`` (J about the centre of mass, global axes).
-    """
-    k = body_kinematics(body, motion)
-    force = k["mass"] * (k["a"] - gravity)
-    j_omega = np.einsum("...ij,...j->...i", k["inertia"], motion.omega)
-    j_alpha = np.einsum("...ij,...j->...i", k["inertia"], motion.alpha)
-    return force, cross(k["r"], force) + j_alpha + cross(motion.omega, j_omega)
-
-
-def mechanical_energy(scene: Scene,
-                      motions: dict[str, BodyMotion]) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy of the three bodies [J] (potential zero at O)."""
-    gravity = np.asarray(scene.gravity)
-    kinetic, potential = 0.0, 0.0
-    for name, body in scene.joint.bodies():
-        k = body_kinematics(body, motions[name])
-        w = motions[name].omega
-        j_omega = np.einsum("...ij,...j->...i", k["inertia"], w)
-        kinetic = kinetic + 0.5 * k["mass"] * np.sum(k["v"] ** 2, -1) + 0.5 * np.sum(w * j_omega, -1)
-        potential = potential - k["mass"] * (k["r"] @ gravity)
-    return kinetic, potential
-
-
-def wrench_columns(motion: JointMotion, components: list[tuple[str, str]]) -> np.ndarray:
-    """Body wrenches of unit pair loads, rows as :func:`reaction_system`, shape (..., 18, m).
-
-    Each component ``(pair, "fx" | "fy" | "fz" | "mx" | "my" | "mz")`` is a unit force along
-    (at the pair origin) or moment about that axis of the pair frame, acting on body b; body a
-    receives the opposite. All components are built in one vectorised pass.
-    """
-    shape = motion.bodies["input"].omega.shape[:-1]
-    if not components:
-        return np.zeros(shape + (6 * len(BODY_NAMES), 0))
-    d = np.stack([motion.frames[p][..., :, "xyz".index(c[1])] for p, c in components], -2)
-    is_force = np.array([c[0] == "f" for _, c in components])[:, None]
-    lever = np.stack([motion.origins[p] for p, _ in components], -2)
-    unit = np.concatenate([np.where(is_force, d, 0.0),
-                           np.where(is_force, cross(lever, d), d)], -1)  # (..., m, 6)
-    incidence = np.zeros((len(BODY_NAMES), len(components)))
-    for j, (pair, _) in enumerate(components):
-        a, b = PAIR_BODIES[pair]
-        for body, sign in ((b, 1.0), (a, -1.0)):
-            if body in BODY_NAMES:
-                incidence[BODY_NAMES.index(body), j] = sign
-    out = np.einsum("bm,...mk->...bkm", incidence, unit)
-    return out.reshape(shape + (6 * len(BODY_NAMES), len(components)))
-
-
-def reaction_system(scene: Scene, motion: JointMotion,
-                    load_torque: float | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Newton-Euler equations of the three bodies as ``matrix @ unknowns = rhs``.
-
-    ``load_torque`` [N m] (scalar or one per sample) is the output load at these samples; None
-    takes the scene's constant load (a load history needs it given: the motion has no time).
-
-    Returns
-    -------
-    matrix : ndarray, shape (..., 18, 18)
-        Rows: per body (input, spider, output) force x, y, z [N] and moment about O x, y, z
-        [N m]; columns: :func:`unknowns`.
-    rhs : ndarray, shape (..., 18)
-        Required wrench minus the known applied wrench (the load torque on the output).
-    """
-    shape = motion.bodies["input"].omega.shape[:-1]
-    rows = {name: 6 * i for i, name in enumerate(BODY_NAMES)}
-    matrix = np.zeros(shape + (18, 18))
-    matrix[..., :-1] = wrench_columns(motion, unknowns()[:-1])
-    matrix[..., rows["input"] + DRIVE_ROW, -1] = 1.0  # drive torque about +x (the fixed input axis)
-    rhs = np.concatenate([np.concatenate(required_wrench(body, motion.bodies[name],
-                                                         np.asarray(scene.gravity)), -1)
-                          for name, body in scene.joint.bodies()], -1)
-    # the load's moment -T u on the output (u its axis, the output_frame pair's z), to the right
-    load = np.asarray(constant_load(scene) if load_torque is None else load_torque, float)
-    rhs[..., rows["output"] + 3:rows["output"] + 6] += (load[..., None]
-                                                       * motion.frames["output_frame"][..., :, 2])
-    return matrix, rhs
-
-
-def constant_load(scene: Scene) -> float:
-    """The scene's load torque [N m]; a history needs the instants, so it is refused here."""
-    if not scene.load.constant:
-        raise ValueError("the scene's load is a torque history: pass `load_torque` for the samples")
-    return float(scene.load.torque)
-
-
-def friction_slots(scene: Scene) -> list[tuple[str, str]]:
-    """The friction values the scene produces: ``(pair, "torque" | "force")`` in solution order.
-
-    A pair with friction gets a torque about its axis; a cylindrical one also an axial force.
-    Frictionless pairs get none, so a frictionless scene has no friction unknowns at all.
-    """
-    slots = []
-    for pair, data in scene.joint.pairs.items():
-        if data.friction_coefficient > 0.0:
-            slots.append((pair, "torque"))
-            if PAIR_KIND[pair] == "cylindrical":
-                slots.append((pair, "force"))
-    return slots
-
-
-def friction_matrix(motion: JointMotion, slots: list[tuple[str, str]]) -> np.ndarray:
-    """Body wrenches of unit friction values, rows as :func:`reaction_system`, shape (..., 18, K).
-
-    A friction torque acts on body b about the pair axis, an axial force along it at the pair
-    origin; body a receives the opposite.
-    """
-    return wrench_columns(motion, [(pair, "mz" if kind == "torque" else "fz") for pair, kind in slots])
-
-
-class FrictionLaw:
-    """Eqs. (3) and (5) as a function of the reaction vector, with its Jacobian.
-
-    The law is linear in the normal force and moment magnitudes ``|F|``, ``|M|``; its
-    coefficients per slot are taken from :func:`reference.physics.friction.friction_magnitudes`.
-
-    Parameters
-    ----------
-    scene : Scene
-    slots : list of (pair, "torque" | "force")
-        From :func:`friction_slots`.
-    """
-
-    def __init__(self, scene: Scene, slots: list[tuple[str, str]]) -> None:
-        position = {key: j for j, key in enumerate(unknowns()[:-1])}
-        self.index = np.array([[position[(pair, c)] for c in ("fx", "fy", "mx", "my")]
-                               for pair, _ in slots], dtype=int).reshape(len(slots), 4)
-        coefficients = []
-        pairs = dict(scene.joint.friction_pairs())
-        for pair, kind in slots:
-            which = 0 if kind == "torque" else 1  # eq. (3) torque or eq. (5) axial force
-            data = pairs[pair]
-            coefficients.append((float(friction_magnitudes(data, 1.0, 0.0)[which]),
-                                 float(friction_magnitudes(data, 0.0, 1.0)[which])))
-        self.k_force, self.k_moment = np.array(coefficients, float).reshape(len(slots), 2).T
-
-    def __call__(self, x: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Friction values ``G(x)`` and Jacobian ``dG/dx``.
-
-        Parameters
-        ----------
-        x : ndarray, shape (n, 18)
-            Reactions (and the drive unknown, unused), ordered as :func:`unknowns`.
-        signs : ndarray, shape (n, K)
-            Regularised sign of the relative motion for each slot, or under the resultant-slip
-            law the slot's component of the regularised unit slip vector (:func:`slot_signs`;
-            fixed by the kinematics).
-
-        Returns
-        -------
-        values : ndarray, shape (n, K)
-            Friction torque [N m] / axial force [N] on body b.
-        jacobian : ndarray, shape (n, K, 18)
-            Derivatives with respect to ``x``; where a norm is exactly zero, the zero
-            subgradient.
-        """
-        return friction_law_values(x, self.index, signs, self.k_force, self.k_moment)
-
-    def reduced(self, c: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reduced_law_values` of the slots' reaction components ``c`` = ``x[:, index]``."""
-        return reduced_law_values(c, signs, self.k_force, self.k_moment)
-
-
-def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
-                slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-    """Relative surface speed (rotation: ``omega_rel d / 2``) or sliding speed of each slot [m/s].
-
-    These are the speeds whose sign the friction law takes, shape (..., K).
-    """
-    out = []
-    for pair, kind in slots:
-        if kind == "torque":
-            out.append(0.5 * getattr(scene.joint.pairs, pair).journal_diameter * omega_rel[pair])
-        else:
-            out.append(slide_rel[pair])
-    return np.stack(out, -1)
-
-
-def slot_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = None) -> np.ndarray:
-    """Width of each slot's sign ramp [m/s] (``bands``, or :func:`reference.physics.bands.sign_bands`),
-    shape (K,).
-
-    Under the resultant-slip law (``scene.friction.law``) both slots of a pair share the ramp of
-    its resultant slip speed.
-    """
-    bands = sign_bands(scene) if bands is None else bands
-    if scene.friction.law == "resultant":
-        return np.array([bands[pair].resultant for pair, _ in slots], dtype=float)
-    return np.array([bands[pair].rotation if kind == "torque" else bands[pair].sliding
-                     for pair, kind in slots], dtype=float)
-
-
-def slip_speeds(slots: list[tuple[str, str]], speeds: np.ndarray) -> np.ndarray:
-    """Per slot, the resultant slip speed of its pair [m/s]: the hypotenuse of the pair's slot
-    speeds (:func:`slot_speeds`, shape (..., K)), shape (..., K)."""
-    out = np.empty_like(speeds)
-    for pair in dict.fromkeys(pair for pair, _ in slots):
-        mine = [j for j, (p, _) in enumerate(slots) if p == pair]
-        out[..., mine] = np.sqrt(np.sum(np.square(speeds[..., mine]), -1))[..., None]
-    return out
-
-
-def slot_signs(scene: Scene, slots: list[tuple[str, str]], speeds: np.ndarray,
-               bands: np.ndarray) -> np.ndarray:
-    """The factor of each slot's Coulomb magnitude, in [-1, 1], shape (..., K).
-
-    ``speeds`` from :func:`slot_speeds`, ``bands`` from :func:`slot_bands`. The paper's law: the
-    regularised sign of each slot's speed (:func:`reference.physics.friction.regularised_sign`). The
-    resultant-slip law: the slot's component of its pair's regularised unit slip vector
-    ``v / max(|v|, band)`` (:mod:`reference.physics.friction`).
-    """
-    if scene.friction.law != "resultant":
-        return regularised_sign(speeds, bands)
-    size = np.maximum(slip_speeds(slots, speeds), bands)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(size > 0.0, speeds / size, 0.0)
-
-
-def ramp_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
-                slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-    """Speeds [m/s] whose crossings of ``+-`` :func:`ramp_bands` are the kinks of the friction
-    factors (:func:`slot_signs`), shape (..., K'): the slot speeds (:func:`slot_speeds`), and under
-    the resultant-slip law also the pairs' slip speeds (the slot speeds' zero crossings stay: with
-    a zero band the factor jumps there when the pair does not slide)."""
-    speeds = slot_speeds(scene, slots, omega_rel, slide_rel)
-    if scene.friction.law != "resultant":
-        return speeds
-    return np.concatenate([speeds, slip_speeds(slots, speeds)], -1)
-
-
-def ramp_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = None) -> np.ndarray:
-    """Ramp widths [m/s] of :func:`ramp_speeds`, shape (K',) (``bands`` as for :func:`slot_bands`)."""
-    bands = slot_bands(scene, slots, bands)
-    return np.concatenate([bands, bands]) if scene.friction.law == "resultant" else bands
+__all__ = ["dynamics_columns", "inverse_dynamics", "solution_columns", "solve_dynamics"]
 
 
 def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,

@@ -1,6 +1,6 @@
 """The friction fixed point of the inverse (and forward) dynamics, for many samples at once.
 
-With the friction values ``phi`` (one per slot of :func:`reference.engine.dynamics.friction_slots`) the
+With the friction values ``phi`` (one per slot of :func:`reference.engine.slots.friction_slots`) the
 reactions are ``x = x0 - S phi`` (``x0`` the frictionless solution, ``S`` its response to unit
 friction), and the law of eqs. (3) and (5) gives ``phi = G(x)``. :func:`solve_friction` solves
 ``phi = G(x0 - S phi)`` by Newton's method per sample; the law reads four components of ``x`` per
@@ -107,7 +107,7 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
 
     Parameters
     ----------
-    law : reference.engine.dynamics.FrictionLaw or alike
+    law : reference.engine.slots.FrictionLaw or alike
         ``G``: its ``index`` (K, 4), the columns of ``x`` each slot reads, and ``reduced(c, signs)``,
         the values and derivatives of :func:`reduced_law_values`.
     x0 : ndarray, shape (n, 18)

@@ -44,114 +44,38 @@ experimental validation": Section 3 (Newton-Euler of the RCCC model), eqs. (3), 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg.lapack import dgeev, dgesv  # LAPACK direct: 1 us, np.linalg.solve 12 us
 
-from reference.engine.dynamics import (
-    DRIVE_ROW,
+from reference.engine.dynamics import solve_dynamics
+from reference.engine.friction_newton import WARM_START_GAIN, friction_newton
+from reference.engine.newton_euler import DRIVE_ROW, reaction_system
+from reference.engine.series import TAU, TrigSeries, fit_periodic
+from reference.engine.slots import (
     FrictionLaw,
     friction_matrix,
     friction_slots,
-    reaction_system,
     slot_bands,
     slot_signs,
     slot_speeds,
-    solve_dynamics,
 )
-from reference.engine.fixed_point import power_bound
 from reference.physics.joint_motion import joint_motion
 from reference.physics.loop_closure import LoopClosureError
 from reference.scene.scene import Scene
 
-__all__ = ["METHODS", "ForwardDynamics", "ForwardState", "TrigSeries", "angle_functions",
-           "direct_acceleration", "fit_periodic", "friction_newton", "right_hand_side"]
+__all__ = ["GRID_SIZES", "METHODS", "PART_SCALE", "ForwardDynamics", "ForwardState", "angle_functions",
+           "direct_acceleration", "right_hand_side"]
 
-TAU = 2.0 * math.pi
 GRID_SIZES = (64, 128, 256, 512, 1024, 2048)
 """Grid points per revolution tried in turn until the series is resolved."""
-RESOLVED_TOLERANCE, KEEP_TOLERANCE = 1e-14, 1e-15
-"""Relative to each group's largest value on the grid (the solution's parts, the friction
-response, the speeds): the upper half of the grid's harmonics must stay below the first, and
-harmonics are kept up to the last one above the second (the samples' rounding noise is about
-1e-17 of that scale, :data:`PART_SCALE`)."""
 PART_SCALE = 1024.0
 """Speed [rad/s], acceleration [rad/s^2] and load [N m] at which the system's parts are taken
 (a power of two: the divisions are exact)."""
-NEWTON_TOLERANCE = 1e-13
-"""Stopping rule of :func:`reference.engine.fixed_point.solve_friction`: a Newton update at most this
-fraction of the largest friction value."""
-NEWTON_ITERATIONS = 50
-WARM_START_GAIN = 0.9
-"""Newton starts from the previous call's friction (the integrator's calls are close: two or three
-iterations instead of five); where the loop gain it finds is at least this, the sample is solved
-again from :func:`reference.engine.fixed_point.solve_friction`'s start, so that a verdict near self-locking
-is the same as the direct solve's."""
 
 Acceleration = Callable[[float, float, float], tuple[float, bool]]
 """``(t [s], theta [rad], theta_t [rad/s]) -> (theta_tt [rad/s^2], self_locking)``."""
-
-
-@dataclass(frozen=True)
-class TrigSeries:
-    """Real Fourier series of many periodic functions of the input angle, evaluated in one product.
-
-    ``f(theta) = sum_k a_k cos(k theta) + b_k sin(k theta)``, k = 0..H.
-
-    Attributes
-    ----------
-    frequencies : ndarray, shape (2 (H + 1),)
-        ``k`` twice: cosine rows, then sine rows.
-    phases : ndarray, shape (2 (H + 1),)
-        0 for the cosine rows, pi/2 for the sine rows (``sin x = cos(x - pi/2)``).
-    table : ndarray, shape (2 (H + 1), M)
-        The coefficients ``a_k`` then ``b_k`` of the M functions.
-    grid : int
-        Grid points per revolution the series was fitted on.
-    """
-
-    frequencies: np.ndarray
-    phases: np.ndarray
-    table: np.ndarray
-    grid: int
-
-    def __call__(self, theta: float) -> np.ndarray:
-        """The M functions at one input angle [rad], shape (M,)."""
-        return np.cos(self.frequencies * (theta % TAU) - self.phases) @ self.table
-
-
-def fit_periodic(values: np.ndarray, scale: np.ndarray) -> TrigSeries | None:
-    """The Fourier series of functions sampled on ``n`` equispaced angles ``2 pi j / n``.
-
-    Parameters
-    ----------
-    values : ndarray, shape (n, M)
-        Samples; n even.
-    scale : ndarray, shape (M,)
-        Each function's scale: its group's largest sample (a function that is zero up to
-        rounding has rounding-level harmonics, judged against its group, not against itself).
-
-    Returns
-    -------
-    TrigSeries or None
-        Harmonics kept up to the last one above :data:`KEEP_TOLERANCE` times the scale; None when
-        some harmonic from ``n / 4`` on exceeds :data:`RESOLVED_TOLERANCE` (not resolved).
-    """
-    n = values.shape[0]
-    c = np.fft.rfft(values, axis=0) / n  # (n/2 + 1, M)
-    a, b = 2.0 * c.real, -2.0 * c.imag
-    a[0] *= 0.5
-    size = np.hypot(a, b) / np.maximum(scale, np.finfo(float).tiny)
-    if np.any(size[n // 4:] > RESOLVED_TOLERANCE):
-        return None
-    kept = np.nonzero(np.any(size > KEEP_TOLERANCE, 1))[0]
-    h = int(kept[-1]) + 1 if kept.size else 1
-    k = np.arange(h, dtype=float)
-    return TrigSeries(np.concatenate([k, k]), np.concatenate([np.zeros(h), np.full(h, 0.5 * math.pi)]),
-                      np.concatenate([a[:h], b[:h]]), n)
 
 
 def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[str, np.ndarray]:
@@ -162,9 +86,9 @@ def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[
     dict
         ``x0``, ``x2``, ``xu``, ``xd`` (n, 18): ``K^-1`` times the right-hand side at rest, its
         share per ``theta_t^2`` [1/s^2], per unit load torque and per unit drive torque
-        (:func:`reference.engine.dynamics.unknowns` order, the input acceleration last); ``s`` (n, 18, K):
+        (:func:`reference.engine.newton_euler.unknowns` order, the input acceleration last); ``s`` (n, 18, K):
         ``K^-1 W``, the solution's response to unit friction values; ``v`` (n, K): slot speeds
-        per unit input speed [m/rad] (:func:`reference.engine.dynamics.slot_speeds`).
+        per unit input speed [m/rad] (:func:`reference.engine.slots.slot_speeds`).
 
     Raises
     ------
@@ -205,7 +129,7 @@ class ForwardState:
     acceleration : float
         Input acceleration [rad/s^2].
     friction : ndarray, shape (K,)
-        Friction values of :func:`reference.engine.dynamics.friction_slots` [N m or N].
+        Friction values of :func:`reference.engine.slots.friction_slots` [N m or N].
     converged : bool
         Newton converged (:func:`reference.engine.fixed_point.solve_friction`'s rule).
     loop_gain : float
@@ -227,123 +151,6 @@ class ForwardState:
         """No converged fixed point, or a loop gain of 1 or more."""
         return not (self.converged and self.loop_gain < 1.0)
 
-
-_TINY = np.finfo(float).tiny  # n + tiny is n for every normal n, and keeps 0 / 0 away
-
-
-def _spectral_radius(matrix: np.ndarray) -> float:
-    wr, wi, _, _, info = dgeev(matrix, compute_vl=0, compute_vr=0)
-    return float(np.max(np.hypot(wr, wi))) if info == 0 else math.inf
-
-
-def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
-    """:func:`reference.engine.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
-    or an upper bound where that is below ``exact_from`` (the infinity norm; for ``exact_from`` >= 1
-    also :func:`reference.engine.fixed_point.power_bound`)."""
-    norm = float(np.abs(matrix).sum(1).max())
-    if not math.isfinite(norm):
-        return math.inf
-    if norm < exact_from:
-        return norm
-    if exact_from >= 1.0:  # the verdict only
-        bound = float(power_bound(matrix[None], np.array([norm]))[0])
-        if bound < exact_from:
-            return bound
-    return _spectral_radius(matrix)
-
-
-def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
-                    start: np.ndarray | None = None) -> tuple[np.ndarray, bool, float, int]:
-    """The friction fixed point of one sample, as :func:`reference.engine.fixed_point.solve_friction`.
-
-    Parameters
-    ----------
-    sxa : ndarray, shape (4 K, K + 1)
-        Row ``4 j + i``: pair component i (fx, fy, mx, my [N, N m]) of slot j's pair, its
-        response to unit friction values (columns ``:K``) and its value without friction (column
-        K): ``c = sxa @ [-phi, 1]``.
-    ks : ndarray, shape (2 K,)
-        Factors of ``|F|`` and ``|M|`` in each friction value, signs included
-        (``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``).
-    coupled : bool
-        False: the friction of the frictionless reactions (coupling ``"uncoupled"``).
-    start : ndarray, shape (K,), or None
-        None: :func:`reference.engine.fixed_point.solve_friction` exactly (first iterate the friction of the
-        frictionless reactions, stop when an update is at most :data:`NEWTON_TOLERANCE` of the
-        largest value, loop gain at the solution). Else the first iterate (a close one: the
-        previous call's), and Newton also stops where its quadratic convergence puts the next
-        update below that tolerance, with the loop gain of the last Jacobian (about the update's
-        relative size off, and the infinity norm where that is below :data:`WARM_START_GAIN`;
-        callers re-solve with ``start=None`` where the verdict is close).
-
-    Returns
-    -------
-    phi, converged, loop_gain, iterations
-    """
-    k = sxa.shape[1] - 1
-    ops = _OPERATORS[k]
-    strict = start is None or not coupled
-    if strict:
-        c0 = sxa[:, k]
-        phi = ops.slots @ (ks * np.sqrt(ops.norms @ (c0 * c0)))
-        if not coupled:
-            return phi, True, 0.0, 0
-    else:
-        phi = start
-    values = phi.tolist()
-    scale = max(map(abs, values))  # warm: the start's size, close to the solution's
-    before, p = 0.0, np.ones(k + 1)
-    for iterations in range(1, NEWTON_ITERATIONS + 1):
-        # G is homogeneous in the pair components: G = W c with W the unit components times
-        # their factors, so Newton's iterate is (I + W sx)^-1 W c0 (one product gives both)
-        p[:k] = -phi
-        both = _products(sxa @ p, ks, sxa, ops)
-        gm = both[:, :k]
-        _, _, phi, info = dgesv(gm + ops.eye, both[:, k])
-        last, values = values, phi.tolist()
-        size, top = max(abs(a - b) for a, b in zip(values, last, strict=True)), max(map(abs, values))
-        if info or not math.isfinite(size + sum(values)):
-            break
-        scale = max(scale, top)
-        if size <= NEWTON_TOLERANCE * scale:
-            if strict:
-                p[:k] = -phi
-                gm = _products(sxa @ p, ks, sxa, ops)[:, :k]
-            return phi, True, _gain(gm, 0.5 if strict else WARM_START_GAIN), iterations
-        if not strict and size ** 3 <= 0.01 * NEWTON_TOLERANCE * scale * before ** 2:
-            return phi, True, _gain(gm, WARM_START_GAIN), iterations
-        before = size
-    return phi, False, math.inf, iterations
-
-
-@dataclass(frozen=True)
-class _Operators:
-    """0/1 matrices of :func:`friction_newton` for K slots: ``norms`` (2 K, 4 K) squared
-    components to squared norms, ``spread`` (4 K, 2 K) back, ``slots`` (K, 2 K) per-norm terms to
-    friction values, ``blocks`` (K, 4 K) rows to their slot; ``eye`` (K, K)."""
-
-    norms: np.ndarray
-    spread: np.ndarray
-    slots: np.ndarray
-    blocks: np.ndarray
-    eye: np.ndarray
-
-    @classmethod
-    def of(cls, k: int) -> _Operators:
-        norms = np.kron(np.eye(2 * k), np.ones(2))
-        return cls(norms, norms.T.copy(), np.kron(np.eye(k), np.ones(2)), np.kron(np.eye(k), np.ones(4)),
-                   np.eye(k))
-
-
-_OPERATORS = [_Operators.of(k) for k in range(8)]  # at most seven friction values
-
-
-def _products(c: np.ndarray, ks: np.ndarray, sxa: np.ndarray, ops: _Operators) -> np.ndarray:
-    """``W @ sxa``, shape (K, K + 1): the loop's Jacobian ``-dG/dphi`` and ``W c0``, with ``W``
-    (K, 4 K) block-diagonal, the unit pair components of ``c`` (4 K,) times their factors (zero
-    where a norm vanishes: there ``c`` is zero)."""
-    w = c * (ops.spread @ (ks / (np.sqrt(ops.norms @ (c * c)) + _TINY)))
-    return (ops.blocks * w) @ sxa
 
 
 class ForwardDynamics:
@@ -447,7 +254,7 @@ class ForwardDynamics:
         return ForwardState(accel, friction, converged, gain, iterations)
 
     def _signs(self, speed: np.ndarray) -> np.ndarray:
-        """:func:`reference.engine.dynamics.slot_signs` on the active slots (speeds [m/s], shape (K,))."""
+        """:func:`reference.engine.slots.slot_signs` on the active slots (speeds [m/s], shape (K,))."""
         if self._inverse_band is None:
             speeds = np.zeros(len(self.slots))
             speeds[self.active] = speed

@@ -21,21 +21,17 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from reference.engine.dynamics import (
-    DRIVE_ROW,
-    cross,
+from reference.engine.dynamics import solution_columns
+from reference.engine.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
+from reference.engine.newton_euler import DRIVE_ROW, cross, mass_kinematics, unknowns, wrench_columns
+from reference.engine.slots import (
     friction_matrix,
     friction_slots,
-    mass_kinematics,
     ramp_bands,
     slip_speeds,
     slot_bands,
     slot_signs,
-    solution_columns,
-    unknowns,
-    wrench_columns,
 )
-from reference.engine.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
 from reference.physics import kinematics, rccc
 from reference.physics.bands import (
     PairBands,
@@ -260,7 +256,7 @@ class SceneStack:
         return k
 
     def _reaction_system(self, idx: np.ndarray, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reference.engine.dynamics.reaction_system` with each sample's masses, gravity, load."""
+        """:func:`reference.engine.newton_euler.reaction_system` with each sample's masses, gravity, load."""
         matrix = np.zeros(idx.shape + (18, 18))
         matrix[..., :-1] = wrench_columns(motion, unknowns()[:-1])
         matrix[..., DRIVE_ROW, -1] = 1.0  # the input's rows come first
@@ -278,7 +274,7 @@ class SceneStack:
         return matrix, rhs
 
     def _energy(self, idx: np.ndarray, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reference.engine.dynamics.mechanical_energy` per sample [J]."""
+        """:func:`reference.engine.newton_euler.mechanical_energy` per sample [J]."""
         kinetic, potential, gravity = 0.0, 0.0, self.gravity[idx]
         for name in BODY_NAMES:
             k, w = self._body(name, idx, motion), motion.bodies[name].omega
@@ -290,13 +286,13 @@ class SceneStack:
 
     def slot_speeds(self, idx: np.ndarray, omega_rel: dict[str, np.ndarray],
                     slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-        """:func:`reference.engine.dynamics.slot_speeds` per sample [m/s], shape (n, K)."""
+        """:func:`reference.engine.slots.slot_speeds` per sample [m/s], shape (n, K)."""
         out = [0.5 * self.diameter[idx, j] * omega_rel[pair] if kind == "torque"
                else slide_rel[pair] for j, (pair, kind) in enumerate(self.slots)]
         return np.stack(out, -1) if out else np.zeros(idx.shape + (0,))
 
     def ramp_speeds(self, idx: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """:func:`reference.engine.dynamics.ramp_speeds` at instants ``t`` [s] of scenes ``idx`` (n, K'),
+        """:func:`reference.engine.slots.ramp_speeds` at instants ``t`` [s] of scenes ``idx`` (n, K'),
         :data:`CHUNK_SAMPLES` at a time."""
         if idx.size <= CHUNK_SAMPLES:
             return self._ramp_speeds(idx, t)

@@ -12,7 +12,7 @@ CONTRACT (kept by every implementation; the sweep runner and the tolerance study
   before anything runs (the error names the scene's index).
 
 How: constant-speed scenes with a constant load share a key when they share the friction slots
-(:func:`reference.engine.dynamics.friction_slots`), the friction law and coupling and whether the
+(:func:`reference.engine.slots.friction_slots`), the friction law and coupling and whether the
 joint is ideal (closed-form kinematics) or has mounting errors (the dual-number loop). Their
 time tables, sign breakpoints and work quadratures are evaluated together, in chunks of at most
 :data:`BATCH_SCENES` scenes (:mod:`reference.engine.batch.model`, :mod:`reference.engine.batch.quadrature`);
@@ -31,10 +31,10 @@ import numpy as np
 
 from reference.engine.batch.model import SceneStack
 from reference.engine.batch.quadrature import work_quadratures
-from reference.engine.dynamics import friction_slots
 from reference.engine.motion import input_motion
 from reference.engine.options import ReferenceOptions
 from reference.engine.periodic import period_rows, repeat_period
+from reference.engine.slots import friction_slots
 from reference.engine.solve import ENGINE_NAME, ENGINE_VERSION, means_from_works, run
 from reference.engine.table import EXTRA_COLUMNS, table_times, table_verdict
 from reference.results.schema import OptionsError, Result, Status, Summary, result_table

@@ -1,0 +1,147 @@
+"""The friction fixed point of one sample by Newton's method, LAPACK called directly.
+
+The forward dynamics' right-hand side (:mod:`reference.engine.forward`) solves
+``phi = G(x0 - S phi)`` (eqs. (3), (5)) for at most seven friction values per call, microseconds
+a call: the same rule as :func:`reference.engine.fixed_point.solve_friction`, without its
+batched arrays.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg.lapack import dgeev, dgesv  # LAPACK direct: 1 us, np.linalg.solve 12 us
+
+from reference.engine.fixed_point import power_bound
+
+__all__ = ["NEWTON_ITERATIONS", "NEWTON_TOLERANCE", "WARM_START_GAIN", "friction_newton"]
+
+NEWTON_TOLERANCE = 1e-13
+"""Stopping rule of :func:`reference.engine.fixed_point.solve_friction`: a Newton update at most this
+fraction of the largest friction value."""
+NEWTON_ITERATIONS = 50
+WARM_START_GAIN = 0.9
+"""Newton starts from the previous call's friction (the integrator's calls are close: two or three
+iterations instead of five); where the loop gain it finds is at least this, the sample is solved
+again from :func:`reference.engine.fixed_point.solve_friction`'s start, so that a verdict near self-locking
+is the same as the direct solve's."""
+
+
+_TINY = np.finfo(float).tiny  # n + tiny is n for every normal n, and keeps 0 / 0 away
+
+
+def _spectral_radius(matrix: np.ndarray) -> float:
+    wr, wi, _, _, info = dgeev(matrix, compute_vl=0, compute_vr=0)
+    return float(np.max(np.hypot(wr, wi))) if info == 0 else math.inf
+
+
+def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
+    """:func:`reference.engine.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
+    or an upper bound where that is below ``exact_from`` (the infinity norm; for ``exact_from`` >= 1
+    also :func:`reference.engine.fixed_point.power_bound`)."""
+    norm = float(np.abs(matrix).sum(1).max())
+    if not math.isfinite(norm):
+        return math.inf
+    if norm < exact_from:
+        return norm
+    if exact_from >= 1.0:  # the verdict only
+        bound = float(power_bound(matrix[None], np.array([norm]))[0])
+        if bound < exact_from:
+            return bound
+    return _spectral_radius(matrix)
+
+
+def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
+                    start: np.ndarray | None = None) -> tuple[np.ndarray, bool, float, int]:
+    """The friction fixed point of one sample, as :func:`reference.engine.fixed_point.solve_friction`.
+
+    Parameters
+    ----------
+    sxa : ndarray, shape (4 K, K + 1)
+        Row ``4 j + i``: pair component i (fx, fy, mx, my [N, N m]) of slot j's pair, its
+        response to unit friction values (columns ``:K``) and its value without friction (column
+        K): ``c = sxa @ [-phi, 1]``.
+    ks : ndarray, shape (2 K,)
+        Factors of ``|F|`` and ``|M|`` in each friction value, signs included
+        (``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``).
+    coupled : bool
+        False: the friction of the frictionless reactions (coupling ``"uncoupled"``).
+    start : ndarray, shape (K,), or None
+        None: :func:`reference.engine.fixed_point.solve_friction` exactly (first iterate the friction of the
+        frictionless reactions, stop when an update is at most :data:`NEWTON_TOLERANCE` of the
+        largest value, loop gain at the solution). Else the first iterate (a close one: the
+        previous call's), and Newton also stops where its quadratic convergence puts the next
+        update below that tolerance, with the loop gain of the last Jacobian (about the update's
+        relative size off, and the infinity norm where that is below :data:`WARM_START_GAIN`;
+        callers re-solve with ``start=None`` where the verdict is close).
+
+    Returns
+    -------
+    phi, converged, loop_gain, iterations
+    """
+    k = sxa.shape[1] - 1
+    ops = _OPERATORS[k]
+    strict = start is None or not coupled
+    if strict:
+        c0 = sxa[:, k]
+        phi = ops.slots @ (ks * np.sqrt(ops.norms @ (c0 * c0)))
+        if not coupled:
+            return phi, True, 0.0, 0
+    else:
+        phi = start
+    values = phi.tolist()
+    scale = max(map(abs, values))  # warm: the start's size, close to the solution's
+    before, p = 0.0, np.ones(k + 1)
+    for iterations in range(1, NEWTON_ITERATIONS + 1):
+        # G is homogeneous in the pair components: G = W c with W the unit components times
+        # their factors, so Newton's iterate is (I + W sx)^-1 W c0 (one product gives both)
+        p[:k] = -phi
+        both = _products(sxa @ p, ks, sxa, ops)
+        gm = both[:, :k]
+        _, _, phi, info = dgesv(gm + ops.eye, both[:, k])
+        last, values = values, phi.tolist()
+        size, top = max(abs(a - b) for a, b in zip(values, last, strict=True)), max(map(abs, values))
+        if info or not math.isfinite(size + sum(values)):
+            break
+        scale = max(scale, top)
+        if size <= NEWTON_TOLERANCE * scale:
+            if strict:
+                p[:k] = -phi
+                gm = _products(sxa @ p, ks, sxa, ops)[:, :k]
+            return phi, True, _gain(gm, 0.5 if strict else WARM_START_GAIN), iterations
+        if not strict and size ** 3 <= 0.01 * NEWTON_TOLERANCE * scale * before ** 2:
+            return phi, True, _gain(gm, WARM_START_GAIN), iterations
+        before = size
+    return phi, False, math.inf, iterations
+
+
+@dataclass(frozen=True)
+class _Operators:
+    """0/1 matrices of :func:`friction_newton` for K slots: ``norms`` (2 K, 4 K) squared
+    components to squared norms, ``spread`` (4 K, 2 K) back, ``slots`` (K, 2 K) per-norm terms to
+    friction values, ``blocks`` (K, 4 K) rows to their slot; ``eye`` (K, K)."""
+
+    norms: np.ndarray
+    spread: np.ndarray
+    slots: np.ndarray
+    blocks: np.ndarray
+    eye: np.ndarray
+
+    @classmethod
+    def of(cls, k: int) -> _Operators:
+        norms = np.kron(np.eye(2 * k), np.ones(2))
+        return cls(norms, norms.T.copy(), np.kron(np.eye(k), np.ones(2)), np.kron(np.eye(k), np.ones(4)),
+                   np.eye(k))
+
+
+_OPERATORS = [_Operators.of(k) for k in range(8)]  # at most seven friction values
+
+
+def _products(c: np.ndarray, ks: np.ndarray, sxa: np.ndarray, ops: _Operators) -> np.ndarray:
+    """``W @ sxa``, shape (K, K + 1): the loop's Jacobian ``-dG/dphi`` and ``W c0``, with ``W``
+    (K, 4 K) block-diagonal, the unit pair components of ``c`` (4 K,) times their factors (zero
+    where a norm vanishes: there ``c`` is zero)."""
+    w = c * (ops.spread @ (ks / (np.sqrt(ops.norms @ (c * c)) + _TINY)))
+    return (ops.blocks * w) @ sxa
