@@ -40,12 +40,14 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
         kin = joint_motion(scene.joint, theta, theta_t, 0.0)  # speeds do not need accelerations
         return ramp_speeds(scene, slots, kin.omega_rel, kin.slide_rel)  # resultant law: slip speeds too
 
-    theta_a, theta_b = motion.angle(t_a), motion.angle(t_b)
+    theta_a = motion.angle(t_a)
+    theta_b = motion.angle(t_b)
     n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
     grid = np.linspace(t_a, t_b, n + 1)
     values = speeds(grid)
     bands = ramp_bands(scene, slots)
-    brackets, grazing = [], []
+    brackets = []
+    grazing = []
     for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
         brackets += sign_change_brackets(grid, values, levels)
         grazing += [(levels, c) for c in grazing_candidates(grid, values, levels)]
@@ -61,8 +63,10 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
         c = b - f_b * (b - a) / (f_b - f_a)
         f_c = speeds(c)[rows, j] - level
         same = np.sign(f_c) == np.sign(f_b)
-        a, f_a = np.where(same, a, b), np.where(same, 0.5 * f_a, f_b)
-        b, f_b = c, f_c
+        a = np.where(same, a, b)
+        f_a = np.where(same, 0.5 * f_a, f_b)
+        b = c
+        f_b = f_c
         if np.all((np.abs(b - a) <= 1e-15) | (f_b == 0.0)):
             break
     return distinct_instants(b, t_b - t_a)

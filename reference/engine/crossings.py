@@ -45,14 +45,19 @@ def grazing_candidates(grid: np.ndarray, values: np.ndarray,
     g = values - levels
     if g.shape[0] < 3:
         return []
-    left, mid, right = g[:-2], g[1:-1], g[2:]
+    left = g[:-2]
+    mid = g[1:-1]
+    right = g[2:]
     curvature = left - 2.0 * mid + right
     extremum = ((mid - left) * (right - mid) < 0) & (np.sign(left) == np.sign(mid)) & (
         np.sign(mid) == np.sign(right)) & (curvature != 0.0)
     i, j = np.nonzero(extremum)
     if i.size == 0:
         return []
-    before, m, after, c = left[i, j], mid[i, j], right[i, j], curvature[i, j]
+    before = left[i, j]
+    m = mid[i, j]
+    after = right[i, j]
+    c = curvature[i, j]
     vertex = m - (after - before) ** 2 / (8.0 * c)
     across = np.sign(vertex) != np.sign(m)
     offset = np.clip(-(after - before) / (2.0 * c), -1.0, 1.0)  # in cells from the middle sample
@@ -67,11 +72,13 @@ def grazing_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray,
     (the column's speed at ``t_vertex``) is across the level; the others are dropped."""
     out = []
     for (t_v, k, col), v in zip(candidates, at_vertex, strict=True):
-        f_v, f_k = v - levels[col], values[k, col] - levels[col]
+        f_v = v - levels[col]
+        f_k = values[k, col] - levels[col]
         if not np.sign(f_v) * np.sign(f_k) < 0:
             continue
         lo, hi = (k - 1, k) if t_v < grid[k] else (k, k + 1)
-        f_lo, f_hi = values[lo, col] - levels[col], values[hi, col] - levels[col]
+        f_lo = values[lo, col] - levels[col]
+        f_hi = values[hi, col] - levels[col]
         out += [(grid[lo], t_v, f_lo, f_v, col, levels[col]), (t_v, grid[hi], f_v, f_hi, col, levels[col])]
     return out
 

@@ -77,19 +77,23 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     if (theta_tt is None) == (torque_in is None):
         raise ValueError("give exactly one of `theta_tt` (inverse) and `torque_in` (forward)")
     joint = scene.joint
-    theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
+    theta = np.atleast_1d(np.asarray(theta, float))
+    theta_t = np.atleast_1d(np.asarray(theta_t, float))
     n = theta.size
     if theta_tt is not None:
         motion = joint_motion(joint, theta, theta_t, np.broadcast_to(theta_tt, theta.shape), method)
         matrix, rhs = reaction_system(scene, motion, load_torque)
-        omega_rel, slide_rel = motion.omega_rel, motion.slide_rel
+        omega_rel = motion.omega_rel
+        slide_rel = motion.slide_rel
         wrenches = friction_matrix(motion, friction_slots(scene))
     else:  # one batch at accelerations 0 and 1: the right-hand side is affine in theta_tt
         pair = joint_motion(joint, np.tile(theta, 2), np.tile(theta_t, 2), np.repeat([0.0, 1.0], n),
                             method)
         load = None if load_torque is None else np.tile(np.broadcast_to(load_torque, theta.shape), 2)
         matrix, rhs = reaction_system(scene, pair, load)
-        matrix, rhs_one, rhs = matrix[:n], rhs[n:], rhs[:n]
+        matrix = matrix[:n]
+        rhs_one = rhs[n:]
+        rhs = rhs[:n]
         matrix[..., :, -1] = -(rhs_one - rhs)  # the acceleration's share moves to the left
         rhs[..., DRIVE_ROW] -= torque_in
         # velocity-level quantities and the pair geometry do not depend on the acceleration
@@ -133,12 +137,15 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     fixed_point : FixedPoint
     """
     motion, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in, method, load_torque)
-    theta, theta_t = np.atleast_1d(np.asarray(theta, float)), np.atleast_1d(np.asarray(theta_t, float))
+    theta = np.atleast_1d(np.asarray(theta, float))
+    theta_t = np.atleast_1d(np.asarray(theta_t, float))
     unknown = np.where(fixed.self_locking, np.nan, fixed.x[:, -1])  # drive torque or acceleration
     if torque_in is None:
-        accel, drive = np.broadcast_to(np.asarray(theta_tt, float), theta.shape) + 0.0, unknown
+        accel = np.broadcast_to(np.asarray(theta_tt, float), theta.shape) + 0.0
+        drive = unknown
     else:
-        accel, drive = unknown, np.where(fixed.self_locking, np.nan, np.broadcast_to(torque_in, theta.shape))
+        accel = unknown
+        drive = np.where(fixed.self_locking, np.nan, np.broadcast_to(torque_in, theta.shape))
     load = constant_load(scene) if load_torque is None else load_torque
     return solution_columns(motion, fixed, friction_slots(scene), (theta, theta_t, accel), drive, load,
                             mechanical_energy(scene, motion.bodies)), fixed
@@ -151,7 +158,8 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
     """:func:`dynamics_columns`' columns from the solution: ``inputs`` the input angle [rad],
     speed [rad/s] and acceleration [rad/s^2], ``drive`` the drive torque [N m], ``load`` the
     output load [N m], ``energy`` the kinetic and potential energy [J], all per sample (n,)."""
-    (theta, theta_t, accel), locked = inputs, fixed.self_locking
+    (theta, theta_t, accel) = inputs
+    locked = fixed.self_locking
     x = np.where(locked[:, None], np.nan, fixed.x)
     phi = np.where(locked[:, None], np.nan, fixed.friction)
     theta_out, omega_out, _ = motion.output
@@ -166,7 +174,8 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
     for pair in PAIR_NAMES:
         torque = applied.get((pair, "torque"), zero)
         force = applied.get((pair, "force"), zero)
-        omega_rel, slide_rel = motion.omega_rel[pair] + zero, motion.slide_rel[pair] + zero
+        omega_rel = motion.omega_rel[pair] + zero
+        slide_rel = motion.slide_rel[pair] + zero
         rotation = pair_power_loss(torque, zero, omega_rel, zero)
         sliding = pair_power_loss(zero, force, zero, slide_rel)
         loss_total = loss_total + rotation + sliding
@@ -183,7 +192,8 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
         cols[f"{pair}_{component}"] = x[:, j]
     cols["power_loss"] = loss_total
     cols["efficiency"] = instantaneous_efficiency(cols["power_in"], loss_total)
-    cols["input_acceleration"], cols["friction_loop_gain"] = accel, fixed.loop_gain
+    cols["input_acceleration"] = accel
+    cols["friction_loop_gain"] = fixed.loop_gain
     cols["self_locking"] = locked
     return cols
 

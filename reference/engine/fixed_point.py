@@ -43,8 +43,10 @@ def reduced_law_values(c: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
     fy, mx, my. Returns the values (n, K) and their derivatives with respect to ``c`` (n, K, 4)
     (the zero subgradient where a norm is exactly zero); :func:`friction_law_values` scatters
     them into ``dG/dx``."""
-    force, moment = np.hypot(c[..., 0], c[..., 1]), np.hypot(c[..., 2], c[..., 3])
-    per_force, per_moment = -signs * k_force, -signs * k_moment
+    force = np.hypot(c[..., 0], c[..., 1])
+    moment = np.hypot(c[..., 2], c[..., 3])
+    per_force = -signs * k_force
+    per_moment = -signs * k_moment
     with np.errstate(invalid="ignore", divide="ignore"):
         along_force = np.where(force > 0, per_force / force, 0.0)
         along_moment = np.where(moment > 0, per_moment / moment, 0.0)
@@ -124,19 +126,26 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
     exact_gain : float
         Loop gain: the spectral radius where its norm bound reaches this, else the bound.
     """
-    n, k = x0.shape[0], s.shape[-1]
+    n = x0.shape[0]
+    k = s.shape[-1]
     if k == 0:
         return FixedPoint(x0, np.zeros((n, 0)), np.ones(n, bool), np.zeros(n), 0)
     # the law reads 4 components per slot: Newton on those, (n, K, 4) and (n, K, 4, K), not on x
     index = law.index
-    c0, s_c = x0[:, index], s[:, index, :]
+    c0 = x0[:, index]
+    s_c = s[:, index, :]
     phi, _ = law.reduced(c0, signs)
     scale = np.max(np.abs(phi), -1)
     converged = np.zeros(n, bool)
     active = np.arange(n)
     # the unconverged samples' data, compacted as samples converge
-    c_a, s_a, signs_a, phi_a, scale_a = c0, s_c, signs, phi.copy(), scale.copy()
-    iterations, eye = 0, np.eye(k)
+    c_a = c0
+    s_a = s_c
+    signs_a = signs
+    phi_a = phi.copy()
+    scale_a = scale.copy()
+    iterations = 0
+    eye = np.eye(k)
     for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported below)
         shift = (s_a.reshape(s_a.shape[0], 4 * k, k) @ phi_a[..., None]).reshape(c_a.shape)
         g, g_c = law.reduced(c_a - shift, signs_a)
@@ -154,8 +163,12 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
             break
         if np.any(stop):
             keep = ~stop
-            active, c_a, s_a, signs_a = active[keep], c_a[keep], s_a[keep], signs_a[keep]
-            phi_a, scale_a = phi_a[keep], scale_a[keep]
+            active = active[keep]
+            c_a = c_a[keep]
+            s_a = s_a[keep]
+            signs_a = signs_a[keep]
+            phi_a = phi_a[keep]
+            scale_a = scale_a[keep]
     x = x0 - np.einsum("nik,nk->ni", s, phi)
     _, g_c = law.reduced(x[:, index], signs)
     with np.errstate(all="ignore"):

@@ -104,7 +104,8 @@ def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[
     load = np.repeat([0.0, 0.0, 0.0, PART_SCALE], n)
     motion = joint_motion(scene.joint, np.tile(theta, 4), speed, accel)
     matrix, rhs = reaction_system(scene, motion, load)
-    rest, parts = rhs[:n], (rhs.reshape(4, n, 18)[1:] - rhs[:n]) / big[:, None, None]
+    rest = rhs[:n]
+    parts = (rhs.reshape(4, n, 18)[1:] - rhs[:n]) / big[:, None, None]
     matrix = matrix[:n].copy()
     matrix[:, :, -1] = -parts[1]  # the acceleration's share moves to the left, as in solve_dynamics
     drive = np.zeros((n, 18))
@@ -175,8 +176,12 @@ class ForwardDynamics:
         slots = friction_slots(scene)
         law = FrictionLaw(scene, slots)
         k = active.size
-        self.scene, self.slots, self.active, self.series = scene, slots, active, series
-        self._frequencies, self._phases = series.frequencies, series.phases
+        self.scene = scene
+        self.slots = slots
+        self.active = active
+        self.series = series
+        self._frequencies = series.frequencies
+        self._phases = series.phases
         # the series of the parts per unit theta_t^2 (and load) stacked under the base's
         self._table = np.concatenate(np.split(series.table, parts, 1))
         self._cut = (4 * k * (k + 1), 4 * k * (k + 1) + k + 1)
@@ -185,7 +190,8 @@ class ForwardDynamics:
         self._coupled = scene.friction.coupling != "uncoupled"
         self._history = scene.load.evaluator()
         self._start: np.ndarray | None = None  # the last call's friction: Newton's warm start
-        bands, pair = self._bands[active], [slots[j][0] for j in active]
+        bands = self._bands[active]
+        pair = [slots[j][0] for j in active]
         # the signs on the active slots without the general code's checks (all bands > 0)
         self._inverse_band = 1.0 / bands if np.all(bands > 0.0) else None
         self._same_pair = np.array([[p == q for q in pair] for p in pair], dtype=float)
@@ -220,7 +226,8 @@ class ForwardDynamics:
 
     def _friction(self, theta: float, theta_t: float, load: float | None) -> tuple:
         """``(theta_tt, phi, converged, loop_gain, iterations)`` on the active slots."""
-        u, m = self._basis, self._frequencies.size
+        u = self._basis
+        m = self._frequencies.size
         np.cos(self._frequencies * (theta % TAU) - self._phases, out=u[:m])
         np.multiply(u[:m], theta_t * theta_t, out=u[m:2 * m])
         if self._history is not None:
@@ -276,7 +283,8 @@ def _layout(scene: Scene, torque_in: float, f: dict[str, np.ndarray], rows: np.n
     the base (drive torque and a constant load folded in), per ``theta_t^2``, per load torque (a
     history only). Columns: per active slot and pair component ``[S row, x]`` (K, 4, K + 1), the
     acceleration's ``[S row, x]`` (K + 1), the unit slot speeds (K)."""
-    n, k = f["x0"].shape[0], active.size
+    n = f["x0"].shape[0]
+    k = active.size
     last = f["x0"].shape[1] - 1
     constant = scene.load.constant
     base = f["x0"] - torque_in * f["xd"] + (float(scene.load.torque) * f["xu"] if constant else 0.0)

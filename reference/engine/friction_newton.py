@@ -93,7 +93,8 @@ def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
         phi = start
     values = phi.tolist()
     scale = max(map(abs, values))  # warm: the start's size, close to the solution's
-    before, p = 0.0, np.ones(k + 1)
+    before = 0.0
+    p = np.ones(k + 1)
     for iterations in range(1, NEWTON_ITERATIONS + 1):
         # G is homogeneous in the pair components: G = W c with W the unit components times
         # their factors, so Newton's iterate is (I + W sx)^-1 W c0 (one product gives both)
@@ -101,8 +102,10 @@ def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
         both = _products(sxa @ p, ks, sxa, ops)
         gm = both[:, :k]
         _, _, phi, info = dgesv(gm + ops.eye, both[:, k])
-        last, values = values, phi.tolist()
-        size, top = max(abs(a - b) for a, b in zip(values, last, strict=True)), max(map(abs, values))
+        last = values
+        values = phi.tolist()
+        size = max(abs(a - b) for a, b in zip(values, last, strict=True))
+        top = max(map(abs, values))
         if info or not math.isfinite(size + sum(values)):
             break
         scale = max(scale, top)

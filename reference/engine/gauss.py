@@ -20,7 +20,8 @@ __all__ = ["GROSS_SCALE", "DENSE_WIDTH", "DENSE_NODES", "MAX_OPEN_PANELS", "init
 
 def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.ndarray]:
     """Panels ``(a, b)`` covering consecutive segments ``edges``, none wider than ``max_width``."""
-    lo, hi = [], []
+    lo = []
+    hi = []
     for a, b in zip(edges[:-1], edges[1:], strict=True):
         if b > a:
             cuts = np.linspace(a, b, max(1, math.ceil((b - a) / max_width - 1e-9)) + 1)
@@ -30,7 +31,8 @@ def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.
 
 
 GROSS_SCALE = 1e-3
-DENSE_WIDTH, DENSE_NODES = 0.125, 3
+DENSE_WIDTH = 0.125
+DENSE_NODES = 3
 """History knots alone making panels mostly below ``DENSE_WIDTH`` of the initial width: at most
 ``DENSE_NODES`` Gauss nodes each (smooth between knots, error O(h^7); 9 evaluations per knot, not 24)."""
 MAX_OPEN_PANELS = 20_000
@@ -72,12 +74,15 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
     gross = float(np.sum(np.abs(whole[:, scale_key])))
     scale = max(abs(float(np.sum(whole[:, scale_key]))), GROSS_SCALE * gross, scale_floor,
                 np.finfo(float).tiny)
-    result, error, closed = np.zeros(whole.shape[1]), np.zeros(whole.shape[1]), 0
+    result = np.zeros(whole.shape[1])
+    error = np.zeros(whole.shape[1])
+    closed = 0
     for rounds in range(1, max_rounds + 1):
         mid = 0.5 * (a + b)
         both = gauss(np.concatenate([a, mid]), np.concatenate([mid, b]))
         evaluations += 2 * a.size * nodes
-        left, right = both[:a.size], both[a.size:]
+        left = both[:a.size]
+        right = both[a.size:]
         diff = np.abs(left + right - whole)
         allowed = rtol * scale * (b - a) / total_width
         # a non-finite panel (NaN from a locked or failed sample) cannot converge: close it and
@@ -92,7 +97,8 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
         # steep panels next to a locked arc would only cost (19 s at 47 deg, 2000 rpm)
         if not np.any(keep) or not np.all(np.isfinite(result)):
             break
-        a, b = np.concatenate([a[keep], mid[keep]]), np.concatenate([mid[keep], b[keep]])
+        a = np.concatenate([a[keep], mid[keep]])
+        b = np.concatenate([mid[keep], b[keep]])
         whole = np.concatenate([left[keep], right[keep]])
     return result, {"evaluations": evaluations, "rounds": rounds, "panels": closed,
                     "error_estimate": error.tolist()}

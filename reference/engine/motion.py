@@ -28,7 +28,8 @@ class SelfLocking(Exception):
 
     def __init__(self, t: float, theta: float) -> None:
         super().__init__(t, theta)
-        self.t, self.theta = t, theta
+        self.t = t
+        self.theta = theta
 
 
 @dataclass
@@ -100,7 +101,8 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         count["n"] += 1
-        theta, theta_t = float(y[0]), float(y[1])
+        theta = float(y[0])
+        theta_t = float(y[1])
         theta_tt, locked = acceleration(t, theta, theta_t)
         if locked:
             raise SelfLocking(t, theta)

@@ -102,7 +102,8 @@ def mechanical_energy(scene: Scene,
                       motions: dict[str, BodyMotion]) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic and potential energy of the three bodies [J] (potential zero at O)."""
     gravity = np.asarray(scene.gravity)
-    kinetic, potential = 0.0, 0.0
+    kinetic = 0.0
+    potential = 0.0
     for name, body in scene.joint.bodies():
         k = body_kinematics(body, motions[name])
         w = motions[name].omega

@@ -34,7 +34,8 @@ def period_rows(t: np.ndarray, speed: float) -> int | None:
     one period after the first)."""
     if t.size < 3 or speed == 0.0:
         return None
-    period, step = 2.0 * math.pi / abs(speed), (t[-1] - t[0]) / (t.size - 1)
+    period = 2.0 * math.pi / abs(speed)
+    step = (t[-1] - t[0]) / (t.size - 1)
     rows = round(period / step)
     if rows < 1 or rows >= t.size or abs(rows * step - period) > 1e-12 * period:
         return None

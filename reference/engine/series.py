@@ -66,7 +66,8 @@ def fit_periodic(values: np.ndarray, scale: np.ndarray) -> TrigSeries | None:
     """
     n = values.shape[0]
     c = np.fft.rfft(values, axis=0) / n  # (n/2 + 1, M)
-    a, b = 2.0 * c.real, -2.0 * c.imag
+    a = 2.0 * c.real
+    b = -2.0 * c.imag
     a[0] *= 0.5
     size = np.hypot(a, b) / np.maximum(scale, np.finfo(float).tiny)
     if np.any(size[n // 4:] > RESOLVED_TOLERANCE):

@@ -92,7 +92,8 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
     if scene.has_friction:
         summary.extras["sign_bands_m_s"] = {p: list(b) for p, b in sign_bands(scene).items()}
     motion = input_motion(scene, options)
-    summary.status, summary.reason = Status(motion.status), motion.reason
+    summary.status = Status(motion.status)
+    summary.reason = motion.reason
     if scene.drive.kind == "torque":
         summary.ode_evaluations = motion.ode_evaluations
     if motion.status == Status.SELF_LOCKING:
@@ -126,7 +127,9 @@ def _efficiency_error(scene: Scene, summary: Summary, options: ReferenceOptions)
     """The quadrature's error estimate of the mean efficiency into the summary (a first-order
     propagation of the input and lost works' estimates, plus the ODE's ``rtol`` for a torque
     drive), and whether it meets ``numerics.accuracy``."""
-    q, w_in, w_loss = summary.extras.get("quadrature"), summary.input_work, summary.loss_work
+    q = summary.extras.get("quadrature")
+    w_in = summary.input_work
+    w_loss = summary.loss_work
     if not q or not w_in or w_loss is None or summary.mean_efficiency is None:
         return
     repeats = summary.revolutions / q["revolutions_integrated"] if q.get("revolutions_integrated") else 1

@@ -51,7 +51,8 @@ def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) ->
         steps = max(1, math.ceil(span / scene.numerics.dt - 1e-9))  # as the Exudyn engine
     else:
         spr = options.samples_per_revolution or 360
-        theta_a, theta_b = motion.angle(motion.t0), motion.angle(motion.t_end)
+        theta_a = motion.angle(motion.t0)
+        theta_b = motion.angle(motion.t_end)
         check_steps(abs(theta_b - theta_a) / (2.0 * math.pi) * spr,
                     f"{scene.revolutions:g} revolutions at {spr} samples per revolution")
         steps = max(1, round(abs(theta_b - theta_a) / (2.0 * math.pi) * spr))
@@ -62,7 +63,8 @@ def table_verdict(t: np.ndarray, columns: dict[str, np.ndarray], summary: Summar
                   origin: float = 0.0) -> None:
     """Step, sample count, self-locking samples, loop gain of the table at ``t`` [s] into ``summary``."""
     locked = columns["self_locking"]
-    summary.dt, summary.steps = float(t[1] - t[0]), int(t.size - 1)
+    summary.dt = float(t[1] - t[0])
+    summary.steps = int(t.size - 1)
     summary.extras["self_locking_samples"] = int(np.count_nonzero(locked))
     summary.max_friction_loop_gain = float(np.max(columns["friction_loop_gain"]))
     if np.any(locked) and summary.success:

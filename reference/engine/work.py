@@ -37,15 +37,18 @@ __all__ = ["WORK_KEYS", "time_at_angle", "window_times", "work_means", "work_qua
 def time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> float:
     """Illinois regula falsi as in :func:`sign_breakpoints`: scipy.optimize would cost every
     command that builds a ``mean_input`` scene (``cardan run``) ~0.3 s of imports."""
-    a, b = lo, hi
-    f_a, f_b = motion.angle(a) - theta, motion.angle(b) - theta
+    a = lo
+    b = hi
+    f_a = motion.angle(a) - theta
+    f_b = motion.angle(b) - theta
     if f_a == 0.0 or f_b == 0.0 or f_a * f_b > 0:  # at an end within rounding
         return a if f_a == 0.0 else b
     for _ in range(100):
         c = b - f_b * (b - a) / (f_b - f_a)
         f_c = motion.angle(c) - theta
         a, f_a = (a, 0.5 * f_a) if (f_c > 0) == (f_b > 0) else (b, f_b)
-        b, f_b = c, f_c
+        b = c
+        f_b = f_c
         if f_b == 0.0 or abs(b - a) <= 1e-15 + 4 * np.finfo(float).eps * abs(b):
             break
     return b
@@ -110,7 +113,8 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     energy [J], zero up to rounding for an exact solution), ``quadrature`` (how it was done) and
     ``self_locking_nodes`` (friction locks at some node); empty when there is no whole revolution.
     """
-    theta, t = table["theta_in"], table["t"]
+    theta = table["theta_in"]
+    t = table["t"]
     theta_0, theta_1, n = whole_revolution_window(theta, scene.record.skip_revolutions)
     if n < 1:
         return {}

@@ -40,7 +40,9 @@ def envelope() -> list[dict[str, Any]]:
         entry = stored.get(case_key(case))
         if entry is None:
             continue
-        lo, hi, paper = entry["lowest"], entry["highest"], case["paper_mean_efficiency"]
+        lo = entry["lowest"]
+        hi = entry["highest"]
+        paper = case["paper_mean_efficiency"]
         out.append({"case": case_key(case), "paper": paper, "lowest": lo, "highest": hi,
                     "reachable": lo <= paper <= hi, "closest": min(max(paper, lo), hi),
                     "lowest_at": dict(entry.get("lowest_at", {})),

@@ -164,14 +164,16 @@ def _zeros_ones(like: Dual) -> tuple[Dual, Dual]:
 
 def rot_z(angle: Dual) -> Dual:
     """Screw displacement about z: rotation ``angle.re`` [rad], slide ``angle.du`` [m]."""
-    c, s = cos(angle), sin(angle)
+    c = cos(angle)
+    s = sin(angle)
     zero, one = _zeros_ones(angle)
     return matrix([[c, -s, zero], [s, c, zero], [zero, zero, one]])
 
 
 def rot_x(angle: Dual) -> Dual:
     """Screw displacement about x: rotation ``angle.re`` [rad], slide ``angle.du`` [m]."""
-    c, s = cos(angle), sin(angle)
+    c = cos(angle)
+    s = sin(angle)
     zero, one = _zeros_ones(angle)
     return matrix([[one, zero, zero], [zero, c, -s], [zero, s, c]])
 

@@ -69,7 +69,9 @@ def friction_magnitudes(pair: Pair, force_normal: Any, moment_normal: Any) -> tu
     ``force_normal`` and ``moment_normal`` are the magnitudes of the reaction force and moment
     normal to the pair axis.
     """
-    f, d, lever = pair.friction_coefficient, pair.journal_diameter, pair.moment_lever
+    f = pair.friction_coefficient
+    d = pair.journal_diameter
+    lever = pair.moment_lever
     force_normal = np.asarray(force_normal, dtype=float)
     moment_normal = np.asarray(moment_normal, dtype=float)
     torque = f * d * moment_normal / lever + 0.5 * f * d * force_normal

@@ -31,8 +31,10 @@ from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 
 def rot_x(angle: np.ndarray) -> np.ndarray:
     """Rotation matrices about x [-], shape ``angle.shape + (3, 3)``."""
-    c, s = np.cos(angle), np.sin(angle)
-    one, zero = np.ones_like(c), np.zeros_like(c)
+    c = np.cos(angle)
+    s = np.sin(angle)
+    one = np.ones_like(c)
+    zero = np.zeros_like(c)
     return np.stack([np.stack([one, zero, zero], -1),
                      np.stack([zero, c, -s], -1),
                      np.stack([zero, s, c], -1)], -2)
@@ -40,8 +42,10 @@ def rot_x(angle: np.ndarray) -> np.ndarray:
 
 def rot_y(angle: np.ndarray) -> np.ndarray:
     """Rotation matrices about y [-], shape ``angle.shape + (3, 3)``."""
-    c, s = np.cos(angle), np.sin(angle)
-    one, zero = np.ones_like(c), np.zeros_like(c)
+    c = np.cos(angle)
+    s = np.sin(angle)
+    one = np.ones_like(c)
+    zero = np.zeros_like(c)
     return np.stack([np.stack([c, zero, s], -1),
                      np.stack([zero, one, zero], -1),
                      np.stack([-s, zero, c], -1)], -2)
@@ -49,8 +53,10 @@ def rot_y(angle: np.ndarray) -> np.ndarray:
 
 def rot_z(angle: np.ndarray) -> np.ndarray:
     """Rotation matrices about z [-], shape ``angle.shape + (3, 3)``."""
-    c, s = np.cos(angle), np.sin(angle)
-    one, zero = np.ones_like(c), np.zeros_like(c)
+    c = np.cos(angle)
+    s = np.sin(angle)
+    one = np.ones_like(c)
+    zero = np.zeros_like(c)
     return np.stack([np.stack([c, -s, zero], -1),
                      np.stack([s, c, zero], -1),
                      np.stack([zero, zero, one], -1)], -2)
@@ -73,7 +79,9 @@ def output_angle(theta: np.ndarray, beta: float) -> np.ndarray:
         ``theta`` plus the lag ``atan2((1 - cos b) sin theta cos theta, cos b cos^2 theta +
         sin^2 theta)``, whose second argument is positive, so no branch jumps occur.
     """
-    c, s, cb = np.cos(theta), np.sin(theta), np.cos(beta)
+    c = np.cos(theta)
+    s = np.sin(theta)
+    cb = np.cos(beta)
     return theta + np.arctan2((1.0 - cb) * s * c, cb * c**2 + s**2)
 
 
@@ -116,8 +124,10 @@ def spider_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
     gamma, gamma_t, gamma_tt : ndarray
         [rad], [rad/s], [rad/s^2].
     """
-    sb, cb = np.sin(beta), np.cos(beta)
-    c, s = np.cos(theta), np.sin(theta)
+    sb = np.sin(beta)
+    cb = np.cos(beta)
+    c = np.cos(theta)
+    s = np.sin(theta)
     d = 1.0 - sb**2 * c**2
     h = sb * cb * c / d
     h_theta = -sb * cb * s * (1.0 + sb**2 * c**2) / d**2
@@ -171,7 +181,8 @@ def body_motions(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
     theta_out, omega_out, alpha_out = output_motion(theta, theta_t, theta_tt, beta)
     a_in = rot_x(theta)
     u1 = a_in[..., :, 1]
-    w_in, dw_in = theta_t[..., None] * e_x, theta_tt[..., None] * e_x
+    w_in = theta_t[..., None] * e_x
+    dw_in = theta_tt[..., None] * e_x
     w_spider = w_in + gamma_t[..., None] * u1
     dw_spider = (dw_in + gamma_tt[..., None] * u1
                  + gamma_t[..., None] * np.cross(w_in, u1))

@@ -114,8 +114,11 @@ def solve_wrapped(twists: Dual, s1: float | np.ndarray, theta1: np.ndarray, sign
     t1 = Dual(theta1, np.full_like(theta1, s1))
     # joint 2 in F_4 Z(theta_4) coordinates, against joint 3 = X(-alpha_4) Z(-theta_4) (0, w_y, w_z)
     z2 = dual.matvec(dual.rot_x(tw[..., 3]) @ dual.screw_transform(t1, tw[..., 0]), E_Z)
-    w_y, w_z = dual.sin(tw[..., 2]), dual.cos(tw[..., 2])
-    a, b, c = z2[..., 1] * w_y, z2[..., 0] * w_y, dual.cos(tw[..., 1]) - z2[..., 2] * w_z
+    w_y = dual.sin(tw[..., 2])
+    w_z = dual.cos(tw[..., 2])
+    a = z2[..., 1] * w_y
+    b = z2[..., 0] * w_y
+    c = dual.cos(tw[..., 1]) - z2[..., 2] * w_z
     radius2 = a.re**2 + b.re**2
     disc = radius2 - c.re**2
     if strict:
@@ -124,7 +127,8 @@ def solve_wrapped(twists: Dual, s1: float | np.ndarray, theta1: np.ndarray, sign
     if not strict:
         open_, meet = _defects(disc, radius2)
         x = np.where(open_ | meet, np.nan, x)
-    cx, sx = np.cos(x), np.sin(x)
+    cx = np.cos(x)
+    sx = np.sin(x)
     # eps part of A cos t4 + B sin t4 = C, linear in s_4; the coefficient is -+sqrt(disc) != 0
     s4 = (c.du - a.du * cx - b.du * sx) / (b.re * cx - a.re * sx)
     t4 = Dual(np.arctan2(sx, cx), s4)

@@ -49,7 +49,8 @@ class LinearHistory:
     def __call__(self, t: float) -> float:
         """The value at one instant ``t`` [s] (plain floats, O(log n); O(1) when ``t`` falls in
         the interval of the previous call, as a time stepper's calls do)."""
-        times, values = self._t, self._v
+        times = self._t
+        values = self._v
         k = self._k
         if not (k < len(times) and times[k - 1] <= t < times[k]):
             k = bisect.bisect_right(times, t)
@@ -58,7 +59,8 @@ class LinearHistory:
             if k == len(times):
                 return values[-1]
             self._k = k
-        t0, v0 = times[k - 1], values[k - 1]
+        t0 = times[k - 1]
+        v0 = values[k - 1]
         # np.interp's formula, so both paths give the same value to rounding
         return (values[k] - v0) / (times[k] - t0) * (t - t0) + v0
 
@@ -92,7 +94,8 @@ class CubicPieces:
     def __call__(self, t: float) -> float:
         """The spline's value at one instant ``t`` (plain floats, O(log n); O(1) when ``t``
         falls in the piece of the previous call)."""
-        x, k = self._x, self._k
+        x = self._x
+        k = self._k
         if not (x[k] <= t < x[k + 1]):
             k = self._k = min(max(bisect.bisect_right(x, t) - 1, 0), self._last)
         s = t - x[k]
@@ -107,7 +110,9 @@ def largest_slope(spline: Any) -> float:
     """
     c = np.asarray(spline.c, dtype=float)
     h = np.diff(np.asarray(spline.x, dtype=float))
-    c0, c1, c2 = c[0], c[1], c[2]
+    c0 = c[0]
+    c1 = c[1]
+    c2 = c[2]
     ends = np.maximum(np.abs(c2), np.abs((3.0 * c0 * h + 2.0 * c1) * h + c2))
     with np.errstate(divide="ignore", invalid="ignore"):
         vertex = -c1 / (3.0 * c0)
@@ -121,7 +126,9 @@ def _turning_points(spline: Any) -> np.ndarray:
     c = np.asarray(spline.c, dtype=float)
     x = np.asarray(spline.x, dtype=float)
     h = np.diff(x)
-    a, b, d = 3.0 * c[0], 2.0 * c[1], c[2]  # s'(tau) = a tau^2 + b tau + d on each piece
+    a = 3.0 * c[0]  # s'(tau) = a tau^2 + b tau + d on each piece
+    b = 2.0 * c[1]
+    d = c[2]
     with np.errstate(divide="ignore", invalid="ignore"):
         root = np.sqrt(np.maximum(b * b - 4.0 * a * d, 0.0))
         quadratic = [(-b - root) / (2.0 * a), (-b + root) / (2.0 * a)]

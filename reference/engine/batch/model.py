@@ -69,7 +69,9 @@ class StackedLoop:
     """
 
     def __init__(self, alpha: np.ndarray, a: np.ndarray, s1: np.ndarray) -> None:
-        self.alpha, self.a, self.s1 = alpha, a, s1
+        self.alpha = alpha
+        self.a = a
+        self.s1 = s1
 
     def twists(self) -> Dual:
         """Dual link twists ``alpha_k + eps a_k``, shape (n, 4)."""
@@ -97,9 +99,11 @@ class StackedLaw:
 
 def _slot_coefficients(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
     """Per slot: journal diameter [m], the law's factors of ``|F|`` and ``|M|``; shape (K, 3)."""
-    out, pairs = [], dict(scene.joint.friction_pairs())  # moment levers resolved
+    out = []  # moment levers resolved
+    pairs = dict(scene.joint.friction_pairs())
     for pair, kind in slots:
-        data, which = pairs[pair], 0 if kind == "torque" else 1
+        data = pairs[pair]
+        which = 0 if kind == "torque" else 1
         out.append((data.journal_diameter, float(friction_magnitudes(data, 1.0, 0.0)[which]),
                     float(friction_magnitudes(data, 0.0, 1.0)[which])))
     return np.array(out, float).reshape(len(slots), 3)
@@ -123,7 +127,8 @@ class SceneStack:
     def __init__(self, scenes: Sequence[Scene], sign_bands: Sequence[dict] | None = None) -> None:
         self.scenes = list(scenes)
         first = self.scenes[0]
-        self.first, self.slots = first, friction_slots(first)
+        self.first = first
+        self.slots = friction_slots(first)
         self.ideal = not first.joint.errors.any
         self.speed = np.array([s.drive.speed for s in self.scenes], float)
         self.load = np.array([float(s.load.torque) for s in self.scenes], float)
@@ -160,7 +165,8 @@ class SceneStack:
         zero = solve_wrapped(Dual(self.alpha, self.offset), self.s1, np.zeros(len(joints)), HOOKE,
                              "the reference input angle", strict=False)
         self.failed.update(np.flatnonzero(~np.all(np.isfinite(zero.re), -1)).tolist())
-        self.zero_angle, self.zero_slide = np.nan_to_num(zero.re), np.nan_to_num(zero.du)
+        self.zero_angle = np.nan_to_num(zero.re)
+        self.zero_slide = np.nan_to_num(zero.du)
 
     def _check_windings(self) -> None:
         """The windings check of :func:`reference.physics.rccc.positions.solve_positions` for every scene at once
@@ -260,9 +266,11 @@ class SceneStack:
         matrix = np.zeros(idx.shape + (18, 18))
         matrix[..., :-1] = wrench_columns(motion, unknowns()[:-1])
         matrix[..., DRIVE_ROW, -1] = 1.0  # the input's rows come first
-        gravity, parts = self.gravity[idx], []
+        gravity = self.gravity[idx]
+        parts = []
         for name in BODY_NAMES:
-            k, m = self._body(name, idx, motion), motion.bodies[name]
+            k = self._body(name, idx, motion)
+            m = motion.bodies[name]
             force = k["mass"] * (k["a"] - gravity)
             j_omega = np.einsum("...ij,...j->...i", k["inertia"], m.omega)
             j_alpha = np.einsum("...ij,...j->...i", k["inertia"], m.alpha)
@@ -275,9 +283,12 @@ class SceneStack:
 
     def _energy(self, idx: np.ndarray, motion: JointMotion) -> tuple[np.ndarray, np.ndarray]:
         """:func:`reference.engine.newton_euler.mechanical_energy` per sample [J]."""
-        kinetic, potential, gravity = 0.0, 0.0, self.gravity[idx]
+        kinetic = 0.0
+        potential = 0.0
+        gravity = self.gravity[idx]
         for name in BODY_NAMES:
-            k, w = self._body(name, idx, motion), motion.bodies[name].omega
+            k = self._body(name, idx, motion)
+            w = motion.bodies[name].omega
             j_omega = np.einsum("...ij,...j->...i", k["inertia"], w)
             kinetic = (kinetic + 0.5 * k["mass"][:, 0] * np.sum(k["v"] ** 2, -1)
                        + 0.5 * np.sum(w * j_omega, -1))
@@ -327,7 +338,8 @@ class SceneStack:
         instants ``t`` [s], shape (n,) each; evaluated :data:`CHUNK_SAMPLES` at a time.
         ``energy`` False: the energy columns are left zero and the loop gain is exact only where it
         decides self-locking (the work integrands need neither)."""
-        idx, t = np.asarray(idx, int), np.asarray(t, float)
+        idx = np.asarray(idx, int)
+        t = np.asarray(t, float)
         if idx.size <= CHUNK_SAMPLES:
             return self._columns(idx, t, energy)
         parts = [self._columns(idx[k:k + CHUNK_SAMPLES], t[k:k + CHUNK_SAMPLES], energy)
@@ -336,7 +348,9 @@ class SceneStack:
 
     def _columns(self, idx: np.ndarray, t: np.ndarray, energy: bool) -> dict[str, np.ndarray]:
         w = self.speed[idx]
-        theta, theta_t, theta_tt = w * t, w + 0.0, np.zeros_like(t)
+        theta = w * t
+        theta_t = w + 0.0
+        theta_tt = np.zeros_like(t)
         motion = self.motion(idx, theta, theta_t, theta_tt)
         fixed = self._fixed_point(idx, motion, 0.5 if energy else 1.0)
         drive = np.where(fixed.self_locking, np.nan, fixed.x[:, -1])

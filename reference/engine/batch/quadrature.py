@@ -36,7 +36,8 @@ def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) ->
     owner = np.repeat(np.asarray(members, int), [g.size for g in grids])
     values = np.split(stack.ramp_speeds(owner, np.concatenate(grids)),
                       np.cumsum([g.size for g in grids])[:-1])
-    found, grazing = [], []
+    found = []
+    grazing = []
     for k, (m, grid, v) in enumerate(zip(members, grids, values, strict=True)):
         for levels in (-stack.ramp_bands[m], stack.ramp_bands[m]):
             found += [(k, *br) for br in sign_change_brackets(grid, v, levels)]
@@ -72,8 +73,10 @@ def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
         c = b[on] - f_b[on] * (b[on] - a[on]) / (f_b[on] - f_a[on])
         f_c = stack.ramp_speeds(scene[on], c)[np.arange(on.size), j[on]] - level[on]
         same = np.sign(f_c) == np.sign(f_b[on])
-        a[on], f_a[on] = np.where(same, a[on], b[on]), np.where(same, 0.5 * f_a[on], f_b[on])
-        b[on], f_b[on] = c, f_c
+        a[on] = np.where(same, a[on], b[on])
+        f_a[on] = np.where(same, 0.5 * f_a[on], f_b[on])
+        b[on] = c
+        f_b[on] = f_c
         converged = (np.abs(b - a) <= 1e-15) | (f_b == 0.0)
         active &= np.bincount(k, (~converged).astype(float), len(members)) > 0
         if not np.any(active):
@@ -84,7 +87,8 @@ def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
 def _gauss(integrand: Callable, rules: dict, nodes: np.ndarray, owner: np.ndarray, lo: np.ndarray,
            hi: np.ndarray) -> np.ndarray:
     """Each panel's Gauss-Legendre integral with its scene's rule, all in one integrand call."""
-    half, centre = 0.5 * (hi - lo), 0.5 * (lo + hi)
+    half = 0.5 * (hi - lo)
+    centre = 0.5 * (lo + hi)
     groups = [(np.flatnonzero(nodes[owner] == n), x, w) for n, (x, w) in rules.items()]
     times = [(centre[sel][:, None] + half[sel][:, None] * x).ravel() for sel, x, _ in groups]
     scenes = [np.repeat(owner[sel], x.size) for sel, x, _ in groups]
@@ -113,15 +117,18 @@ def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.
     gross = np.bincount(owner, np.abs(whole[:, 0]), count)
     scale = np.maximum.reduce([np.abs(np.bincount(owner, whole[:, 0], count)), GROSS_SCALE * gross,
                                scale_floor, np.full(count, np.finfo(float).tiny)])
-    result, error = np.zeros((count, whole.shape[1])), np.zeros((count, whole.shape[1]))
-    closed, rounds = np.zeros(count, int), np.zeros(count, int)
+    result = np.zeros((count, whole.shape[1]))
+    error = np.zeros((count, whole.shape[1]))
+    closed = np.zeros(count, int)
+    rounds = np.zeros(count, int)
     for r in range(1, max_rounds + 1):
         rounds[np.unique(owner)] = r
         mid = 0.5 * (a + b)
         both = _gauss(integrand, rules, nodes, np.concatenate([owner, owner]), np.concatenate([a, mid]),
                       np.concatenate([mid, b]))
         evaluations += 2 * np.bincount(owner, nodes[owner], count)
-        left, right = both[:a.size], both[a.size:]
+        left = both[:a.size]
+        right = both[a.size:]
         diff = np.abs(left + right - whole)
         allowed = rtol * scale[owner] * (b - a) / total_width[owner]
         open_ = np.bincount(owner, minlength=count)[owner]
@@ -133,7 +140,8 @@ def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.
         keep = ~done & np.all(np.isfinite(result), -1)[owner]  # a NaN decides its scene's integral
         if not np.any(keep):
             break
-        a, b = np.concatenate([a[keep], mid[keep]]), np.concatenate([mid[keep], b[keep]])
+        a = np.concatenate([a[keep], mid[keep]])
+        b = np.concatenate([mid[keep], b[keep]])
         owner = np.concatenate([owner[keep], owner[keep]])
         whole = np.concatenate([left[keep], right[keep]])
     return result, [{"evaluations": int(evaluations[s]), "rounds": int(rounds[s]), "panels": int(closed[s]),
@@ -142,7 +150,8 @@ def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.
 
 def _window(scene, motion: InputMotion, table: dict[str, np.ndarray]) -> tuple[float, float, int] | None:
     """Start and end of the window [s] and the whole revolutions in it (None: none)."""
-    theta, t = table["theta_in"], table["t"]
+    theta = table["theta_in"]
+    t = table["t"]
     theta_0, theta_1, n = whole_revolution_window(theta, scene.record.skip_revolutions)
     if n < 1:
         return None
@@ -165,7 +174,10 @@ def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequenc
     t_end = t_a + period
     kinks = sign_breakpoints(stack, ids, t_a, t_end)
     width = period / options.panels_per_revolution
-    owner, lo, hi, nodes = [], [], [], np.empty(ids.size, int)
+    owner = []
+    lo = []
+    hi = []
+    nodes = np.empty(ids.size, int)
     for s in range(ids.size):
         a, b = initial_panels(np.unique(np.concatenate([[t_a[s], t_end[s]], kinks[s]])), width[s])
         nodes[s] = options.gauss_nodes  # no history knots at constant speed and load: never dense

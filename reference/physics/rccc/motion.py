@@ -141,7 +141,8 @@ def body_motions(params: DHParameters, positions: LoopPositions,
     the angular velocity, its dual part the velocity of the body point at the global origin.
     """
     screws = joint_screws(params, positions)
-    joint_rates, joint_accels = Dual(rates.theta_t, rates.s_t), Dual(rates.theta_tt, rates.s_tt)
+    joint_rates = Dual(rates.theta_t, rates.s_t)
+    joint_accels = Dual(rates.theta_tt, rates.s_tt)
     twist = (joint_rates[..., None] * screws).cumsum(-2)
     twist_t = (joint_accels[..., None] * screws
                + joint_rates[..., None] * _screw_rates(screws, joint_rates)).cumsum(-2)
@@ -150,7 +151,8 @@ def body_motions(params: DHParameters, positions: LoopPositions,
     out = {"ground": BodyMotion(poses["ground"].rotation, zero, zero, zero, zero, zero)}
     for k, name in enumerate(LINK_NAMES[:3]):
         p = poses[name].origin
-        omega, alpha = twist.re[..., k, :], twist_t.re[..., k, :]
+        omega = twist.re[..., k, :]
+        alpha = twist_t.re[..., k, :]
         velocity = twist.du[..., k, :] + np.cross(omega, p)
         acceleration = twist_t.du[..., k, :] + np.cross(alpha, p) + np.cross(omega, velocity)
         out[name] = BodyMotion(poses[name].rotation, p, omega, velocity, alpha, acceleration)

@@ -82,7 +82,9 @@ class DHParameters:
     def with_errors(self, a: Sequence[float] = (0.0,) * 4, alpha: Sequence[float] = (0.0,) * 4,
                     s1: float = 0.0) -> DHParameters:
         """These parameters with errors added: offsets ``a`` [m], twists ``alpha`` [rad], ``s1`` [m]."""
-        d_a, d_alpha, d_s1 = four_numbers("a", a), four_numbers("alpha", alpha), finite_number("s1", s1)
+        d_a = four_numbers("a", a)
+        d_alpha = four_numbers("alpha", alpha)
+        d_s1 = finite_number("s1", s1)
         return DHParameters(alpha=tuple(x + y for x, y in zip(self.alpha, d_alpha, strict=True)),
                             a=tuple(x + y for x, y in zip(self.a, d_a, strict=True)), s1=self.s1 + d_s1)
 

@@ -88,7 +88,8 @@ def at_zero(params: DHParameters, branch: str) -> tuple[np.ndarray, np.ndarray]:
     Every solve and every pair-frame evaluation of a parameter set needs them; solved once.
     """
     angles = _solve(params, np.zeros(1), branch, "the reference input angle")
-    theta, slide = angles.re[0].copy(), angles.du[0].copy()
+    theta = angles.re[0].copy()
+    slide = angles.du[0].copy()
     theta.flags.writeable = slide.flags.writeable = False  # shared by every caller
     return theta, slide
 
