@@ -14,12 +14,11 @@ typed result::
 
 To run the same scene with Exudyn or MuJoCo, use ``cardan_exudyn.run(scene, engine=...)``.
 
-Modules, bottom up: ``validation`` (SceneError, unit constants), ``joint`` (bodies, geometry,
-pairs, mounting errors), ``scene`` (drives, load, numerics, the scene and its dictionary form),
-``paper`` (the paper's data as named scenes), ``scene_files`` (TOML files, ``base = "..."``),
-``schema`` (the result), and the engine: ``kinematics``, ``dual``, ``loop_closure``, ``rccc``,
-``joint_motion``, ``friction``, ``dynamics``, ``gauss`` (panel quadrature), ``engine``;
-``quadrature`` (time-table integrals across friction jumps, for every engine's means), ``batch``.
+Subpackages, bottom up: ``scene`` (the scene: joint, drives, load, settings, its dictionary form
+and TOML files), ``paper`` (the paper's data, parameter sets and named scenes), ``results`` (the
+result schema and the means every engine shares), ``physics`` (kinematics, the RCCC loop, joint
+motion, friction laws, sign bands) and ``engine`` (the reference engine; ``engine.batch``: many
+scenes at once).
 
 Names are imported on first use (PEP 562): every ``import reference.<module>`` runs this file
 first, so it imports nothing itself (the engine's modules and scipy load only when needed).

@@ -1,4 +1,4 @@
-"""Forward dynamics of a torque-driven scene at one state in microseconds, not milliseconds.
+"""Forward dynamics of a torque-driven scene at one state in microseconds.
 
 A torque drive is integrated in time (:func:`reference.engine.motion.input_motion`); every call of the
 integrator's right-hand side needs the input acceleration at one state ``(t, theta, theta_t)``.
@@ -29,10 +29,7 @@ This module takes the same equations apart instead:
 The parts are taken at a large speed, acceleration and load (:data:`PART_SCALE`), so their
 differences keep all digits; the direct solve takes the acceleration's column as the difference
 of two right-hand sides at accelerations 0 and 1 and loses about three digits to gravity and the
-centrifugal terms. Measured: the two agree to 2e-12 of the acceleration (random states, with
-friction, mounting errors, both friction laws), and the series' acceleration and friction satisfy
-the Newton-Euler equations and the friction law to 3e-14 (drive torque) where the direct solve's
-do to 4e-12, and to 1e-9 near self-locking (``tests/test_forward_dynamics.py``). Where the grid
+centrifugal terms (measured: docs/engines.md#constants-of-the-reference-engine). Where the grid
 cannot be built (the loop with mounting errors does not close at some angle) or no grid of
 :data:`GRID_SIZES` resolves the series, :func:`right_hand_side` falls back to the direct solve.
 

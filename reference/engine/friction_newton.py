@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg.lapack import dgeev, dgesv  # LAPACK direct: 1 us, np.linalg.solve 12 us
+from scipy.linalg.lapack import dgeev, dgesv  # a tenth of np.linalg.solve's cost: docs/engines.md
 
 from reference.engine.fixed_point import power_bound
 

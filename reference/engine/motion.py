@@ -142,7 +142,20 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
 
 def input_motion(scene: Scene, options: ReferenceOptions) -> InputMotion:
-    """The input's motion for the scene's drive (integrating it for a torque drive)."""
+    """The input's motion for the scene's drive (integrating it for a torque drive).
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene on the run's clock (:func:`reference.scene.histories.run_clock`).
+    options : ReferenceOptions
+        The ODE tolerances of a torque drive.
+
+    Returns
+    -------
+    InputMotion
+        Its span, state function and, for a torque drive that stops early, the status and why.
+    """
     drive = scene.drive
     if isinstance(drive, SpeedDrive):
         return _speed_motion(scene, drive)

@@ -23,7 +23,22 @@ EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
 
 
 def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
-    """Result-schema columns at the instants ``t`` (plus :data:`EXTRA_COLUMNS`)."""
+    """Result-schema columns at the instants ``t`` (plus :data:`EXTRA_COLUMNS`).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene on the run's clock.
+    motion : InputMotion
+        The input's motion (:func:`reference.engine.motion.input_motion`).
+    t : ndarray, shape (n,)
+        Instants [s].
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        ``t`` and every column of :func:`reference.engine.dynamics.dynamics_columns`.
+    """
     theta, theta_t, theta_tt = motion.state(t)
     theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
     theta_t = np.broadcast_to(np.asarray(theta_t, float), np.shape(t))
@@ -34,9 +49,12 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np
 
 
 def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`columns_at` on the table's instants ``t`` [s]. Summary only (no table recorded): a
-    periodic motion's first period, repeated (:mod:`reference.engine.periodic`); a recorded table is
-    evaluated row by row, so that each row's angle is the one its state was computed at."""
+    """:func:`columns_at` on the table's instants ``t`` (n,) [s], the same arguments.
+
+    Summary only (no table recorded): a periodic motion's first period, repeated
+    (:mod:`reference.engine.periodic`); a recorded table is evaluated row by row, so that each
+    row's angle is the one its state was computed at.
+    """
     rows = period_rows(t, scene.drive.speed) if motion.periodic and not scene.record.timeseries else None
     if rows is None:
         return columns_at(scene, motion, t)
@@ -44,6 +62,28 @@ def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str,
 
 
 def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
+    """The time table's instants.
+
+    Parameters
+    ----------
+    scene : Scene
+        ``numerics.dt`` sets the spacing when the options give no samples per revolution (so that
+        the rows line up with a fixed-step engine's).
+    motion : InputMotion
+        The span ``[t0, t_end]`` [s] and the angle turned in it.
+    options : ReferenceOptions
+        ``samples_per_revolution`` (None: ``dt``, else 360).
+
+    Returns
+    -------
+    ndarray, shape (steps + 1,)
+        Equispaced instants from ``t0`` to ``t_end`` [s].
+
+    Raises
+    ------
+    SceneError
+        More steps than :data:`reference.scene.validation.MAX_STEPS`.
+    """
     span = motion.t_end - motion.t0
     if options.samples_per_revolution is None and scene.numerics.dt is not None:
         check_steps(span / scene.numerics.dt,

@@ -103,15 +103,42 @@ def work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str,
     return out
 
 
+def _panels(t_a: float, t_end: float, kinks: np.ndarray, knots: np.ndarray, width: float,
+            gauss_nodes: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """Initial panels ``(lo, hi)`` [s] over ``[t_a, t_end]`` at most ``width`` [s] wide, broken at
+    the friction ramps' edges ``kinks`` and the histories' ``knots`` [s], and the nodes per panel
+    (fewer where the knots alone make the panels dense: a densely sampled history)."""
+    edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
+    lo, hi = initial_panels(edges, width)
+    k_lo, k_hi = initial_panels(np.unique(np.concatenate([[t_a, t_end], knots])), width)
+    dense = knots.size and np.median(k_hi - k_lo) < DENSE_WIDTH * width
+    return lo, hi, (min(gauss_nodes, DENSE_NODES) if dense else gauss_nodes)
+
+
 def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarray],
                     options: ReferenceOptions) -> dict:
     """Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature.
 
-    Returns the summary keys ``input_work``, ``output_work``, ``loss_work`` [J],
-    ``loss_work_<pair>`` and its axial-friction part ``loss_work_<pair>_sliding`` [J] (zero in
-    the ideal joint), ``energy_balance_residual`` (W_in - W_out - W_loss - change of mechanical
-    energy [J], zero up to rounding for an exact solution), ``quadrature`` (how it was done) and
-    ``self_locking_nodes`` (friction locks at some node); empty when there is no whole revolution.
+    Parameters
+    ----------
+    scene : Scene
+        The scene on the run's clock.
+    motion : InputMotion
+        The input's motion (:func:`reference.engine.motion.input_motion`).
+    table : dict of str to ndarray
+        The time table's ``t`` [s] and ``theta_in`` [rad] (they locate the window).
+    options : ReferenceOptions
+        Panels per revolution, nodes per panel and the quadrature's tolerance.
+
+    Returns
+    -------
+    dict
+        The summary keys ``input_work``, ``output_work``, ``loss_work`` [J], ``loss_work_<pair>``
+        and its axial-friction part ``loss_work_<pair>_sliding`` [J] (zero in the ideal joint),
+        ``energy_balance_residual`` (W_in - W_out - W_loss - change of mechanical energy [J], zero
+        up to rounding for an exact solution), ``quadrature`` (how it was done) and
+        ``self_locking_nodes`` (friction locks at some node); empty when there is no whole
+        revolution.
     """
     theta = table["theta_in"]
     t = table["t"]
@@ -126,11 +153,8 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     kinks = sign_breakpoints(scene, motion, t_a, t_end)
     knots = np.concatenate([motion.knots, scene.load.knots])  # drive and load histories' knots
     knots = knots[(knots > t_a) & (knots < t_end)]
-    edges = np.unique(np.concatenate([[t_a, t_end], kinks, knots]))
-    lo, hi = initial_panels(edges, width := period / options.panels_per_revolution)
-    k_lo, k_hi = initial_panels(np.unique(np.concatenate([[t_a, t_end], knots])), width)
-    dense = knots.size and np.median(k_hi - k_lo) < DENSE_WIDTH * width
-    nodes = min(options.gauss_nodes, DENSE_NODES) if dense else options.gauss_nodes
+    lo, hi, nodes = _panels(t_a, t_end, kinks, knots, period / options.panels_per_revolution,
+                            options.gauss_nodes)
     ends = columns_at(scene, motion, np.array([t_a, t_b]))
     values, info = _integrate_powers(scene, motion, lo, hi, ends, options, nodes)
     work = dict(zip(WORK_KEYS, (repeats * values).tolist(), strict=True))

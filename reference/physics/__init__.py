@@ -1,4 +1,5 @@
-"""Physics every engine shares: Cardan and RCCC kinematics, joint motion, the friction law (eqs. (1)-(5)), sign bands."""
+"""Physics every engine shares: Cardan and RCCC kinematics, joint motion, the friction law
+(eqs. (1)-(5)), sign bands."""
 
 from __future__ import annotations
 

@@ -50,8 +50,18 @@ from reference.scene.scene import Scene
 def regularised_sign(speed: Any, band: Any) -> np.ndarray:
     """``clip(speed / band, -1, 1)``; the exact sign where ``band`` is 0.
 
-    ``band`` [m/s] is a scalar or an array broadcasting with ``speed`` [m/s] (one band per
-    friction value along the last axis).
+    Parameters
+    ----------
+    speed : array_like
+        Relative surface or sliding speed [m/s], any shape.
+    band : array_like
+        Ramp width [m/s], a scalar or broadcasting with ``speed`` (one band per friction value
+        along the last axis); 0 where the sign is exact.
+
+    Returns
+    -------
+    ndarray
+        The regularised sign [-], in [-1, 1], the broadcast shape.
     """
     speed = np.asarray(speed, dtype=float)
     band = np.asarray(band, dtype=float)
@@ -66,8 +76,20 @@ def regularised_sign(speed: Any, band: Any) -> np.ndarray:
 def friction_magnitudes(pair: Pair, force_normal: Any, moment_normal: Any) -> tuple[np.ndarray, np.ndarray]:
     """Unsigned friction torque (eqs. (2)-(4)) and axial friction force (eq. (5)).
 
-    ``force_normal`` and ``moment_normal`` are the magnitudes of the reaction force and moment
-    normal to the pair axis.
+    Parameters
+    ----------
+    pair : Pair
+        Friction coefficient ``f``, journal diameter ``d`` [m] and moment lever ``L`` [m].
+    force_normal, moment_normal : array_like
+        Magnitudes of the reaction force [N] and moment [N m] normal to the pair axis
+        (broadcasting together).
+
+    Returns
+    -------
+    torque : ndarray
+        ``f d |M| / L + f d |F| / 2`` [N m].
+    force : ndarray
+        ``f (|F| + 2 |M| / L)`` [N].
     """
     f = pair.friction_coefficient
     d = pair.journal_diameter
@@ -82,9 +104,17 @@ def friction_magnitudes(pair: Pair, force_normal: Any, moment_normal: Any) -> tu
 def slip_direction(surface_speed: Any, slide_speed: Any, band: Any) -> tuple[np.ndarray, np.ndarray]:
     """Regularised unit slip vector ``v / max(|v|, band)`` of ``v = (surface_speed, slide_speed)``.
 
-    ``surface_speed`` (``omega_rel d / 2``) and ``slide_speed`` [m/s] broadcast together;
-    ``band`` [m/s] broadcasts with them (0: ``v / |v|``, and 0 where ``v = 0``). Returns the
-    circumferential and axial components [-], each in [-1, 1], their hypotenuse at most 1.
+    Parameters
+    ----------
+    surface_speed, slide_speed : array_like
+        Circumferential (``omega_rel d / 2``) and axial slip speed [m/s], broadcasting together.
+    band : array_like
+        Ramp width [m/s], broadcasting with them (0: ``v / |v|``, and 0 where ``v = 0``).
+
+    Returns
+    -------
+    circumferential, axial : ndarray
+        The components [-], each in [-1, 1], their hypotenuse at most 1.
     """
     surface = np.asarray(surface_speed, dtype=float)
     slide = np.asarray(slide_speed, dtype=float)
@@ -129,9 +159,22 @@ def pair_friction(pair: Pair, kind: str, fx: Any, fy: Any, mx: Any, my: Any, ome
 
 def friction_from_columns(scene: Scene,
                           columns: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Friction torque and force of every pair from result-schema columns (reactions, speeds),
-    with the scene's sign bands (:func:`reference.physics.bands.sign_bands`) and friction law
-    (``scene.friction.law``)."""
+    """Friction torque and force of every pair from result-schema columns.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its pairs, sign bands (:func:`reference.physics.bands.sign_bands`) and friction law
+        (``scene.friction.law``).
+    columns : mapping
+        ``<pair>_fx``, ``_fy`` [N], ``_mx``, ``_my`` [N m], ``_omega_rel`` [rad/s] and
+        ``_slide_rel`` [m/s] of every pair with friction, arrays of one shape.
+
+    Returns
+    -------
+    dict of str to (ndarray, ndarray)
+        Per pair with friction: torque about [N m] and force along [N] its axis on body ``b``.
+    """
     out = {}
     bands = sign_bands(scene)
     for name, pair in scene.joint.friction_pairs():
@@ -146,7 +189,20 @@ def friction_from_columns(scene: Scene,
 
 
 def pair_power_loss(torque: Any, force: Any, omega_rel: Any, slide_rel: Any) -> np.ndarray:
-    """Power dissipated by friction in a pair [W]: ``-(M_z omega_rel + F_z v_slide)``."""
+    """Power dissipated by friction in a pair: ``-(M_z omega_rel + F_z v_slide)``.
+
+    Parameters
+    ----------
+    torque, force : array_like
+        Friction torque about [N m] and force along [N] the pair axis on body ``b``.
+    omega_rel, slide_rel : array_like
+        Angular [rad/s] and sliding [m/s] speed of ``b`` relative to ``a`` (all four broadcast).
+
+    Returns
+    -------
+    ndarray
+        The dissipated power [W], >= 0 when friction opposes the motion.
+    """
     return -(np.asarray(torque) * np.asarray(omega_rel) + np.asarray(force) * np.asarray(slide_rel))
 
 

@@ -15,9 +15,10 @@ closed form to rounding (a test checks it, reactions included).
 Conventions shared by both: a body's mass properties (:meth:`reference.scene.joint.Body.canonical`) are
 given in its canonical frame, whose origin is the body's D-H link-frame origin (the joint centre O
 for the ideal joint). Each pair's frame is attached to body ``a`` of the pair
-(:data:`reference.scene.joint.PAIR_BODIES`), z along the pair axis; its origin, the point about which
-reaction moments are taken, is where the bearing sits (:func:`reference.physics.rccc.frames.axial_positions`) and
-moves with body ``b`` when the pair slides (:func:`reference.physics.rccc.frames.pair_frames`).
+(:data:`reference.scene.joint.PAIR_BODIES`), z along the pair axis; its origin, the point about
+which reaction moments are taken, is where the bearing sits
+(:func:`reference.physics.rccc.frames.axial_positions`) and moves with body ``b`` when the pair
+slides (:func:`reference.physics.rccc.frames.pair_frames`).
 """
 
 from __future__ import annotations

@@ -4,9 +4,8 @@ An engine that steps in time evaluates the drive's angle and the load's torque a
 evaluation, one instant at a time, from Python (Exudyn's user functions): that evaluation must
 cost O(log n) in the number of samples ``n``, not O(n). :class:`LinearHistory` and
 :class:`CubicPieces` find the sample interval by bisection in precomputed lists and evaluate one
-linear or cubic piece in plain floats (about 1 us, against 15 us for a call of a
-``scipy.interpolate.CubicSpline`` and 3 ms for ``np.interp`` over a 30,000-sample tuple, which
-converts the tuple at every call). Arrays of instants go to ``np.interp`` / the spline itself
+linear or cubic piece in plain floats, a fraction of a spline call's cost (measured:
+docs/engines.md#constants-of-the-reference-engine). Arrays of instants go to ``np.interp`` / the spline itself
 (vectorised, O(m log n)).
 
 :func:`largest_slope` and :func:`first_turn` answer the two questions engines ask of a whole

@@ -33,9 +33,10 @@ class Scene:
     gravity : tuple, shape (3,)
         Gravitational acceleration in the global frame [m/s^2].
     parameter_set : str
-        The paper's parameter set the scene was built with (:data:`reference.paper.parameter_sets.PARAMETER_SETS`,
-        ``"custom"`` for values given by hand), or ``""`` for a scene that is not the paper's;
-        every result carries it, and ``cardan run`` prints it.
+        The paper's parameter set the scene was built with
+        (:data:`reference.paper.parameter_sets.PARAMETER_SETS`, ``"custom"`` for values given by
+        hand), or ``""`` for a scene that is not the paper's; every result carries it, and
+        ``cardan run`` prints it.
     """
 
     joint: Joint

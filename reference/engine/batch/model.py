@@ -51,14 +51,14 @@ from reference.scene.scene import Scene
 HOOKE = -1.0
 """Root of the loop's input-output equation on the ``"hooke"`` branch (the one every engine uses)."""
 CHUNK_SAMPLES = 4096
-"""Samples per vectorised evaluation: bounds the memory and is the fastest size measured (work
-columns of rig samples with mounting errors, shared 2-core machine: 111, 76, 63, 45, 49, 64 us per
-sample at 256, 1024, 2048, 4096, 8192, 16384 samples per call; larger calls leave the caches)."""
+"""Samples per vectorised evaluation: bounds the memory and is the fastest size measured (larger
+calls leave the caches). Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
 class StackedLoop:
     """The loop parameters of many scenes, one row per sample; it stands in for
-    :class:`reference.physics.rccc.parameters.DHParameters` where :mod:`reference.physics.rccc` only asks for the twists.
+    :class:`reference.physics.rccc.parameters.DHParameters` where :mod:`reference.physics.rccc`
+    only asks for the twists.
 
     Parameters
     ----------
@@ -169,10 +169,10 @@ class SceneStack:
         self.zero_slide = np.nan_to_num(zero.du)
 
     def _check_windings(self) -> None:
-        """The windings check of :func:`reference.physics.rccc.positions.solve_positions` for every scene at once
-        (:data:`reference.physics.rccc.positions.WINDING_SAMPLES` input angles each): a scene whose joint angles
-        jump, or whose loop does not close at one of them, is added to :attr:`failed` (run on its
-        own, the engine reports why)."""
+        """The windings check of :func:`reference.physics.rccc.positions.solve_positions` for every
+        scene at once (:data:`reference.physics.rccc.positions.WINDING_SAMPLES` input angles each): a
+        scene whose joint angles jump, or whose loop does not close at one of them, is added to
+        :attr:`failed` (run on its own, the engine reports why)."""
         live = np.array([k for k in range(len(self.scenes)) if k not in self.failed], int)
         if live.size == 0:
             return

@@ -1,4 +1,4 @@
-"""Many scenes through the reference engine at once (issue 20).
+"""Many scenes through the reference engine at once.
 
 CONTRACT (kept by every implementation; the sweep runner and the tolerance study build on it):
 
@@ -46,9 +46,8 @@ from reference.scene.validation import SceneError, check_steps, require_scene
 __all__ = ["BATCH_SCENES", "batch_key", "check_scenes", "run_batch"]
 
 BATCH_SCENES = 32
-"""Scenes evaluated together at most: bounds the memory (their time tables are held at once).
-Measured on rig samples with mounting errors (2 shared cores): 257, 204, 202, 197 ms per scene
-for 1, 8, 32, 64 scenes per pass; peak RSS 51, 96, 113, 142 MB."""
+"""Scenes evaluated together at most: bounds the memory (their time tables are held at once); more
+gain little time. Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
 def batch_key(scene) -> Hashable | None:
