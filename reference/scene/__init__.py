@@ -9,7 +9,7 @@ _HOMES = {
     "reference.scene.joint": ('PAIR_NAMES', 'Body', 'Geometry', 'Pair', 'Pairs', 'MountingErrors', 'Joint'),
     "reference.scene.drives": ("SpeedDrive", "AngleDrive", "TorqueDrive"),
     "reference.scene.load": ("Load",),
-    "reference.scene.settings": ("Numerics", "FrictionSettings", "Record"),
+    "reference.scene.settings": ("Numerics", "FrictionSettings", "Record", "COUPLINGS", "FRICTION_LAWS"),
     "reference.scene.scene": ("Scene",),
     "reference.scene.mapping": ("replace", "scene_to_dict", "scene_from_dict"),
     "reference.scene.files": ('load_scene', 'scene_from_mapping'),

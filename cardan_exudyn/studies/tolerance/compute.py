@@ -46,14 +46,10 @@ from cardan_exudyn.engines import ENGINES, run
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep
-from reference.paper.data import value
-from reference.paper.parameter_sets import PARAMETER_SETS
-from reference.paper.scenes import paper_errors, rig_scene
+from reference.paper import PARAMETER_SETS, paper_errors, rig_scene, value
 from reference.results.schema import Status, Summary
+from reference.scene import FRICTION_LAWS, Scene, replace
 from reference.scene.joint import ERROR_NAMES, PAIR_NAMES
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
-from reference.scene.settings import FRICTION_LAWS
 
 CYLINDRICAL = PAIR_NAMES[1:]
 COUPLINGS = ("converged", "uncoupled")
