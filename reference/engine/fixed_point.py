@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FixedPoint", "friction_law_values", "reduced_law_values", "solve_friction", "power_bound",
-           "POWER_SQUARINGS"]
+__all__ = ["FixedPoint", "friction_law_values", "loop_gain", "reduced_law_values", "solve_friction",
+           "power_bound", "POWER_SQUARINGS"]
 
 POWER_SQUARINGS = 6
 """Squarings of :func:`power_bound`: the bound of ``||G^64||^(1/64)``, within 12 % of the spectral
@@ -170,6 +170,29 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
             scale_a = scale_a[keep]
     x = x0 - np.einsum("nik,nk->ni", s, phi)
     _, g_c = law.reduced(x[:, index], signs)
+    gain = loop_gain(g_c, s_c, exact_gain)
+    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
+    return FixedPoint(x, phi, converged, gain, iterations)
+
+
+def loop_gain(g_c: np.ndarray, s_c: np.ndarray, exact_gain: float = 0.5) -> np.ndarray:
+    """The friction loop's gain per sample: the spectral radius of ``dG/dphi``, or an upper bound.
+
+    Parameters
+    ----------
+    g_c : ndarray, shape (n, K, 4)
+        Derivatives of each friction value by its pair's four reaction components at the solution.
+    s_c : ndarray, shape (n, K, 4, K)
+        Response of those components to unit friction values.
+    exact_gain : float
+        The spectral radius where the infinity-norm bound reaches this, else the bound; at 1 or
+        more only the verdict is asked for, and :func:`power_bound` may settle it first.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The gain [-]; infinite where the Jacobian is not finite.
+    """
     with np.errstate(all="ignore"):
         gain_matrix = np.nan_to_num((g_c[:, :, None, :] @ s_c)[:, :, 0, :], nan=np.inf, posinf=np.inf,
                                     neginf=-np.inf)
@@ -180,5 +203,4 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
         gain[exact] = power_bound(gain_matrix[exact], gain[exact])
         exact &= gain >= exact_gain
     gain[exact] = np.max(np.abs(np.linalg.eigvals(gain_matrix[exact])), -1)
-    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
-    return FixedPoint(x, phi, converged, gain, iterations)
+    return gain
