@@ -38,7 +38,8 @@ from cardan_exudyn.model.solve import MODEL_FLOOR
 from cardan_exudyn.studies.calibrate.compute import case_rows, fit_statistics
 from cardan_exudyn.studies.calibrate.fitting import CaseModel
 from cardan_exudyn.testing import make_scene
-from reference.paper.paper import envelope, paper_cases, parameter_set, set_values
+from reference.paper.cases import envelope, paper_cases
+from reference.paper.parameter_sets import parameter_set, set_values
 
 pytest_plugins = ["pytester"]
 

@@ -11,6 +11,8 @@ from test_reference_kinematics import derivative
 from reference.engine import solve as engine
 from reference.engine.dynamics import inverse_dynamics
 from reference.engine.newton_euler import reaction_system
+from reference.engine.options import ReferenceOptions
+from reference.engine.table import EXTRA_COLUMNS
 from reference.paper.scenes import named_scene
 from reference.physics.joint_motion import joint_motion
 from reference.physics.kinematics import body_motions, speed_ratio
@@ -63,7 +65,7 @@ def hand_statics(gy: float, gz: float) -> dict[str, list[float]]:
 
 
 def run(scene: Scene, samples_per_revolution: int | None = None):
-    return engine.run(scene, engine.ReferenceOptions(samples_per_revolution=samples_per_revolution))
+    return engine.run(scene, ReferenceOptions(samples_per_revolution=samples_per_revolution))
 
 
 GRAVITIES = {"gravity-z": (0.0, 0.0, -9.81), "gravity-y": (0.0, -9.81, 0.0),
@@ -161,7 +163,7 @@ def test_result_follows_the_schema():
     scene = replace(named_scene("paper-literal-10deg-frictionless"), **{"record.every": 2})
     result = run(scene, samples_per_revolution=36)
     table, s = result.table, result.summary
-    assert list(table.columns) == table_columns() + list(engine.EXTRA_COLUMNS)
+    assert list(table.columns) == table_columns() + list(EXTRA_COLUMNS)
     assert len(table) == (2 * 36) // 2 + 1  # 2 revolutions, endpoint included, every 2nd row
     assert table["t"].iloc[0] == 0.0
     assert table["theta_in"].iloc[-1] == pytest.approx(4 * np.pi, rel=1e-15)
