@@ -39,10 +39,8 @@ from reference.results.schema import (
     instantaneous_efficiency,
     result_table,
 )
-from reference.scene.drives import AngleDrive, SpeedDrive, TorqueDrive
+from reference.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
-from reference.scene.mapping import scene_to_dict
-from reference.scene.scene import Scene
 from reference.scene.validation import refuse_steps_per_revolution
 
 ENGINE_NAME = "mujoco"
