@@ -33,10 +33,10 @@ _LAZY = {
     "ExudynOptions": "cardan_exudyn.model.options",
     "compare": "cardan_exudyn.comparison",
     "Comparison": "cardan_exudyn.comparison",
-    "Result": "reference.results.schema",
-    "Summary": "reference.results.schema",
-    "Status": "reference.results.schema",
-    "OptionsError": "reference.results.schema",
+    "Result": "reference.results.result",
+    "Summary": "reference.results.summary",
+    "Status": "reference.results.summary",
+    "OptionsError": "reference.results.summary",
     "sweep": "cardan_exudyn.sweep",
 }
 

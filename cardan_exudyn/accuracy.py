@@ -45,7 +45,9 @@ from cardan_exudyn.engines import make_options, options_class
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.model.stepsize import convergence_order
 from cardan_exudyn.report.format import is_number
-from reference.results.schema import MEAN_KEYS, Result, Summary, after_revolutions
+from reference.results.means import after_revolutions
+from reference.results.result import Result
+from reference.results.summary import MEAN_KEYS, Summary
 from reference.scene.mapping import replace, scene_from_dict
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError

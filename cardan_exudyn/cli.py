@@ -50,7 +50,7 @@ from cardan_exudyn.io import (
 )
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies import COMMANDS
-from reference.results.schema import OptionsError, Status, Summary
+from reference.results.summary import OptionsError, Status, Summary
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError

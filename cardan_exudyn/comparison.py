@@ -39,7 +39,10 @@ from scipy.interpolate import CubicSpline
 
 from cardan_exudyn.engines import get_engine, resolve, run
 from cardan_exudyn.report.format import is_number, markdown_table
-from reference.results.schema import OptionsError, Result, Summary, after_revolutions, table_columns
+from reference.results.columns import table_columns
+from reference.results.means import after_revolutions
+from reference.results.result import Result
+from reference.results.summary import OptionsError, Summary
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

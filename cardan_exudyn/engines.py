@@ -1,5 +1,5 @@
 """The one engine dispatch: every engine takes a :class:`reference.scene.scene.Scene` and options, and
-returns a :class:`reference.results.schema.Result` with the same columns and summary fields.
+returns a :class:`reference.results.result.Result` with the same columns and summary fields.
 
 Like scipy's ``solve_ivp(method=...)`` over its ``METHODS`` table: callers name an engine (or
 pass options of an engine's class) and never import an engine module themselves. Engines are
@@ -17,7 +17,8 @@ from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from reference.results.schema import OptionsError, Result
+from reference.results.result import Result
+from reference.results.summary import OptionsError
 from reference.scene.scene import Scene
 from reference.scene.validation import require_scene
 

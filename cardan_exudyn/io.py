@@ -26,7 +26,8 @@ from typing import IO, Any
 import numpy as np
 
 from cardan_exudyn.interrupts import deferred_signals
-from reference.results.schema import Result, Summary
+from reference.results.result import Result
+from reference.results.summary import Summary
 
 
 class OutputError(ValueError):

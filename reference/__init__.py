@@ -38,7 +38,8 @@ _HOMES = {
     "reference.scene.mapping": ("replace", "scene_to_dict", "scene_from_dict"),
     "reference.scene.files": ("load_scene", "scene_from_mapping"),
     "reference.paper.scenes": ("named_scene", "paper_scene", "rig_scene"),
-    "reference.results.schema": ("Status", "Result", "Summary", "OptionsError"),
+    "reference.results.summary": ("Status", "Summary", "OptionsError"),
+    "reference.results.result": ("Result",),
     "reference.engine.options": ("ReferenceOptions",),
     "reference.engine.solve": ("run",),
 }

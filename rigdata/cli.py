@@ -25,7 +25,7 @@ from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInp
 from cardan_exudyn.engines import EngineUnavailable
 from cardan_exudyn.io import OutputError
 from cardan_exudyn.report.format import number
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

@@ -18,7 +18,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from cardan_exudyn import engines
-from reference.results.schema import Result
+from reference.results.result import Result
 from reference.scene.drives import AngleDrive
 from reference.scene.load import Load
 from reference.scene.scene import Scene
@@ -73,10 +73,10 @@ def computed_efficiency(result: Result) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``status`` (:class:`~reference.results.schema.Status`), ``reason``, ``engine``,
+        ``status`` (:class:`~reference.results.summary.Status`), ``reason``, ``engine``,
         ``mean_efficiency`` [-], ``work_ratio`` [-], ``mean_torque_in`` [N m] (None unless the
         status is ok), ``wall_time_s`` [s], ``efficiency_error_estimate`` [-] (the engine's own
-        estimate of its mean-efficiency error, :class:`~reference.results.schema.Summary`); and when the
+        estimate of its mean-efficiency error, :class:`~reference.results.summary.Summary`); and when the
         run is ok and recorded its time series, ``series``: ``t`` [s], ``theta_in`` [rad],
         ``efficiency`` and ``power_ratio`` [-], ``torque_in`` [N m].
     """

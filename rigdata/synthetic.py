@@ -31,7 +31,7 @@ from reference.engine.motion import input_motion
 from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
 from reference.paper.scenes import named_scene
-from reference.results.schema import Result
+from reference.results.result import Result
 from reference.scene.drives import AngleDrive
 from reference.scene.load import Load
 from reference.scene.mapping import replace as replace_field

@@ -25,7 +25,7 @@ import numpy as np
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.io import to_jsonable
 from reference.paper.scenes import named_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.files import load_scene
 from reference.scene.scene import Scene
 from rigdata.conditioning import Conditioned, Conditioning, condition

@@ -32,7 +32,8 @@ from cardan_exudyn.io import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
-from reference.results.schema import OptionsError, Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import OptionsError, Status, Summary
 from reference.scene.files import load_scene
 from reference.scene.joint import Body
 from reference.scene.load import Load

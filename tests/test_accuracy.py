@@ -33,7 +33,7 @@ from cardan_exudyn.studies.accuracy.compute import (
     run_cell_limited,
 )
 from reference.paper.scenes import named_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 

@@ -40,7 +40,8 @@ from cardan_exudyn.studies.bench.targets import (
     paper_scenes_timing,
 )
 from reference.paper.scenes import named_scene
-from reference.results.schema import Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
 from reference.scene.mapping import replace
 
 

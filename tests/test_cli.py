@@ -34,7 +34,7 @@ def test_run_out_writes_files(tmp_path):
     """--out writes timeseries.csv with every schema column and summary.json."""
     import pandas as pd
 
-    from reference.results.schema import table_columns
+    from reference.results.columns import table_columns
 
     assert main(["run", "--angle", "5", "--rpm", "500", "--revolutions", "1",
                  "--out", str(tmp_path / "r")]) == 0

@@ -30,7 +30,7 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.io import dumps
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
-from reference.results.schema import OptionsError, Status
+from reference.results.summary import OptionsError, Status
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 

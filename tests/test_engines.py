@@ -12,7 +12,7 @@ import cardan_exudyn
 from cardan_exudyn import engines
 from cardan_exudyn.model import coupling
 from reference import named_scene, replace
-from reference.results.schema import SCHEMA_VERSION, OptionsError, Status, Summary
+from reference.results.summary import SCHEMA_VERSION, OptionsError, Status, Summary
 
 SHORT = {"revolutions": 1.0}
 

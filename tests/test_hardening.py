@@ -20,7 +20,8 @@ from bad_inputs import CASES, DIRECTORY, ENTRY_POINTS, MARKER, Case
 from cardan_exudyn import io as cio
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
-from reference.results.schema import Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
 
 #: Non-finite numbers as a command would print them (``nan``, ``inf``, ``-inf``, ``infinity``).
 NON_FINITE = re.compile(r"(?<![\w.])[-+]?(nan|inf|infinity)(?![\w])", re.IGNORECASE)

@@ -31,7 +31,9 @@ from cardan_exudyn.studies.mujoco_settings.compute import (  # noqa: E402
 )
 from reference.engine.dynamics import inverse_dynamics  # noqa: E402
 from reference.paper.scenes import named_scene  # noqa: E402
-from reference.results.schema import OptionsError, Result, Status, table_columns  # noqa: E402
+from reference.results.columns import table_columns  # noqa: E402
+from reference.results.result import Result  # noqa: E402
+from reference.results.summary import OptionsError, Status  # noqa: E402
 from reference.scene.drives import TorqueDrive  # noqa: E402
 from reference.scene.mapping import replace  # noqa: E402
 from reference.scene.scene import Scene  # noqa: E402

@@ -16,7 +16,8 @@ from cardan_exudyn.accuracy import SAFETY_FACTOR, AccuracyError, error_estimate
 from cardan_exudyn.engines import get_engine, make_options
 from cardan_exudyn.testing import CachingRunner, assert_efficiency, assert_engines_agree, make_scene
 from cardan_exudyn.testing.assertions import MAX_RELATIVE_ERROR, Limit, tolerance
-from reference.results.schema import Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
 from reference.scene.mapping import scene_to_dict
 from reference.scene.validation import SceneError
 

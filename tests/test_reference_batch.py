@@ -13,7 +13,7 @@ from reference.engine.batch.solve import batch_key, run_batch
 from reference.engine.options import ReferenceOptions
 from reference.engine.solve import run
 from reference.paper.scenes import named_scene, rig_scene
-from reference.results.schema import OptionsError, Status
+from reference.results.summary import OptionsError, Status
 from reference.scene.drives import TorqueDrive
 from reference.scene.mapping import replace
 from reference.scene.validation import SceneError

@@ -16,7 +16,8 @@ from reference.engine.table import EXTRA_COLUMNS
 from reference.paper.scenes import named_scene
 from reference.physics.joint_motion import joint_motion
 from reference.physics.kinematics import body_motions, speed_ratio
-from reference.results.schema import Status, Summary, table_columns
+from reference.results.columns import table_columns
+from reference.results.summary import Status, Summary
 from reference.scene.drives import SpeedDrive
 from reference.scene.joint import PAIR_NAMES, Body, Geometry, Joint
 from reference.scene.load import Load

@@ -18,7 +18,8 @@ from reference.engine.table import EXTRA_COLUMNS
 from reference.paper.scenes import named_scene, paper_scene
 from reference.physics.friction import friction_from_columns
 from reference.physics.joint_motion import joint_motion
-from reference.results.schema import Status, table_columns
+from reference.results.columns import table_columns
+from reference.results.summary import Status
 from reference.scene.drives import AngleDrive, TorqueDrive
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

@@ -11,7 +11,7 @@ from reference.engine.options import ReferenceOptions
 from reference.engine.solve import run
 from reference.paper.scenes import named_scene
 from reference.results.quadrature import jump_breaks, segment_integrals
-from reference.results.schema import whole_revolution_window, window_integral
+from reference.results.means import whole_revolution_window, window_integral
 from reference.scene.mapping import replace
 
 

@@ -18,7 +18,8 @@ from cardan_exudyn.studies.reproduce import report as report
 from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
 from reference.paper.parameter_sets import PARAMETER_SETS, parameter_set
 from reference.paper.scenes import paper_scene
-from reference.results.schema import Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 

@@ -19,7 +19,7 @@ import pytest
 import rigdata
 from cardan_exudyn.engines import run
 from reference.paper.scenes import named_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.mapping import replace as replace_field
 from rigdata import synthetic
 from rigdata.conditioning import Conditioning, condition, estimate_phase, pulse_edges

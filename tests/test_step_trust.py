@@ -18,7 +18,8 @@ from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.stepsize import MAX_STEPS_PER_REVOLUTION, revolution_period
 from cardan_exudyn.studies.accuracy.compute import cell_scene
 from reference.paper.scenes import named_scene
-from reference.results.schema import Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
 from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 

@@ -79,7 +79,7 @@ from cardan_exudyn.model import friction_io as io
 from cardan_exudyn.model.friction_law import LawTable, PairLaw
 from reference.physics.bands import sign_bands
 from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 # geometric growth of the friction (lagged and extrapolated schemes) taken as self-locking
 LAGGED_GROWTH_LIMIT = 1e3

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from reference.scene.scene import Scene
-from reference.results.schema import OptionsError
+from reference.results.summary import OptionsError
 
 __all__ = ["ExudynOptions", "NODE_TYPES", "SENSOR_SCOPES"]
 

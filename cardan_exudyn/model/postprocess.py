@@ -20,7 +20,7 @@ from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.friction_law import PairLaw, bdf2_weights, pair_loads
 from cardan_exudyn.model.projection import cross_rows, project_velocities
 from reference.physics.bands import sign_bands
-from reference.results.schema import instantaneous_efficiency
+from reference.results.columns import instantaneous_efficiency
 from reference.scene.drives import AngleDrive
 from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 

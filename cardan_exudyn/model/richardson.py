@@ -43,7 +43,8 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from reference.results.schema import Summary, instantaneous_efficiency
+from reference.results.columns import instantaneous_efficiency
+from reference.results.summary import Summary
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

@@ -1,5 +1,5 @@
 """Run a scene with Exudyn: the one solve sequence (step choice, solver settings, friction set-up,
-stop function) and the run that turns it into the common result (:class:`reference.results.schema.Result`).
+stop function) and the run that turns it into the common result (:class:`reference.results.result.Result`).
 """
 
 from __future__ import annotations
@@ -33,13 +33,9 @@ from cardan_exudyn.model.stepsize import (
     richardson,
 )
 from reference.physics.loop_closure import LoopClosureError
-from reference.results.schema import (
-    REACTION_SUFFIXES,
-    Result,
-    Status,
-    Summary,
-    result_table,
-)
+from reference.results.columns import REACTION_SUFFIXES
+from reference.results.result import Result, result_table
+from reference.results.summary import Status, Summary
 from reference.scene.drives import AngleDrive
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace, scene_to_dict

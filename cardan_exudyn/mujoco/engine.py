@@ -31,14 +31,9 @@ import mujoco
 import numpy as np
 
 from reference.physics.kinematics import body_motions, pair_frames_in_body_a, rot_z
-from reference.results.schema import (
-    OptionsError,
-    Result,
-    Status,
-    Summary,
-    instantaneous_efficiency,
-    result_table,
-)
+from reference.results.columns import instantaneous_efficiency
+from reference.results.result import Result, result_table
+from reference.results.summary import OptionsError, Status, Summary
 from reference.scene import AngleDrive, Scene, SpeedDrive, TorqueDrive, scene_to_dict
 from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 from reference.scene.validation import refuse_steps_per_revolution
@@ -552,7 +547,7 @@ def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
     Returns
     -------
     Result
-        The columns of :func:`reference.results.schema.table_columns` (pair forces and frame-pair
+        The columns of :func:`reference.results.columns.table_columns` (pair forces and frame-pair
         reactions NaN, see the module docstring) and the summary with the mean values.
 
     Raises

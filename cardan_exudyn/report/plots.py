@@ -8,7 +8,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from reference.results.schema import Status  # noqa: E402
+from reference.results.summary import Status  # noqa: E402
 
 
 def _axes(ax):

@@ -27,7 +27,7 @@ from cardan_exudyn.io import atomic_write, to_jsonable
 from cardan_exudyn.sweep.plan import Case, Plan, plan_difference
 from cardan_exudyn.sweep.spec import SweepError
 from reference.scene.scene import Scene
-from reference.results.schema import Status, Summary
+from reference.results.summary import Status, Summary
 
 __all__ = ["PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE", "SWEEP_FILES", "RECORD_KEYS",
            "RESERVED_OUTPUTS", "read_records", "RecordWriter", "existing_records", "locked",

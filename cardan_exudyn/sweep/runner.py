@@ -67,7 +67,7 @@ from cardan_exudyn.sweep.records import (
 )
 from cardan_exudyn.sweep.spec import SweepError, SweepSpec
 from cardan_exudyn.sweep.tasks import Batch, plan_tasks
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 __all__ = ["run_sweep", "environment"]
 

@@ -25,7 +25,7 @@ from cardan_exudyn.io import to_jsonable
 from cardan_exudyn.sweep.plan import Case
 from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, scalar_summary
 from cardan_exudyn.sweep.spec import DEFAULT_FUNCTION, CaseFunction, flatten_paths, resolve_function
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

@@ -34,7 +34,8 @@ from cardan_exudyn.comparison import run_engines as comparison_runs  # with the 
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.report.format import is_number, markdown_table, number
 from reference.scene.scene import Scene
-from reference.results.schema import Result, after_revolutions
+from reference.results.means import after_revolutions
+from reference.results.result import Result
 
 __all__ = ["MAX_RELATIVE_ERROR", "ROUNDING", "DEFAULT_COLUMNS", "CardanToleranceWarning", "Limit",
            "Check", "assert_efficiency", "assert_engines_agree", "tolerance"]

@@ -17,7 +17,8 @@ from cardan_exudyn.accuracy import ErrorEstimate, error_estimate
 from cardan_exudyn.engines import resolve
 from cardan_exudyn.engines import run as run_engine
 from reference.scene.scene import Scene
-from reference.results.schema import Result, Status
+from reference.results.result import Result
+from reference.results.summary import Status
 
 __all__ = ["RunRecord", "CachingRunner"]
 

@@ -45,7 +45,7 @@ from reference.engine.slots import (
 )
 from reference.physics.friction import pair_power_loss
 from reference.physics.joint_motion import JointMotion, joint_motion
-from reference.results.schema import PAIR_SUFFIXES, instantaneous_efficiency
+from reference.results.columns import PAIR_SUFFIXES, instantaneous_efficiency
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.scene import Scene
 
@@ -130,7 +130,7 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     Returns
     -------
     columns : dict of str to ndarray, shape (n,)
-        Every column of :func:`reference.results.schema.table_columns` but ``t``, plus
+        Every column of :func:`reference.results.columns.table_columns` but ``t``, plus
         ``input_acceleration`` [rad/s^2], ``friction_loop_gain`` [-], ``self_locking`` and, per
         pair, ``<pair>_slide`` [m] (the D-H slide; zero in the ideal joint) and the two parts of
         its loss, ``power_loss_<pair>_rotation`` and ``power_loss_<pair>_sliding`` [W].

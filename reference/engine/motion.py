@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.engine.options import ReferenceOptions
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.drives import AngleDrive, SpeedDrive, TorqueDrive
 from reference.scene.scene import Scene
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.results.schema import OptionsError
+from reference.results.summary import OptionsError
 
 __all__ = ["ReferenceOptions"]
 

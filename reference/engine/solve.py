@@ -23,13 +23,8 @@ from reference.engine.table import EXTRA_COLUMNS, table_columns, table_times, ta
 from reference.engine.work import work_quadrature
 from reference.physics.bands import sign_bands
 from reference.physics.loop_closure import LoopClosureError
-from reference.results.schema import (
-    OptionsError,
-    Result,
-    Status,
-    Summary,
-    result_table,
-)
+from reference.results.result import Result, result_table
+from reference.results.summary import OptionsError, Status, Summary
 from reference.scene.histories import run_clock
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
@@ -59,7 +54,7 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
     Result
         Time table (the schema's columns plus :data:`EXTRA_COLUMNS`, every
         ``scene.record.every``-th row; None when ``record.timeseries`` is off) and summary: the
-        keys of :func:`reference.results.schema.mean_values` taken from :func:`work_quadrature`'s works,
+        keys of :func:`reference.results.means.mean_values` taken from :func:`work_quadrature`'s works,
         ``self_locking_samples`` and, when friction locks, status ``self_locking`` with the first
         input angle where it does; status ``unphysical`` when the means are impossible; status
         ``loop_does_not_close`` (no table) when mounting errors keep the loop from closing.

@@ -10,7 +10,7 @@ from reference.engine.dynamics import dynamics_columns
 from reference.engine.motion import InputMotion
 from reference.engine.options import ReferenceOptions
 from reference.engine.periodic import period_rows, repeat_period
-from reference.results.schema import Status, Summary
+from reference.results.summary import Status, Summary
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.scene import Scene
 from reference.scene.validation import check_steps

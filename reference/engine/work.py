@@ -27,7 +27,7 @@ from reference.engine.gauss import (
 from reference.engine.motion import InputMotion
 from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
-from reference.results.schema import whole_revolution_window
+from reference.results.means import whole_revolution_window
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.scene import Scene
 
@@ -91,7 +91,7 @@ def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.
 
 def work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
     """Summary keys from the works [J] over the window (the means derived from them are
-    :func:`reference.results.schema.mean_values`')."""
+    :func:`reference.results.means.mean_values`')."""
     out = {"input_work": work["power_in"], "output_work": work["power_out"],
            "loss_work": work["power_loss"]}
     for pair in PAIR_NAMES:

@@ -8,7 +8,7 @@ the same efficiency. An aiding load (one that turns the output the way it alread
 drive that brakes makes the output shaft the source. So the efficiency is defined for the
 direction the work actually flows, from the signs of the window's works.
 
-Sign conventions (:mod:`reference.results.schema`): ``W_in`` is the work the drive does on the input
+Sign conventions (:mod:`reference.results.summary`): ``W_in`` is the work the drive does on the input
 shaft, ``W_out`` the work the output shaft does on the load, ``W_loss`` the friction losses
 (never negative); over the window ``W_in = W_out + W_loss + dE`` (``dE`` the change of mechanical
 energy, zero over whole revolutions of a periodic motion).

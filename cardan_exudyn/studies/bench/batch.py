@@ -44,7 +44,7 @@ from cardan_exudyn.studies.tolerance.compute import default_distributions, monte
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene, rig_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

@@ -37,7 +37,8 @@ from reference.engine.motion import InputMotion, input_motion
 from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
-from reference.results.schema import Result, Summary
+from reference.results.result import Result
+from reference.results.summary import Summary
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

@@ -28,7 +28,7 @@ from cardan_exudyn.studies.bench.targets import (
     evaluate_targets,
     paper_scenes_timing,
 )
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.settings import COUPLINGS
 
 __all__ = ["BenchResult", "check_inputs", "check_paper", "run_bench"]

@@ -31,7 +31,8 @@ from cardan_exudyn.studies.bench.startup import IMPORT_TARGET_MS
 from reference.engine.options import ReferenceOptions
 from reference.paper.cases import paper_cases
 from reference.paper.scenes import paper_scene
-from reference.results.schema import Result, Status
+from reference.results.result import Result
+from reference.results.summary import Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

@@ -26,7 +26,7 @@ from cardan_exudyn.mujoco.engine import (
 from reference.engine.dynamics import inverse_dynamics
 from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
-from reference.results.schema import Result
+from reference.results.result import Result
 from reference.scene.mapping import replace as replace_scene
 from reference.scene.scene import Scene
 

@@ -83,7 +83,8 @@ from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths
 from reference.paper.cases import paper_cases
 from reference.paper.parameter_sets import DEFAULT_PARAMETER_SET, PARAMETER_SETS
 from reference.paper.scenes import paper_scene
-from reference.results.schema import Result, Status
+from reference.results.result import Result
+from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace, scene_to_dict
 from reference.scene.scene import Scene

@@ -25,7 +25,7 @@ from reference.paper.parameter_sets import (
     parameter_set,
     parameter_table,
 )
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES
 
 __all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_report",

@@ -132,7 +132,8 @@ from cardan_exudyn.studies.stress.longrun_plan import (
 )
 from cardan_exudyn.studies.stress.longrun_summary import summarise
 from reference.engine.options import ReferenceOptions
-from reference.results.schema import Status, cumulative
+from reference.results.means import cumulative
+from reference.results.summary import Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

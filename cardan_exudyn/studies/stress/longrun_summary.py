@@ -27,7 +27,7 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     LongRunPlan,
     settings,
 )
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 DRIFT_MEASURES = ("position_violation_m", "angle_violation_rad", "velocity_violation_m_s",
                   "angular_velocity_violation_rad_s", "orthogonality_error", "ep_norm_error",

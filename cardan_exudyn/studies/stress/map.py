@@ -53,7 +53,7 @@ from cardan_exudyn.sweep import CASES_FILE, SweepSpec, read_records, run_sweep
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.physics.kinematics import speed_ratio
-from reference.results.schema import Status, Summary
+from reference.results.summary import Status, Summary
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene

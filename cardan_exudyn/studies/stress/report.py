@@ -37,7 +37,7 @@ from cardan_exudyn.studies.stress.map import (
     as_float,
     run_map,
 )
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 PARTS = ("map", "long")
 #: Where the parts that left ``cardan stress`` now live.

@@ -27,7 +27,7 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table
 from reference.paper.scenes import named_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 

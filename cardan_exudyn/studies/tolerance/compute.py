@@ -47,7 +47,7 @@ from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep
 from reference.paper import PARAMETER_SETS, paper_errors, rig_scene, value
-from reference.results.schema import Status, Summary
+from reference.results.summary import Status, Summary
 from reference.scene import FRICTION_LAWS, Scene, replace
 from reference.scene.joint import ERROR_NAMES, PAIR_NAMES
 

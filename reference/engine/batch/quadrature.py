@@ -27,7 +27,7 @@ from reference.engine.gauss import GROSS_SCALE, MAX_OPEN_PANELS, initial_panels,
 from reference.engine.motion import InputMotion
 from reference.engine.options import ReferenceOptions
 from reference.engine.work import WORK_KEYS, window_times, work_means
-from reference.results.schema import whole_revolution_window
+from reference.results.means import whole_revolution_window
 
 
 def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) -> list[tuple]:

@@ -5,7 +5,7 @@ CONTRACT (kept by every implementation; the sweep runner and the tolerance study
 - :func:`batch_key(scene)` is a hashable key; scenes with equal keys can share one vectorised
   pass (same drive kind, same set of active friction pairs, same friction law and options that
   change the code path). ``None``: the scene must run on its own (torque drive, angle history...).
-- :func:`run_batch(scenes, options)` returns one :class:`reference.results.schema.Result` per scene, in
+- :func:`run_batch(scenes, options)` returns one :class:`reference.results.result.Result` per scene, in
   order, each equal to ``reference.engine.solve.run(scene, options)`` (to rounding, or to the
   quadrature tolerance where the adaptivity differs). A scene that locks, fails or does not close
   its loop gets its own failed Result and does not spoil the others. Invalid scenes raise
@@ -37,7 +37,8 @@ from reference.engine.periodic import period_rows, repeat_period
 from reference.engine.slots import friction_slots
 from reference.engine.solve import ENGINE_NAME, ENGINE_VERSION, means_from_works, run
 from reference.engine.table import EXTRA_COLUMNS, table_times, table_verdict
-from reference.results.schema import OptionsError, Result, Status, Summary, result_table
+from reference.results.result import Result, result_table
+from reference.results.summary import OptionsError, Status, Summary
 from reference.scene.drives import SpeedDrive
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
