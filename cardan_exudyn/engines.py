@@ -41,7 +41,7 @@ class Engine:
 
 
 ENGINES: dict[str, Engine] = {
-    "exudyn": Engine("exudyn", "cardan_exudyn.model.solve", "cardan_exudyn.model.options:ExudynOptions",
+    "exudyn": Engine("exudyn", "cardan_exudyn.model.accuracy", "cardan_exudyn.model.options:ExudynOptions",
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
     "reference": Engine("reference", "reference.engine.solve", "reference.engine.options:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "

@@ -40,6 +40,8 @@ _HOMES = {
     "reference.paper.scenes": ("named_scene", "paper_scene", "rig_scene"),
     "reference.results.summary": ("Status", "Summary", "OptionsError"),
     "reference.results.result": ("Result",),
+    "reference.results.accuracy": ("RunAccuracy",),
+    "reference.results.friction_diagnostics": ("FrictionDiagnostics",),
     "reference.engine.options": ("ReferenceOptions",),
     "reference.engine.solve": ("run",),
 }

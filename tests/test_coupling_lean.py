@@ -89,7 +89,7 @@ def test_second_order_where_friction_is_smooth():
     errors = []
     for steps in (200, 400):
         s = engines.run(_at_steps(scene, steps), "exudyn", OPTIONS).summary
-        assert s.extras["friction"]["coupling"] == "extrapolated"
+        assert s.friction.coupling == "extrapolated"
         errors.append(abs(s.mean_efficiency - exact))
     assert errors[1] < 2e-4
     assert errors[0] / errors[1] > 3.0  # order > 1.58
@@ -101,16 +101,16 @@ def test_one_newton_solve_per_step_off_the_reversals():
     revolution: 16 steps iterated, 1.26 solves per step on average)."""
     s = engines.run(_at_steps(named_scene("paper-literal-10deg"), 400, revolutions=1), "exudyn",
                     OPTIONS).summary
-    friction = s.extras["friction"]
-    assert 1.0 < friction["mean_iterations_per_step"] < 1.35
+    friction = s.friction
+    assert 1.0 < friction.mean_iterations_per_step < 1.35
     # four reversals a revolution (each spider pair twice), each iterated while the stencil (the
     # three steps' inputs and the prediction) holds the regime before it: the crossing step and
     # the three after it
-    assert friction["steps_iterated_at_reversals"] == 4 * 4
+    assert friction.steps_iterated_at_reversals == 4 * 4
     # every other step is solved once, a probe twice: the extra solves come from those two
-    extra = (friction["mean_iterations_per_step"] - 1.0) * (s.steps - 1)
-    assert extra >= friction["gain_probes"] + friction["steps_iterated_at_reversals"] - 1e-9
-    assert friction["escalated_to_converged_at"] is None
+    extra = (friction.mean_iterations_per_step - 1.0) * (s.steps - 1)
+    assert extra >= friction.gain_probes + friction.steps_iterated_at_reversals - 1e-9
+    assert friction.escalated_to_converged_at is None
 
 
 def test_second_order_at_a_high_loop_gain():
@@ -125,7 +125,7 @@ def test_second_order_at_a_high_loop_gain():
     for steps in (800, 1600):
         s = engines.run(_at_steps(scene, steps, revolutions=1), "exudyn", OPTIONS).summary
         assert s.status == "ok", s.reason
-        assert s.extras["friction"]["escalated_to_converged_at"] is None
+        assert s.friction.escalated_to_converged_at is None
         errors.append(abs(s.mean_efficiency - exact))
     assert errors[1] < 5e-4
     assert errors[0] / errors[1] > 3.0

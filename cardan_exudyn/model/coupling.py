@@ -78,8 +78,9 @@ import numpy as np
 from cardan_exudyn.model import friction_io as io
 from cardan_exudyn.model.friction_law import LawTable, PairLaw
 from reference.physics.bands import sign_bands
-from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
+from reference.results.friction_diagnostics import FrictionDiagnostics
 from reference.results.summary import Status
+from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 
 # geometric growth of the friction (lagged and extrapolated schemes) taken as self-locking
 LAGGED_GROWTH_LIMIT = 1e3
@@ -550,30 +551,24 @@ class FrictionCoupling:
         else:
             self._growth_steps = 0
 
-    def summary(self) -> dict[str, Any]:
+    def diagnostics(self) -> FrictionDiagnostics:
+        """The run's counters and loop-gain estimates (the loop gain: the median and the largest
+        of the estimates; the median is robust to the start-up steps)."""
         iterations = np.asarray(self.log.iterations, dtype=float)
-        return {
-            "coupling": self.settings.coupling,
-            "sign_bands_m_s": {p.name: list(self.bands[p.name]) for p in self.pairs},
-            "pairs_with_friction": [p.name for p in self.pairs],
-            "tolerance": self.settings.tolerance if self.mode != "lagged" else None,
-            "mean_iterations_per_step": float(iterations.mean()) if iterations.size else 0.0,
-            "max_iterations_in_a_step": int(iterations.max()) if iterations.size else 0,
-            "unconverged_steps": self.unconverged_steps,
-            # extrapolated scheme: the time its first probe above ESCALATE_GAIN switched it to the
-            # converged scheme (None: it never did)
-            "escalated_to_converged_at": self.escalated_at,
-            # extrapolated scheme: steps solved to their fixed point because a motion reversed
-            "steps_iterated_at_reversals": self.iterated_steps,
-            # spectral radius of the secant estimate of the friction feedback map, every
-            # GAIN_EVERY-th accepted
-            # step (see _accept); the median is robust to the start-up steps
-            "loop_gain_estimate": float(np.median(self._gains)) if self._gains else None,
-            "loop_gain_estimate_max": float(np.max(self._gains)) if self._gains else None,
-            # extrapolated scheme: probe steps solved twice; a probe whose friction did not move
-            # beyond rounding (PROBE_NOISE) gives no gain
-            "gain_probes": self.probes,
-        }
+        return FrictionDiagnostics(
+            coupling=self.settings.coupling,
+            sign_bands_m_s={p.name: tuple(self.bands[p.name]) for p in self.pairs},
+            pairs_with_friction=tuple(p.name for p in self.pairs),
+            tolerance=self.settings.tolerance if self.mode != "lagged" else None,
+            mean_iterations_per_step=float(iterations.mean()) if iterations.size else 0.0,
+            max_iterations_in_a_step=int(iterations.max()) if iterations.size else 0,
+            unconverged_steps=self.unconverged_steps,
+            escalated_to_converged_at=self.escalated_at,
+            steps_iterated_at_reversals=self.iterated_steps,
+            loop_gain_estimate=float(np.median(self._gains)) if self._gains else None,
+            loop_gain_estimate_max=float(np.max(self._gains)) if self._gains else None,
+            gain_probes=self.probes,
+        )
 
     def columns(self, times: np.ndarray) -> dict[str, np.ndarray]:
         """Friction applied in the step ending at each recorded time, per pair (zeros elsewhere)."""

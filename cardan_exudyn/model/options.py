@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from reference.scene.scene import Scene
 from reference.results.summary import OptionsError
+from reference.scene.scene import Scene
 
 __all__ = ["ExudynOptions", "NODE_TYPES", "SENSOR_SCOPES"]
 
@@ -42,10 +42,10 @@ class ExudynOptions:
         input; the drive torque, reactions and friction keep the integrator's error.
     error_estimate : bool
         With friction, run the pilot and companion that choose the step and estimate the mean
-        efficiency's error (:func:`cardan_exudyn.model.solve.run`). False: one run at the given
-        ``numerics.dt``, or a pilot run and one run at the step it plans for ``numerics.accuracy``
-        (:func:`cardan_exudyn.model.solve._planned_run`), no estimate (for a caller that estimates
-        the error itself, such as step halving, which would otherwise repeat the run it halves).
+        efficiency's error (:func:`cardan_exudyn.model.accuracy.run`). False: one run at the given
+        ``numerics.dt``, or a pilot run and one run at the step it plans for ``numerics.accuracy``,
+        no estimate (for a caller that estimates the error itself, such as step halving, which
+        would otherwise repeat the run it halves).
     """
 
     spectral_radius: float = 0.6

@@ -39,18 +39,24 @@ for a scene with friction.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Mapping
 
 import numpy as np
 
+from cardan_exudyn.model.build import ExudynModel
+from cardan_exudyn.model.options import ExudynOptions
+from cardan_exudyn.model.solve import result_of, reusable, run_model
 from reference.results.columns import instantaneous_efficiency
+from reference.results.result import Result
 from reference.results.summary import Summary
 from reference.scene.joint import PAIR_NAMES
-from reference.scene.mapping import replace
+from reference.scene.mapping import replace, scene_to_dict
 from reference.scene.scene import Scene
+from reference.scene.validation import SceneError
 
 __all__ = ["EXTRAPOLATED", "FROM_FINE", "FILTERED", "smooth", "extrapolate", "combine", "refusal",
-           "run_pair"]
+           "run_pair", "run_combined"]
 
 _PAIR_SUFFIXES = ("fx", "fy", "fz", "mx", "my", "mz", "omega_rel", "slide_rel")
 EXTRAPOLATED = ("omega_in", "omega_out", "torque_in", "energy_kinetic",
@@ -162,3 +168,52 @@ def run_pair(scene: Scene, run: Callable[[Scene], tuple[Summary, Columns | None]
     if fine is None:
         return coarse_summary, fine_summary, None
     return coarse_summary, fine_summary, combine(coarse, fine)
+
+
+def run_combined(scene: Scene, options: ExudynOptions) -> Result:
+    """``scene`` at its step and at half of it, combined (:func:`run_pair`): the fine run's
+    summary with the combined table's means, the coarse run's step and grid, both runs' counters
+    and wall time; ``extras["richardson"]`` says what was combined. The fine run solves the coarse
+    run's model again where it can (:func:`cardan_exudyn.model.solve.reusable`).
+
+    Raises :class:`SceneError` for a scene with friction (:func:`refusal`).
+    """
+    why = refusal(scene)
+    if why is not None:
+        raise SceneError(why)
+    wall_start = time.perf_counter()
+    origin = [0.0]
+    built: list[ExudynModel | None] = [None]
+
+    def one(s: Scene) -> tuple[Summary, Columns | None]:
+        # both runs' means are replaced by the combined table's: not taken per run
+        summary_, columns_, origin[0], model = run_model(s, options, built[0], means=False)
+        keep = model is not None and reusable(model, options.records_reactions(s))
+        built[0] = model if keep else None
+        return summary_, columns_
+
+    coarse, fine, columns = run_pair(scene, one)
+    summary = coarse if fine is None or not coarse.success else fine
+    if summary is fine:
+        _combined_summary(coarse, fine, columns, scene)
+    summary.scene = scene_to_dict(scene)
+    summary.wall_time_s = time.perf_counter() - wall_start
+    return result_of(scene, summary, columns if summary is fine else None, origin[0])
+
+
+def _combined_summary(coarse: Summary, fine: Summary, columns: Columns | None, scene: Scene) -> None:
+    """Turn the fine run's summary into the combination's: what was combined, the coarse step,
+    both runs' counters, and the means of the combined ``columns``."""
+    fine.extras["richardson"] = {
+        "coarse_dt": coarse.dt, "fine_dt": fine.dt, "coarse_wall_time_s": coarse.wall_time_s,
+        "fine_wall_time_s": fine.wall_time_s, "extrapolated": list(EXTRAPOLATED),
+        "from_fine": list(FROM_FINE), "recomputed": ["power_in", "power_out", "efficiency"]}
+    fine.dt = coarse.dt
+    fine.dt_choice = f"{coarse.dt_choice}; Richardson with a run at dt/2"
+    for key in ("steps", "newton_iterations", "jacobian_evaluations"):
+        setattr(fine, key, (getattr(coarse, key) or 0) + (getattr(fine, key) or 0))
+    if columns is not None and fine.success:
+        fine.clear_means()
+        means = fine.whole_revolution_means(columns, scene.record.skip_revolutions)
+        if means is not None:
+            fine.set_means(means)

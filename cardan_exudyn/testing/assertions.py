@@ -1,8 +1,8 @@
 """Assertions for a test suite: a run's mean efficiency, and engines agreeing on a scene.
 
 Without a tolerance from the test, it comes from the runs' own accuracy
-(:mod:`cardan_exudyn.accuracy`): a value may differ by
-:data:`~cardan_exudyn.accuracy.SAFETY_FACTOR` times its estimated error (the sum of both runs'
+(:mod:`cardan_exudyn.model.error_estimate`): a value may differ by
+:data:`~cardan_exudyn.model.error_estimate.SAFETY_FACTOR` times its estimated error (the sum of both runs'
 errors when two runs are compared). A tolerance the test gives (``rtol``, ``atol``) is used as
 given, never widened: where ``SAFETY_FACTOR`` times the estimate exceeds it, the runs cannot
 resolve it and the check fails, naming the tolerance asked and the one the runs support. A check
@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.accuracy import (
+from cardan_exudyn.model.error_estimate import (
     ESTIMATED_MEANS,
     SAFETY_FACTOR,
     AccuracyError,

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from cardan_exudyn.accuracy import ErrorEstimate, error_estimate
+from cardan_exudyn.model.error_estimate import ErrorEstimate, error_estimate
 from cardan_exudyn.engines import resolve
 from cardan_exudyn.engines import run as run_engine
 from reference.scene.scene import Scene
@@ -104,7 +104,7 @@ class CachingRunner:
         return scene, engine, options
 
     def error_estimate(self, result: Result) -> ErrorEstimate | None:
-        """:func:`cardan_exudyn.accuracy.error_estimate` with this runner for the rerun at half
+        """:func:`cardan_exudyn.model.error_estimate.error_estimate` with this runner for the rerun at half
         the step, so an estimate is computed once per run."""
         return error_estimate(result, run=self)
 

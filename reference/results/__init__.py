@@ -2,6 +2,8 @@
 
 - :mod:`~reference.results.columns`: the time table's columns;
 - :mod:`~reference.results.summary`: :class:`Summary`, :class:`Status`, the JSON shape on disk;
+- :mod:`~reference.results.accuracy`, :mod:`~reference.results.friction_diagnostics`: the
+  summary's typed records of a run's error estimate and friction coupling;
 - :mod:`~reference.results.result`: :class:`Result` (table and summary);
 - :mod:`~reference.results.means`: the window over whole revolutions and the mean values;
 - :mod:`~reference.results.power_flow`, :mod:`~reference.results.quadrature`: the direction of
@@ -15,6 +17,8 @@ from reference.lazy import lazy_face
 _HOMES = {
     "reference.results.summary": ("Status", "Summary", "OptionsError", "SCHEMA_VERSION"),
     "reference.results.result": ("Result",),
+    "reference.results.accuracy": ("RunAccuracy",),
+    "reference.results.friction_diagnostics": ("FrictionDiagnostics",),
     "reference.results.columns": ("table_columns",),
     "reference.results.means": ("mean_values",),
 }

@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from reference.results.accuracy import RunAccuracy
+from reference.results.friction_diagnostics import FrictionDiagnostics
 from reference.results.means import mean_values
 from reference.results.power_flow import PowerFlow, classify_works
 
@@ -58,7 +60,12 @@ MEAN_KEYS = ("revolutions", "window_start_s", "window_duration_s", "input_work",
              "loss_work", "mean_efficiency", "mean_instantaneous_efficiency", "work_ratio",
              "mean_torque_in", "mean_speed_in")
 FLOW_KEYS = ("power_flow", "power_reversals")
-"""Keys of the power flow over the window (:mod:`reference.results.power_flow`), set and cleared with the means."""
+"""Keys of the power flow over the window (:mod:`reference.results.power_flow`), set and cleared
+with the means."""
+
+
+_RECORDS: dict[str, Any] = {"friction": FrictionDiagnostics, "accuracy": RunAccuracy}
+"""The summary's typed records by field name, each a table of its own on disk."""
 
 
 @dataclass
@@ -68,8 +75,10 @@ class Summary:
     Modelled on scipy's ``OdeResult``: the outcome (:attr:`status`, :attr:`reason`), the solution's
     mean values over whole input revolutions (``None`` unless the status is ``ok``; definitions
     in :func:`mean_values`), the cost counters next to them (``None`` where an engine has no
-    such counter), and engine-specific diagnostics in :attr:`extras` (Exudyn's ``friction``,
-    the reference's ``quadrature``, ...).
+    such counter), how a time-stepping engine's estimate was made (:attr:`accuracy`) and how its
+    friction coupling behaved (:attr:`friction`), and what is truly engine-specific in
+    :attr:`extras` (the reference's ``quadrature``, ...). The fields are listed in the order
+    :meth:`to_dict` writes them.
 
     Attributes
     ----------
@@ -132,8 +141,14 @@ class Summary:
         Its part from axial friction [J] (``loss_work_<pair>_sliding`` on disk).
     warnings : list of str
         What a reader of the means must know (power flowing backwards, an undefined mean).
+    friction : FrictionDiagnostics or None
+        The friction coupling's counters and loop gains (Exudyn with friction); ``friction`` on
+        disk.
     extras : dict
         Engine-specific diagnostics, written at the top level of the JSON.
+    accuracy : RunAccuracy or None
+        How :attr:`efficiency_error_estimate` was made: target, method, companion and pilot runs
+        (Exudyn); ``accuracy`` on disk.
     """
 
     status: Status
@@ -170,7 +185,9 @@ class Summary:
     pair_loss_work: dict[str, float] = field(default_factory=dict)
     pair_sliding_loss_work: dict[str, float] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    friction: FrictionDiagnostics | None = None
     extras: dict[str, Any] = field(default_factory=dict)
+    accuracy: RunAccuracy | None = None
 
     def __post_init__(self) -> None:
         self.status = Status(self.status)
@@ -240,6 +257,9 @@ class Summary:
                 out.update({f"loss_work_{p}_sliding": v for p, v in value.items()})
             elif f.name == "extras":
                 out.update(value)
+            elif f.name in _RECORDS:
+                if value is not None:
+                    out[f.name] = value.to_dict()
             else:
                 out[f.name] = value
         return out
@@ -247,13 +267,23 @@ class Summary:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Summary:
         """Inverse of :meth:`to_dict`; also reads versions 1 (no version key) and 2, whose
-        efficiencies it takes again from their works by version 3's rules (:meth:`upgrade`)."""
-        names = {f.name for f in fields(cls)} - {"pair_loss_work", "pair_sliding_loss_work", "extras"}
+        efficiencies it takes again from their works by version 3's rules (:meth:`upgrade`).
+        An ``accuracy`` or ``friction`` table with keys this version does not know stays, as it
+        was, in :attr:`extras`."""
+        names = {f.name for f in fields(cls)} - {"pair_loss_work", "pair_sliding_loss_work", "extras",
+                                                 *_RECORDS}
         summary = cls(status=Status(data["status"]))
         for key, value in data.items():
             if key == "schema_version":
                 continue
-            if key in names:
+            record = None
+            if key in _RECORDS and isinstance(value, Mapping):
+                record = _RECORDS[key].from_dict(value)
+            if record is not None:
+                setattr(summary, key, record)
+            elif key in _RECORDS:  # a shape this version does not know: kept as it was
+                summary.extras[key] = value
+            elif key in names:
                 setattr(summary, key, list(value) if key == "warnings" else value)
             else:
                 summary.set_means({key: value})
@@ -282,4 +312,3 @@ class Summary:
             self.mean_instantaneous_efficiency = None
             self.warn(f"the time average of eq. (18) read from a version-2 summary ({eta:.6g}) "
                       "is not reported: it may span a reversal of the power flow")
-

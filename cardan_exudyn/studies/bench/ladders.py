@@ -121,11 +121,11 @@ def table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[str
 def cost_counters(summary: Summary) -> dict[str, Any]:
     """The engine's own cost counters, flattened: steps, Newton iterations, Jacobians, friction
     evaluations per step (Exudyn with friction), quadrature panels (reference)."""
-    friction = summary.extras.get("friction") or {}
+    friction = summary.friction
     quadrature = summary.extras.get("quadrature")
     return {"steps": summary.steps, "newton_iterations": summary.newton_iterations,
             "jacobian_evaluations": summary.jacobian_evaluations,
-            "friction_evaluations_per_step": friction.get("mean_iterations_per_step"),
+            "friction_evaluations_per_step": friction.mean_iterations_per_step if friction else None,
             "quadrature_panels": quadrature.get("panels") if isinstance(quadrature, dict) else None}
 
 

@@ -120,7 +120,7 @@ def run_numbers(result: Result) -> dict[str, Any]:
     t = result.table
     energy = t["energy_kinetic"] + t["energy_potential"]
     work = {c: float(np.trapezoid(t[c], t["t"])) for c in ("power_in", "power_out", "power_loss")}
-    friction = s.extras["friction"]
+    friction = s.friction
     speed = s.mean_speed_in
     out.update({
         "engine": s.engine,
@@ -138,8 +138,8 @@ def run_numbers(result: Result) -> dict[str, Any]:
         "loss_work_J": s.loss_work,
         "energy_balance_residual_J": work["power_in"] - work["power_out"] - work["power_loss"]
         - float(energy.iloc[-1] - energy.iloc[0]),
-        "loop_gain_estimate": friction["loop_gain_estimate"],
-        "friction_evaluations_per_step": friction["mean_iterations_per_step"],
+        "loop_gain_estimate": friction.loop_gain_estimate,
+        "friction_evaluations_per_step": friction.mean_iterations_per_step,
         "steps": s.steps,
         "wall_time_s": s.wall_time_s,
     })

@@ -166,7 +166,7 @@ def simulate(scene: Scene, options: ExudynOptions,
                "dt_choice": solved.dt_reason, "newton_iterations": int(solved.solver.it.newtonStepsCount),
                "solve_wall_time_s": solved.wall_time_s, "wall_time_s": time.perf_counter() - wall_start}
     if model.friction is not None:
-        summary["friction"] = model.friction.summary()
+        summary["friction"] = model.friction.diagnostics().to_dict()
     return summary, model, cols
 
 

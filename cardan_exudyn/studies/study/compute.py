@@ -71,8 +71,8 @@ def efficiency_row(scene: Scene) -> dict[str, Any]:
     out = {"status": s.status.value, "reason": s.reason, "wall_time_s": wall, "steps": s.steps,
            "newton_iterations": s.newton_iterations, "mean_efficiency": _value(s.mean_efficiency),
            "mean_instantaneous_efficiency": _value(s.mean_instantaneous_efficiency)}
-    if "friction" in s.extras:
-        out["friction_evaluations_per_step"] = s.extras["friction"]["mean_iterations_per_step"]
+    if s.friction is not None:
+        out["friction_evaluations_per_step"] = s.friction.mean_iterations_per_step
     return out
 
 

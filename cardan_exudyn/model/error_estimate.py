@@ -1,35 +1,20 @@
-"""How accurate a run is: an estimate of the error of its mean values and time-table columns,
-from what the run knows about itself.
+"""The error of a finished run's mean values and time-table columns, as the pytest plugin's
+checks use it (:func:`error_estimate`), from what the run knows about itself.
 
-- The reference engine integrates the works by adaptive Gauss-Legendre quadrature and reports
-  the error estimates of the input and lost work (``summary.extras["quadrature"]``); the works
-  without an estimate of their own (output work, per-pair losses) get the quadrature's acceptance
-  bound, ``rtol`` times the input work, and the ratios (mean efficiency, work ratio) the
-  propagated error. Its time table has no discretisation error (each row is solved on its own)
-  for a prescribed input motion; a torque-driven scene adds the ODE's relative tolerance.
-- A fixed-step engine (Exudyn) reports its own estimate of the mean-efficiency error in every
-  run (``summary.efficiency_error_estimate``: Richardson from a companion run at 2-3 times the
-  step, at least a third of the a-priori model while friction sign ramps are unresolved;
-  :func:`cardan_exudyn.model.solve.run`, ``docs/accuracy.md``). This module's estimate, used by
-  the pytest plugin's checks for every mean value and column, is separate: step halving, the
-  same scene and options run again at half the step, and the change of every mean value and
-  column, times the Richardson factor ``2**p / (2**p - 1)`` of the order ``p`` in
-  :data:`STEP_ORDERS` (generalized-alpha: 2; 1 with the ``"lagged"`` friction coupling or while
-  friction sign ramps are unresolved, :func:`cardan_exudyn.model.stepsize.convergence_order`),
-  estimates the error of the run at the full step; for the mean efficiency the larger of that
-  and the run's own estimate is taken.
-- Other engines (MuJoCo) give no estimate (:func:`error_estimate` returns None).
+- Reference engine: its quadrature's error estimates of the input and lost work
+  (``summary.extras["quadrature"]``); works without an estimate of their own (output work,
+  per-pair losses) get the quadrature's acceptance bound, ``rtol`` times the input work, the
+  ratios (mean efficiency, work ratio) the propagated error. Its table rows are exact for a
+  prescribed input motion; a torque-driven scene adds the ODE's relative tolerance.
+- Exudyn (:data:`STEP_ORDERS`): step halving. The same scene and options run again at half the
+  step; the change of every mean value and column times ``2**p / (2**p - 1)``, ``p`` the order
+  of :func:`cardan_exudyn.model.stepsize.convergence_order`, estimates the error at the full step.
+  For the mean efficiency the larger of that and the run's own estimate
+  (``summary.efficiency_error_estimate``, :mod:`cardan_exudyn.model.accuracy`) is taken, and
+  every mean is scaled alike: where friction reverses, step halving at order 2 under-reads.
+- Other engines (MuJoCo): no estimate (None).
 
-With friction that changes sign (a shaft angle, mounting errors) the mean efficiency converges
-at first order, not 2, until the sign ramps are resolved (about 25,000 steps per revolution with
-the relative sign band, ``docs/accuracy.md``), so order 2 under-reads here: at ``paper-10deg``'s
-automatic step (266 per revolution, accuracy 1e-3) the true error (against the reference engine,
-quadrature rtol 1e-11) was 7.5 times this step-halving estimate (5.0 times with ``p = 1``), and
-at ``paper-35deg``'s (376) 3.1 times; the run's own ``efficiency_error_estimate`` was within 1.1
-and 1.7 times of it: hence the order from ``convergence_order`` and, for the mean efficiency, the
-larger of the two estimates. The 13-scene measurement of 0.14 to 3.4 behind :data:`SAFETY_FACTOR` (5)
-was made with the old absolute sign band and no longer bounds the ratio; the factor is what a
-check multiplies an estimate by (the table is in ``docs/pytest.md``).
+Measured: docs/pytest.md#what-the-default-tolerance-means.
 """
 
 from __future__ import annotations
@@ -57,9 +42,8 @@ __all__ = ["SAFETY_FACTOR", "STEP_ORDERS", "ESTIMATED_MEANS", "AccuracyError", "
            "step_halving_estimate", "half_step_scene", "row_changes", "ratio_error"]
 
 SAFETY_FACTOR = 5.0
-"""What a check multiplies an error estimate by. Chosen over a largest measured ratio of true to
-estimated error of 3.4 (old absolute sign band); with the relative band the order-2 step halving
-under-reads the mean efficiency of reversing-friction scenes by up to 7.5 (module docstring)."""
+"""What a check multiplies an error estimate by (a margin over the measured ratios of true to
+estimated error). Measured: docs/pytest.md#what-the-default-tolerance-means."""
 STEP_ORDERS = {"exudyn": 2}
 """Fixed-step engines whose error is estimated by step halving, with their order of convergence."""
 ESTIMATED_MEANS = tuple(k for k in MEAN_KEYS if k not in ("revolutions", "window_start_s",
