@@ -12,8 +12,10 @@
 - :mod:`~cardan_exudyn.model.options`: :class:`ExudynOptions`, the solver settings;
 - :mod:`~cardan_exudyn.model.postprocess`: the result's columns from the sensors;
 - :mod:`~cardan_exudyn.model.friction_law`: eqs. (1)-(5) as pure functions (no Exudyn);
-- :mod:`~cardan_exudyn.model.coupling`: the friction loads and the user functions that update
-  them from the joint reactions;
+- :mod:`~cardan_exudyn.model.coupling`: the friction loads and what every coupling scheme
+  shares; the schemes :mod:`~cardan_exudyn.model.extrapolated` (the default),
+  :mod:`~cardan_exudyn.model.converged` and :mod:`~cardan_exudyn.model.lagged`;
+  :mod:`~cardan_exudyn.model.friction_io`: reading the reactions and setting the loads;
 - :mod:`~cardan_exudyn.model.rotations`, :mod:`~cardan_exudyn.model.projection`: node rotation
   parameters, velocity projection.
 
@@ -21,4 +23,5 @@ Run scenes through :func:`cardan_exudyn.run` (the engine dispatch), not through 
 """
 
 __all__ = ["accuracy", "stepsize", "solve", "richardson", "error_estimate", "build", "options",
-           "postprocess", "friction_law", "coupling", "rotations", "projection"]
+           "postprocess", "friction_law", "friction_io", "coupling", "extrapolated", "converged",
+           "lagged", "rotations", "projection"]

@@ -170,7 +170,7 @@ def _planned_run(scene: Scene, options: ExudynOptions) -> Result:
     as in :func:`_automatic_runs`, the main run is the only other run. With the extrapolated
     coupling the steps grow by ``sqrt(1 / (1 - g))`` for the pilot's loop gain ``g``
     (:func:`pilot_gain`): no estimate will catch the extrapolation's error, which grows as
-    ``1 / (1 - g)`` (:mod:`cardan_exudyn.model.coupling`) and which the model leaves out."""
+    ``1 / (1 - g)`` (:mod:`cardan_exudyn.model.extrapolated`) and which the model leaves out."""
     plan = pilot_plan(scene, options)
     steps = plan.steps
     why = plan.why

@@ -41,7 +41,9 @@ import exudyn as exu
 import exudyn.itemInterface as eii
 import numpy as np
 
-from cardan_exudyn.model.coupling import FrictionCoupling
+from cardan_exudyn.model.converged import ConvergedCoupling
+from cardan_exudyn.model.extrapolated import ExtrapolatedCoupling
+from cardan_exudyn.model.lagged import LaggedCoupling
 from cardan_exudyn.model.rotations import ROTATION_COORDINATES, TWO_PI, RotationCoordinates, WholeTurns
 from reference.physics import rccc
 from reference.scene.drives import AngleDrive, SpeedDrive
@@ -50,6 +52,10 @@ from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.scene.scene import Scene
 
 CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
+COUPLINGS = {"extrapolated": ExtrapolatedCoupling, "converged": ConvergedCoupling,
+             "lagged": LaggedCoupling}
+"""The friction coupling scheme of each ``scene.friction.coupling`` but ``uncoupled`` (friction
+evaluated after the run, :mod:`cardan_exudyn.model.postprocess`)."""
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -166,7 +172,7 @@ class ExudynModel:
     pair_kinematics: dict = field(default_factory=dict)
     mass: dict[str, float] = field(default_factory=dict)
     inertia: dict[str, np.ndarray] = field(default_factory=dict)
-    friction: Any = None  # cardan_exudyn.model.coupling.FrictionCoupling when friction is applied
+    friction: Any = None  # a cardan_exudyn.model.coupling.FrictionCoupling when friction is applied
     node_type: str = "Rxyz"  # the build_model argument
     # per body: the node's rotation coordinates (cardan_exudyn.model.rotations.ROTATION_COORDINATES)
     rotations: dict[str, RotationCoordinates] = field(default_factory=dict)
@@ -214,7 +220,7 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
     _add_drive(model, ground)
     _add_loads(model)
     if scene.has_friction and scene.friction.coupling != "uncoupled":
-        model.friction = FrictionCoupling(model)
+        model.friction = COUPLINGS[scene.friction.coupling](model)
     if sensors:
         add_sensors(model, reactions=reactions)
     mbs.Assemble()

@@ -1,7 +1,7 @@
 """How a time-stepping engine's friction coupling behaved over a run: :class:`FrictionDiagnostics`.
 
 On disk it is the summary's ``friction`` table (``docs/outputs.md``); the coupling schemes are
-described in :mod:`cardan_exudyn.model.coupling`.
+described in :mod:`cardan_exudyn.model.coupling` and its schemes.
 """
 
 from __future__ import annotations
