@@ -34,7 +34,7 @@ import pytest
 import cardan_exudyn
 from cardan_exudyn.arguments import scene_from_args
 from cardan_exudyn.cli import build_parser, main
-from cardan_exudyn.model.solve import MODEL_FLOOR
+from cardan_exudyn.model.accuracy import MODEL_FLOOR
 from cardan_exudyn.studies.calibrate.compute import case_rows, fit_statistics
 from cardan_exudyn.studies.calibrate.fitting import CaseModel
 from cardan_exudyn.testing import make_scene
@@ -146,7 +146,7 @@ def exudyn_cells(folder: Path, row: list[str], accuracies: list[str], reference)
         error = s.mean_efficiency - reference.mean_efficiency
         out.append({"text": f"{s.mean_efficiency:.6f} ({error:+.1e}; est. {s.efficiency_error_estimate:.1e})",
                     "error": error, "estimate": s.efficiency_error_estimate, "accuracy": float(accuracy),
-                    "floored": s.efficiency_error_estimate == MODEL_FLOOR * s.extras["accuracy"]["model"]})
+                    "floored": s.efficiency_error_estimate == MODEL_FLOOR * s.accuracy.model})
     return out
 
 
