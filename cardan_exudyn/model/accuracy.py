@@ -58,14 +58,25 @@ Measured: docs/accuracy.md#accuracy-constants."""
 
 def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
     """Simulate ``scene`` with Exudyn: its time table and summary, with the estimated error of
-    its mean efficiency (``summary.efficiency_error_estimate``, ``accuracy_met``, how in
-    ``summary.accuracy``).
+    its mean efficiency.
 
     A given ``numerics.dt`` runs with a companion at twice the step; an automatic step is planned
-    by a pilot (:func:`pilot_plan`). ``ExudynOptions.error_estimate`` off: no companion and no
-    estimate (an automatic step is still planned by the pilot). ``numerics.richardson``
-    (frictionless scenes only): the Richardson combination of the scene at its step and at half
-    of it (:func:`cardan_exudyn.model.richardson.run_combined`).
+    by a pilot (:func:`pilot_plan`). ``numerics.richardson`` (frictionless scenes only): the
+    Richardson combination of the scene at its step and at half of it
+    (:func:`cardan_exudyn.model.richardson.run_combined`).
+
+    Parameters
+    ----------
+    scene : Scene
+    options : ExudynOptions, optional
+        The solver settings; ``error_estimate=False``: no companion and no estimate (an
+        automatic step is still planned by the pilot).
+
+    Returns
+    -------
+    Result
+        The main run: ``summary.efficiency_error_estimate`` and ``accuracy_met`` (None without an
+        estimate), how in ``summary.accuracy``; ``wall_time_s`` of every run it took.
 
     Raises
     ------
@@ -148,11 +159,22 @@ class Verdict(NamedTuple):
 
 
 def pilot_plan(scene: Scene, options: ExudynOptions) -> PilotPlan:
-    """Run the pilot of an automatic step (half the speed-ratio step, at least
-    :data:`~cardan_exudyn.model.stepsize.MIN_COMPANION_STEPS` per revolution) and plan the main
-    run's steps from its loss fraction (1 when the pilot failed).
+    """Run the pilot of an automatic step and plan the main run's steps from its loss fraction.
 
-    Raises :class:`SceneError` when the speed ratio or the plan needs more steps than allowed.
+    The pilot runs at half the speed-ratio step, at least
+    :data:`~cardan_exudyn.model.stepsize.MIN_COMPANION_STEPS` per revolution, without a table; a
+    pilot that failed counts as losing everything (loss fraction 1).
+
+    Parameters
+    ----------
+    scene : Scene
+        With an automatic step (``numerics.dt`` None).
+    options : ExudynOptions
+
+    Raises
+    ------
+    SceneError
+        The speed ratio or the plan needs more steps than allowed.
     """
     period = revolution_period(scene)
     pilot_steps = max(MIN_COMPANION_STEPS, math.ceil(0.5 * _kinematic_steps(scene, options)))
@@ -281,9 +303,20 @@ def loss_fraction(result: Result) -> float:
 
 
 def publish(main: Result, record: RunAccuracy, estimate: float | None) -> None:
-    """Write a run's accuracy into its summary: ``record`` as ``summary.accuracy``, and when it
-    has a target the ``estimate`` [-], ``accuracy_met`` and a warning when the estimate exceeds
-    the target or there is none (a record without a target: a plan without an estimate)."""
+    """Write a run's accuracy into its summary, each field once.
+
+    Parameters
+    ----------
+    main : Result
+        The run (its summary is changed).
+    record : RunAccuracy
+        Becomes ``summary.accuracy``. Without a target (a plan without an estimate) nothing else
+        is written.
+    estimate : float or None
+        Estimated absolute error of the mean efficiency [-]: ``efficiency_error_estimate``, and
+        ``accuracy_met`` against the target; a warning when it exceeds the target, or when there
+        is none.
+    """
     s = main.summary
     s.accuracy = record
     target = record.target
@@ -302,16 +335,31 @@ def publish(main: Result, record: RunAccuracy, estimate: float | None) -> None:
 
 def assess(main: Result, coarse: Result, scene: Scene,
            options: ExudynOptions) -> Verdict | None:
-    """The estimate of ``main``'s mean-efficiency error [-] from its companion ``coarse`` and how
-    it was made; None when ``main`` has no usable efficiency.
+    """The estimate of ``main``'s mean-efficiency error and how it was made.
 
     Richardson at the order of :func:`~cardan_exudyn.model.stepsize.convergence_order`; at first
     order and wherever friction reverses at least :data:`MODEL_FLOOR` times the a-priori model;
     at least the model when the companion has fewer than
     :data:`~cardan_exudyn.model.stepsize.MIN_COMPANION_STEPS` steps per revolution (outside the
-    asymptotic range). A failed companion gives no estimate (None with the record): the run it
-    should check is then close to what fails at the coarser step (a friction loop near
-    self-locking), where the a-priori model does not hold.
+    asymptotic range). A failed companion gives no estimate: the run it should check is then
+    close to what fails at the coarser step (a friction loop near self-locking), where the
+    a-priori model does not hold.
+
+    Parameters
+    ----------
+    main : Result
+        The run whose error is estimated.
+    coarse : Result
+        Its companion at a coarser step.
+    scene : Scene
+        The scene as asked for (its ``numerics.accuracy`` is the target).
+    options : ExudynOptions
+
+    Returns
+    -------
+    Verdict or None
+        The record and the estimate (None when the companion failed); None when ``main`` has no
+        usable mean efficiency.
     """
     if failed(main):
         return None

@@ -23,7 +23,7 @@ Modelling choices
 - Gravity loads and the output load only when they are non-zero; friction loads and their user
   function only for pairs with a non-zero coefficient (``cardan_exudyn.model.coupling``).
 - Mounting errors (``scene.joint.errors``): each pair's marker frames are displaced and rotated
-  to the joint's Denavit-Hartenberg geometry (the pair axes no longer meet at one point, so the
+  to the joint's Denavit-Hartenberg geometry (the pair axes do not meet at one point, so the
   cylindrical pairs slide). The marker frames and the initial assembled state are taken from
   :mod:`reference.physics.rccc` at the start; from there on the motion is Exudyn's own (its constraints
   keep the loop closed; the tests compare it with the reference engine). The ideal joint keeps
@@ -187,23 +187,33 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
                 node_type: str = "Rxyz") -> ExudynModel:
     """Assemble the Exudyn system for ``scene`` (no solving), with recording sensors.
 
-    ``reactions=False`` leaves out the eight pair-reaction sensors (the summary does not need
-    them: friction reads the reactions itself); see :func:`add_sensors`.
+    Parameters
+    ----------
+    scene : Scene
+    sensors : bool
+        Add the recording sensors (:func:`add_sensors`).
+    reactions : bool
+        Record the eight pair reactions too (the table needs them; the summary does not:
+        friction reads the reactions itself).
+    node_type : str
+        The rigid-body node of the spider and the output: ``"Rxyz"`` (``NodeRigidBodyRxyz``,
+        Tait-Bryan angles), ``"EP"`` (``NodeRigidBodyEP``, Euler parameters with their
+        normalisation constraint: one more coordinate and one algebraic equation per body) or
+        ``"RotVecLG"`` (``NodeRigidBodyRotVecLG``, rotation vector updated by Exudyn's Lie-group
+        generalized-alpha; its velocity coordinates are the local angular velocity; it needs a
+        spectral radius of 0.8 or less, docs/engines.md#exudyn-model-measurements). The input
+        keeps ``NodeRigidBodyRxyz`` under every value: the drive (a coordinate connector) and the
+        input angle of the results use its raw first angle (coordinate 3), which no other node
+        type has; that coordinate is kept within ``[-pi, pi]`` between steps and
+        ``ExudynModel.input_turns`` gives back the continuous input angle. Every node's reference
+        rotation is the identity (node axes = global axes at input angle 0); rotation vectors are
+        kept within ``|nu| <= pi`` between steps (:func:`_wrap_rotations`).
 
-    ``node_type`` chooses the rigid-body node of the spider and the output: ``"Rxyz"``
-    (``NodeRigidBodyRxyz``, Tait-Bryan angles), ``"EP"`` (``NodeRigidBodyEP``, Euler parameters
-    with their normalisation constraint: one more coordinate and one algebraic equation per
-    body) or ``"RotVecLG"`` (``NodeRigidBodyRotVecLG``, rotation vector updated by Exudyn's
-    Lie-group generalized-alpha; its velocity coordinates are the local angular velocity). The
-    input keeps ``NodeRigidBodyRxyz`` under every value: the drive (a coordinate connector) and
-    the input angle of the results use its raw first angle (coordinate 3), which no other node
-    type has; that coordinate is kept within ``[-pi, pi]`` between steps and
-    ``ExudynModel.input_turns`` gives back the continuous input angle. Every node's reference
-    rotation is the identity (node axes = global axes at input angle 0). Rotation vectors are kept
-    within ``|nu| <= pi`` between steps (:func:`_wrap_rotations`). Measured at 35 deg, 200 steps
-    per revolution: ``"RotVecLG"`` needs a spectral radius of 0.8 or less (at 0.9 and 0.95 the
-    run with friction ends "ok" with a mean efficiency off by 0.23 and 4.8, and at 0.95 the
-    frictionless run fails).
+    Returns
+    -------
+    ExudynModel
+        The assembled model on a clock starting at 0 (``time_origin``: the scene's time there),
+        its friction coupling prepared when the scene has friction.
     """
     if node_type not in ROTATION_COORDINATES:
         raise ValueError(f"node_type must be one of {list(ROTATION_COORDINATES)}, got {node_type!r}")
@@ -232,7 +242,8 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
 
 def _add_bodies(model: ExudynModel) -> None:
     """A node and a rigid body per moving body, in the assembled initial state."""
-    scene, mbs = model.scene, model.mbs
+    scene = model.scene
+    mbs = model.mbs
     theta0, omega0, t0 = _initial_drive_state(scene)
     model.start_time = t0
     state = assembled_state(scene, theta0, omega0)
@@ -298,43 +309,29 @@ def _wrap_rotations(model: ExudynModel) -> None:
     """After every step, keep the input's angle coordinate and the other Rxyz angles within
     ``[-pi, pi]``, and the rotation vectors of ``NodeRigidBodyRotVecLG`` nodes within ``|nu| <= pi``.
 
-    Input angle: the input's first Rxyz angle is the input angle, unbounded. Left so, each step's
-    update rounds at the spacing of doubles at the angle (1.8e-12 rad after 2000 revolutions), so
-    the angle wanders from ``omega t`` (7e-8 rad after 2000 revolutions: the velocity-level drive
-    holds the speed, nothing holds the angle), and with ``"RotVecLG"`` nodes the run fails at
-    revolution 268: the spider passes the identity at every whole input revolution, where Exudyn's
-    ``CompositionRotationVector`` (``w = pi - 2 atan2(x, sqrt(|1 - x^2|))``, ``x = cos(w/2)``)
-    resolves angles near zero only in steps of about 3e-8 rad, so the pair input-spider is
-    misaligned there by the input angle's wander, which Newton could not accept by then (1.3e-9
-    rad). The hook removes whole revolutions (``ExudynModel.input_turns`` records them; exact in
-    floating point: ``q - 2 pi`` for ``pi < q < 4 pi``), so the update rounds at 4.4e-16 rad at
-    most. Nothing else depends on the choice: ``Rx`` is periodic, the speed drive acts on the
-    velocity, an angle drive's offset and a torque drive's stop subtract the same revolutions, the
-    friction coupling reads relative angles of rotation matrices, and the results' ``theta_in``
-    adds them back (:func:`cardan_exudyn.model.postprocess.body_states`). The angles of the
-    spider's and output's Rxyz nodes are wrapped the same way, unrecorded (only their rotation
-    matrices are read): the spider's first angle is the input angle too, and with it unbounded
-    against a wrapped input their roundings no longer cancel in the pair input-spider (measured
-    over 2000 revolutions with friction: misalignment up to 1.8e-12 rad and marker distance
-    1.5e-14 m, growing, against 1e-15 rad and 4e-17 m with both wrapped or both unbounded).
+    Input angle: the input's first Rxyz angle is the input angle. Unbounded, its update rounds at
+    the spacing of doubles at the angle and the angle wanders from ``omega t`` (the velocity-level
+    drive holds the speed, nothing holds the angle); with ``"RotVecLG"`` nodes the pair
+    input-spider then ends misaligned where the spider passes the identity. The hook removes whole
+    revolutions (exact in floating point: ``q - 2 pi`` for ``pi < q < 4 pi``;
+    ``ExudynModel.input_turns`` records them). Nothing else depends on the choice: ``Rx`` is
+    periodic, the speed drive acts on the velocity, an angle drive's offset and a torque drive's
+    stop subtract the same revolutions, the friction coupling reads relative angles of rotation
+    matrices, and the results' ``theta_in`` adds them back
+    (:func:`cardan_exudyn.model.postprocess.body_states`). The spider's and output's Rxyz angles
+    are wrapped the same way, unrecorded: the spider's first angle is the input angle too, and
+    their roundings cancel in the pair input-spider only when both are wrapped.
 
-    Rotation vectors: Exudyn's Lie-group update keeps ``0 <= |nu| <= 2 pi`` and lets a body that
-    turns whole revolutions reach ``|nu| = 2 pi`` (the identity again) once every two revolutions,
-    where the exponential map is singular: measured at 35 deg, Newton needs 6 iterations in that
-    step at 200 steps per revolution and fails at 100, and the reactions and drive torque spike.
-    A vector with ``|nu| > pi`` is replaced by the same rotation ``nu (1 - 2 pi / |nu|)``. The
-    velocity coordinates (local angular velocity) and the integrator's accelerations do not depend
-    on that choice, so the step sequence is otherwise the same. Node axes turned away from the body
-    (e.g. by a half-turn about z) would keep ``|nu|`` away from ``2 pi`` too, but Exudyn 1.13.6
-    computes wrong initial accelerations and Lagrange multipliers when a rotation vector is not
-    zero at the start (measured: reactions off by 3e3 N at 35 deg, decaying over about 30 steps;
-    its initial-acceleration solve seems to take the local angular velocity for the rate of ``nu``
-    in the ``(C_q q_t)_q q_t`` term). The nodes therefore start at the identity, which holds for a
-    drive starting at input angle 0; an angle drive starting elsewhere gets that start-up error
-    with ``RotVecLG``.
+    Rotation vectors: Exudyn's Lie-group update lets a body that turns whole revolutions reach
+    ``|nu| = 2 pi`` once every two revolutions, where the exponential map is singular. A vector
+    with ``|nu| > pi`` is replaced by the same rotation ``nu (1 - 2 pi / |nu|)``; the velocity
+    coordinates (local angular velocity) and the integrator's accelerations do not depend on the
+    choice. The nodes start at the identity (Exudyn computes wrong initial multipliers for a
+    non-zero initial rotation vector), which holds for a drive starting at input angle 0; an angle
+    drive starting elsewhere gets that start-up error with ``RotVecLG``.
 
     The hook runs before Exudyn stores the step's sensor values, and the next step starts from
-    the state it leaves.
+    the state it leaves. Measured: docs/engines.md#exudyn-model-measurements.
     """
     mbs = model.mbs
     angle = mbs.GetNodeODE2Index(model.nodes["input"]) + 3
@@ -382,7 +379,8 @@ def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
 
 
 def _add_drive(model: ExudynModel, ground) -> None:
-    mbs, drive = model.mbs, model.scene.drive
+    mbs = model.mbs
+    drive = model.scene.drive
     if drive.kind == "torque":
         m_in = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=model.bodies["input"]))
         mbs.AddLoad(eii.LoadTorqueVector(markerNumber=m_in, loadVector=[drive.torque, 0.0, 0.0]))
@@ -409,7 +407,8 @@ def _add_drive(model: ExudynModel, ground) -> None:
 
 
 def _add_loads(model: ExudynModel) -> None:
-    mbs, scene = model.mbs, model.scene
+    mbs = model.mbs
+    scene = model.scene
     axis = model.pair_frames["output_frame"][:, 2]  # the output axis, fixed in the ground
     if not scene.load.constant:  # a measured history: interpolated at each instant
         torque = scene.load.evaluator()  # O(log n) per call in plain floats (reference.scene.histories)

@@ -48,16 +48,20 @@ class ConvergedCoupling(FrictionCoupling):
         self._accepted: list[tuple] = []  # the last accepted steps' friction (flat)
 
     def initialise(self, solver: Any, settings: Any) -> tuple[np.ndarray, list] | None:
-        """Friction consistent with the initial state, the first accepted state; returns
-        :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s."""
+        """Friction consistent with the initial state, the first accepted state; call after
+        ``solver.InitializeSolver`` with the run's ``settings``. Returns
+        :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
+        """
         start = self.consistent_start(solver, settings)
         if start is not None:
             self._accepted = [tuple(start[0].ravel().tolist())]
         return start
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
-        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`)."""
+        """Exudyn's post-Newton user function after a solve at time ``t`` [s] of system ``mbs``:
+        :meth:`update`, an exception kept
+        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
+        """
         try:
             return self.update(t)
         except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it

@@ -242,8 +242,15 @@ class FrictionCoupling:
         return None
 
     def apply(self, friction: Any, size: float | None = None) -> None:
-        """Set every friction load from ``friction``: flat ``(M_z, F_z)`` per pair, or an array
-        of shape (n, 2); ``size``: its largest magnitude, when known."""
+        """Set every friction load.
+
+        Parameters
+        ----------
+        friction : tuple or ndarray
+            Flat ``(M_z, F_z)`` per pair [N m, N], or an array of shape (n, 2).
+        size : float, optional
+            Its largest magnitude, when known.
+        """
         values = tuple(friction.ravel().tolist()) if isinstance(friction, np.ndarray) else friction
         self.loads.apply(values)
         self.applied = values
@@ -281,7 +288,9 @@ class FrictionCoupling:
         return True
 
     def change(self, friction: tuple, before: tuple) -> float:
-        """Largest change between two flat friction states, forces weighted by ``d / 2`` [N m]."""
+        """Largest change [N m] between two flat friction states ``friction`` and ``before``, forces
+        weighted by ``d / 2``.
+        """
         return max((w * abs(a - b) for w, a, b in zip(self._flat_weight, friction, before, strict=True)),
                    default=0.0)
 
@@ -359,8 +368,15 @@ class FrictionCoupling:
 
 
 def friction_pairs(model: Any, bands: dict[str, Any]) -> list[PairData]:
-    """The pairs of ``model``'s scene with a non-zero friction coefficient, in order, with their
-    sign ``bands`` (:func:`reference.physics.bands.sign_bands`)."""
+    """The pairs of ``model``'s scene with a non-zero friction coefficient, in order.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        The model being built (its joints added).
+    bands : dict of str to (float, float, float)
+        Each pair's sign ramps [m/s] (:func:`reference.physics.bands.sign_bands`).
+    """
     scene = model.scene
     out = []
     for name, pair in scene.joint.friction_pairs():
@@ -373,8 +389,9 @@ def friction_pairs(model: Any, bands: dict[str, Any]) -> list[PairData]:
 
 
 def body_contributions(model: Any, name: str) -> list[tuple[int, Any, int]]:
-    """The moving bodies of pair ``name`` that carry its friction: ``(body, marker position in
-    the body, sign)``, -1 for body ``a`` and +1 for body ``b``."""
+    """The moving bodies of pair ``name`` in ``model`` that carry its friction: ``(body, marker
+    position in the body [m], sign)``, -1 for body ``a`` and +1 for body ``b``.
+    """
     return [(model.bodies[body], local, role) for role, body, local in
             zip((-1, 1), PAIR_BODIES[name], model.marker_local[name], strict=True) if body != "ground"]
 

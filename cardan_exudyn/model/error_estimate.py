@@ -158,7 +158,9 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
 
 def ratio_error(numerator: float, denominator: float, numerator_error: float,
                 denominator_error: float) -> float:
-    """First-order error of ``numerator / denominator`` (and of one minus it) from theirs."""
+    """First-order error of ``numerator / denominator`` (and of one minus it) from the errors
+    ``numerator_error`` and ``denominator_error`` of the two, in the ratio's units.
+    """
     d = abs(denominator)
     return numerator_error / d + abs(numerator) * denominator_error / d ** 2
 
@@ -167,7 +169,9 @@ def quadrature_estimate(result: Result) -> ErrorEstimate:
     """The reference engine's estimate: its quadrature's, the ODE's tolerance for a torque drive."""
     s = result.summary
     q = s.extras["quadrature"]
-    w_in, w_out, w_loss = s.input_work, s.output_work, s.loss_work
+    w_in = s.input_work
+    w_out = s.output_work
+    w_loss = s.loss_work
     # a constant-speed run integrates one revolution and repeats it: so do its errors
     repeats = s.revolutions / q["revolutions_integrated"] if q.get("revolutions_integrated") else 1
     e_in = repeats * float(q["input_work_error_estimate"])
@@ -192,8 +196,9 @@ def quadrature_estimate(result: Result) -> ErrorEstimate:
 
 
 def half_step_scene(scene: Scene, dt: float, table: bool) -> Scene:
-    """``scene`` at half the step ``dt`` [s], keeping the rows of a table at ``dt`` (every
-    second step), recording a table only when ``table``."""
+    """``scene`` at half the step ``dt`` [s], keeping the rows of a table at ``dt`` (every second
+    step), recording a table only when ``table``.
+    """
     every = 2 * scene.record.every if table else 1
     return replace(scene, **{"numerics.dt": 0.5 * dt, "record.every": every,
                              "record.timeseries": table})
@@ -201,8 +206,28 @@ def half_step_scene(scene: Scene, dt: float, table: bool) -> Scene:
 
 def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int,
                           run: Callable[..., Result], skip_revolutions: float = 0.0) -> ErrorEstimate:
-    """Estimate by a rerun at half the step: ``2**order / (2**order - 1)`` times the changes
-    (of the columns, after ``skip_revolutions``)."""
+    """Estimate by a rerun at half the step: ``2**order / (2**order - 1)`` times the changes.
+
+    Parameters
+    ----------
+    result : Result
+        The run at the full step (``ok``).
+    scene : Scene
+        Its scene.
+    options : engine options
+        Its options (a companion run is switched off for the rerun).
+    order : int
+        Order of convergence in the step.
+    run : callable
+        ``run(scene, engine, options) -> Result`` for the rerun.
+    skip_revolutions : float
+        Input revolutions [-] left out of the columns' changes.
+
+    Raises
+    ------
+    AccuracyError
+        No step to halve, the rerun refused (too many steps) or failed.
+    """
     s = result.summary
     if not is_number(s.dt) or s.dt <= 0:
         raise AccuracyError(f"the {s.engine} run reports no time step to halve")
@@ -217,7 +242,8 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
         raise AccuracyError(f"the rerun at half the step (dt = {0.5 * s.dt:.4g} s) ended "
                             f"{finer.status}: {finer.message}")
     factor = 2.0 ** order / (2.0 ** order - 1.0)
-    coarse, fine = mean_values(s), mean_values(finer.summary)
+    coarse = mean_values(s)
+    fine = mean_values(finer.summary)
     means = {k: factor * abs(v - fine[k]) for k, v in coarse.items() if k in fine}
     columns = {}
     if result.has_table and finer.has_table:
@@ -228,10 +254,13 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
 
 
 def row_changes(coarse: Any, fine: Any, dt: float, skip_revolutions: float = 0.0) -> dict[str, float]:
-    """Largest change of each column between two tables with the same rows, after the first
-    ``skip_revolutions`` (empty when their times differ by more than a millionth of ``dt``)."""
+    """Largest change of each column between two tables ``coarse`` and ``fine`` (pandas) with the
+    same rows, after the first ``skip_revolutions`` [-]; empty when their times differ by more than
+    a millionth of ``dt`` [s].
+    """
     n = min(len(coarse), len(fine))
-    t_coarse, t_fine = coarse["t"].to_numpy(float)[:n], fine["t"].to_numpy(float)[:n]
+    t_coarse = coarse["t"].to_numpy(float)[:n]
+    t_fine = fine["t"].to_numpy(float)[:n]
     if n == 0 or np.max(np.abs(t_coarse - t_fine)) > 1e-6 * dt:
         return {}
     keep = after_revolutions(coarse["theta_in"].to_numpy(float)[:n], skip_revolutions)

@@ -62,9 +62,12 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         self._predicted_regime: tuple = ()  # the regime the step was solved with
 
     def initialise(self, solver: Any, settings: Any) -> tuple[Any, list] | None:
-        """The probe interval for the run's step (at least :data:`PROBES_PER_REVOLUTION` probes
-        per revolution at the drive's top speed, at most every :data:`PROBE_EVERY`-th step), then
-        the consistent initial friction, whose inputs and regime start the extrapolation."""
+        """The probe interval for the run's ``settings`` (at least :data:`PROBES_PER_REVOLUTION`
+        probes per revolution at the drive's top speed, at most every :data:`PROBE_EVERY`-th step),
+        then the consistent initial friction, whose inputs and regime start the extrapolation; call
+        after ``solver.InitializeSolver``. Returns
+        :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
+        """
         ti = settings.timeIntegration
         speed = self.model.scene.drive.max_speed()
         duration = ti.endTime - ti.startTime
@@ -79,8 +82,10 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return start
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
-        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`)."""
+        """Exudyn's post-Newton user function after a solve at time ``t`` [s] of system ``mbs``:
+        :meth:`update`, an exception kept
+        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
+        """
         try:
             return self.update(t)
         except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it

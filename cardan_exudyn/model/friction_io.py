@@ -57,7 +57,8 @@ _DISPLACEMENT = exu.OutputVariableType.DisplacementLocal
 _ANGULAR_VELOCITY = exu.OutputVariableType.AngularVelocityLocal
 _VELOCITY = exu.OutputVariableType.VelocityLocal
 _CURRENT = exu.ConfigurationType.Current
-_PI, _TWO_PI = math.pi, 2.0 * math.pi
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -105,7 +106,8 @@ def read_reactions(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, f
         else:
             (a, b, d), (e, f, g) = c.force_rows
             gx, gy, gz = ae[i], ae[i + 1], ae[i + 2]
-            fx, fy = a * gx + b * gy + d * gz, e * gx + f * gy + g * gz
+            fx = a * gx + b * gy + d * gz
+            fy = e * gx + f * gy + g * gz
         out.append((fx, fy, ae[i + 3], ae[i + 4]))
     return out
 
@@ -128,7 +130,8 @@ def bdf2_speeds(coords: list, h1: float, previous: list, h2: float | None = None
             out.append((((a - a1 + _PI) % _TWO_PI - _PI) / h1, (s - s1) / h1))
         return out
     w1, w2 = bdf2_weights(h1, h2)
-    w1, w2 = w1 / h1, w2 / h1
+    w1 = w1 / h1
+    w2 = w2 / h1
     for (a, s), (a1, s1), (a2, s2) in zip(coords, previous, before, strict=True):
         d1 = (a - a1 + _PI) % _TWO_PI - _PI
         d2 = (a1 - a2 + _PI) % _TWO_PI - _PI
@@ -175,15 +178,18 @@ class PairReader:
                       for c, side in zip(self.channels, sides, strict=True)]
         self.regime: tuple[int, ...] = ()
         self.coords = pair_coordinates(mbs, self.channels)
-        self._t1, self._c1 = start_time, self.coords
+        self._t1 = start_time
+        self._c1 = self.coords
         self._t2 = self._c2 = None
         self._back: list | None = None  # per pair (a1, s1, d2, s1 - s2) of the accepted steps
         self._steps = self._weights = (None, None)
 
     def accept(self, t: float) -> None:
         """The coordinates read last are those of the step accepted at ``t`` [s]."""
-        self._t2, self._c2 = self._t1, self._c1
-        self._t1, self._c1 = t, self.coords
+        self._t2 = self._t1
+        self._c2 = self._c1
+        self._t1 = t
+        self._c1 = self.coords
         self._back = [(a1, s1, (a1 - a2 + _PI) % _TWO_PI - _PI, s1 - s2)
                       for (a1, s1), (a2, s2) in zip(self._c1, self._c2, strict=True)]
 
@@ -193,14 +199,19 @@ class PairReader:
         accepted steps, and the coordinates are kept as :attr:`coords`)."""
         if t is None or self._back is None:
             return self._read_plain(t)
-        h1, h2 = t - self._t1, self._t1 - self._t2
+        h1 = t - self._t1
+        h2 = self._t1 - self._t2
         if (h1, h2) != self._steps:
             w1, w2 = bdf2_weights(h1, h2)
-            self._steps, self._weights = (h1, h2), (w1 / h1, w2 / h1)
+            self._steps = (h1, h2)
+            self._weights = (w1 / h1, w2 / h1)
         w1, w2 = self._weights
         ae = self._multipliers(_CURRENT, False).tolist()
-        get, hypot = self._get, math.hypot
-        coords, out, regime = [], [], []
+        get = self._get
+        hypot = math.hypot
+        coords = []
+        out = []
+        regime = []
         for (joint, i, rows, slides, radius, band, slide_band), (a1, s1, d2, e2) in zip(
                 self._rows, self._back, strict=True):
             a = float(get(joint, _ROTATION)[2])
@@ -215,12 +226,14 @@ class PairReader:
             else:
                 (ra, rb, rd), (re, rf, rg) = rows
                 gx, gy, gz = ae[i], ae[i + 1], ae[i + 2]
-                fx, fy = ra * gx + rb * gy + rd * gz, re * gx + rf * gy + rg * gz
+                fx = ra * gx + rb * gy + rd * gz
+                fy = re * gx + rf * gy + rg * gz
             w = w1 * ((a - a1 + _PI) % _TWO_PI - _PI) - w2 * d2
             out.append((hypot(fx, fy), hypot(ae[i + 3], ae[i + 4]), w, v))
             surface = radius * w
             regime += ((surface > band) - (surface < -band), (v > slide_band) - (v < -slide_band))
-        self.coords, self.regime = coords, tuple(regime)
+        self.coords = coords
+        self.regime = tuple(regime)
         return out
 
     def _read_plain(self, t: float | None) -> list[tuple[float, float, float, float]]:

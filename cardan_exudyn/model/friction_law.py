@@ -227,8 +227,10 @@ class LawTable:
             law, radius, fd, lever, fr, f, cylindrical, slide, band, ramp, slide_band, slide_ramp, res = row
             force_n, moment_n, omega, slide_rel = x
             if older is not None:
-                force_n, moment_n = a * force_n - b * y[0], a * moment_n - b * y[1]
-                omega, slide_rel = a * omega - b * y[2], a * slide_rel - b * y[3]
+                force_n = a * force_n - b * y[0]
+                moment_n = a * moment_n - b * y[1]
+                omega = a * omega - b * y[2]
+                slide_rel = a * slide_rel - b * y[3]
             surface = radius * omega
             turn = (surface > band) - (surface < -band)
             axial_side = (slide_rel > slide_band) - (slide_rel < -slide_band)
@@ -255,7 +257,8 @@ class LawTable:
             if scale > sliding:
                 sliding = scale
             friction += (torque, axial)
-            torque, axial = abs(torque), abs(axial)
+            torque = abs(torque)
+            axial = abs(axial)
             if torque > size:
                 size = torque
             if axial > size:

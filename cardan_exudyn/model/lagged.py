@@ -23,12 +23,16 @@ class LaggedCoupling(FrictionCoupling):
     iterates = False
 
     def initialise(self, solver: Any, settings: Any) -> None:
-        """Friction consistent with the initial state (it acts in the first step)."""
+        """Friction consistent with the initial state (it acts in the first step); call after
+        ``solver.InitializeSolver`` with the run's ``settings``.
+        """
         self.consistent_start(solver, settings)
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
-        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`)."""
+        """Exudyn's post-Newton user function after a solve at time ``t`` [s] of system ``mbs``:
+        :meth:`update`, an exception kept
+        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
+        """
         try:
             return self.update(t)
         except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it

@@ -71,8 +71,7 @@ class ExudynOptions:
         if self.node_type not in NODE_TYPES:
             raise OptionsError(f"`node_type` must be one of {list(NODE_TYPES)}, got {self.node_type!r}")
         if self.node_type == "RotVecLG" and self.spectral_radius > 0.8:
-            # measured: at 0.9 friction runs end "ok" with the efficiency 0.2 off, at 0.95 the
-            # frictionless run fails
+            # measured: docs/engines.md#exudyn-model-measurements
             raise OptionsError(f"`spectral_radius` must be <= 0.8 with node_type 'RotVecLG', got "
                              f"{self.spectral_radius!r}")
         if self.sensors not in SENSOR_SCOPES:

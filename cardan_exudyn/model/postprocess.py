@@ -59,7 +59,8 @@ def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
         q = stored(model, f"{name}_q")
         q_t = stored(model, f"{name}_q_t")
         n = min(len(q), len(q_t))
-        q, q_t = q[:n], q_t[:n]
+        q = q[:n]
+        q_t = q_t[:n]
         rot = model.rotations[name]
         end = 4 + rot.size
         p = q[:, 4:end] if rot.zero_reference else q[:, 4:end] + np.asarray(rot.reference)
@@ -153,7 +154,8 @@ def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarr
         torque, force = applied[name]
         loss = -(torque * cols[f"{name}_omega_rel"] + force * cols[f"{name}_slide_rel"])
         loss_total += loss
-        cols[f"{name}_friction_torque"], cols[f"{name}_friction_force"] = torque, force
+        cols[f"{name}_friction_torque"] = torque
+        cols[f"{name}_friction_force"] = force
         cols[f"power_loss_{name}"] = loss
     cols["power_loss"] = loss_total
     cols["energy_kinetic"], cols["energy_potential"] = mechanical_energy(model, states, n)
@@ -282,7 +284,8 @@ def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
         if len(c) > 1:
             out[1] = (c[1] - c[0]) / (t[1] - t[0])
         if len(c) > 2:
-            h1, h2 = np.diff(t)[1:], np.diff(t)[:-1]
+            h1 = np.diff(t)[1:]
+            h2 = np.diff(t)[:-1]
             w1, w2 = bdf2_weights(h1, h2)
             out[2:] = (w1 * (c[2:] - c[1:-1]) - w2 * (c[1:-1] - c[:-2])) / h1
         speeds.append(out)
@@ -297,7 +300,8 @@ def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndar
     potential = np.zeros(n)
     g = np.asarray(model.scene.gravity)
     for name, s in states.items():
-        m, j_body = model.mass[name], model.inertia[name]
+        m = model.mass[name]
+        j_body = model.inertia[name]
         w_body = np.einsum("nji,nj->ni", s["A"][:n], s["omega"][:n])  # A^T omega
         kinetic += 0.5 * m * np.einsum("ni,ni->n", s["v"][:n], s["v"][:n])
         kinetic += 0.5 * np.einsum("ni,ij,nj->n", w_body, j_body, w_body)
@@ -312,10 +316,12 @@ def constraint_violation(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> d
     marker a (cylindrical). Angle [rad]: misalignment of the two pair axes, and for the revolute
     the twist is free so only the axis counts.
     """
-    pos, ang = 0.0, 0.0
+    pos = 0.0
+    ang = 0.0
     for name, k in pair_kinematics.items():
         d = k["pb"] - k["pa"]
-        za, zb = k["frame_a"][:, :, 2], k["frame_b"][:, :, 2]
+        za = k["frame_a"][:, :, 2]
+        zb = k["frame_b"][:, :, 2]
         if PAIR_KIND[name] == "cylindrical":
             d = d - np.einsum("ij,ij->i", d, za)[:, None] * za
         pos = max(pos, float(np.max(np.linalg.norm(d, axis=1))))

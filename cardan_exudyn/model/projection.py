@@ -48,7 +48,8 @@ BODIES = ("input", "spider", "output")
 def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a x b`` row by row for ``(n, 3)`` arrays (either may be one ``(3,)`` vector): the same
     as ``np.cross`` without its axis handling, which costs more than the product on short runs."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
+    a = np.asarray(a, float)
+    b = np.asarray(b, float)
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     out = np.empty(np.broadcast_shapes(a.shape, b.shape))
@@ -77,7 +78,8 @@ def constraint_jacobian(states: dict[str, dict[str, np.ndarray]],
     for name in PAIR_NAMES:
         body_a, body_b = PAIR_BODIES[name]
         k = pairs[name]
-        frame, p_b = k["frame_a"][:n], k["pb"][:n]
+        frame = k["frame_a"][:n]
+        p_b = k["pb"][:n]
         bodies = [(BODIES.index(body), sign) for body, sign in ((body_b, 1.0), (body_a, -1.0))
                   if body != "ground"]
         for j in (0, 1, 2) if PAIR_KIND[name] == "revolute" else (0, 1):

@@ -88,7 +88,8 @@ def extrapolate(fine: np.ndarray, coarse: np.ndarray, ratio: float = 2.0, order:
     ``fine`` and ``coarse`` are the histories on the same rows, ``ratio`` the step ratio [-].
     """
     factor = 1.0 / (ratio ** order - 1.0)
-    fine, coarse = np.asarray(fine, float), np.asarray(coarse, float)
+    fine = np.asarray(fine, float)
+    coarse = np.asarray(coarse, float)
     return fine + factor * (fine - coarse)
 
 
@@ -116,7 +117,8 @@ def combine(coarse: Mapping[str, np.ndarray], fine: Mapping[str, np.ndarray],
     ValueError
         When the fine run's even rows are not at the coarse run's times.
     """
-    t_c, t_f = np.asarray(coarse["t"], float), np.asarray(fine["t"], float)
+    t_c = np.asarray(coarse["t"], float)
+    t_f = np.asarray(fine["t"], float)
     n = len(t_c)
     step = (t_c[-1] - t_c[0]) / max(n - 1, 1)
     if len(t_f) != 2 * n - 1 or np.max(np.abs(t_f[::2] - t_c)) > rtol * step + 1e-15:
@@ -154,12 +156,24 @@ Columns = dict[str, np.ndarray]
 def run_pair(scene: Scene, run: Callable[[Scene], tuple[Summary, Columns | None]]
              ) -> tuple[Summary, Summary | None, Columns | None]:
     """The two runs: ``scene`` at its step ``h`` (the given ``numerics.dt`` or the engine's
-    choice, read back from the coarse run's ``summary.dt``) and at ``h / 2``, with
-    ``run(scene) -> (summary, columns)`` (columns on the model's clock, before any table).
+    choice, read back from the coarse run's ``summary.dt``) and at ``h / 2``.
 
-    Returns ``(coarse_summary, fine_summary, combined columns)``: the fine summary is None when
-    the coarse run has no columns, the columns None when either run has none (the summaries say
-    why). Raises ``ValueError`` (:func:`combine`) when the time grids do not match.
+    Parameters
+    ----------
+    scene : Scene
+    run : callable
+        ``run(scene) -> (summary, columns)``, columns on the model's clock, before any table.
+
+    Returns
+    -------
+    coarse_summary, fine_summary, columns
+        The fine summary is None when the coarse run has no columns; the combined columns
+        (:func:`combine`) None when either run has none (the summaries say why).
+
+    Raises
+    ------
+    ValueError
+        The time grids do not match (:func:`combine`).
     """
     coarse_summary, coarse = run(scene)
     if coarse is None or not coarse_summary.dt:
@@ -171,12 +185,26 @@ def run_pair(scene: Scene, run: Callable[[Scene], tuple[Summary, Columns | None]
 
 
 def run_combined(scene: Scene, options: ExudynOptions) -> Result:
-    """``scene`` at its step and at half of it, combined (:func:`run_pair`): the fine run's
-    summary with the combined table's means, the coarse run's step and grid, both runs' counters
-    and wall time; ``extras["richardson"]`` says what was combined. The fine run solves the coarse
-    run's model again where it can (:func:`cardan_exudyn.model.solve.reusable`).
+    """``scene`` at its step and at half of it, combined (:func:`run_pair`).
 
-    Raises :class:`SceneError` for a scene with friction (:func:`refusal`).
+    Parameters
+    ----------
+    scene : Scene
+        Frictionless.
+    options : ExudynOptions
+
+    Returns
+    -------
+    Result
+        The fine run's summary with the combined table's means, the coarse run's step and grid,
+        both runs' counters and wall time; ``extras["richardson"]`` says what was combined. The
+        fine run solves the coarse run's model again where it can
+        (:func:`cardan_exudyn.model.solve.reusable`).
+
+    Raises
+    ------
+    SceneError
+        The scene has friction (:func:`refusal`).
     """
     why = refusal(scene)
     if why is not None:

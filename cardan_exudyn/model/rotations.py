@@ -41,8 +41,10 @@ def rxyz_angular_velocity(psi: np.ndarray, psi_t: np.ndarray) -> np.ndarray:
     """Global angular velocity ``G(psi) psi_t``, shape (n, 3) [rad/s]."""
     psi = np.atleast_2d(psi)
     psi_t = np.atleast_2d(psi_t)
-    c0, c1 = np.cos(psi[:, 0]), np.cos(psi[:, 1])
-    s0, s1 = np.sin(psi[:, 0]), np.sin(psi[:, 1])
+    c0 = np.cos(psi[:, 0])
+    c1 = np.cos(psi[:, 1])
+    s0 = np.sin(psi[:, 0])
+    s1 = np.sin(psi[:, 1])
     w = np.empty_like(psi_t, dtype=float)
     w[:, 0] = psi_t[:, 0] + s1 * psi_t[:, 2]
     w[:, 1] = c0 * psi_t[:, 1] - s0 * c1 * psi_t[:, 2]
@@ -61,8 +63,10 @@ def rxyz_from_matrix(a: np.ndarray) -> np.ndarray:
 
 def rxyz_rates(psi: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Angle rates psi_t with ``G(psi) psi_t = omega`` (global angular velocity)."""
-    c0, c1 = np.cos(psi[0]), np.cos(psi[1])
-    s0, s1 = np.sin(psi[0]), np.sin(psi[1])
+    c0 = np.cos(psi[0])
+    c1 = np.cos(psi[1])
+    s0 = np.sin(psi[0])
+    s1 = np.sin(psi[1])
     g = np.array([[1.0, 0.0, s1], [0.0, c0, -s0 * c1], [0.0, s0, c0 * c1]])
     return np.linalg.solve(g, omega)
 
@@ -196,10 +200,12 @@ def rotvec_frame_one(p, p_t) -> tuple[np.ndarray, np.ndarray]:
     x, y, z = float(p[0]), float(p[1]), float(p[2])
     phi = math.sqrt(x * x + y * y + z * z)
     if phi == 0.0:
-        s, c = 1.0, 0.5
+        s = 1.0
+        c = 0.5
     else:
         half = math.sin(0.5 * phi)
-        s, c = math.sin(phi) / phi, 2.0 * half * half / (phi * phi)
+        s = math.sin(phi) / phi
+        c = 2.0 * half * half / (phi * phi)
     a = np.array([
         [1.0 - c * (y * y + z * z), -s * z + c * x * y, s * y + c * x * z],
         [s * z + c * x * y, 1.0 - c * (x * x + z * z), -s * x + c * y * z],

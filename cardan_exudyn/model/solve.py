@@ -37,11 +37,21 @@ ENGINE_NAME = "exudyn"
 
 
 def engine_version() -> str:
+    """The installed Exudyn's version string."""
     return exu.config.Version() if hasattr(exu, "config") else exu.GetVersionString()
 
 
 def end_time(scene: Scene, start: float) -> float:
-    """Time at which the input has turned ``scene.revolutions`` revolutions [s]."""
+    """Time [s] at which the input has turned ``scene.revolutions`` revolutions in a run starting at
+    ``start`` [s] (a torque drive: the time it is allowed).
+
+    Parameters
+    ----------
+    scene : Scene
+        On the model's clock (:func:`reference.scene.histories.run_clock`).
+    start : float
+        The run's start time [s].
+    """
     drive = scene.drive
     target = 2.0 * math.pi * scene.revolutions
     if drive.kind == "speed":
@@ -52,16 +62,28 @@ def end_time(scene: Scene, start: float) -> float:
 
 
 def steps_for_span(span: float, dt: float) -> int:
-    """Fewest whole steps of at most ``dt`` (to rounding) that cover ``span``.
+    """Fewest whole steps of at most ``dt`` [s] (to rounding) that cover ``span`` [s].
 
-    Rounding to the nearest count instead would stop short of the span by up to half a step, and
-    a span of exactly ``1 + skip`` revolutions would then average less than one revolution.
+    Why not the nearest count: it would stop short of the span by up to half a step, and a span
+    of exactly ``1 + skip`` revolutions would then average less than one revolution.
     """
     return max(1, math.ceil(span / dt - 1e-9))
 
 
 def simulation_settings(dt: float, t_start: float, t_end: float,
                         options: ExudynOptions) -> Any:
+    """Exudyn's simulation settings of one run: fixed step, no solution file, sensors stored at
+    every step.
+
+    Parameters
+    ----------
+    dt : float
+        The step [s].
+    t_start, t_end : float
+        The span [s]; it ends at ``t_end`` or up to one step later (:func:`steps_for_span`).
+    options : ExudynOptions
+        Spectral radius and Newton settings.
+    """
     s = exu.SimulationSettings()
     ti = s.timeIntegration
     n = steps_for_span(t_end - t_start, dt)
@@ -85,8 +107,24 @@ def simulation_settings(dt: float, t_start: float, t_end: float,
 
 @dataclass
 class Solved:
-    """A finished (or failed) Exudyn solve of a scene: the model with its sensors, the solver's
-    counters, the status and reason, the step used and how it was chosen, the solve's wall time."""
+    """A finished (or failed) Exudyn solve of a scene.
+
+    Attributes
+    ----------
+    model : ExudynModel
+        The model, its sensors holding every step.
+    solver : exudyn.MainSolverImplicitSecondOrder
+        The solver, with its counters (``solver.it``).
+    status : Status
+    reason : str
+        Why the solve did not end ``ok`` (empty when it did).
+    dt : float
+        The step used [s] (whole steps over the span).
+    dt_reason : str
+        How the step was chosen.
+    wall_time_s : float
+        Wall time of build and solve [s].
+    """
 
     model: ExudynModel
     solver: Any
@@ -101,45 +139,73 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
           tweak: Callable[[ExudynModel, Any], None] | None = None,
           model: ExudynModel | None = None) -> Solved:
     """Build the model of ``scene`` and integrate it: the step choice, solver settings, friction
-    set-up and stop function of every Exudyn run (:func:`run`, the long runs, the benchmark).
+    set-up and stop function of every Exudyn run (:func:`run_once`, the long runs, the benchmark).
 
-    ``tweak(model, settings)``, when given, is called once the model and its simulation settings
-    are made and before the solver starts (the benchmark's skip audit adds or removes one thing).
+    Parameters
+    ----------
+    scene : Scene
+    options : ExudynOptions
+    reactions : bool
+        Record the pair reactions (sensors) for the table.
+    tweak : callable, optional
+        ``tweak(model, settings)``, called once the model and its simulation settings are made
+        and before the solver starts (the benchmark's skip audit adds or removes one thing).
+    model : ExudynModel, optional
+        Integrate this model again instead of building one: a model :func:`reusable` for the
+        same scene up to ``numerics.dt``, whose earlier results have been read. Exudyn starts
+        every solve from the model's initial coordinates and clears the sensors' stored data, so
+        the run is the one a fresh build gives, bit for bit (``tests/test_fixed_costs.py``);
+        only the whole revolutions the post-step hook took out of the input angle are reset.
 
-    ``model``: integrate this model again instead of building one (:func:`reusable`): a
-    frictionless model built for the same scene up to ``numerics.dt``, whose earlier results have
-    been read. Exudyn starts every solve from the model's initial coordinates and clears the
-    sensors' stored data, so the run is the one a fresh build gives (bit for bit, measured; pinned
-    by ``tests/test_fixed_costs.py``); only the whole revolutions the post-step hook took out of
-    the input angle are reset here. Saves the build (a tenth of a short run).
-
-    Raises :class:`LoopClosureError` when the mounting errors cannot be assembled.
+    Raises
+    ------
+    LoopClosureError
+        The mounting errors cannot be assembled.
     """
     wall_start = time.perf_counter()
     dt, dt_reason = choose_step(scene, options.node_type)
-    if model is None:
-        model = build_model(scene, reactions=reactions, node_type=options.node_type)
-    else:
-        if not reusable(model, reactions):
-            raise ValueError("`model` cannot be solved again: it has friction or lacks the "
-                             "reaction sensors asked for")
-        model.input_turns.reset()
+    model = _model(scene, options, reactions, model)
     t_end = end_time(model.scene, model.start_time)  # on the model's clock (build.run_clock)
     span = t_end - model.start_time
     check_steps(span / dt, f"{scene.revolutions:g} revolutions at dt = {dt:.3g} s")
     dt = span / steps_for_span(span, dt)  # whole steps end exactly at the span's end
     settings = simulation_settings(dt, model.start_time, t_end, options)
-    target = 2.0 * math.pi * scene.revolutions
-    friction = model.friction
-    if friction is not None:
-        friction.configure(settings)
-    _set_pre_step(model, target if scene.drive.kind == "torque" else None)
+    if model.friction is not None:
+        model.friction.configure(settings)
+    _set_pre_step(model, 2.0 * math.pi * scene.revolutions if scene.drive.kind == "torque" else None)
     if tweak is not None:
         tweak(model, settings)
     solver = exu.MainSolverImplicitSecondOrder()
-    status, reason = Status.OK, ""
-    # Ctrl-C / SIGTERM inside the solver comes back as a failed solve or a SystemError: the watch
-    # raises the interruption instead, so it is never recorded as an integration failure
+    status, reason = _integrate(model, solver, settings)
+    if status == Status.INTEGRATION_FAILURE and scene.numerics.dt is None:
+        reason += torque_step_hint(scene)
+    return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
+
+
+def _model(scene: Scene, options: ExudynOptions, reactions: bool,
+           model: ExudynModel | None) -> ExudynModel:
+    """A new model of ``scene``, or ``model`` made ready to be solved again (:func:`solve`)."""
+    if model is None:
+        return build_model(scene, reactions=reactions, node_type=options.node_type)
+    if not reusable(model, reactions):
+        raise ValueError("`model` cannot be solved again: it has friction or lacks the "
+                         "reaction sensors asked for")
+    model.input_turns.reset()
+    return model
+
+
+def _integrate(model: ExudynModel, solver: Any, settings: Any) -> tuple[Status, str]:
+    """Run the solver over ``settings``' span: the status and reason of the solve.
+
+    With friction the coupling's initial friction is made consistent first; a self-locking
+    coupling's status wins over the solver's, and a Python error inside its user function is
+    raised here. Ctrl-C / SIGTERM inside the solver come back from Exudyn as a failed solve or a
+    SystemError: :func:`cardan_exudyn.interrupts.watch_signals` raises the interruption instead,
+    so it is never recorded as an integration failure.
+    """
+    friction = model.friction
+    status = Status.OK
+    reason = ""
     with watch_signals():
         try:
             if friction is None:
@@ -150,16 +216,16 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
                 ok = friction.status != Status.OK or solver.SolveSteps(model.mbs, settings)
                 solver.FinalizeSolver(model.mbs, settings)
             if not ok:
-                status, reason = Status.INTEGRATION_FAILURE, solver.GetErrorString() or "solver failed"
+                status = Status.INTEGRATION_FAILURE
+                reason = solver.GetErrorString() or "solver failed"
         except (RuntimeError, ValueError) as exc:  # how Exudyn reports a failed solve
-            status, reason = Status.INTEGRATION_FAILURE, str(exc).strip().splitlines()[0][:300]
+            status = Status.INTEGRATION_FAILURE
+            reason = str(exc).strip().splitlines()[0][:300]
     if friction is not None and friction.error is not None:
         raise friction.error
     if friction is not None and friction.status != Status.OK:
-        status, reason = friction.status, friction.reason
-    if status == Status.INTEGRATION_FAILURE and scene.numerics.dt is None:
-        reason += torque_step_hint(scene)
-    return Solved(model, solver, status, reason, dt, dt_reason, time.perf_counter() - wall_start)
+        return friction.status, friction.reason
+    return status, reason
 
 
 def torque_step_hint(scene: Scene) -> str:
@@ -173,33 +239,52 @@ def torque_step_hint(scene: Scene) -> str:
 
 
 def reusable(model: ExudynModel, reactions: bool) -> bool:
-    """Whether :func:`solve` can integrate ``model`` again: no friction coupling (its state
-    belongs to one run) and the reaction sensors when ``reactions`` asks for them."""
+    """Whether :func:`solve` can integrate ``model`` again: no friction coupling (its state belongs
+    to one run) and the reaction sensors when ``reactions`` asks for them.
+    """
     recorded = f"{PAIR_NAMES[0]}_force" in model.sensors
     return model.friction is None and (recorded or not reactions)
 
 
 def run_once(scene: Scene, options: ExudynOptions) -> Result:
-    """One Exudyn run of ``scene`` at its own step (given, or :func:`choose_step`'s), without the
-    companion run and error estimate of :func:`run`."""
+    """One Exudyn run of ``scene`` at its own step (given, or
+    :func:`~cardan_exudyn.model.stepsize.choose_step`'s) with ``options``: its table (when the scene
+    records one) and summary, means included.
+    """
     summary, columns, origin = run_columns(scene, options)
     return result_of(scene, summary, columns, origin)
 
 
 def run_columns(scene: Scene, options: ExudynOptions) -> tuple[Summary, dict[str, np.ndarray] | None, float]:
-    """One run as :func:`run_once` does it, before the table: its summary (means included), its
-    columns on the model's clock (None when nothing usable was recorded) and the scene's time at
-    the model's ``t = 0`` [s]."""
+    """One run as :func:`run_once` does it, before the table.
+
+    Returns
+    -------
+    summary : Summary
+        Means included.
+    columns : dict of str to ndarray or None
+        On the model's clock; None when nothing usable was recorded.
+    origin : float
+        The scene's time at the model's ``t = 0`` [s].
+    """
     summary, columns, origin, _ = run_model(scene, options)
     return summary, columns, origin
 
 
 def run_model(scene: Scene, options: ExudynOptions, model: ExudynModel | None = None,
-               means: bool = True) -> tuple[Summary, dict[str, np.ndarray] | None, float,
-                                            ExudynModel | None]:
-    """:func:`run_columns` and the model it solved (None when the loop did not close); ``model``
-    solved again instead of a new build (:func:`solve`); ``means=False`` leaves the summary's
-    means out (a caller that takes them from other columns)."""
+              means: bool = True) -> tuple[Summary, dict[str, np.ndarray] | None, float,
+                                           ExudynModel | None]:
+    """:func:`run_columns` and the model it solved (None when the loop did not close).
+
+    Parameters
+    ----------
+    scene : Scene
+    options : ExudynOptions
+    model : ExudynModel, optional
+        Solved again instead of a new build (:func:`solve`).
+    means : bool
+        False: the summary's means are left out (a caller that takes them from other columns).
+    """
     wall_start = time.perf_counter()
     summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=engine_version(),
                       scene=scene_to_dict(scene),
@@ -210,12 +295,8 @@ def run_model(scene: Scene, options: ExudynOptions, model: ExudynModel | None = 
         summary.fail(Status.LOOP_DOES_NOT_CLOSE, str(exc))
         summary.wall_time_s = time.perf_counter() - wall_start
         return summary, None, 0.0, None
-    model, solver = solved.model, solved.solver
-    summary.status, summary.reason = Status(solved.status), solved.reason
-    summary.dt, summary.dt_choice = solved.dt, solved.dt_reason
-    summary.steps = int(solver.it.currentStepIndex)
-    summary.newton_iterations = int(solver.it.newtonStepsCount)
-    summary.jacobian_evaluations = int(solver.it.newtonJacobiCount)
+    model = solved.model
+    _record_solve(summary, solved)
     summary.wall_time_s = time.perf_counter() - wall_start
     if model.friction is not None:
         summary.friction = model.friction.diagnostics()
@@ -230,10 +311,33 @@ def run_model(scene: Scene, options: ExudynOptions, model: ExudynModel | None = 
     return summary, columns, model.time_origin, model
 
 
+def _record_solve(summary: Summary, solved: Solved) -> None:
+    """The solve's status, step and cost counters into ``summary``."""
+    solver = solved.solver
+    summary.status = Status(solved.status)
+    summary.reason = solved.reason
+    summary.dt = solved.dt
+    summary.dt_choice = solved.dt_reason
+    summary.steps = int(solver.it.currentStepIndex)
+    summary.newton_iterations = int(solver.it.newtonStepsCount)
+    summary.jacobian_evaluations = int(solver.it.newtonJacobiCount)
+
+
 def result_of(scene: Scene, summary: Summary, columns: dict[str, np.ndarray] | None,
-            origin: float) -> Result:
-    """The result of a run's columns: the scene's own time (the means were taken before) and the
-    table when the scene records one."""
+              origin: float) -> Result:
+    """The result of a run's columns.
+
+    Parameters
+    ----------
+    scene : Scene
+        Says whether and how often the table is recorded.
+    summary : Summary
+        The run's, its means taken before.
+    columns : dict of str to ndarray or None
+        On the model's clock; time is shifted by ``origin`` to the scene's own (in place).
+    origin : float
+        The scene's time at the model's ``t = 0`` [s].
+    """
     if columns is None:
         return Result(None, summary)
     columns["t"] = columns["t"] + origin
@@ -268,7 +372,8 @@ def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarr
 
 
 def _set_pre_step(model: ExudynModel, target: float | None) -> None:
-    """Stop the run after ``target`` radians (torque drive) or when friction self-locks."""
+    """Stop the run after ``target`` [rad] of the input (torque drive) or when the friction
+    coupling's status is no longer ``ok``."""
     node = model.nodes["input"]
     friction = model.friction
     if target is None and friction is None:

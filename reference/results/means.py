@@ -25,16 +25,29 @@ __all__ = ["after_revolutions", "whole_revolution_window", "cumulative", "window
 
 
 def after_revolutions(theta_in: np.ndarray, skip_revolutions: float) -> np.ndarray:
-    """Mask of the rows after the first ``skip_revolutions`` of the input angle (either sense)."""
+    """Mask, shape of ``theta_in``, of the rows after the first ``skip_revolutions`` [-] of the
+    input angle ``theta_in`` [rad] (either sense).
+    """
     theta = np.asarray(theta_in, float)
     return np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
 
 
 def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tuple[float, float, int]:
-    """Input-angle window [theta_0, theta_1] spanning whole revolutions after the skipped ones.
+    """Input-angle window spanning whole revolutions after the skipped ones.
 
-    Returns ``(theta_0, theta_1, n)`` with ``theta_1 = theta_0 + 2 pi n`` in the direction of
-    motion; ``n`` is 0 when less than one whole revolution is available.
+    Parameters
+    ----------
+    theta_in : ndarray, shape (n,)
+        Input angle [rad], monotonic.
+    skip_revolutions : float
+        Revolutions [-] left out at the start.
+
+    Returns
+    -------
+    theta_0, theta_1 : float
+        The window's ends [rad], ``theta_1 = theta_0 + 2 pi n`` in the direction of motion.
+    n : int
+        Whole revolutions in it; 0 when less than one is available.
     """
     sign = 1.0 if theta_in[-1] >= theta_in[0] else -1.0
     theta_0 = theta_in[0] + sign * 2.0 * math.pi * skip_revolutions
@@ -45,8 +58,9 @@ def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tu
 
 
 def cumulative(y: np.ndarray, t: np.ndarray, breaks: Sequence[tuple[int, int, float]] = ()) -> np.ndarray:
-    """Integral of ``y dt`` from the first row to each row: trapezoidal, except across the
-    friction jumps ``breaks`` (:func:`reference.results.quadrature.jump_breaks`)."""
+    """Integral of ``y dt`` from the first row to each row, shape of ``t``: trapezoidal, except
+    across the friction jumps ``breaks`` (:func:`reference.results.quadrature.jump_breaks`).
+    """
     out = np.zeros(np.shape(t), float)
     out[1:] = np.cumsum(segment_integrals(y, t, breaks))
     return out
@@ -55,24 +69,35 @@ def cumulative(y: np.ndarray, t: np.ndarray, breaks: Sequence[tuple[int, int, fl
 def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
                     theta_0: float, theta_1: float,
                     breaks: Sequence[tuple[int, int, float]] = ()) -> float:
-    """Integral of y dt between the instants where theta passes theta_0 and theta_1
-    (:func:`cumulative`, with the friction jumps ``breaks``).
+    """Integral of ``y dt`` between the instants where ``theta`` passes ``theta_0`` and ``theta_1``.
 
-    ``theta`` must be monotonic; the ends are interpolated linearly in theta.
+    Parameters
+    ----------
+    y, t, theta : ndarray, shape (n,)
+        The integrand, time [s] and a monotonic angle [rad] (the input angle).
+    theta_0, theta_1 : float
+        The window's ends [rad]; the integral is interpolated linearly in ``theta`` there.
+    breaks : sequence of (int, int, float)
+        The friction jumps integrated across (:func:`cumulative`).
     """
     cum = cumulative(np.asarray(y, float), np.asarray(t, float), breaks)
     th = np.asarray(theta, float)
     if th[-1] < th[0]:
-        th, cum, theta_0, theta_1 = -th, cum, -theta_0, -theta_1
+        th = -th
+        theta_0 = -theta_0
+        theta_1 = -theta_1
     return float(np.interp(theta_1, th, cum) - np.interp(theta_0, th, cum))
 
 
 def window_duration(t: np.ndarray, theta: np.ndarray, theta_0: float, theta_1: float) -> float:
-    """Time [s] between the instants where ``theta`` (monotonic) passes ``theta_0`` and
-    ``theta_1`` [rad], interpolated linearly in theta."""
+    """Time [s] between the instants where ``theta`` (monotonic, [rad]) passes ``theta_0`` and
+    ``theta_1`` [rad], interpolated linearly in ``theta``; ``t`` the rows' time [s].
+    """
     th = np.asarray(theta, float)
     if th[-1] < th[0]:
-        th, theta_0, theta_1 = -th, -theta_0, -theta_1
+        th = -th
+        theta_0 = -theta_0
+        theta_1 = -theta_1
     return float(np.interp(theta_1, th, t) - np.interp(theta_0, th, t))
 
 
@@ -137,10 +162,31 @@ def mean_values(columns: Mapping[str, np.ndarray], skip_revolutions: float,
 
 def flow_means(columns: Mapping[str, np.ndarray], works: Mapping[str, float], integral: Any,
                duration: float, inside: np.ndarray) -> dict[str, Any]:
-    """The means that depend on the direction of the power flow (:func:`mean_values`), from the
-    window's ``works`` [J], ``integral(y)`` (of ``y dt`` over the window), its ``duration`` [s]
-    and the mask of its rows ``inside``."""
-    w_in, w_out, w_loss = works["input_work"], works["output_work"], works["loss_work"]
+    """The means that depend on the direction of the power flow (:func:`mean_values`).
+
+    Parameters
+    ----------
+    columns : mapping
+        The table's columns (powers [W], energies [J], time [s]).
+    works : mapping
+        ``input_work``, ``output_work``, ``loss_work`` of the window [J].
+    integral : callable
+        ``integral(y)``: the window's integral of ``y dt``.
+    duration : float
+        The window's duration [s].
+    inside : ndarray of bool
+        The rows of the window (:func:`window_rows`).
+
+    Returns
+    -------
+    dict
+        ``mean_efficiency``, ``work_ratio``, ``mean_instantaneous_efficiency``, ``power_flow``,
+        ``power_reversals``, ``warnings`` and ``unphysical`` (why the means are impossible, with the
+        likely cause; empty when they are not).
+    """
+    w_in = works["input_work"]
+    w_out = works["output_work"]
+    w_loss = works["loss_work"]
     energy = np.asarray(columns["energy_kinetic"]) + np.asarray(columns["energy_potential"])
     scale = integral(np.abs(columns["power_in"]) + np.abs(columns["power_out"])
                      + np.abs(columns["power_loss"])) + float(np.max(np.abs(energy[inside])))
@@ -161,10 +207,13 @@ def flow_means(columns: Mapping[str, np.ndarray], works: Mapping[str, float], in
 
 
 def window_rows(theta: np.ndarray, theta_0: float, theta_1: float) -> np.ndarray:
-    """Mask of the rows whose values enter the window's integrals: those between ``theta_0`` and
-    ``theta_1`` and the row on either side that brackets an end (``theta`` monotonic)."""
+    """Mask of the rows whose values enter the window's integrals: those of ``theta`` (monotonic,
+    [rad]) between ``theta_0`` and ``theta_1`` and the row on either side that brackets an end.
+    """
     sign = 1.0 if theta_1 >= theta_0 else -1.0
-    th, lo, hi = sign * np.asarray(theta, float), sign * theta_0, sign * theta_1
+    th = sign * np.asarray(theta, float)
+    lo = sign * theta_0
+    hi = sign * theta_1
     first = max(int(np.searchsorted(th, lo, side="right")) - 1, 0)
     last = min(int(np.searchsorted(th, hi, side="left")), th.size - 1)
     mask = np.zeros(th.size, bool)
@@ -173,8 +222,9 @@ def window_rows(theta: np.ndarray, theta_0: float, theta_1: float) -> np.ndarray
 
 
 def pair_loss_works(columns: Mapping[str, np.ndarray], integral: Any) -> dict[str, float]:
-    """``loss_work_<pair>`` and its axial-friction part ``loss_work_<pair>_sliding`` [J] of the
-    pairs whose columns are there, with ``integral(y)`` the window's integral of ``y dt``."""
+    """``loss_work_<pair>`` and its axial-friction part ``loss_work_<pair>_sliding`` [J] of the pairs
+    whose columns are in ``columns``, with ``integral(y)`` the window's integral of ``y dt``.
+    """
     out = {}
     for p in PAIR_NAMES:
         key = f"power_loss_{p}"
@@ -188,13 +238,34 @@ def pair_loss_works(columns: Mapping[str, np.ndarray], integral: Any) -> dict[st
 
 def flow_time_average(columns: Mapping[str, np.ndarray], flow: str | None, inside: np.ndarray,
                       integral: Any, duration: float) -> tuple[float | None, int | None, str]:
-    """Time average of eq. (18) over the window for the direction ``flow``, the sign changes of
-    the source power at the rows ``inside`` the window, and why the average is not reported.
+    """Time average of eq. (18) over the window for the direction of the power flow.
 
     Eq. (18) is ``1 - P_loss / P_src`` with the source power ``P_src`` = ``P_in``, or ``-P_out``
     when the power flows from the output to the input. The average is defined only when
     ``P_src > 0`` at every row of the window (it has poles where ``P_src`` changes sign) and is
-    reported only in [0, 1]; otherwise it is None and the note says why.
+    reported only in [0, 1].
+
+    Parameters
+    ----------
+    columns : mapping
+        The table's columns.
+    flow : str or None
+        A :class:`reference.results.power_flow.PowerFlow` value.
+    inside : ndarray of bool
+        The rows of the window.
+    integral : callable
+        ``integral(y)``: the window's integral of ``y dt``.
+    duration : float
+        The window's duration [s].
+
+    Returns
+    -------
+    average : float or None
+        None where it is not reported.
+    reversals : int or None
+        Sign changes of the source power at the window's rows.
+    note : str
+        Why the average is not reported (empty when it is).
     """
     if flow is None:
         return None, None, ""

@@ -103,7 +103,9 @@ def classify_works(input_work: float, output_work: float, loss_work: float,
     ----------
     Eq. (18) of the paper, integrated over the window, for the direction the work flows.
     """
-    w_in, w_out, w_loss = float(input_work), float(output_work), float(loss_work)
+    w_in = float(input_work)
+    w_out = float(output_work)
+    w_loss = float(loss_work)
     works = _works(w_in, w_out, w_loss)
     if not all(np.isfinite((w_in, w_out, w_loss))):
         return FlowVerdict(None, None, None, problem=f"non-finite works ({works})")

@@ -5,9 +5,7 @@ over whole revolutions. Where a pair's relative motion reverses, its friction ch
 within a sign ramp far narrower than a step (:mod:`reference.physics.bands`), and the drive torque and
 every pair's reaction jump with it. The trapezoid between the two rows around such a jump
 integrates a straight line across the step, an error of half the jump times the step at every
-reversal: first order in the step, whatever the engine's own order (measured on the reference
-engine's own, exact rows of paper-literal-10deg: mean-efficiency error 1.1e-3, 5.3e-4,
-2.5e-4, 1.1e-4 at 200, 400, 800, 1600 steps per revolution).
+reversal: first order in the step, whatever the engine's own order.
 
 :func:`jump_breaks` finds every reversal from the table's relative speeds (the crossing instant
 interpolated linearly between the rows around it) and :func:`segment_integrals` integrates each
@@ -16,7 +14,7 @@ step to the crossing (in particular a row exactly at it, as on a constant-speed 
 per revolution, where the crossings of a symmetric joint fall on rows) may lie inside the sign
 ramp, where its value belongs to neither side: it is left out and the two steps around it are
 integrated as one; so are the rows of a ramp the steps partly resolve (:data:`RAMP_GROWTH`).
-With the same exact rows the error falls to 1.1e-4, 3.7e-5, 1.9e-6 and -1.6e-5
+Measured on the reference engine's exact rows: docs/accuracy.md#step-model-constants
 (``tests/test_reference_quadrature.py`` pins the improvement).
 """
 
@@ -98,12 +96,14 @@ def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float
     out = []
     for p in PAIR_NAMES:
         for load, motion in _MOTIONS:
-            f, w = columns.get(f"{p}_{load}"), columns.get(f"{p}_{motion}")
+            f = columns.get(f"{p}_{load}")
+            w = columns.get(f"{p}_{motion}")
             if f is None or w is None or not np.any(np.asarray(f, float)):
                 continue
             f = np.asarray(f, float)
             for a, b, ts in _crossings(np.asarray(w, float), f, t, noise):
-                a, b = _off_ramp(f, a, -1), _off_ramp(f, b, +1)
+                a = _off_ramp(f, a, -1)
+                b = _off_ramp(f, b, +1)
                 if b - a - 1 > RESOLVED_ROWS:
                     continue
                 if b == a + 1:
@@ -125,7 +125,8 @@ def segment_integrals(y: np.ndarray, t: np.ndarray,
     line through the row on its side and the next one beyond it (a constant at the table's ends).
     A jump is then integrated exactly to second order, and so is a sign ramp that the steps
     resolve (where the trapezoid was right): either way the error stays O(h^2)."""
-    y, t = np.asarray(y, float), np.asarray(t, float)
+    y = np.asarray(y, float)
+    t = np.asarray(t, float)
     seg = 0.5 * np.diff(t) * (y[:-1] + y[1:])
     last = t.size - 1
     for a, b, ts in breaks:

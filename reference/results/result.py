@@ -74,6 +74,7 @@ class Result:
 
     @property
     def status(self) -> Status:
+        """How the run ended."""
         return self.summary.status
 
     @property
@@ -93,7 +94,17 @@ class Result:
 
 
 def result_table(columns: Mapping[str, np.ndarray], every: int, extra: tuple[str, ...] = ()) -> Any:
-    """The time table of a result: the schema's columns (and an engine's ``extra`` ones), every
-    ``every``-th row, built as a pandas DataFrame when first read (:class:`DeferredTable`)."""
+    """The time table of a result, built as a pandas DataFrame when first read
+    (:class:`DeferredTable`).
+
+    Parameters
+    ----------
+    columns : mapping of str to ndarray
+        At least :func:`~reference.results.columns.table_columns`.
+    every : int
+        Keep every ``every``-th row.
+    extra : tuple of str
+        An engine's extra columns, after the schema's.
+    """
     return DeferredTable(columns, every, table_columns() + list(extra))
 

@@ -21,7 +21,7 @@ from reference.results.friction_diagnostics import FrictionDiagnostics
 from reference.results.means import mean_values
 from reference.results.power_flow import PowerFlow, classify_works
 
-__all__ = ["SCHEMA_VERSION", "Status", "OptionsError", "MEAN_KEYS", "FLOW_KEYS", "Summary"]
+__all__ = ["SCHEMA_VERSION", "Status", "OptionsError", "MEAN_KEYS", "FLOW_KEYS", "RECORD_FIELDS", "Summary"]
 
 SCHEMA_VERSION = 3
 """Version of the summary written to disk (``summary.json``, sweep records): 2 adds
@@ -65,7 +65,9 @@ with the means."""
 
 
 _RECORDS: dict[str, Any] = {"friction": FrictionDiagnostics, "accuracy": RunAccuracy}
-"""The summary's typed records by field name, each a table of its own on disk."""
+RECORD_FIELDS = tuple(_RECORDS)
+"""The summary's typed records of a time-stepping engine's run, each a table of its own on disk,
+written only when the run has it (engine-specific, like :attr:`Summary.extras`)."""
 
 
 @dataclass
@@ -213,10 +215,24 @@ class Summary:
 
     def whole_revolution_means(self, columns: Mapping[str, np.ndarray], skip_revolutions: float,
                                works: Mapping[str, float] | None = None) -> dict[str, Any] | None:
-        """:func:`mean_values` of ``columns`` (``works``: see there); None, with the status and
-        reason, when there is no whole revolution to average over (``no_whole_revolution``) or
-        the means are impossible (``unphysical``): every engine's rules. Its warnings are added
-        to :attr:`warnings` either way."""
+        """The means of ``columns`` over whole input revolutions by every engine's rules.
+
+        Parameters
+        ----------
+        columns : mapping
+            The table's columns.
+        skip_revolutions : float
+            Input revolutions [-] left out at the start.
+        works : mapping, optional
+            The window's works from a better integration (:func:`~reference.results.means.mean_values`).
+
+        Returns
+        -------
+        dict or None
+            :func:`~reference.results.means.mean_values`' keys; None, with the status and reason set,
+            when there is no whole revolution (``no_whole_revolution``) or the means are impossible
+            (``unphysical``). Their warnings are added to :attr:`warnings` either way.
+        """
         means = mean_values(columns, skip_revolutions, works)
         if means["revolutions"] < 1:
             self.fail(Status.NO_WHOLE_REVOLUTION, means["mean_status"])
@@ -241,7 +257,8 @@ class Summary:
 
     def fail(self, status: Status | str, reason: str) -> None:
         """End the run with ``status`` and ``reason`` and forget its means."""
-        self.status, self.reason = Status(status), reason
+        self.status = Status(status)
+        self.reason = reason
         self.clear_means()
 
     def to_dict(self) -> dict[str, Any]:
@@ -305,7 +322,8 @@ class Summary:
             self.fail(Status.UNPHYSICAL, verdict.problem)
             return
         self.power_flow = None if verdict.power_flow is None else verdict.power_flow.value
-        self.mean_efficiency, self.work_ratio = verdict.mean_efficiency, verdict.work_ratio
+        self.mean_efficiency = verdict.mean_efficiency
+        self.work_ratio = verdict.work_ratio
         self.warn(*[verdict.note] if verdict.note else [])
         eta = self.mean_instantaneous_efficiency
         if eta is not None and not (verdict.power_flow == PowerFlow.INPUT_TO_OUTPUT and 0.0 <= eta <= 1.0):
