@@ -51,6 +51,9 @@ from reference.scene.histories import run_clock
 from reference.scene.joint import PAIR_BODIES, PAIR_KIND, PAIR_NAMES
 from reference.scene.scene import Scene
 
+__all__ = ["CONSTRAINED_AXES", "COUPLINGS", "node_axes_in_canonical", "pair_geometry", "assembled_state",
+           "ExudynModel", "build_model", "add_sensors"]
+
 CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 1, 0]}
 COUPLINGS = {"extrapolated": ExtrapolatedCoupling, "converged": ConvergedCoupling,
              "lagged": LaggedCoupling}
@@ -243,7 +246,6 @@ def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
 def _add_bodies(model: ExudynModel) -> None:
     """A node and a rigid body per moving body, in the assembled initial state."""
     scene = model.scene
-    mbs = model.mbs
     theta0, omega0, t0 = _initial_drive_state(scene)
     model.start_time = t0
     state = assembled_state(scene, theta0, omega0)
@@ -253,32 +255,41 @@ def _add_bodies(model: ExudynModel) -> None:
         mass, com_c, inertia_c = body.canonical()
         r = axes[name]
         com = r @ com_c  # from the body's frame origin, node axes = global axes at reference
-        inertia = r @ inertia_c @ r.T
         model.com_reference[name] = reference_state[name]["origin"] + com
         model.mass[name] = mass
-        model.inertia[name] = inertia
+        model.inertia[name] = r @ inertia_c @ r.T
         rot = ROTATION_COORDINATES["Rxyz" if name == "input" else model.node_type]
         model.rotations[name] = rot
-        a0 = state[name]["A"]
-        p0 = rot.from_matrix(a0)
+        p0 = rot.from_matrix(state[name]["A"])
         if name == "input":  # its angle coordinate starts within [-pi, pi]: the rest is whole turns
             model.input_turns = WholeTurns(start=round((theta0 - p0[0]) / TWO_PI))
-        w = state[name]["omega"]
-        arm = a0 @ com
-        pos0 = state[name]["origin"] + arm
-        node = mbs.AddNode(getattr(eii, rot.node_class)(
-            referenceCoordinates=[*model.com_reference[name], *rot.reference],
-            initialCoordinates=[*(pos0 - model.com_reference[name]), *(p0 - np.asarray(rot.reference))],
-            initialVelocities=[*(state[name]["velocity"] + _cross(w, arm)), *rot.rates(p0, w)],
-        ))
-        model.nodes[name] = node
-        model.bodies[name] = mbs.AddObject(eii.ObjectRigidBody(
-            mass=mass,
-            inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2],
-                     inertia[1, 2], inertia[0, 2], inertia[0, 1]],
-            centerOfMass=[0.0, 0.0, 0.0],
-            nodeNumber=node,
-        ))
+        _add_body(model, name, state[name], com, p0)
+
+
+def _add_body(model: ExudynModel, name: str, state: dict[str, np.ndarray], com: np.ndarray,
+              p0: np.ndarray) -> None:
+    """The node and rigid body of body ``name`` (its mass, inertia, reference position and
+    rotation coordinates already in ``model``) in its initial ``state`` (``A``, ``origin``,
+    ``velocity``, ``omega``), ``com`` its centre of mass from its frame origin [m] and ``p0`` its
+    initial rotation coordinates."""
+    rot = model.rotations[name]
+    inertia = model.inertia[name]
+    w = state["omega"]
+    arm = state["A"] @ com
+    pos0 = state["origin"] + arm
+    node = model.mbs.AddNode(getattr(eii, rot.node_class)(
+        referenceCoordinates=[*model.com_reference[name], *rot.reference],
+        initialCoordinates=[*(pos0 - model.com_reference[name]), *(p0 - np.asarray(rot.reference))],
+        initialVelocities=[*(state["velocity"] + _cross(w, arm)), *rot.rates(p0, w)],
+    ))
+    model.nodes[name] = node
+    model.bodies[name] = model.mbs.AddObject(eii.ObjectRigidBody(
+        mass=model.mass[name],
+        inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2],
+                 inertia[1, 2], inertia[0, 2], inertia[0, 1]],
+        centerOfMass=[0.0, 0.0, 0.0],
+        nodeNumber=node,
+    ))
 
 
 def _add_pairs(model: ExudynModel, ground: int) -> None:
@@ -334,11 +345,7 @@ def _wrap_rotations(model: ExudynModel) -> None:
     the state it leaves. Measured: docs/engines.md#exudyn-model-measurements.
     """
     mbs = model.mbs
-    angle = mbs.GetNodeODE2Index(model.nodes["input"]) + 3
-    angles = [mbs.GetNodeODE2Index(node) + 3 + k for name, node in model.nodes.items()
-              if name != "input" and model.rotations[name].name == "Rxyz" for k in range(3)]
-    vectors = [mbs.GetNodeODE2Index(node) + 3 for name, node in model.nodes.items()
-               if model.rotations[name].name == "RotVecLG"]
+    angle, angles, vectors = _rotation_indices(model)
     system_data = mbs.systemData
     current = exu.ConfigurationType.Current
     turns = model.input_turns
@@ -366,6 +373,18 @@ def _wrap_rotations(model: ExudynModel) -> None:
     mbs.SetPostStepUserFunction(post_step)
 
 
+def _rotation_indices(model: ExudynModel) -> tuple[int, list[int], list[int]]:
+    """Indices in the ODE2 coordinates of the input angle, of the other Rxyz nodes' three angles
+    and of the first component of each ``RotVecLG`` node's rotation vector."""
+    mbs = model.mbs
+    angle = mbs.GetNodeODE2Index(model.nodes["input"]) + 3
+    angles = [mbs.GetNodeODE2Index(node) + 3 + k for name, node in model.nodes.items()
+              if name != "input" and model.rotations[name].name == "Rxyz" for k in range(3)]
+    vectors = [mbs.GetNodeODE2Index(node) + 3 for name, node in model.nodes.items()
+               if model.rotations[name].name == "RotVecLG"]
+    return angle, angles, vectors
+
+
 def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
     """Input angle [rad], speed [rad/s] and time [s] at the start of the simulation."""
     drive = scene.drive
@@ -379,6 +398,9 @@ def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
 
 
 def _add_drive(model: ExudynModel, ground) -> None:
+    """The drive of the input: a torque load, or a coordinate constraint on the input angle
+    (velocity level for a constant speed, position level with a spline offset for an angle
+    history) against ``ground``."""
     mbs = model.mbs
     drive = model.scene.drive
     if drive.kind == "torque":

@@ -18,6 +18,11 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["rxyz_matrix", "rxyz_angular_velocity", "rxyz_from_matrix", "rxyz_rates", "rxyz_frame",
+           "rxyz_frame_one", "ep_frame", "ep_frame_one", "ep_from_matrix", "ep_rates", "rotvec_frame",
+           "rotvec_frame_one", "rotvec_from_matrix", "rotvec_rates", "RotationCoordinates", "TWO_PI",
+           "WholeTurns", "ROTATION_COORDINATES"]
+
 
 def rxyz_matrix(psi: np.ndarray) -> np.ndarray:
     """Rotation matrices ``Rx(psi0) Ry(psi1) Rz(psi2)``, shape (n, 3, 3), for psi of shape (n, 3)."""
