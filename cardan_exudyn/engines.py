@@ -46,7 +46,7 @@ ENGINES: dict[str, Engine] = {
     "reference": Engine("reference", "reference.engine.solve", "reference.engine.options:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "
                         "minimal-coordinate dynamics, adaptive work quadrature", batch="reference.engine.batch.solve"),
-    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco.engine", "cardan_exudyn.mujoco.engine:MujocoOptions",
+    "mujoco": Engine("mujoco", "cardan_exudyn.mujoco.engine", "cardan_exudyn.mujoco.options:MujocoOptions",
                      "MuJoCo (optional extra): frictionless scenes with a constant load only"),
 }
 

@@ -24,7 +24,7 @@ from reference.paper.scenes import named_scene
 HEAVY = ("pandas", "matplotlib", "scipy", "dask", "distributed", "mujoco", "exudyn", "tqdm")
 """Third-party packages a run loads only when it needs them (tables, plots, the engines)."""
 JOBS = ("cardan_exudyn.studies.", "cardan_exudyn.sweep", "cardan_exudyn.model", "cardan_exudyn.comparison",
-        "cardan_exudyn.mujoco.engine", "cardan_exudyn.report.plots", "rigdata")
+        "cardan_exudyn.mujoco", "cardan_exudyn.report.plots", "rigdata")
 """Modules of this project that ``cardan run`` has no use for before its engine runs."""
 
 PROBE = f"""

@@ -4,7 +4,7 @@ Tolerances come from docs/mujoco.md. With the recommended settings (RK4, constra
 constant 20 steps, impedance 0.9999) at dt = 1e-4 s (300 steps per revolution at 2000 rpm):
 
 - the speed-ratio error is bounded by the documented error model
-  (:func:`cardan_exudyn.mujoco.engine.speed_ratio_error_model`), which over-estimates the
+  (:func:`cardan_exudyn.mujoco.timestep.speed_ratio_error_model`), which over-estimates the
   measured values (3.9e-9 at 10 deg, 2.4e-8 at 30 deg) by 2-40x;
 - every constraint force, the drive torque included, misses a fraction of about ``1 - d = 1e-4``
   (MuJoCo caps the impedance d at 0.9999): the measured torque and spider-moment errors are
@@ -22,7 +22,7 @@ pytest.importorskip("mujoco")
 
 from cardan_exudyn import engines
 from cardan_exudyn.mujoco import engine as mujoco_engine  # noqa: E402 (after the optional-import skip)
-from cardan_exudyn.mujoco.engine import MujocoOptions, speed_ratio_error_model  # noqa: E402
+from cardan_exudyn.mujoco import MujocoOptions, choose_timestep, speed_ratio_error_model  # noqa: E402
 from cardan_exudyn.studies.mujoco_settings.compute import (  # noqa: E402
     MUJOCO_DEFAULTS,
     accuracy,
@@ -162,7 +162,7 @@ def test_unreachable_accuracy_is_refused_before_running():
                     **{"joint.geometry.shaft_angle": math.radians(89.9)})
     unreachable = r"speed-ratio error of 0.001 at 89.9 deg needs .* steps per input revolution .* about .* s"
     with pytest.raises(SceneError, match=unreachable):
-        mujoco_engine.choose_timestep(scene, MujocoOptions())
+        choose_timestep(scene, MujocoOptions())
     with pytest.raises(SceneError, match=unreachable):
         run(scene)
 
