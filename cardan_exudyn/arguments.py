@@ -23,7 +23,7 @@ if sys.version_info >= (3, 11):
 else:  # Python 3.10
     import tomli as tomllib
 
-from cardan_exudyn.io import OutputError, check_output_folder
+from cardan_exudyn.outputs import OutputError, check_output_folder
 from reference.paper.scenes import named_scene
 from reference.scene.files import load_scene
 from reference.scene.mapping import replace

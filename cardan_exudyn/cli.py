@@ -39,10 +39,10 @@ from cardan_exudyn.arguments import (
 )
 from cardan_exudyn.engines import ENGINES, EngineUnavailable, make_options, run
 from cardan_exudyn.interrupts import Terminated, exit_status, terminate_raises
-from cardan_exudyn.io import (
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import (
     WRITE_ERRORS,
     OutputError,
-    dumps,
     output_lock,
     result_files,
     write_error,
@@ -352,7 +352,7 @@ def _run_command(args: argparse.Namespace) -> int:
 
 @contextlib.contextmanager
 def _holding_output(args: argparse.Namespace) -> Iterator[None]:
-    """Hold the command's ``--out`` (:func:`cardan_exudyn.io.output_lock`) from its start, so a
+    """Hold the command's ``--out`` (:func:`cardan_exudyn.outputs.output_lock`) from its start, so a
     second command writing there is refused at once; when the output's folder does not exist yet,
     the writer locks it when it makes it. A path the command will refuse is left to it."""
     out = getattr(args, "out", None)

@@ -23,7 +23,7 @@ import rigdata
 from cardan_exudyn import arguments
 from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInput
 from cardan_exudyn.engines import EngineUnavailable
-from cardan_exudyn.io import OutputError
+from cardan_exudyn.outputs import OutputError
 from cardan_exudyn.report.format import number
 from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
-from cardan_exudyn.io import atomic_open
+from cardan_exudyn.outputs import atomic_open
 from rigdata.units import split_header
 
 #: Column names recognised as time by the writers (the first such column is the time axis).

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
 from reference.paper.scenes import named_scene
 from reference.results.summary import Status
 from reference.scene.files import load_scene

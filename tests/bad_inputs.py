@@ -5,7 +5,7 @@ command line (every subcommand, ``cardan rig ...`` included) exits with status 2
 stderr, nothing on stdout, no traceback, and leaves an output folder it was given as it was; the
 Python API raises a documented exception (:class:`~reference.scene.validation.SceneError`,
 :class:`~cardan_exudyn.sweep.SweepError`, :class:`~cardan_exudyn.engines.EngineUnavailable`,
-:class:`~cardan_exudyn.io.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
+:class:`~cardan_exudyn.outputs.OutputError`, ``ValueError``; ``rigdata``'s ``RigDataError``) with a
 one-line message. A run that fails is not bad input: it exits with status 3 and a status line
 with its reason, and prints no NaN or infinite efficiency (nor does a run with no input work,
 whose efficiency is 0/0: it says "undefined").
@@ -28,7 +28,7 @@ import numpy as np
 from cardan_exudyn import ExudynOptions
 from cardan_exudyn.comparison import compare
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
-from cardan_exudyn.io import OutputError, write_result
+from cardan_exudyn.outputs import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
@@ -214,7 +214,7 @@ def _api_distribution(d: Path) -> Any:
 
 
 def _api_write_result_file(d: Path) -> Any:
-    """cardan_exudyn.io.write_result(result, "a-file"): the target exists and is not a folder"""
+    """cardan_exudyn.outputs.write_result(result, "a-file"): the target exists and is not a folder"""
     return write_result(Result(None, Summary(Status.OK)), d / "out")
 
 

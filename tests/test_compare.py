@@ -27,7 +27,7 @@ from cardan_exudyn import ExudynOptions
 from cardan_exudyn.cli import main
 from cardan_exudyn.comparison import Comparison, compare, join_on_input_angle
 from cardan_exudyn.engines import run
-from cardan_exudyn.io import dumps
+from cardan_exudyn.jsonable import dumps
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.results.summary import OptionsError, Status

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from bad_inputs import CASES, DIRECTORY, ENTRY_POINTS, MARKER, Case
 
-from cardan_exudyn import io as cio
+from cardan_exudyn import outputs as cio
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
 from reference.results.result import Result

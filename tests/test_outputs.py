@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 from processes import start, wait_for
 
-import cardan_exudyn.io as cio
+import cardan_exudyn.outputs as cio
 from cardan_exudyn.cli import main
 from cardan_exudyn.sweep import run_sweep
 
@@ -121,7 +121,7 @@ def test_kill_at_a_random_instant_leaves_previous_or_new(tmp_path, previous, see
 
 SWAPPER = """
 import itertools, sys
-import cardan_exudyn.io as cio
+import cardan_exudyn.outputs as cio
 if sys.argv[2] == "two-renames":
     cio.exchange = lambda a, b: False
 for i in itertools.count():

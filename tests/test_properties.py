@@ -125,7 +125,7 @@ from reference.scene.validation import DEG, RPM
 #: values), ``incomplete`` (torque drive short of its span), ``no_whole_revolution`` (means
 #: impossible), ``loop_does_not_close`` (mounting errors), ``unphysical`` (an efficiency outside
 #: [0, 1]). A mean that is undefined is None in an ``ok`` summary, with a warning: the CLI prints
-#: "undefined" and JSON writes null (``cardan_exudyn.cli``, ``cardan_exudyn.io``).
+#: "undefined" and JSON writes null (``cardan_exudyn.cli``, ``cardan_exudyn.outputs``).
 COMMON_STATUSES = {"ok", "self_locking", "integration_failure", "incomplete", "no_whole_revolution",
                    "loop_does_not_close", "unphysical"}
 STATUSES = {"reference": COMMON_STATUSES, "exudyn": COMMON_STATUSES | {"diverged"}}

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import get_engine
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.sweep.spec import (
     SweepError,
     SweepSpec,

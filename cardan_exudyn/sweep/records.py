@@ -23,7 +23,8 @@ import numpy as np
 
 from cardan_exudyn import engines
 from cardan_exudyn.interrupts import deferred_signals
-from cardan_exudyn.io import atomic_write, to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
+from cardan_exudyn.outputs import atomic_write
 from cardan_exudyn.sweep.plan import Case, Plan, plan_difference
 from cardan_exudyn.sweep.spec import SweepError
 from reference.scene.scene import Scene

@@ -38,7 +38,8 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.interrupts import deferred_signals
-from cardan_exudyn.io import OutputError, check_output_folder, to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
+from cardan_exudyn.outputs import OutputError, check_output_folder
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.sweep.executors import (
     Emit,

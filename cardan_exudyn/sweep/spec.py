@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
 from reference.scene.files import read_toml
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene

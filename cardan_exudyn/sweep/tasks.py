@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cardan_exudyn import engines
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.sweep.plan import Case
 from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, scalar_summary
 from cardan_exudyn.sweep.spec import DEFAULT_FUNCTION, CaseFunction, flatten_paths, resolve_function

@@ -35,7 +35,8 @@ import numpy as np
 import pandas as pd
 
 from cardan_exudyn import engines
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.bench.report import header

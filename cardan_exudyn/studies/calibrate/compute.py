@@ -25,7 +25,8 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, out_folder
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.calibrate.envelope import envelope_study, envelope_text
 from cardan_exudyn.studies.calibrate.fitting import (

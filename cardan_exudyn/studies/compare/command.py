@@ -24,7 +24,8 @@ from cardan_exudyn.arguments import (
     out_folder,
     scene_from_args,
 )
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
 from reference.scene.joint import PAIR_NAMES
 

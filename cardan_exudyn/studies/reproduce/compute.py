@@ -77,7 +77,8 @@ import numpy as np
 
 from cardan_exudyn import engines
 from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, count, out_folder
-from cardan_exudyn.io import atomic_directory, atomic_write, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory, atomic_write
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
 from reference.paper.cases import paper_cases

@@ -46,7 +46,7 @@ def handler(args: argparse.Namespace) -> int:
     """Run ``cardan stress``; exit 3 when a map cell or a long run raised in the harness."""
     # Imported here, not at the top: `cardan` imports this module to register the command, and the
     # parts load pandas, Exudyn and matplotlib (about 2 s) that no other command should wait for.
-    from cardan_exudyn.io import dumps
+    from cardan_exudyn.jsonable import dumps
     from cardan_exudyn.studies.stress.report import StressError, parse_parts, run_stress, summary_lines
     from cardan_exudyn.sweep import SweepError
 

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.ticker import NullFormatter, ScalarFormatter
 
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.stress.longrun import LongRuns

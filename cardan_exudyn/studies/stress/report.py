@@ -18,7 +18,8 @@ from typing import Any
 
 import pandas as pd
 
-from cardan_exudyn.io import atomic_directory, check_output_folder, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory, check_output_folder
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.report.format import markdown_table
@@ -117,7 +118,7 @@ def run_stress(out: str | os.PathLike, *, quick: bool = False, parts: Sequence[s
 
     Raises
     ------
-    cardan_exudyn.io.OutputError
+    cardan_exudyn.outputs.OutputError
         ``out`` cannot be a folder; raised before anything runs.
     """
     say = say or (lambda text: None)

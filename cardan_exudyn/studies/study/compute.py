@@ -24,7 +24,8 @@ import numpy as np
 
 from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, out_folder
 from cardan_exudyn.engines import run
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
 from reference.paper.scenes import named_scene
 from reference.results.summary import Status

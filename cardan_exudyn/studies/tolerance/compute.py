@@ -43,7 +43,8 @@ from cardan_exudyn.arguments import (
     scene_from_args,
 )
 from cardan_exudyn.engines import ENGINES, run
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep
 from reference.paper import PARAMETER_SETS, paper_errors, rig_scene, value

@@ -13,21 +13,17 @@ import contextlib
 import ctypes
 import errno
 import functools
-import math
 import os
 import re
 import shutil
 import sys
 from collections.abc import Callable, Iterator
-from enum import Enum
 from pathlib import Path
 from typing import IO, Any
 
-import numpy as np
-
 from cardan_exudyn.interrupts import deferred_signals
+from cardan_exudyn.jsonable import dumps
 from reference.results.result import Result
-from reference.results.summary import Summary
 
 
 class OutputError(ValueError):
@@ -35,28 +31,6 @@ class OutputError(ValueError):
     replaced, its parent cannot hold it or another command is writing it (raised before anything
     is written), or the disk is full (the previous output is kept). The CLI prints it, exit
     status 2."""
-
-
-def to_jsonable(value: Any) -> Any:
-    """Plain JSON data: numpy scalars and arrays converted, NaN and infinities as null."""
-    if isinstance(value, Summary):
-        return to_jsonable(value.to_dict())
-    if isinstance(value, Enum):
-        return value.value
-    if isinstance(value, dict):
-        return {str(k): to_jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [to_jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return to_jsonable(value.tolist())
-    if isinstance(value, (np.integer,)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        value = float(value)
-        return value if math.isfinite(value) else None
-    if isinstance(value, (np.bool_,)):
-        return bool(value)
-    return value
 
 
 @contextlib.contextmanager
@@ -98,12 +72,6 @@ def atomic_write(path: str | os.PathLike, write: Callable[[IO], Any]) -> None:
     """Write one binary file atomically and durably: ``write(f)`` fills it (:func:`atomic_open`)."""
     with atomic_open(path, "wb") as f:
         write(f)
-
-
-def dumps(data: Any) -> str:
-    import json  # import cost: a plain `cardan run` writes no JSON
-
-    return json.dumps(to_jsonable(data), indent=2, allow_nan=False)
 
 
 def check_output_folder(target: str | os.PathLike, replace: bool = True) -> Path:
