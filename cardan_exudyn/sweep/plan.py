@@ -19,13 +19,9 @@ import numpy as np
 
 from cardan_exudyn.engines import get_engine
 from cardan_exudyn.jsonable import to_jsonable
-from cardan_exudyn.sweep.spec import (
-    SweepError,
-    SweepSpec,
-    looks_like_path,
-    resolve_function,
-    spec_from_mapping,
-)
+from cardan_exudyn.sweep.checks import SweepError
+from cardan_exudyn.sweep.functions import resolve_function
+from cardan_exudyn.sweep.spec import SweepSpec, looks_like_path, spec_from_mapping
 from reference.paper.scenes import named_scene
 from reference.scene.files import load_scene, scene_from_mapping
 from reference.scene.mapping import replace, scene_to_dict

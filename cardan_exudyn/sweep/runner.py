@@ -66,7 +66,8 @@ from cardan_exudyn.sweep.records import (
     statistics,
     write_text,
 )
-from cardan_exudyn.sweep.spec import SweepError, SweepSpec
+from cardan_exudyn.sweep.checks import SweepError
+from cardan_exudyn.sweep.spec import SweepSpec
 from cardan_exudyn.sweep.tasks import Batch, plan_tasks
 from reference.results.summary import Status
 

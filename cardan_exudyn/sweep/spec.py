@@ -1,18 +1,14 @@
-"""What a sweep runs: the specification, its distributions and grids, and reading it from TOML.
+"""What a sweep runs: the specification (:class:`SweepSpec`), its grids, and reading it from TOML.
 
 A :class:`SweepSpec` names a base scene, an engine, overrides applied to every case (``fixed``),
-and the cases: a ``grid`` (cartesian product), ``random`` samples (:class:`RandomSpec` of
-:class:`Distribution`), both, or an explicit list. Its case function is named ``"module:name"``
-(with keyword arguments ``function_args``) so that worker processes and Dask workers can import
-it: :class:`CaseFunction` is what they receive. Everything here validates on construction and
-raises :class:`SweepError` naming the key.
+and the cases: a ``grid`` (cartesian product), ``random`` samples
+(:class:`~cardan_exudyn.sweep.sampling.RandomSpec`), both, or an explicit list; and its case
+function by name (:mod:`~cardan_exudyn.sweep.functions`). Everything here validates on
+construction and raises :class:`~cardan_exudyn.sweep.checks.SweepError` naming the key.
 """
 
 from __future__ import annotations
 
-import functools
-import importlib
-import json
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
@@ -23,217 +19,19 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.jsonable import to_jsonable
+from cardan_exudyn.sweep.checks import MAX_CASES, SweepError, finite_number
+from cardan_exudyn.sweep.functions import DEFAULT_FUNCTION, CaseFunction, function_args, function_name
+from cardan_exudyn.sweep.sampling import DISTRIBUTIONS, Distribution, RandomSpec
 from reference.scene.files import read_toml
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
 
-__all__ = ["SweepError", "Distribution", "RandomSpec", "SweepSpec", "CaseFunction",
-           "DEFAULT_FUNCTION", "grid_values", "function_name", "resolve_function", "flatten_paths",
+__all__ = ["GRID_FORMS", "SPEC_KEYS", "RANDOM_KEYS", "SweepSpec", "grid_values", "flatten_paths",
            "random_spec", "spec_from_mapping", "read_spec_file", "load_spec", "looks_like_path"]
 
-# the public face's name, not the defining module's: it survives moves inside the package
-DEFAULT_FUNCTION = "cardan_exudyn.sweep:summary_outputs"
 GRID_FORMS = ("linspace", "geomspace")
-MAX_CASES = 100_000
-"""Most cases one sweep may have (grid points times random samples): more would take weeks and a
-plan too large for memory."""
-SAMPLING_METHODS = ("random", "lhs")
-DISTRIBUTIONS = {"uniform": ("low", "high"), "loguniform": ("low", "high"),
-                 "normal": ("mean", "std", "low", "high")}
 SPEC_KEYS = ("scene", "engine", "function", "function_args", "fixed", "grid", "random", "cases")
 RANDOM_KEYS = ("samples", "seed", "method", "parameters")
-# arguments a case function always receives; `function_args` must not set them
-CASE_ARGUMENTS = ("scene", "engine")
-
-
-class SweepError(ValueError):
-    """The sweep specification or the output folder is invalid; the message names the key."""
-
-
-def finite_number(where: str, value: Any) -> float:
-    """``value`` as a float; :class:`SweepError` naming ``where`` unless a finite number."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise SweepError(f"{where} must be a number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise SweepError(f"{where} must be finite, got {value!r}")
-    return value
-
-
-@dataclass(frozen=True)
-class Distribution:
-    """Distribution of one random parameter.
-
-    Attributes
-    ----------
-    dist : {"uniform", "loguniform", "normal"}
-        ``uniform``: on [low, high); ``loguniform``: log-uniform on [low, high), 0 < low;
-        ``normal``: mean and standard deviation, optionally truncated to [low, high] (either
-        bound may be given alone).
-    low, high, mean, std : float or None
-        In the parameter's own unit (the unit of its scene path, e.g. deg for ``..._deg``).
-    """
-
-    dist: str
-    low: float | None = None
-    high: float | None = None
-    mean: float | None = None
-    std: float | None = None
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.dist, str) or self.dist not in DISTRIBUTIONS:
-            raise SweepError(f"`dist` must be one of {sorted(DISTRIBUTIONS)}, got {self.dist!r}")
-        self._set_parameters()
-        self._check_ranges()
-
-    def _set_parameters(self) -> None:
-        allowed = DISTRIBUTIONS[self.dist]
-        for name in ("low", "high", "mean", "std"):
-            value = getattr(self, name)
-            if value is not None:
-                if name not in allowed:
-                    raise SweepError(f"`{name}` is not a parameter of {self.dist!r}; give {allowed}")
-                object.__setattr__(self, name, finite_number(f"`{name}`", value))
-        required = ("mean", "std") if self.dist == "normal" else ("low", "high")
-        missing = [n for n in required if getattr(self, n) is None]
-        if missing:
-            raise SweepError(f"{self.dist!r} needs {list(required)}, missing {missing}")
-
-    def _check_ranges(self) -> None:
-        if self.std is not None and self.std <= 0.0:
-            raise SweepError(f"`std` must be positive, got {self.std!r}")
-        if self.low is not None and self.high is not None and not self.low < self.high:
-            raise SweepError(f"`low` must be below `high`, got low = {self.low!r}, high = {self.high!r}")
-        if self.dist == "loguniform" and self.low <= 0.0:
-            raise SweepError(f"`low` of 'loguniform' must be positive, got {self.low!r}")
-        if self.dist == "normal" and self._truncated() and self._mass() < 1e-12:
-            raise SweepError(f"normal(mean = {self.mean!r}, std = {self.std!r}) has no probability in "
-                             f"[{self.low!r}, {self.high!r}]")
-
-    def _truncated(self) -> bool:
-        return self.low is not None or self.high is not None
-
-    def _bounds(self) -> tuple[float, float]:
-        """Truncation bounds in standard deviations from the mean."""
-        lo = -math.inf if self.low is None else (self.low - self.mean) / self.std
-        hi = math.inf if self.high is None else (self.high - self.mean) / self.std
-        return lo, hi
-
-    def _mass(self) -> float:
-        from scipy.special import ndtr  # scipy loads only for a normal distribution
-
-        lo, hi = self._bounds()
-        return float(ndtr(hi) - ndtr(lo))
-
-    def ppf(self, u: np.ndarray) -> np.ndarray:
-        """Inverse distribution function.
-
-        Parameters
-        ----------
-        u : array_like
-            Probabilities in [0, 1).
-
-        Returns
-        -------
-        numpy.ndarray
-            The values, in the parameter's unit.
-        """
-        u = np.clip(np.asarray(u, dtype=float), np.finfo(float).tiny, 1.0 - np.finfo(float).epsneg)
-        if self.dist == "uniform":
-            return self.low + u * (self.high - self.low)
-        if self.dist == "loguniform":
-            return np.exp(math.log(self.low) + u * (math.log(self.high) - math.log(self.low)))
-        if self._truncated():
-            from scipy.stats import truncnorm  # scipy.stats takes about 0.5 s to import
-
-            lo, hi = self._bounds()
-            return truncnorm.ppf(u, lo, hi, loc=self.mean, scale=self.std)
-        from scipy.special import ndtri  # as above: only a normal distribution needs scipy
-
-        return self.mean + self.std * ndtri(u)
-
-    def to_dict(self) -> dict[str, Any]:
-        """The table of the spec file (parameters that are set)."""
-        return {k: v for k, v in vars(self).items() if v is not None}
-
-
-@dataclass(frozen=True)
-class RandomSpec:
-    """Random samples of several parameters, reproducible from ``seed``.
-
-    Attributes
-    ----------
-    samples : int
-        Number of samples N, >= 1.
-    seed : int
-        Seed of :func:`numpy.random.default_rng`; the same seed gives the same samples.
-    parameters : dict of str to Distribution
-        Dotted scene path -> distribution. The order matters: parameter j takes column j of the
-        unit-cube samples.
-    method : {"random", "lhs"}
-        Independent uniform draws, or a Latin hypercube (:class:`scipy.stats.qmc.LatinHypercube`),
-        mapped through each distribution's inverse distribution function.
-    """
-
-    samples: int
-    seed: int
-    parameters: dict[str, Distribution]
-    method: str = "random"
-
-    def __post_init__(self) -> None:
-        for name in ("samples", "seed"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-                raise SweepError(f"`random.{name}` must be an integer, got {value!r}")
-        if not 1 <= self.samples <= MAX_CASES:
-            raise SweepError(f"`random.samples` must be in [1, {MAX_CASES}], got {self.samples!r}")
-        if self.seed < 0:
-            raise SweepError(f"`random.seed` must be >= 0, got {self.seed!r}")
-        if self.method not in SAMPLING_METHODS:
-            raise SweepError(f"`random.method` must be one of {list(SAMPLING_METHODS)}, got {self.method!r}")
-        if not self.parameters:
-            raise SweepError("`random.parameters` is empty: give at least one parameter")
-
-    def points(self) -> list[dict[str, float]]:
-        """The N samples, each a dictionary path -> value (in the parameter's unit)."""
-        rng = np.random.default_rng(self.seed)
-        d = len(self.parameters)
-        if self.method == "lhs":
-            from scipy.stats import qmc  # scipy.stats takes about 0.5 s to import
-
-            u = qmc.LatinHypercube(d, rng=rng).random(self.samples)
-        else:
-            u = rng.random((self.samples, d))
-        columns = [dist.ppf(u[:, j]) for j, dist in enumerate(self.parameters.values())]
-        return [{path: float(col[i]) for path, col in zip(self.parameters, columns, strict=True)}
-                for i in range(self.samples)]
-
-    def to_dict(self) -> dict[str, Any]:
-        """The ``[random]`` table of the spec file."""
-        return {"samples": int(self.samples), "seed": int(self.seed), "method": self.method,
-                "parameters": {k: v.to_dict() for k, v in self.parameters.items()}}
-
-
-@dataclass(frozen=True)
-class CaseFunction:
-    """A case function by name, with keyword arguments: ``name(scene, engine, **args)``.
-
-    What the driver sends to worker processes and Dask workers (a name and plain data pickle
-    anywhere the package is installed), like :func:`functools.partial` of an importable function.
-
-    Attributes
-    ----------
-    name : str
-        ``"module:qualname"`` of a top-level callable ``fn(scene, engine, **args) -> dict``.
-    args : dict
-        Keyword arguments (JSON-able values), e.g. a folder the function writes files into.
-    """
-
-    name: str = DEFAULT_FUNCTION
-    args: Mapping[str, Any] = field(default_factory=dict)
-
-    def __call__(self, scene: Scene, engine: str) -> Any:
-        return resolve_function(self.name)(scene, engine, **self.args)
 
 
 @dataclass(frozen=True)
@@ -294,7 +92,7 @@ class SweepSpec:
             raise SweepError(f"the sweep has {max(total, len(self.cases))} cases; at most {MAX_CASES} are "
                              "allowed (fewer grid values or samples)")
         object.__setattr__(self, "function", function_name(self.function))
-        object.__setattr__(self, "function_args", _function_args(self.function_args))
+        object.__setattr__(self, "function_args", function_args(self.function_args))
 
     def case_function(self) -> CaseFunction:
         """The case function with its arguments, as sent to the workers."""
@@ -320,23 +118,6 @@ def _check_disjoint(spec: SweepSpec) -> None:
             raise SweepError(f"{sorted(keys)} appear in both `{a}` and `{b}`")
     if "engine" in spec.fixed or "engine" in random:
         raise SweepError("`engine` can be set at the top level, in `grid` or in `cases` only")
-
-
-def _function_args(args: Any) -> dict[str, Any]:
-    """``function_args`` checked: a table of keyword names to JSON-able values."""
-    if not isinstance(args, Mapping):
-        raise SweepError(f"`function_args` must be a table, got {args!r}")
-    for name in args:
-        if not isinstance(name, str) or not name.isidentifier():
-            raise SweepError(f"`function_args` keys must be argument names, got {name!r}")
-        if name in CASE_ARGUMENTS:
-            raise SweepError(f"`function_args` cannot set `{name}`: the runner passes it")
-    values = to_jsonable(dict(args))
-    try:
-        json.dumps(values)  # they go into plan.json and to the workers
-    except (TypeError, ValueError) as exc:
-        raise SweepError(f"`function_args` must hold JSON values: {exc}") from None
-    return values
 
 
 def grid_values(path: str, spec: Any) -> tuple:
@@ -379,45 +160,6 @@ def _spaced_values(where: str, spec: Mapping) -> tuple:
     if form == "geomspace" and (start <= 0.0 or stop <= 0.0):
         raise SweepError(f"{where}: geomspace needs positive start and stop, got {args!r}")
     return tuple(float(v) for v in getattr(np, form)(start, stop, num))
-
-
-def function_name(function: Any) -> str:
-    """``"module:qualname"`` of a case function, checked to import back to the same object.
-
-    Parameters
-    ----------
-    function : str or callable
-        The name, or a top-level callable.
-    """
-    if isinstance(function, str):
-        resolve_function(function)
-        return function
-    name = f"{getattr(function, '__module__', None)}:{getattr(function, '__qualname__', None)}"
-    try:
-        same = resolve_function(name) is function
-    except SweepError:
-        same = False
-    if not same:
-        raise SweepError(f"`function` must be a top-level callable importable as 'module:name' "
-                         f"(it is sent to worker processes), got {function!r}")
-    return name
-
-
-@functools.lru_cache(maxsize=16)
-def resolve_function(name: str) -> Callable[..., Mapping[str, Any]]:
-    """The callable named ``"module:qualname"``; :class:`SweepError` when it does not import."""
-    module, sep, qualname = name.partition(":") if isinstance(name, str) else ("", "", "")
-    if not (module and sep and qualname):
-        raise SweepError(f"`function` must look like 'package.module:function', got {name!r}")
-    try:
-        obj: Any = importlib.import_module(module)
-        for part in qualname.split("."):
-            obj = getattr(obj, part)
-    except (ImportError, AttributeError) as exc:
-        raise SweepError(f"`function` {name!r} cannot be imported: {exc}") from None
-    if not callable(obj):
-        raise SweepError(f"`function` {name!r} is not callable")
-    return obj
 
 
 def flatten_paths(table: Mapping[str, Any], is_leaf: Callable[[Any], bool] | None = None,
