@@ -33,7 +33,7 @@ from scipy.optimize import minimize_scalar
 
 from reference.physics.kinematics import speed_ratio
 from rigdata.record import SHAFTS, RigDataError, RigRecord
-from rigdata.units import check_magnitudes
+from rigdata.conversion import check_magnitudes
 
 DERIVATIVES = ("savgol", "spline")
 

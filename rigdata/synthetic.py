@@ -39,7 +39,8 @@ from reference.scene.scene import Scene
 from rigdata import files
 from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
-from rigdata.units import parse_unit, to_si
+from rigdata.conversion import to_si
+from rigdata.units import parse_unit
 
 GENERATOR = "rigdata.synthetic 1"
 FORMATS = ("csv", "lvm", "tdms")

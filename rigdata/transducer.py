@@ -11,6 +11,15 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+__all__ = ["FULL_SCALE", "SENSITIVITY", "PULSES_PER_REV", "PROVENANCE", "Transducer"]
+
+FULL_SCALE = 100.0
+"""Rated torque of the Magtrol TMB 210 [N m] (paper, section 4.2)."""
+SENSITIVITY = 0.1
+"""Torque output of the Magtrol TMB 210 [V/(N m)]: 100 mV/(N m) (paper, section 4.2)."""
+PULSES_PER_REV = 60
+"""Pulses per revolution of the Magtrol TMB 210 speed output (paper, section 4.2)."""
+
 #: Where each default comes from.
 PROVENANCE = {
     "full_scale": "paper section 4.2: Magtrol TMB 210, max torque 100.00 N m",
@@ -50,9 +59,9 @@ class Transducer:
         Acquisition resolution [bit].
     """
 
-    full_scale: float = 100.0
-    sensitivity: float = 0.1
-    pulses_per_rev: int = 60
+    full_scale: float = FULL_SCALE
+    sensitivity: float = SENSITIVITY
+    pulses_per_rev: int = PULSES_PER_REV
     accuracy_class: float = 1e-3
     zero_drift: float = 0.01
     adc_range: float = 10.0

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from rigdata import files, units
+from rigdata import conversion, files, units
 from rigdata.readers import read, read_table, recognise
 from rigdata.record import RigDataError
 
@@ -257,18 +257,18 @@ def test_unit_table_is_consistent():
 def test_conversions(spelling, kind, si, expected):
     """Units to SI at the paper's 0.1 V/(N m) and 60 pulses per revolution."""
     unit = units.parse_unit(spelling, kind=kind)
-    assert units.to_si(np.array([si]), unit).values[0] == pytest.approx(expected, rel=1e-14)
+    assert conversion.to_si(np.array([si]), unit).values[0] == pytest.approx(expected, rel=1e-14)
 
 
 def test_counter_wrap_and_reset_are_undone():
     """A 16-bit counter wrap is undone exactly; a reset is bridged by the local step."""
     counts = np.arange(65530, 65540, dtype=float)
     counts[counts >= 65536] -= 65536
-    out, notes = units.unwrap_counter(counts)
+    out, notes = conversion.unwrap_counter(counts)
     assert_array_equal(out, np.arange(65530, 65540))
     assert len(notes) == 1 and "wrapped at 2^16" in notes[0]
     reset = np.array([500, 502, 504, 506, 0, 2, 4, 6], dtype=float)
-    out, notes = units.unwrap_counter(reset)
+    out, notes = conversion.unwrap_counter(reset)
     assert_array_equal(out, [500, 502, 504, 506, 508, 510, 512, 514])
     assert len(notes) == 1 and "reset" in notes[0]
 

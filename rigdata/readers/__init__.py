@@ -3,7 +3,7 @@
 :func:`read_table` returns what a file holds (:class:`RawTable`: columns as floats, units and
 header as written); :func:`read` goes on to the record: it picks the time axis and the four
 transducer channels (explicit ``mapping`` or recognition by name, :func:`match_channels`),
-converts them to SI with :mod:`rigdata.units` and returns a validated
+converts them to SI with :mod:`rigdata.conversion` and returns a validated
 :class:`~rigdata.record.RigRecord` whose ``provenance`` says where every number came from.
 
 Every problem with a file is one :class:`~rigdata.record.RigDataError` naming the file, the
@@ -19,7 +19,7 @@ Assumptions
 * A time column without a unit (header ``time`` or ``t``) is in seconds; the record's
   provenance lists this under ``assumptions``. LVM X values and TDMS waveform timing are seconds
   by the formats' definitions.
-* Pulse counts are a cumulative counter (:func:`rigdata.units.unwrap_counter`); a speed given as
+* Pulse counts are a cumulative counter (:func:`rigdata.conversion.unwrap_counter`); a speed given as
   a pulse frequency must say ``pulses/s``, ``Hz`` is refused as ambiguous.
 * Raw conversions default to the paper's Magtrol TMB 210: 0.1 V/(N m), 60 pulses per revolution.
 """
@@ -40,7 +40,7 @@ from rigdata.readers.lvm import read_lvm
 from rigdata.readers.table import FORMATS, RawTable, TextCells
 from rigdata.readers.tdms import read_tdms
 from rigdata.record import RigRecord
-from rigdata.units import PULSES_PER_REV, SENSITIVITY
+from rigdata.transducer import PULSES_PER_REV, SENSITIVITY
 
 __all__ = ["FORMATS", "KIND_WORDS", "SIDE_WORDS", "TIME_WORDS", "RawTable", "TextCells",
            "match_channels", "read", "read_table", "recognise"]
