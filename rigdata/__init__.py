@@ -13,11 +13,12 @@ The public face::
 Modules:
 
 - ``record``: :class:`RigRecord`, the validated measurement (SI units), and :class:`RigDataError`.
-- ``units``: the explicit table of unit spellings, header unit parsing, raw conversions to SI.
+- ``units``: the explicit table of unit spellings, header unit parsing; ``conversion``: values
+  to SI (raw signals included), counter wraps, plausible magnitudes.
 - ``readers``: ``read`` (file -> RigRecord) and ``read_table`` for delimited text, LVM and TDMS.
 - ``files``: atomic writers of the same formats (synthetic rig, tests).
 - ``transducer``: the transducers' data (paper) and accuracy, drift, acquisition (assumed).
-- ``conditioning``: angles from pulse edges, zero-phase low-pass, derivatives, whole-revolution
+- ``conditioning``: angles from pulse edges, zero-phase low-pass, speeds, whole-revolution
   window, input yoke phase.
 - ``efficiency``: measured efficiency with its GUM budget and Monte Carlo.
 - ``model``: the engines driven by the measurement; ``validation``: ``measure`` and

@@ -15,6 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+import scipy.signal
 
 import rigdata
 from cardan_exudyn.engines import run
@@ -65,6 +66,24 @@ def test_phase_estimate_is_exact_on_exact_speed_ratio(truth):
     fit = estimate_phase(truth.angle_in - truth.angle_in[0], truth.speed_out / truth.speed_in, BETA)
     assert fit["phase"] == pytest.approx(truth.angle_in[0] % math.pi, abs=1e-8)
     assert fit["shaft_angle_fit"] == pytest.approx(BETA, abs=1e-6)
+
+
+def test_conditioning_takes_only_the_derivatives_it_keeps(truth, monkeypatch):
+    """A measured speed channel is the shaft's speed, so its angle is not differentiated, and no
+    acceleration is taken (nothing reads one): with speeds on both shafts no Savitzky-Golay
+    derivative runs, with pulse counts one first derivative per shaft."""
+    real = scipy.signal.savgol_filter
+    orders = []
+
+    def counted(*args, **kwargs):
+        orders.append(kwargs.get("deriv", 0))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(scipy.signal, "savgol_filter", counted)
+    condition(perfect(truth, noise=0.0, speed_channel="rpm")[0], BETA)
+    assert orders == []
+    condition(perfect(truth, noise=0.0)[0], BETA)
+    assert orders == [1, 1]
 
 
 def test_conditioning_recovers_phase_and_whole_revolutions(truth):

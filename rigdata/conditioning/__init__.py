@@ -1,0 +1,27 @@
+"""Conditioning: from a raw record to conditioned signals on whole input revolutions.
+
+:func:`condition` (:mod:`~rigdata.conditioning.pipeline`) runs the steps; each concept has its
+module: :mod:`~rigdata.conditioning.options` (:class:`Conditioning`),
+:mod:`~rigdata.conditioning.angles` (angles from pulse edges), :mod:`~rigdata.conditioning.filters`
+(zero-phase low-pass, speed of an angle), :mod:`~rigdata.conditioning.window` (whole-revolution
+window), :mod:`~rigdata.conditioning.phase` (input yoke phase). The choices and their defaults:
+``docs/rigdata.md``.
+"""
+
+from __future__ import annotations
+
+from reference.lazy import lazy_face
+
+_HOMES = {
+    "rigdata.conditioning.options": ("DERIVATIVES", "Conditioning"),
+    "rigdata.conditioning.pipeline": ("Conditioned", "condition"),
+    "rigdata.conditioning.angles": ("pulse_edges", "angle_on_grid"),
+    "rigdata.conditioning.filters": ("lowpass", "angular_speed"),
+    "rigdata.conditioning.window": ("revolution_window",),
+    "rigdata.conditioning.phase": ("estimate_phase",),
+}
+_LAZY = {name: module for module, names in _HOMES.items() for name in names}
+
+__all__ = list(_LAZY)
+
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)
