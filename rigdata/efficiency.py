@@ -10,49 +10,50 @@ transducer's accuracy-class error (a constant offset within +-class x full scale
 the acquisition's resolution (half a step either way, rectangular: without noise to dither it,
 rounding is a constant error, at 0.2 N m on a 16-bit card 0.8 % of the torque), its zero drift
 (a linear ramp over the record, rectangular limit), its noise (white, its level estimated from
-the data) and the timing of the window's ends (one sample interval,
-rectangular). Monte Carlo (GUM Supplement 1) propagates the same distributions through the
-filter and the integrals as a check on the linearisation; at 0.2 N m the accuracy class makes
-the relative uncertainty of each torque about 30 %, where first order starts to be rough.
+the data) and the timing of the window's ends (one sample interval, rectangular). Monte Carlo
+(:mod:`rigdata.montecarlo`) propagates the same distributions through the filter and the
+integrals as a check on the linearisation; at 0.2 N m the accuracy class makes the relative
+uncertainty of each torque about 30 %, where first order starts to be rough.
 """
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigdata.conditioning import Conditioned, lowpass
+from rigdata.conditioning import Conditioned, lowpass, window_weights
+from rigdata import montecarlo
 from rigdata.record import RigDataError
 from rigdata.transducer import Transducer
 
+__all__ = ["SQRT3", "SQRT12", "noise_level", "Measured", "filtered_noise_factor", "instantaneous_efficiency",
+           "uncertainty_budget", "measured_efficiency"]
+
 SQRT3 = math.sqrt(3.0)
+"""A rectangular distribution of half width ``a`` has standard deviation ``a / SQRT3``."""
 SQRT12 = math.sqrt(12.0)
-
-
-def window_weights(t: np.ndarray, t_a: float, t_b: float) -> np.ndarray:
-    """Trapezoid weights [s] of ``int_{t_a}^{t_b} y dt`` for samples ``y`` on the grid ``t``.
-
-    The ends are interpolated linearly between the samples that bracket them, so the weights
-    are exact for piecewise-linear ``y`` and the integral moves continuously with ``t_a, t_b``.
-    """
-    grid = np.concatenate([[t_a], t[(t > t_a) & (t < t_b)], [t_b]])
-    half = 0.5 * np.diff(grid)
-    w_grid = np.zeros(grid.size)
-    w_grid[:-1] += half
-    w_grid[1:] += half
-    # spread each node's weight onto the two samples it is interpolated from
-    k = np.clip(np.searchsorted(t, grid, side="right") - 1, 0, t.size - 2)
-    frac = (grid - t[k]) / (t[k + 1] - t[k])
-    weights = np.zeros(t.size)
-    np.add.at(weights, k, w_grid * (1.0 - frac))
-    np.add.at(weights, k + 1, w_grid * frac)
-    return weights
+"""A rectangular distribution of full width ``a`` has standard deviation ``a / SQRT12``."""
 
 
 def noise_level(raw: np.ndarray, filtered: np.ndarray) -> float:
-    """Standard deviation of the noise [same unit]: robust (MAD) spread of raw - filtered."""
+    """Standard deviation of the noise: robust (MAD) spread of ``raw - filtered``.
+
+    Parameters
+    ----------
+    raw : ndarray, shape (n,)
+        The signal as measured.
+    filtered : ndarray, shape (n,)
+        The same signal low-passed.
+
+    Returns
+    -------
+    float
+        In the signals' unit.
+    """
     r = np.asarray(raw) - np.asarray(filtered)
     return float(1.4826 * np.median(np.abs(r - np.median(r))))
 
@@ -71,11 +72,13 @@ class Measured:
         Per input quantity: ``quantity``, ``standard_uncertainty`` with ``unit``,
         ``sensitivity`` [-/unit] and ``contribution`` [-] (sensitivity x uncertainty).
     monte_carlo : dict
-        ``samples``, ``std``, ``mean``, ``interval_95`` when Monte Carlo ran, else empty.
+        ``samples``, ``seed``, ``std``, ``mean``, ``interval_95`` when Monte Carlo ran, else empty.
     summary : dict
         JSON-ready numbers: works, means, noise levels, window.
-    instantaneous : dict of str to ndarray
-        ``t`` [s], ``efficiency`` (P_out / P_in) and its standard uncertainty ``u`` [-].
+    draws : dict of str to ndarray
+        The Monte Carlo draws (:func:`rigdata.montecarlo.monte_carlo`), else empty.
+    band : callable or None
+        Computes :attr:`instantaneous` when it is first read (only Figure 10 reads it).
     """
 
     efficiency: float
@@ -83,70 +86,118 @@ class Measured:
     budget: list
     monte_carlo: dict = field(default_factory=dict)
     summary: dict = field(default_factory=dict)
-    instantaneous: dict = field(default_factory=dict)
     draws: dict = field(default_factory=dict, repr=False)
+    band: Callable[[], dict] | None = field(default=None, repr=False, compare=False)
+
+    @functools.cached_property
+    def instantaneous(self) -> dict:
+        """``t`` [s], ``efficiency`` (``P_out / P_in``) [-] and its standard uncertainty ``u`` [-],
+        each of shape (n,); empty without a :attr:`band`."""
+        return self.band() if self.band is not None else {}
 
     def as_dict(self) -> dict:
-        """The JSON summary: ``measured_efficiency`` and its ``_u``, the budget, Monte Carlo."""
+        """The JSON summary: ``measured_efficiency`` and its ``_u``, the summary's numbers, the
+        budget, Monte Carlo."""
         return {"measured_efficiency": self.efficiency, "measured_efficiency_u": self.u,
                 **self.summary, "uncertainty_budget": self.budget, "monte_carlo": self.monte_carlo}
 
 
-def _works(c: Conditioned, t_a: float, t_b: float, torque_in, torque_out) -> tuple[float, float]:
-    w = window_weights(c.t, t_a, t_b)
-    return float(w @ (torque_in * c.speed_in)), float(w @ (torque_out * c.speed_out))
-
-
-MAX_DRAWS = 100_000
-"""Most Monte Carlo draws of one measurement: its 95 % interval is settled long before (the
-draws are held in memory, eight bytes each, and filtered in chunks of 200)."""
-
-
-def check_draws(monte_carlo: object, seed: object) -> None:
-    """``ValueError`` naming the argument unless ``monte_carlo`` is an integer in [0,
-    :data:`MAX_DRAWS`] and ``seed`` one in [0, 2**63 - 1]."""
-    for name, value, top in (("monte_carlo", monte_carlo, MAX_DRAWS), ("seed", seed, 2**63 - 1)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= top:
-            raise ValueError(f"`{name}` must be an integer in [0, {top}], got {value!r:.40}")
-
-
 def filtered_noise_factor(c: Conditioned, order: int, seed: int = 0) -> float:
-    """Standard deviation of unit white noise after the conditioning low-pass [-]."""
-    noise = np.random.default_rng(seed).standard_normal(c.t.size)
-    return float(np.std(lowpass(noise, c.cutoff, 1.0 / c.dt, order)))
-
-
-def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transducer] | Transducer | None = None,
-                        monte_carlo: int = 0, seed: int = 0) -> Measured:
-    """Measured mean efficiency over ``c``'s whole-revolution window, with its uncertainty.
+    """Standard deviation of unit white noise after the conditioning low-pass [-].
 
     Parameters
     ----------
     c : Conditioned
-    transducers : Transducer or (input, output) pair
-    monte_carlo : int
-        Monte Carlo draws (0: GUM only).
+        Its grid and cut-off are read.
+    order : int
+        Butterworth order of one pass.
     seed : int
+        Seed of the noise drawn.
     """
-    check_draws(monte_carlo, seed)
+    noise = np.random.default_rng(seed).standard_normal(c.t.size)
+    return float(np.std(lowpass(noise, c.cutoff, 1.0 / c.dt, order)))
+
+
+def instantaneous_efficiency(c: Conditioned, transducers: tuple[Transducer, Transducer], sigma: dict,
+                             ramp: np.ndarray) -> dict:
+    """The instantaneous efficiency ``P_out / P_in`` and its standard uncertainty at every sample.
+
+    Each torque's variance: accuracy class and resolution (rectangular), the zero drift up to
+    that instant (rectangular ramp) and the noise as the low-pass leaves it; speeds are exact.
+
+    Parameters
+    ----------
+    c : Conditioned
+        The conditioned signals.
+    transducers : (Transducer, Transducer)
+        Input and output transducers.
+    sigma : dict
+        Noise level of each torque (``"in"``, ``"out"``) before the low-pass [N m].
+    ramp : ndarray, shape (n,)
+        The drift's ramp, 0 at the first sample and 1 at the last [-].
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        ``t`` [s], ``efficiency`` [-], ``u`` [-].
+    """
+    order = int(c.settings.get("filter_order", 4))
+    factor = filtered_noise_factor(c, order)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p_in = c.torque_in * c.speed_in
+        p_out = c.torque_out * c.speed_out
+        eta = p_out / p_in
+        rel = np.zeros_like(eta)
+        for (torque, shaft), tr in zip(((c.torque_in, "in"), (c.torque_out, "out")), transducers,
+                                       strict=True):
+            u_t2 = (tr.accuracy_limit / SQRT3) ** 2 + (tr.adc_step / SQRT12) ** 2 \
+                + (tr.zero_drift * ramp / SQRT3) ** 2 + (factor * sigma[shaft]) ** 2
+            rel = rel + u_t2 / torque ** 2
+        u = np.abs(eta) * np.sqrt(rel)
+    return {"t": c.t, "efficiency": eta, "u": u}
+
+
+def _transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | None) -> tuple[Transducer, Transducer]:
+    """Input and output transducers from one, a pair or None (the default :class:`Transducer`)."""
     transducers = transducers or Transducer()
     tin, tout = transducers if isinstance(transducers, tuple) else (transducers, transducers)
     if not (isinstance(tin, Transducer) and isinstance(tout, Transducer)):
         raise TypeError(f"`transducers` must be a Transducer or a pair of them, got {transducers!r:.80}")
+    return tin, tout
+
+
+def uncertainty_budget(c: Conditioned, transducers: tuple[Transducer, Transducer], eta: float,
+                       w_in: float, sigma: dict, ramp: np.ndarray) -> list[dict]:
+    """The GUM budget of the measured efficiency: one row per input quantity.
+
+    Parameters
+    ----------
+    c : Conditioned
+        The conditioned signals and window.
+    transducers : (Transducer, Transducer)
+        Input and output transducers.
+    eta : float
+        The measured efficiency [-].
+    w_in : float
+        Input work over the window [J].
+    sigma : dict
+        Noise level of each torque (``"in"``, ``"out"``) [N m].
+    ramp : ndarray, shape (n,)
+        The drift's ramp, 0 at the first sample and 1 at the last [-].
+
+    Returns
+    -------
+    list of dict
+        ``quantity``, ``standard_uncertainty`` in ``unit``, ``sensitivity`` [-/unit] and
+        ``contribution`` [-] (|sensitivity| x uncertainty).
+    """
+    tin, tout = transducers
     t_a, t_b = c.window
     weights = window_weights(c.t, t_a, t_b)
-    w_in, w_out = _works(c, t_a, t_b, c.torque_in, c.torque_out)
-    if not w_in > 0:
-        raise RigDataError(f"the input work over the window is {w_in:.3g} J (not positive): the "
-                           "input torque or speed has the wrong sign or the joint is driven backwards",
-                           channel="torque_in")
-    eta = w_out / w_in
-    angle_in, angle_out = float(weights @ c.speed_in), float(weights @ c.speed_out)
-    span = c.t[-1] - c.t[0]
-    ramp = (c.t - c.t[0]) / span
-    sigma = {"in": noise_level(c.raw_torque_in, c.torque_in),
-             "out": noise_level(c.raw_torque_out, c.torque_out)}
-    p_in, p_out = c.torque_in * c.speed_in, c.torque_out * c.speed_out
+    angle_in = float(weights @ c.speed_in)
+    angle_out = float(weights @ c.speed_out)
+    p_in = c.torque_in * c.speed_in
+    p_out = c.torque_out * c.speed_out
     p_a = np.interp(t_a, c.t, p_out) - eta * np.interp(t_a, c.t, p_in)
     p_b = np.interp(t_b, c.t, p_out) - eta * np.interp(t_b, c.t, p_in)
     rows = [
@@ -167,11 +218,22 @@ def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transduce
         ("window start (edge timing)", c.dt / SQRT12, "s", -p_a / w_in),
         ("window end (edge timing)", c.dt / SQRT12, "s", p_b / w_in),
     ]
-    budget = [{"quantity": q, "standard_uncertainty": u, "unit": unit, "sensitivity": s,
-               "contribution": abs(s) * u} for q, u, unit, s in rows]
-    u = math.sqrt(sum(b["contribution"] ** 2 for b in budget))
+    return [{"quantity": q, "standard_uncertainty": u, "unit": unit, "sensitivity": s,
+             "contribution": abs(s) * u} for q, u, unit, s in rows]
+
+
+def _summary(c: Conditioned, transducers: tuple[Transducer, Transducer], w_in: float, w_out: float,
+             sigma: dict) -> dict:
+    """The JSON-ready numbers of a measurement: window, works [J], mean speeds [rad/s] and torques
+    [N m], noise levels [N m], each torque's relative uncertainty from class and drift [-], the
+    transducers."""
+    tin, tout = transducers
+    t_a, t_b = c.window
+    weights = window_weights(c.t, t_a, t_b)
+    angle_in = float(weights @ c.speed_in)
+    angle_out = float(weights @ c.speed_out)
     duration = t_b - t_a
-    summary = {
+    return {
         "revolutions": int(c.revolutions), "window_s": [t_a, t_b],
         "input_work": w_in, "output_work": w_out,
         "mean_speed_in": angle_in / duration, "mean_speed_out": angle_out / duration,
@@ -183,54 +245,49 @@ def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transduce
         / abs(w_out / angle_out),
         "transducer_in": tin.as_dict(), "transducer_out": tout.as_dict(),
     }
-    mc, draws = _monte_carlo(c, (tin, tout), sigma, monte_carlo, seed) if monte_carlo else ({}, {})
-    return Measured(eta, u, budget, mc, summary, _instantaneous(c, (tin, tout), sigma, ramp), draws)
 
 
-def _instantaneous(c: Conditioned, transducers, sigma: dict, ramp: np.ndarray) -> dict:
-    order = int(c.settings.get("filter_order", 4))
-    factor = filtered_noise_factor(c, order)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        p_in, p_out = c.torque_in * c.speed_in, c.torque_out * c.speed_out
-        eta = p_out / p_in
-        rel = np.zeros_like(eta)
-        for (torque, shaft), tr in zip(((c.torque_in, "in"), (c.torque_out, "out")), transducers,
-                                       strict=True):
-            u_t2 = (tr.accuracy_limit / SQRT3) ** 2 + (tr.adc_step / SQRT12) ** 2 \
-                + (tr.zero_drift * ramp / SQRT3) ** 2 + (factor * sigma[shaft]) ** 2
-            rel = rel + u_t2 / torque ** 2
-        u = np.abs(eta) * np.sqrt(rel)
-    return {"t": c.t, "efficiency": eta, "u": u}
+def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transducer] | Transducer | None = None,
+                        monte_carlo: int = 0, seed: int = 0) -> Measured:
+    """Measured mean efficiency over ``c``'s whole-revolution window, with its uncertainty.
 
+    Parameters
+    ----------
+    c : Conditioned
+        The conditioned signals and window.
+    transducers : Transducer or (input, output) pair, optional
+        Default: :class:`~rigdata.transducer.Transducer` for both.
+    monte_carlo : int
+        Monte Carlo draws (0: GUM only).
+    seed : int
+        Seed of the draws.
 
-def _monte_carlo(c: Conditioned, transducers, sigma: dict, samples: int, seed: int) -> tuple[dict, dict]:
-    """The same input distributions drawn ``samples`` times through filter and integrals.
+    Returns
+    -------
+    Measured
+        The instantaneous efficiency and its band are computed when first read.
 
-    Returns the summary and the draws (``efficiency``, and ``offset_out``: the output torque
-    offsets drawn, for quantities correlated with them)."""
-    rng = np.random.default_rng(seed)
-    order = int(c.settings.get("filter_order", 4))
-    ramp = (c.t - c.t[0]) / (c.t[-1] - c.t[0])
+    Raises
+    ------
+    RigDataError
+        Input work over the window not positive.
+    """
+    montecarlo.check_draws(monte_carlo, seed)
+    pair = _transducer_pair(transducers)
     t_a, t_b = c.window
-    values, offsets_out = np.empty(samples), np.empty(samples)
-    chunk = 200
-    for start in range(0, samples, chunk):
-        m = min(chunk, samples - start)
-        torques = []
-        for torque, shaft, tr in ((c.torque_in, "in", transducers[0]),
-                                  (c.torque_out, "out", transducers[1])):
-            offset = rng.uniform(-1, 1, (m, 1)) * tr.accuracy_limit \
-                + rng.uniform(-0.5, 0.5, (m, 1)) * tr.adc_step
-            drift = rng.uniform(-1, 1, (m, 1)) * tr.zero_drift * ramp
-            noise = lowpass(rng.standard_normal((m, c.t.size)) * sigma[shaft], c.cutoff, 1.0 / c.dt, order)
-            torques.append(torque + offset + drift + noise)
-            if shaft == "out":
-                offsets_out[start:start + m] = offset[:, 0]
-        shift = rng.uniform(-0.5, 0.5, (m, 2)) * c.dt
-        for i in range(m):
-            w = window_weights(c.t, t_a + shift[i, 0], t_b + shift[i, 1])
-            values[start + i] = (w @ (torques[1][i] * c.speed_out)) / (w @ (torques[0][i] * c.speed_in))
-    lo, hi = np.percentile(values, [2.5, 97.5])
-    return {"samples": int(samples), "seed": int(seed), "mean": float(np.mean(values)),
-            "std": float(np.std(values, ddof=1)), "interval_95": [float(lo), float(hi)]}, \
-        {"efficiency": values, "offset_out": offsets_out}
+    weights = window_weights(c.t, t_a, t_b)
+    w_in = float(weights @ (c.torque_in * c.speed_in))
+    w_out = float(weights @ (c.torque_out * c.speed_out))
+    if not w_in > 0:
+        raise RigDataError(f"the input work over the window is {w_in:.3g} J (not positive): the "
+                           "input torque or speed has the wrong sign or the joint is driven backwards",
+                           channel="torque_in")
+    eta = w_out / w_in
+    ramp = (c.t - c.t[0]) / (c.t[-1] - c.t[0])
+    sigma = {"in": noise_level(c.raw_torque_in, c.torque_in),
+             "out": noise_level(c.raw_torque_out, c.torque_out)}
+    budget = uncertainty_budget(c, pair, eta, w_in, sigma, ramp)
+    u = math.sqrt(sum(b["contribution"] ** 2 for b in budget))
+    mc, draws = montecarlo.monte_carlo(c, pair, sigma, monte_carlo, seed) if monte_carlo else ({}, {})
+    return Measured(eta, u, budget, mc, _summary(c, pair, w_in, w_out, sigma), draws,
+                    band=functools.partial(instantaneous_efficiency, c, pair, sigma, ramp))

@@ -29,7 +29,8 @@ from reference.results.summary import Status
 from reference.scene.files import load_scene
 from reference.scene.scene import Scene
 from rigdata.conditioning import Conditioned, Conditioning, condition
-from rigdata.efficiency import SQRT3, Measured, check_draws, measured_efficiency
+from rigdata.efficiency import SQRT3, Measured, measured_efficiency
+from rigdata.montecarlo import check_draws
 from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
 from rigdata.readers import read
 from rigdata.record import RigRecord

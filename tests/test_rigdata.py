@@ -22,9 +22,9 @@ from cardan_exudyn.engines import run
 from reference.paper.scenes import named_scene
 from reference.results.summary import Status
 from reference.scene.mapping import replace as replace_field
-from rigdata import synthetic
-from rigdata.conditioning import Conditioning, condition, estimate_phase, pulse_edges
-from rigdata.efficiency import measured_efficiency, window_weights
+from rigdata import efficiency, synthetic
+from rigdata.conditioning import Conditioning, condition, estimate_phase, pulse_edges, window_weights
+from rigdata.efficiency import measured_efficiency
 from rigdata.model import computed_efficiency, measured_scene
 from rigdata.record import ChannelSource, RigDataError, RigRecord
 from rigdata.report import write_report
@@ -84,6 +84,25 @@ def test_conditioning_takes_only_the_derivatives_it_keeps(truth, monkeypatch):
     assert orders == []
     condition(perfect(truth, noise=0.0)[0], BETA)
     assert orders == [1, 1]
+
+
+def test_instantaneous_uncertainty_is_computed_when_read(truth, monkeypatch):
+    """`cardan rig measure` reports the mean efficiency only: the instantaneous efficiency and its
+    uncertainty (Figure 10's band, one low-pass of a noise record) wait until the report reads them."""
+    real = efficiency.filtered_noise_factor
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(efficiency, "filtered_noise_factor", counted)
+    m = rigdata.measure(perfect(truth, noise=0.0)[0], 15.0, monte_carlo=0)
+    m.as_dict()
+    assert calls == []
+    band = m.measured.instantaneous
+    assert calls == [1] and band["u"].shape == band["t"].shape == band["efficiency"].shape
+    assert m.measured.instantaneous is band and calls == [1]
 
 
 def test_conditioning_recovers_phase_and_whole_revolutions(truth):

@@ -4,7 +4,7 @@
 module: :mod:`~rigdata.conditioning.options` (:class:`Conditioning`),
 :mod:`~rigdata.conditioning.angles` (angles from pulse edges), :mod:`~rigdata.conditioning.filters`
 (zero-phase low-pass, speed of an angle), :mod:`~rigdata.conditioning.window` (whole-revolution
-window), :mod:`~rigdata.conditioning.phase` (input yoke phase). The choices and their defaults:
+window, integral weights over it), :mod:`~rigdata.conditioning.phase` (input yoke phase). The choices and their defaults:
 ``docs/rigdata.md``.
 """
 
@@ -17,7 +17,7 @@ _HOMES = {
     "rigdata.conditioning.pipeline": ("Conditioned", "condition"),
     "rigdata.conditioning.angles": ("pulse_edges", "angle_on_grid"),
     "rigdata.conditioning.filters": ("lowpass", "angular_speed"),
-    "rigdata.conditioning.window": ("revolution_window",),
+    "rigdata.conditioning.window": ("revolution_window", "window_weights"),
     "rigdata.conditioning.phase": ("estimate_phase",),
 }
 _LAZY = {name: module for module, names in _HOMES.items() for name in names}

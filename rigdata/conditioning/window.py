@@ -1,4 +1,5 @@
-"""The whole-revolution window: where the measured efficiency is averaged.
+"""The whole-revolution window, where the measured efficiency is averaged, and the weights of an
+integral over it.
 
 ``settle`` revolutions are dropped at each end (filter transients, start-up); the window starts
 at the first input pulse edge after them (or at the settled angle, without pulses) and ends a
@@ -13,7 +14,7 @@ import numpy as np
 
 from rigdata.record import RigDataError
 
-__all__ = ["revolution_window"]
+__all__ = ["revolution_window", "window_weights"]
 
 
 def _window_start(t: np.ndarray, a: np.ndarray, edges: np.ndarray | None, first: float, last: float,
@@ -78,3 +79,35 @@ def revolution_window(t: np.ndarray, angle: np.ndarray, edges: np.ndarray | None
     else:
         t_b = float(np.interp(target, a, t))
     return t_a, t_b, n
+
+
+def window_weights(t: np.ndarray, t_a: float, t_b: float) -> np.ndarray:
+    """Trapezoid weights of ``int_{t_a}^{t_b} y dt`` for samples ``y`` on the grid ``t``.
+
+    The ends are interpolated linearly between the samples that bracket them, so the weights
+    are exact for piecewise-linear ``y`` and the integral moves continuously with ``t_a, t_b``.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Sample times [s], increasing, ``n >= 2``.
+    t_a, t_b : float
+        The integral's limits [s], ``t[0] <= t_a < t_b <= t[-1]``.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Weights [s]: ``weights @ y`` is the integral.
+    """
+    grid = np.concatenate([[t_a], t[(t > t_a) & (t < t_b)], [t_b]])
+    half = 0.5 * np.diff(grid)
+    w_grid = np.zeros(grid.size)
+    w_grid[:-1] += half
+    w_grid[1:] += half
+    # spread each node's weight onto the two samples it is interpolated from
+    k = np.clip(np.searchsorted(t, grid, side="right") - 1, 0, t.size - 2)
+    frac = (grid - t[k]) / (t[k + 1] - t[k])
+    weights = np.zeros(t.size)
+    np.add.at(weights, k, w_grid * (1.0 - frac))
+    np.add.at(weights, k + 1, w_grid * frac)
+    return weights

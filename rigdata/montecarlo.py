@@ -1,0 +1,101 @@
+"""Monte Carlo propagation of the measured efficiency's uncertainty (GUM Supplement 1): the same
+input distributions as the first-order budget of :mod:`rigdata.efficiency`, drawn and pushed
+through the filter and the window integrals, as a check on the linearisation."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigdata.conditioning import Conditioned, lowpass, window_weights
+from rigdata.transducer import Transducer
+
+__all__ = ["MAX_DRAWS", "CHUNK", "check_draws", "monte_carlo"]
+
+MAX_DRAWS = 100_000
+"""Most Monte Carlo draws of one measurement: its 95 % interval is settled long before (the
+draws are held in memory, eight bytes each, and filtered in chunks of :data:`CHUNK`)."""
+CHUNK = 200
+"""Draws filtered together (one 2-D low-pass): memory ``CHUNK x samples`` floats per torque."""
+
+
+def check_draws(monte_carlo: object, seed: object) -> None:
+    """``ValueError`` naming the argument unless ``monte_carlo`` is an integer in [0,
+    :data:`MAX_DRAWS`] and ``seed`` one in [0, 2**63 - 1].
+
+    Parameters
+    ----------
+    monte_carlo : object
+        Number of draws, as the caller gave it.
+    seed : object
+        Seed of the draws, as the caller gave it.
+    """
+    for name, value, top in (("monte_carlo", monte_carlo, MAX_DRAWS), ("seed", seed, 2**63 - 1)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= top:
+            raise ValueError(f"`{name}` must be an integer in [0, {top}], got {value!r:.40}")
+
+
+def _drawn_torques(c: Conditioned, transducers: tuple[Transducer, Transducer], sigma: dict,
+                   rng: np.random.Generator, m: int, ramp: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+    """``m`` draws of both torques [N m], shape (m, n) each: offset (class and resolution), drift
+    ramp and low-passed noise added to the conditioned torque; and the output offsets drawn [N m]."""
+    order = int(c.settings.get("filter_order", 4))
+    torques = []
+    offsets_out = None
+    for torque, shaft, tr in ((c.torque_in, "in", transducers[0]), (c.torque_out, "out", transducers[1])):
+        offset = rng.uniform(-1, 1, (m, 1)) * tr.accuracy_limit \
+            + rng.uniform(-0.5, 0.5, (m, 1)) * tr.adc_step
+        drift = rng.uniform(-1, 1, (m, 1)) * tr.zero_drift * ramp
+        noise = lowpass(rng.standard_normal((m, c.t.size)) * sigma[shaft], c.cutoff, 1.0 / c.dt, order)
+        torques.append(torque + offset + drift + noise)
+        if shaft == "out":
+            offsets_out = offset[:, 0]
+    return torques, offsets_out
+
+
+def monte_carlo(c: Conditioned, transducers: tuple[Transducer, Transducer], sigma: dict,
+                samples: int, seed: int) -> tuple[dict, dict]:
+    """The measured efficiency drawn ``samples`` times through the filter and the integrals.
+
+    Each draw takes, per transducer, a constant offset (accuracy class and resolution,
+    rectangular), a zero-drift ramp (rectangular limit) and white noise at the estimated level,
+    low-passed as the conditioning does; and a timing shift of each window end (one sample,
+    rectangular).
+
+    Parameters
+    ----------
+    c : Conditioned
+        The conditioned signals and window.
+    transducers : (Transducer, Transducer)
+        Input and output transducers.
+    sigma : dict
+        Noise level of each torque (``"in"``, ``"out"``) [N m].
+    samples : int
+        Number of draws, in [1, :data:`MAX_DRAWS`].
+    seed : int
+        Seed of :func:`numpy.random.default_rng`.
+
+    Returns
+    -------
+    summary : dict
+        ``samples``, ``seed``, ``mean``, ``std`` and ``interval_95`` of the efficiency [-].
+    draws : dict of str to ndarray, shape (samples,)
+        ``efficiency`` [-] and ``offset_out`` [N m] (the output torque offsets drawn, for
+        quantities correlated with them).
+    """
+    rng = np.random.default_rng(seed)
+    ramp = (c.t - c.t[0]) / (c.t[-1] - c.t[0])
+    t_a, t_b = c.window
+    values = np.empty(samples)
+    offsets_out = np.empty(samples)
+    for start in range(0, samples, CHUNK):
+        m = min(CHUNK, samples - start)
+        torques, drawn_offsets = _drawn_torques(c, transducers, sigma, rng, m, ramp)
+        offsets_out[start:start + m] = drawn_offsets
+        shift = rng.uniform(-0.5, 0.5, (m, 2)) * c.dt
+        for i in range(m):
+            w = window_weights(c.t, t_a + shift[i, 0], t_b + shift[i, 1])
+            values[start + i] = (w @ (torques[1][i] * c.speed_out)) / (w @ (torques[0][i] * c.speed_in))
+    lo, hi = np.percentile(values, [2.5, 97.5])
+    summary = {"samples": int(samples), "seed": int(seed), "mean": float(np.mean(values)),
+               "std": float(np.std(values, ddof=1)), "interval_95": [float(lo), float(hi)]}
+    return summary, {"efficiency": values, "offset_out": offsets_out}
