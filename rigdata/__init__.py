@@ -20,9 +20,10 @@ Modules:
 - ``transducer``: the transducers' data (paper) and accuracy, drift, acquisition (assumed).
 - ``conditioning``: angles from pulse edges, zero-phase low-pass, speeds, whole-revolution
   window, input yoke phase.
-- ``efficiency``: measured efficiency with its GUM budget and Monte Carlo.
-- ``model``: the engines driven by the measurement; ``validation``: ``measure`` and
-  ``validate``; ``report``: Figure 10 and the report folder.
+- ``efficiency``: measured efficiency with its GUM budget; ``montecarlo``: its Monte Carlo.
+- ``measurement``: ``measure`` (a record or file to its measured efficiency).
+- ``model``: the engines driven by the measurement; ``validation``: ``validate``; ``report``:
+  Figure 10 and the report folder.
 - ``synthetic``: the synthetic rig; ``cli``: ``cardan rig``. See ``docs/rigdata.md``.
 
 The names below are loaded on first use (PEP 562): ``import rigdata`` costs nothing more than
@@ -41,7 +42,7 @@ __all__ = ["read", "read_table", "measure", "Measurement", "validate", "Validati
 #: Public name -> the module that defines it (a name that is a module maps to itself).
 _WHERE = {
     "read": "rigdata.readers", "read_table": "rigdata.readers",
-    "measure": "rigdata.validation", "Measurement": "rigdata.validation",
+    "measure": "rigdata.measurement", "Measurement": "rigdata.measurement",
     "validate": "rigdata.validation", "Validation": "rigdata.validation",
     "MODEL_ENGINES": "rigdata.validation", "write_report": "rigdata.report",
     "RigRecord": "rigdata.record", "RigDataError": "rigdata.record", "ChannelSource": "rigdata.record",

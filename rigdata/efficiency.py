@@ -30,7 +30,7 @@ from rigdata import montecarlo
 from rigdata.record import RigDataError
 from rigdata.transducer import Transducer
 
-__all__ = ["SQRT3", "SQRT12", "noise_level", "Measured", "filtered_noise_factor", "instantaneous_efficiency",
+__all__ = ["SQRT3", "SQRT12", "noise_level", "Measured", "transducer_pair", "filtered_noise_factor", "instantaneous_efficiency",
            "uncertainty_budget", "measured_efficiency"]
 
 SQRT3 = math.sqrt(3.0)
@@ -157,7 +157,7 @@ def instantaneous_efficiency(c: Conditioned, transducers: tuple[Transducer, Tran
     return {"t": c.t, "efficiency": eta, "u": u}
 
 
-def _transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | None) -> tuple[Transducer, Transducer]:
+def transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | None) -> tuple[Transducer, Transducer]:
     """Input and output transducers from one, a pair or None (the default :class:`Transducer`)."""
     transducers = transducers or Transducer()
     tin, tout = transducers if isinstance(transducers, tuple) else (transducers, transducers)
@@ -273,7 +273,7 @@ def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transduce
         Input work over the window not positive.
     """
     montecarlo.check_draws(monte_carlo, seed)
-    pair = _transducer_pair(transducers)
+    pair = transducer_pair(transducers)
     t_a, t_b = c.window
     weights = window_weights(c.t, t_a, t_b)
     w_in = float(weights @ (c.torque_in * c.speed_in))

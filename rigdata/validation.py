@@ -1,14 +1,10 @@
-"""The two computations of ``cardan rig``, as functions that return data.
-
-:func:`measure` (``cardan rig measure``): a record or file, conditioned over whole input
-revolutions, its measured efficiency with the GUM budget and Monte Carlo.
-
-:func:`validate` (``cardan rig validate`` without the report): the same measurement, then each
-engine driven by it (:func:`rigdata.model.measured_scene`) and the comparison: the difference,
-its standard uncertainty (the output transducer's error enters both sides, so that part is
-propagated as correlated) and whether it is significant at k = 2 (and by the Monte Carlo
-interval, which at 0.2 N m is far from symmetric). :func:`rigdata.report.write_report` puts a
-:class:`Validation` in a folder.
+"""Measured against computed efficiency for one record (``cardan rig validate`` without the
+report): the measurement (:mod:`rigdata.measurement`), then each engine driven by it
+(:func:`rigdata.model.measured_scene`) and the comparison: the difference, its standard
+uncertainty (the output transducer's error enters both sides, so that part is propagated as
+correlated) and whether it is significant at k = 2 (and by the Monte Carlo interval, which at
+0.2 N m is far from symmetric). :func:`rigdata.report.write_report` puts a :class:`Validation`
+in a folder.
 """
 
 from __future__ import annotations
@@ -29,34 +25,21 @@ from reference.results.summary import Status
 from reference.scene.files import load_scene
 from reference.scene.scene import Scene
 from rigdata.conditioning import Conditioned, Conditioning, condition
-from rigdata.efficiency import SQRT3, Measured, measured_efficiency
-from rigdata.montecarlo import check_draws
+from rigdata.efficiency import SQRT3, Measured, measured_efficiency, transducer_pair
+from rigdata.measurement import Source, as_record
 from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
-from rigdata.readers import read
+from rigdata.montecarlo import check_draws
 from rigdata.record import RigRecord
 from rigdata.transducer import PROVENANCE, Transducer
 
-__all__ = ["K", "MODEL_ENGINES", "Measurement", "Validation", "accuracy_needed", "as_record", "as_scene",
-           "compare", "measure", "validate"]
+__all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare",
+           "accuracy_needed", "validate"]
 
-#: A record, or a rig file to read.
-Source = RigRecord | str | os.PathLike
 #: Engines that take the measured angle drive and load history (MuJoCo takes constant loads only).
 MODEL_ENGINES = ("reference", "exudyn")
 K = 2.0  # coverage factor of the significance test
 #: Budget rows that are a constant error of the output torque, which the model's load shares.
 CONSTANT_OUTPUT_ERRORS = ("accuracy class, output torque", "resolution (acquisition step), output torque")
-
-
-def as_record(source: Source, **read_options: Any) -> RigRecord:
-    """``source`` itself when it is a record, else the record :func:`rigdata.readers.read` reads
-    from it with ``read_options`` (``format``, ``mapping``, ``units``, ``sensitivity``,
-    ``pulses_per_rev``)."""
-    if isinstance(source, RigRecord):
-        if read_options:
-            raise ValueError(f"read options {sorted(read_options)} apply to a file, not to a RigRecord")
-        return source
-    return read(source, **read_options)
 
 
 def as_scene(scene: Scene | str | os.PathLike) -> Scene:
@@ -71,88 +54,6 @@ def as_scene(scene: Scene | str | os.PathLike) -> Scene:
     if isinstance(scene, os.PathLike) or path.suffix.lower() == ".toml" or path.is_file():
         return load_scene(path)
     return named_scene(scene)
-
-
-def _pair(transducers: Transducer | tuple[Transducer, Transducer] | None) -> tuple[Transducer, Transducer]:
-    if transducers is None:
-        return Transducer(), Transducer()
-    return transducers if isinstance(transducers, tuple) else (transducers, transducers)
-
-
-@dataclass(frozen=True)
-class Measurement:
-    """The measured efficiency of one record (what ``cardan rig measure`` prints).
-
-    Attributes
-    ----------
-    record : RigRecord
-    conditioned : Conditioned
-        The signals over the whole-revolution window and the input yoke phase.
-    measured : Measured
-        Efficiency, its standard uncertainty, budget and Monte Carlo.
-    """
-
-    record: RigRecord
-    conditioned: Conditioned
-    measured: Measured
-
-    @property
-    def efficiency(self) -> float:
-        """Measured ``W_out / W_in`` over the window [-]."""
-        return self.measured.efficiency
-
-    @property
-    def u(self) -> float:
-        """Its combined standard uncertainty [-]."""
-        return self.measured.u
-
-    def as_dict(self) -> dict[str, Any]:
-        """``cardan rig measure --json``: file, the measured efficiency and its uncertainty
-        (:meth:`Measured.as_dict`), input yoke phase [deg], whether the data are synthetic."""
-        return {"file": str(self.record.file), **self.measured.as_dict(),
-                "phase_deg": math.degrees(self.conditioned.phase),
-                "synthetic": bool(self.record.provenance.get("synthetic"))}
-
-
-def measure(source: Source, shaft_angle_deg: float = 15.0, *, conditioning: Conditioning | None = None,
-            transducers: Transducer | tuple[Transducer, Transducer] | None = None,
-            monte_carlo: int = 2000, seed: int = 0, **read_options: Any) -> Measurement:
-    """Measured efficiency over whole input revolutions, with its uncertainty.
-
-    Parameters
-    ----------
-    source : RigRecord, str or path-like
-        A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
-    shaft_angle_deg : float
-        The joint's shaft angle [deg] (for the yoke phase estimate); 15 is the paper's rig.
-    conditioning : Conditioning, optional
-        Filter, window and derivative settings (default: :class:`Conditioning`).
-    transducers : Transducer or (input, output) pair, optional
-        Accuracy, drift and acquisition of the transducers (default: the paper's, with the
-        assumptions of :data:`rigdata.transducer.PROVENANCE`).
-    monte_carlo : int
-        Monte Carlo draws (0: GUM only).
-    seed : int
-        Seed of the draws.
-
-    Returns
-    -------
-    Measurement
-
-    Raises
-    ------
-    RigDataError
-        A file or record that cannot be measured (fewer than one whole revolution, ...).
-    """
-    if isinstance(shaft_angle_deg, bool) or not isinstance(shaft_angle_deg, (int, float, np.number)):
-        raise TypeError(f"`shaft_angle_deg` must be a number [deg], got {shaft_angle_deg!r:.80}")
-    if not (math.isfinite(shaft_angle_deg) and 0.0 <= shaft_angle_deg < 90.0):
-        raise ValueError(f"`shaft_angle_deg` must be in [0, 90) deg, got {shaft_angle_deg!r}")
-    check_draws(monte_carlo, seed)
-    record = as_record(source, **read_options)
-    cond = condition(record, math.radians(shaft_angle_deg), conditioning)
-    measured = measured_efficiency(cond, _pair(transducers), monte_carlo=monte_carlo, seed=seed)
-    return Measurement(record, cond, measured)
 
 
 def compare(measured: Measured, computed: Mapping[str, Any], sensitivities: Mapping[str, float]) -> dict:
@@ -251,7 +152,9 @@ class Validation:
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary (``validation.json``): file, provenance, conditioning, the measured
         efficiency with its budget, the computed ones, comparisons, sensitivities, assumptions."""
-        rec, cond, meas = self.record, self.conditioned, self.measured
+        rec = self.record
+        cond = self.conditioned
+        meas = self.measured
         out = {
             "file": str(rec.file), "provenance": {k: val for k, val in rec.provenance.items()
                                                   if k not in ("header", "synthetic")},
@@ -297,7 +200,7 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
         Engines to drive (keys of :data:`cardan_exudyn.engines.ENGINES` that take angle drives
         and load histories: :data:`MODEL_ENGINES`).
     conditioning, transducers, monte_carlo, seed
-        As for :func:`measure`.
+        As for :func:`rigdata.measurement.measure`.
     progress : callable(str), optional
         Called with a line before each long step.
 
@@ -319,18 +222,36 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
                         f"one string: got {engines!r:.80}")
     check_draws(monte_carlo, seed)
     base = as_scene(scene)
-    for engine in engines:  # fail now, not after the measurement
-        if engine not in MODEL_ENGINES:
-            get_engine(engine)  # unknown or not installed: its own message
-            raise EngineUnavailable(f"engine {engine!r} cannot be driven by a measurement (angle "
-                                    f"and load histories): use {' and/or '.join(MODEL_ENGINES)}")
-    record, pair = as_record(source, **read_options), _pair(transducers)
+    _check_engines(engines)  # now, not after the measurement
+    record = as_record(source, **read_options)
+    pair = transducer_pair(transducers)
     say("conditioning")
     cond = condition(record, base.joint.geometry.shaft_angle, conditioning)
     say("measured efficiency and its uncertainty")
     measured = measured_efficiency(cond, pair, monte_carlo=monte_carlo, seed=seed)
     model = measured_scene(cond, base)
-    computed, comparisons, sens = {}, {}, None
+    computed, comparisons, sens = _run_models(cond, base, model, engines, measured, pair, say)
+    return Validation(record, cond, measured, model, computed, comparisons, sens, pair)
+
+
+def _check_engines(engines: tuple[str, ...]) -> None:
+    """:class:`EngineUnavailable` for an engine that is unknown, not installed, or cannot take a
+    measured angle drive and load history."""
+    for engine in engines:
+        if engine not in MODEL_ENGINES:
+            get_engine(engine)  # unknown or not installed: its own message
+            raise EngineUnavailable(f"engine {engine!r} cannot be driven by a measurement (angle "
+                                    f"and load histories): use {' and/or '.join(MODEL_ENGINES)}")
+
+
+def _run_models(cond: Conditioned, base: Scene, model: Scene, engines: tuple[str, ...], measured: Measured,
+                pair: tuple[Transducer, Transducer], say: Callable[[str], None]) -> tuple[dict, dict, dict]:
+    """Each engine on the measured scene ``model``: per engine its computed efficiency and, for
+    those that ran ``ok``, the comparison; and the model sensitivities (run once, with the first
+    engine that ran ``ok``; empty when none did)."""
+    computed: dict[str, dict[str, Any]] = {}
+    comparisons: dict[str, dict[str, Any]] = {}
+    sens = None
     for engine in engines:
         say(f"model driven by the measurement: {engine}")
         computed[engine] = computed_efficiency(run(model, engine))
@@ -341,4 +262,4 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
             sens = model_sensitivities(cond, base, pair[1].accuracy_limit / SQRT3,
                                        _ok_efficiency(computed.get("reference")))
         comparisons[engine] = compare(measured, computed[engine], sens)
-    return Validation(record, cond, measured, model, computed, comparisons, sens or {}, pair)
+    return computed, comparisons, sens or {}

@@ -46,7 +46,8 @@ from rigdata.record import ChannelSource, RigDataError, RigRecord
 from rigdata.synthetic import RigSettings
 from rigdata.synthetic import write as synthetic_write
 from rigdata.transducer import Transducer
-from rigdata.validation import measure, validate
+from rigdata.measurement import measure
+from rigdata.validation import validate
 
 __all__ = ["CASES", "Case", "DIRECTORY", "ENTRY_POINTS", "MARKER"]
 
