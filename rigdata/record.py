@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.integrate import trapezoid
 
 #: Channels a record may hold; SI units. ``angle_*`` come from pulse counts or an angle channel.
 CHANNELS = {
@@ -161,12 +160,13 @@ class RigRecord:
 
     def turned(self, shaft: str = "in") -> float:
         """Angle turned by a shaft over the record [rad], from its angle channel when there is
-        one, else the trapezoidal integral of its speed."""
+        one, else the trapezoidal integral of its speed (written out: scipy's would cost
+        ``cardan rig inspect`` 0.3 s of import for one sum)."""
         angle = self.channels.get(f"angle_{shaft}")
         if angle is not None:
             return float(angle[-1] - angle[0])
         speed = self.channels[f"speed_{shaft}"]
-        return float(trapezoid(speed, self.time))
+        return float(np.sum(np.diff(self.time) * (speed[1:] + speed[:-1]) / 2.0))
 
     def revolutions(self, shaft: str = "in") -> float:
         """Whole and partial revolutions turned by a shaft (absolute value) [-]."""

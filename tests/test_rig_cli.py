@@ -26,6 +26,24 @@ def lvm(tmp_path_factory):
     return path, json.loads(proc.stdout)
 
 
+INSPECT_IMPORTS = """
+import sys
+from cardan_exudyn.cli import main
+status = main(["rig", "inspect", sys.argv[1], "--json"])
+print(status, sorted({m.split(".")[0] for m in sys.modules} & {"scipy", "pandas", "matplotlib", "exudyn"}))
+"""
+
+
+def test_inspect_loads_no_scipy(lvm):
+    """inspect reads and describes a file: no filter, no engine, so neither scipy nor pandas loads
+    (in a fresh interpreter; a revolution count from a speed channel is a trapezoid sum)."""
+    path, _ = lvm
+    proc = subprocess.run([sys.executable, "-c", INSPECT_IMPORTS, str(path)], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[-1] == "0 []"
+
+
 def test_inspect_reports_channels_rate_and_revolutions(lvm):
     """inspect names every channel with its column and unit, the rate and the revolutions."""
     path, _ = lvm
