@@ -30,12 +30,10 @@ from cardan_exudyn.arguments import (
     EXIT_INCOMPLETE,
     EXIT_OK,
     BadInput,
-    add_scene_options,
     cli_value,
     count,
     out_folder,
     path_value,
-    scene_from_args,
 )
 from cardan_exudyn.engines import ENGINES, EngineUnavailable, make_options, run
 from cardan_exudyn.interrupts import Terminated, exit_status, terminate_raises
@@ -49,6 +47,7 @@ from cardan_exudyn.outputs import (
     write_result,
 )
 from cardan_exudyn.report.format import number
+from cardan_exudyn.scene_options import add_scene_options, scene_from_args
 from cardan_exudyn.studies import COMMANDS
 from reference.results.summary import OptionsError, Status, Summary
 from reference.scene.mapping import scene_to_dict

@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigdata.conditioning import Conditioned, lowpass, window_weights
 from rigdata import montecarlo
+from rigdata.conditioning import Conditioned, lowpass, window_weights
 from rigdata.record import RigDataError
 from rigdata.transducer import Transducer
 

@@ -37,9 +37,9 @@ from reference.scene.load import Load
 from reference.scene.mapping import replace as replace_field
 from reference.scene.scene import Scene
 from rigdata import files
+from rigdata.conversion import to_si
 from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
-from rigdata.conversion import to_si
 from rigdata.units import parse_unit
 
 GENERATOR = "rigdata.synthetic 1"

@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from cardan_exudyn.arguments import override_name, scene_from_args
+from cardan_exudyn.scene_options import override_name, scene_from_args
 from cardan_exudyn.cli import build_parser, main
 from reference.paper.scenes import named_scene
 from reference.scene.files import scene_from_mapping

@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from cardan_exudyn.arguments import DEFAULT_SCENE
+from cardan_exudyn.scene_options import DEFAULT_SCENE
 from cardan_exudyn.studies import COMMANDS
 from cardan_exudyn.studies.bench.startup import SCENE_MARKER, import_cost, parse_importtime
 from reference.paper.data import paper_data

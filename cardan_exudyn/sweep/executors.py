@@ -26,9 +26,9 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 from cardan_exudyn.interrupts import deferred_signals
-from cardan_exudyn.sweep.records import error_record
 from cardan_exudyn.sweep.checks import SweepError
 from cardan_exudyn.sweep.functions import CaseFunction
+from cardan_exudyn.sweep.records import error_record
 from cardan_exudyn.sweep.tasks import Batch, Task, run_case, run_task, task_cases, task_key
 from reference.scene.scene import Scene
 

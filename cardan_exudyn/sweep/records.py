@@ -25,8 +25,8 @@ from cardan_exudyn import engines
 from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.outputs import atomic_write
-from cardan_exudyn.sweep.plan import Case, Plan, plan_difference
 from cardan_exudyn.sweep.checks import SweepError
+from cardan_exudyn.sweep.plan import Case, Plan, plan_difference
 from reference.scene.scene import Scene
 from reference.results.summary import Status, Summary
 

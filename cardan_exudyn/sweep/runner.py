@@ -41,6 +41,7 @@ from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.outputs import OutputError, check_output_folder
 from cardan_exudyn.report.environment import environment
+from cardan_exudyn.sweep.checks import SweepError
 from cardan_exudyn.sweep.executors import (
     Emit,
     SweepInterrupted,
@@ -66,7 +67,6 @@ from cardan_exudyn.sweep.records import (
     statistics,
     write_text,
 )
-from cardan_exudyn.sweep.checks import SweepError
 from cardan_exudyn.sweep.spec import SweepSpec
 from cardan_exudyn.sweep.tasks import Batch, plan_tasks
 from reference.results.summary import Status

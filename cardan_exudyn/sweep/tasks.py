@@ -22,9 +22,9 @@ from typing import Any
 
 from cardan_exudyn import engines
 from cardan_exudyn.jsonable import to_jsonable
+from cardan_exudyn.sweep.functions import DEFAULT_FUNCTION, CaseFunction, resolve_function
 from cardan_exudyn.sweep.plan import Case
 from cardan_exudyn.sweep.records import ERROR, RESERVED_OUTPUTS, scalar_summary
-from cardan_exudyn.sweep.functions import DEFAULT_FUNCTION, CaseFunction, resolve_function
 from cardan_exudyn.sweep.spec import flatten_paths
 from reference.results.summary import Status
 from reference.scene.mapping import replace

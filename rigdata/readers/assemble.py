@@ -14,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from rigdata.conversion import check_magnitudes, to_si
 from rigdata.readers.channels import MAP_HINT, channel_unit
 from rigdata.readers.table import RawTable
 from rigdata.record import RATE_TOLERANCE, ChannelSource, RigDataError, RigRecord
-from rigdata.conversion import check_magnitudes, to_si
 from rigdata.units import normalise, parse_unit, split_header
 
 __all__ = ["time_axis", "to_record"]

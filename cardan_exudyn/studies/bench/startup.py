@@ -3,7 +3,7 @@
 :func:`import_cost` runs, in fresh interpreters under ``python -X importtime``, what ``cardan
 run`` does before it hands the scene to an engine: import :mod:`cardan_exudyn.cli`, parse the
 command line (:func:`cardan_exudyn.cli.parse_args`), then build the default scene
-(:func:`cardan_exudyn.arguments.scene_from_args`, which for the paper's ``physical`` set runs the
+(:func:`cardan_exudyn.scene_options.scene_from_args`, which for the paper's ``physical`` set runs the
 reference engine twice to find the output load). A marker written to stderr between the parse and
 the scene splits the imports into those made before the scene is built (the target's figure) and
 those made while it is built. The cost of a phase is the sum of the cumulative times of its

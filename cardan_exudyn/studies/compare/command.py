@@ -15,15 +15,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from cardan_exudyn.arguments import (
-    EXIT_FAILED,
-    EXIT_OK,
-    BadInput,
-    add_scene_options,
-    number,
-    out_folder,
-    scene_from_args,
-)
+from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, number, out_folder
+from cardan_exudyn.scene_options import add_scene_options, scene_from_args
 from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table

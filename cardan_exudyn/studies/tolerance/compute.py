@@ -33,15 +33,13 @@ from cardan_exudyn.arguments import (
     COUNT_LIMITS,
     EXIT_FAILED,
     EXIT_OK,
-    SCENE_OPTIONS,
     BadInput,
-    add_scene_options,
     count,
     out_folder,
     path_value,
     refuse_options,
-    scene_from_args,
 )
+from cardan_exudyn.scene_options import SCENE_OPTIONS, add_scene_options, scene_from_args
 from cardan_exudyn.engines import ENGINES, run
 from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.outputs import atomic_directory
