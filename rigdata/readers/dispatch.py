@@ -1,0 +1,130 @@
+"""Reading a rig file: the format chosen and its reader run (:func:`read_table`), then the
+channels chosen and converted into a record (:func:`read`)."""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping
+from pathlib import Path, PurePath
+
+import numpy as np
+
+from rigdata.readers.assemble import to_record
+from rigdata.readers.channels import match_channels
+from rigdata.readers.delimited import read_delimited
+from rigdata.readers.detect import FORMAT_ALIASES, choose_format, decode, file_bytes
+from rigdata.readers.lvm import read_lvm
+from rigdata.readers.table import FORMATS, RawTable
+from rigdata.readers.tdms import read_tdms
+from rigdata.record import RigRecord
+from rigdata.transducer import PULSES_PER_REV, SENSITIVITY
+
+__all__ = ["read_table", "read"]
+
+
+def read_table(path: str | Path, format: str = "auto") -> RawTable:
+    """Read a rig file's columns, units and header as they are, without choosing channels.
+
+    Parameters
+    ----------
+    path : str or Path
+        File to read.
+    format : {"auto", "csv", "lvm", "tdms"}
+        ``"auto"`` goes by the extension (``.lvm``, ``.tdms``, anything else delimited text);
+        content that contradicts the extension or the given format is an error.
+
+    Returns
+    -------
+    RawTable
+
+    Raises
+    ------
+    RigDataError
+        File missing, empty, binary where text is expected, of another format than stated,
+        truncated, without a header line, with rows of the wrong number of fields, or that the
+        format's library cannot parse.
+    """
+    if not isinstance(format, str) or format not in FORMAT_ALIASES:
+        raise ValueError(f"`format` must be 'auto' or one of {FORMATS}, got {format!r:.80}")
+    if not isinstance(path, (str, PurePath)) or not str(path).strip():
+        raise TypeError(f"`path` must be a str or pathlib.Path naming a rig file, got {path!r:.80}")
+    path = Path(path)
+    data = file_bytes(path)
+    fmt = choose_format(path, format, data[:64])
+    sha = hashlib.sha256(data).hexdigest()
+    if fmt == "tdms":
+        return read_tdms(path, data, sha)
+    text = decode(data, path)
+    return read_lvm(path, text, sha) if fmt == "lvm" else read_delimited(path, text, sha)
+
+
+def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | None] | None = None,
+         units: Mapping[str, str] | None = None, sensitivity: float = SENSITIVITY,
+         pulses_per_rev: int = PULSES_PER_REV) -> RigRecord:
+    """Read a rig file into a validated record in SI units.
+
+    Parameters
+    ----------
+    path : str or Path
+        Delimited text (``.csv``, ``.tsv``, ``.txt``, ``.dat``), LabVIEW Measurement (``.lvm``)
+        or NI TDMS (``.tdms``) file.
+    format : {"auto", "csv", "lvm", "tdms"}
+        See :func:`read_table`.
+    mapping : mapping of str to str or None, optional
+        Record channel (or ``"time"``) -> column; channels not named are recognised by their
+        headers (:func:`recognise`). None drops a channel.
+    units : mapping of str to str, optional
+        Unit by channel or column name; overrides or supplies the file's units (``{"speed_in":
+        "rpm"}``, ``{"time": "ms"}``).
+    sensitivity : float
+        Torque transducer output [V/(N m)] for channels in volts; default 0.1 (paper, section 4:
+        Magtrol TMB 210, 100 mV/(N m)).
+    pulses_per_rev : int
+        Pulses per revolution for channels in pulse counts or pulses/s; default 60 (paper,
+        section 4: Magtrol TMB 210).
+
+    Returns
+    -------
+    RigRecord
+        Time [s], torques [N m], speeds [rad/s], angles [rad]; ``provenance`` holds ``file``,
+        ``format``, ``reader`` (name, version), ``sha256``, ``header`` (the file's key/value
+        pairs), ``time`` (column or how the time axis was built), ``conversion``
+        (sensitivity, pulses per revolution), ``notes``, ``assumptions`` and, when the header
+        has a ``synthetic`` key, ``synthetic`` (``synthetic``, ``generator``, ``settings`` as
+        written).
+
+    Raises
+    ------
+    RigDataError
+        Any problem with the file or its data, naming the file, the channel and the problem.
+    ValueError
+        Bad arguments (``format``, ``mapping`` keys, ``sensitivity``, ``pulses_per_rev``).
+    """
+    _check_read_arguments(sensitivity, pulses_per_rev, mapping, units)
+    raw = read_table(path, format)
+    chosen = match_channels(raw, mapping)
+    return to_record(raw, chosen, dict(units or {}), sensitivity, pulses_per_rev)
+
+
+def _check_read_arguments(sensitivity: float, pulses_per_rev: int, mapping: Mapping[str, str | None] | None,
+                          units: Mapping[str, str] | None) -> None:
+    """``ValueError``/``TypeError`` naming the argument of :func:`read` that is out of range or of
+    the wrong type."""
+    if isinstance(sensitivity, bool) or not (isinstance(sensitivity, (int, float))
+                                             and 1e-12 <= sensitivity <= 1e12):  # NaN fails too
+        raise ValueError(f"`sensitivity` must be a number of V/(N m) in [1e-12, 1e12], "
+                         f"got {sensitivity!r:.80}")
+    if isinstance(pulses_per_rev, bool) or not (isinstance(pulses_per_rev, (int, np.integer))
+                                                and 0 < pulses_per_rev <= 1_000_000):
+        raise ValueError(f"`pulses_per_rev` must be an integer in [1, 1000000], "
+                         f"got {pulses_per_rev!r:.80}")
+    for name, table in (("mapping", mapping), ("units", units)):
+        if table is None:
+            continue
+        if not isinstance(table, Mapping):
+            raise TypeError(f"`{name}` must be a mapping of channel names to strings, got {table!r:.80}")
+        wrong = [(k, v) for k, v in table.items()
+                 if not isinstance(k, str) or not (isinstance(v, str) or (v is None and name == "mapping"))]
+        if wrong:
+            raise TypeError(f"`{name}` must map names (str) to strings, "
+                            f"got {wrong[0][0]!r:.40}: {wrong[0][1]!r:.40}")
