@@ -62,7 +62,9 @@ SAMPLED_ENGINES = ("reference",)
 """Engines whose ``numerics.dt`` only sets where an exact solution is sampled (not its error):
 they are asked for rows at the base engine's step, so that no interpolation enters."""
 STATISTICS = ("max_abs", "rms", "scale", "max_rel", "rows")
-SERIALISED = ("max_abs", "rms", "scale", "rows")  # the JSON report's per-column keys
+"""Per-column statistics of a difference (:func:`column_differences`)."""
+SERIALISED = ("max_abs", "rms", "scale", "rows")
+"""The per-column keys the JSON report writes (``max_rel`` follows from two of them)."""
 
 
 @dataclass
@@ -176,8 +178,18 @@ class Comparison:
         return pd.concat(frames, ignore_index=True)[columns]
 
     def differences_table(self, rtol: float = 0.0, atol: float = 0.0, steady: bool = True) -> str:
-        """:meth:`differing` as a markdown table (engine, column, max |difference|, RMS, scale,
-        max |difference| / scale), for an assertion message or a terminal."""
+        """:meth:`differing` as a markdown table, for an assertion message or a terminal.
+
+        Parameters
+        ----------
+        rtol, atol, steady
+            As for :meth:`differing`.
+
+        Returns
+        -------
+        str
+            Columns engine, column, max |difference|, RMS, scale, max |difference| / scale.
+        """
         columns = ["engine", "column", "max_abs", "rms", "scale", "max_rel"]
         formats = {c: ".3e" for c in columns[2:]}
         return markdown_table(self.differing(rtol, atol, steady), columns, formats)
@@ -191,7 +203,8 @@ def summary_values(summary: Summary) -> dict[str, float]:
 
 
 def statistics_dict(stats: pd.DataFrame) -> dict[str, dict[str, float]]:
-    """Per-column statistics as the JSON report writes them (``rows`` an integer)."""
+    """Per-column statistics as the JSON report writes them: column -> :data:`SERIALISED` key ->
+    value (``rows`` an integer)."""
     return {column: {key: int(row[key]) if key == "rows" else float(row[key]) for key in SERIALISED}
             for column, row in stats.iterrows()}
 
@@ -202,6 +215,20 @@ def join_on_input_angle(base: pd.DataFrame, other: pd.DataFrame) -> tuple[dict[s
     Rows are taken as they are when both tables have the same input angles (to 1e-9 rad);
     otherwise each column is interpolated by a cubic spline in the input angle, over the span
     both tables cover (base rows outside it are NaN).
+
+    Parameters
+    ----------
+    base : pandas.DataFrame
+        The base engine's time table (``theta_in`` [rad] and the :data:`COMPARED` columns).
+    other : pandas.DataFrame
+        Another engine's time table of the same scene.
+
+    Returns
+    -------
+    columns : dict of str to ndarray
+        Each :data:`COMPARED` column ``other`` has, at ``base``'s rows (units of the column).
+    join : str
+        ``"same rows"`` or ``"cubic spline in the input angle"``.
     """
     theta_b = base["theta_in"].to_numpy(float)
     theta_o = other["theta_in"].to_numpy(float)
@@ -225,6 +252,15 @@ def join_on_input_angle(base: pd.DataFrame, other: pd.DataFrame) -> tuple[dict[s
 def column_differences(base: pd.DataFrame, joined: Mapping[str, np.ndarray],
                        mask: np.ndarray) -> pd.DataFrame:
     """Statistics of ``joined - base`` over the rows in ``mask``, per column.
+
+    Parameters
+    ----------
+    base : pandas.DataFrame
+        The base engine's time table.
+    joined : mapping of str to ndarray
+        The other engine's columns at the base's rows (:func:`join_on_input_angle`).
+    mask : ndarray of bool
+        The base rows to take.
 
     Returns
     -------
@@ -327,7 +363,22 @@ def engine_list(engines: Any) -> list[str]:
 
 
 def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutions: float) -> None:
-    """Refuse a comparison that cannot be made, before any engine runs."""
+    """Refuse a comparison that cannot be made, before any engine runs.
+
+    Parameters
+    ----------
+    engines : list of str
+        The engines, the base first.
+    options : mapping
+        Engine name -> options of that engine.
+    skip_revolutions : float
+        Input revolutions left out of the steady statistics [-].
+
+    Raises
+    ------
+    TypeError, ValueError, EngineUnavailable, OptionsError
+        As :func:`compare` describes.
+    """
     engines = engine_list(engines)
     if isinstance(skip_revolutions, bool) or not isinstance(skip_revolutions, (int, float, np.integer,
                                                                                np.floating)):
@@ -349,13 +400,33 @@ def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutio
 def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],
                 progress: Callable[[str], None] | None = None,
                 runner: Callable[..., Result] = run) -> tuple[dict[str, Result], dict[str, float]]:
-    """Each engine's result and wall time [s], in order; engines in :data:`SAMPLED_ENGINES` are
-    sampled at the step of the first engine that reports one, unless the scene sets it.
+    """Run each engine on ``scene`` with every step recorded; engines in :data:`SAMPLED_ENGINES`
+    are sampled at the step of the first engine that reports one, unless the scene sets it.
 
-    ``runner(scene, engine, options)`` runs one engine: :func:`cardan_exudyn.engines.run`, or a
-    caching wrapper of it (the pytest plugin's)."""
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    engines : sequence of str
+        The engines, in order.
+    options : mapping
+        Engine name -> options; engines not in it run with their defaults.
+    progress : callable, optional
+        Called with one line of text before each engine runs.
+    runner : callable
+        ``runner(scene, engine, options) -> Result``: :func:`cardan_exudyn.engines.run`, or a
+        caching wrapper of it (the pytest plugin's).
+
+    Returns
+    -------
+    results : dict of str to Result
+        Per engine, in order.
+    walls : dict of str to float
+        Per engine, the wall time of its run [s].
+    """
     scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
-    results, walls = {}, {}
+    results: dict[str, Result] = {}
+    walls: dict[str, float] = {}
     base_dt = None
     for engine in engines:
         run_scene = scene
@@ -372,7 +443,20 @@ def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any]
 
 
 def differences(results: Mapping[str, Result], skip_revolutions: float) -> dict[str, EngineDifference]:
-    """Every later engine that produced a table against the first (none without a base table)."""
+    """Every later engine that produced a table against the first (none without a base table).
+
+    Parameters
+    ----------
+    results : mapping of str to Result
+        Per engine, the base first.
+    skip_revolutions : float
+        Input revolutions left out of the steady statistics [-].
+
+    Returns
+    -------
+    dict of str to EngineDifference
+        Per later engine with a table.
+    """
     base_name, *others = results
     base = results[base_name].table
     if base is None:
@@ -384,11 +468,27 @@ def differences(results: Mapping[str, Result], skip_revolutions: float) -> dict[
 
 def difference(base: Result, other: Result, base_name: str, engine: str,
                steady: np.ndarray) -> EngineDifference:
-    """``other`` against ``base``: the join, the mean-value and the per-column differences."""
+    """``other`` against ``base``: the join, the mean-value and the per-column differences.
+
+    Parameters
+    ----------
+    base, other : Result
+        The two runs, each with a table.
+    base_name, engine : str
+        Their engines.
+    steady : ndarray of bool
+        The base rows after the skipped revolutions.
+
+    Returns
+    -------
+    EngineDifference
+        Mean-value differences only when both runs ended ``ok``.
+    """
     joined, how = join_on_input_angle(base.table, other.table)
     means = {}
     if base.success and other.success:
-        a, b = summary_values(base.summary), summary_values(other.summary)
+        a = summary_values(base.summary)
+        b = summary_values(other.summary)
         means = {k: b[k] - a[k] for k in SUMMARY_KEYS if is_number(a.get(k)) and is_number(b.get(k))}
     return EngineDifference(engine, base_name, how, means,
                             column_differences(base.table, joined, np.ones_like(steady)),

@@ -6,8 +6,8 @@ pass options of an engine's class) and never import an engine module themselves.
 imported on first use, so a missing optional engine (MuJoCo) costs nothing until asked for.
 
 Many scenes at once: :func:`run_batch`. An engine with a batched pass (the reference engine's
-:mod:`reference.engine.batch.solve`) runs the scenes of equal :func:`batch_key` together; the others, and
-scenes whose key is None, run one at a time as :func:`run` would.
+:mod:`reference.engine.batch.solve`) runs the scenes of equal :func:`batch_key` together; the
+others, and scenes whose key is None, run one at a time as :func:`run` would.
 """
 
 from __future__ import annotations
@@ -25,22 +25,36 @@ from reference.scene.validation import require_scene
 
 @dataclass(frozen=True)
 class Engine:
-    """An entry of :data:`ENGINES`: the module whose ``run(scene, options)`` runs a scene, and
-    its options class as ``"module:Class"``."""
+    """An entry of :data:`ENGINES`.
+
+    Attributes
+    ----------
+    name : str
+        The key in :data:`ENGINES`.
+    module : str
+        The module whose ``run(scene, options) -> Result`` runs a scene (imported on first use).
+    options : str
+        Its options class, as ``"module:Class"``.
+    description : str
+        One line for listings.
+    batch : str
+        Module with ``check_scenes``, ``batch_key(scene)`` and ``run_batch(scenes, options)``;
+        "": no batched pass.
+    """
 
     name: str
     module: str
     options: str
     description: str
     batch: str = ""
-    """Module with ``batch_key(scene)`` and ``run_batch(scenes, options)``; "": no batched pass."""
 
     @property
     def options_name(self) -> str:
+        """The options class's name (what :func:`engine_of` matches)."""
         return self.options.rpartition(":")[2]
 
 
-ENGINES: dict[str, Engine] = {
+ENGINES: dict[str, Engine] = {  # the one dispatch table
     "exudyn": Engine("exudyn", "cardan_exudyn.model.accuracy", "cardan_exudyn.model.options:ExudynOptions",
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
     "reference": Engine("reference", "reference.engine.solve", "reference.engine.options:ReferenceOptions",
@@ -60,6 +74,8 @@ class EngineUnavailable(ValueError):
 
 
 def _entry(name: str) -> Engine:
+    """The entry of engine ``name``; ``TypeError`` for a non-string, :class:`EngineUnavailable`
+    for an unknown name."""
     if not isinstance(name, str):
         raise TypeError(f"`engine` must be the name of an engine (a string, one of {sorted(ENGINES)}), "
                         f"got {type(name).__name__} {name!r:.80}")
@@ -69,6 +85,7 @@ def _entry(name: str) -> Engine:
 
 
 def _import(name: str, module: str) -> Any:
+    """Import an engine's ``module``; a missing dependency makes engine ``name`` unavailable."""
     try:
         return importlib.import_module(module)
     except ImportError as exc:
@@ -76,13 +93,39 @@ def _import(name: str, module: str) -> Any:
 
 
 def options_class(engine: str) -> type:
-    """The options class of ``engine`` (a frozen dataclass validated on construction)."""
+    """The options class of ``engine`` (a frozen dataclass validated on construction).
+
+    Raises
+    ------
+    EngineUnavailable
+        An unknown engine, or one whose options module does not import.
+    """
     module, _, cls = _entry(engine).options.partition(":")
     return getattr(_import(engine, module), cls)
 
 
 def make_options(engine: str, **values: Any) -> Any:
-    """Options of ``engine`` from keyword values; unknown names raise :class:`OptionsError`."""
+    """Options of ``engine`` from keyword values.
+
+    Parameters
+    ----------
+    engine : str
+        A key of :data:`ENGINES`.
+    **values
+        Fields of its options class.
+
+    Returns
+    -------
+    object
+        An instance of :func:`options_class` ``(engine)``.
+
+    Raises
+    ------
+    EngineUnavailable
+        An unknown or uninstalled engine.
+    OptionsError
+        An unknown field name, or a value its class refuses.
+    """
     cls = options_class(engine)
     unknown = sorted(set(values) - set(cls.__dataclass_fields__))
     if unknown:
@@ -92,12 +135,25 @@ def make_options(engine: str, **values: Any) -> Any:
 
 
 def get_engine(name: str) -> Callable[..., Result]:
-    """The run function ``run(scene, options=None) -> Result`` of the named engine."""
+    """The run function ``run(scene, options=None) -> Result`` of the named engine.
+
+    Raises
+    ------
+    EngineUnavailable
+        An unknown engine, or one that is not installed.
+    """
     return _import(name, _entry(name).module).run
 
 
 def engine_of(options: Any) -> str:
-    """The engine whose options class ``options`` is an instance of."""
+    """The engine whose options class ``options`` is an instance of (matched by class name, so
+    that the engine's module need not be imported).
+
+    Raises
+    ------
+    OptionsError
+        ``options`` of no engine's class.
+    """
     for name, entry in ENGINES.items():
         if type(options).__name__ == entry.options_name:
             return name
@@ -106,10 +162,26 @@ def engine_of(options: Any) -> str:
 
 
 DEFAULT_ENGINE = "exudyn"
+"""The engine of a run that names none and gives no options."""
 
 
 def resolve(engine: str | None = None, options: Any = None, **option_values: Any) -> tuple[str, Any]:
     """The engine and an instance of its options from what a caller gave (see :func:`run`).
+
+    Parameters
+    ----------
+    engine : str, optional
+        A key of :data:`ENGINES`; by default the engine of ``options``, else :data:`DEFAULT_ENGINE`.
+    options : optional
+        An instance of the engine's options class.
+    **option_values
+        Or the fields of the options, as keywords.
+
+    Returns
+    -------
+    engine : str
+    options : object
+        An instance of the engine's options class.
 
     Raises
     ------
@@ -137,11 +209,20 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
     Parameters
     ----------
     scene : Scene
+        The scene to run.
     engine : str, optional
         A key of :data:`ENGINES`; by default the engine of ``options``, else ``"exudyn"``.
     options : optional
         An instance of the engine's options class (``ExudynOptions``, ``ReferenceOptions``,
         ``MujocoOptions``); or give its fields as keywords (``node_type="EP"``).
+    **option_values
+        The options' fields, when ``options`` is not given.
+
+    Returns
+    -------
+    Result
+        The time table (built when first read) and the summary; a run that failed returns a
+        result with its status and reason, it does not raise.
 
     Raises
     ------
@@ -168,8 +249,20 @@ def has_batch(engine: str) -> bool:
 
 
 def batch_key(scene: Scene, engine: str | None = None) -> Hashable | None:
-    """Scenes of one engine with equal keys run together in :func:`run_batch`; None: the scene
-    runs on its own (always None for an engine without a batched pass).
+    """The key that groups scenes in :func:`run_batch`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene.
+    engine : str, optional
+        A key of :data:`ENGINES` (default :data:`DEFAULT_ENGINE`).
+
+    Returns
+    -------
+    hashable or None
+        Scenes of one engine with equal keys run together; None: the scene runs on its own
+        (always None for an engine without a batched pass).
 
     Raises
     ------
@@ -197,8 +290,14 @@ def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any =
     Parameters
     ----------
     scenes : sequence of Scene
+        The scenes, in the order of the results.
     engine, options, option_values
         As in :func:`run`.
+
+    Returns
+    -------
+    list of Result
+        One per scene, in order.
 
     Raises
     ------
@@ -215,7 +314,8 @@ def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any =
     for i, scene in enumerate(scenes):
         require_scene(scene, f"scenes[{i}]")
     engine, options = resolve(engine, options, **option_values)
-    entry, run_function = _entry(engine), get_engine(engine)
+    entry = _entry(engine)
+    run_function = get_engine(engine)
     module = _import(engine, entry.batch) if entry.batch else None
     if module is not None:  # every scene, before any group runs, named by its index in `scenes`
         module.check_scenes(scenes, options)

@@ -1,4 +1,5 @@
-"""Writing results: CSV time table plus JSON summary, atomically, one writer at a time.
+"""A command's output: folders and files written atomically, one writer at a time, and a run's
+result folder (CSV time table, JSON summary).
 
 A command writes into a new hidden sibling of its output folder and exchanges it with the
 previous one in one step when it is complete (:func:`atomic_directory`), so a command killed at
@@ -24,6 +25,10 @@ from typing import IO, Any
 from cardan_exudyn.interrupts import deferred_signals
 from cardan_exudyn.jsonable import dumps
 from reference.results.result import Result
+
+__all__ = ["OutputError", "WRITE_ERRORS", "write_error", "check_output_folder", "atomic_open", "atomic_write",
+           "lock_path", "output_lock", "clean_leftovers", "exchange", "atomic_directory", "result_files",
+           "write_result_files", "write_result"]
 
 
 class OutputError(ValueError):
@@ -69,19 +74,44 @@ def atomic_open(path: str | os.PathLike, mode: str = "wb", **kwargs: Any) -> Ite
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[IO], Any]) -> None:
-    """Write one binary file atomically and durably: ``write(f)`` fills it (:func:`atomic_open`)."""
+    """Write one binary file atomically and durably (:func:`atomic_open`).
+
+    Parameters
+    ----------
+    path : path-like
+        Target file; its folder must exist.
+    write : callable
+        ``write(f)`` fills the binary file object ``f``.
+    """
     with atomic_open(path, "wb") as f:
         write(f)
 
 
 def check_output_folder(target: str | os.PathLike, replace: bool = True) -> Path:
-    """``target`` as a folder a command may create (and, with ``replace``, replace as a whole): it
-    is a folder or does not exist, and its nearest existing parent is a folder; raises
-    :class:`OutputError` otherwise.
+    """``target`` as a folder a command may create (and, with ``replace``, replace as a whole).
 
     A folder that is replaced as a whole must be one of its own: not the current folder, the home
     folder, the root or a folder above one of them (however it is spelt: ``.``, ``$(pwd)``,
-    ``~/..``), and not a folder holding a ``.git`` repository."""
+    ``~/..``), and not a folder holding a ``.git`` repository.
+
+    Parameters
+    ----------
+    target : path-like
+        The output folder.
+    replace : bool
+        The command replaces the folder as a whole (False: it writes into it, as a sweep does).
+
+    Returns
+    -------
+    Path
+        ``target``.
+
+    Raises
+    ------
+    OutputError
+        ``target`` exists and is not a folder, its nearest existing parent is not a folder, or
+        (with ``replace``) it is not a folder of its own.
+    """
     target = Path(target)
     if replace and target.name in ("", ".", ".."):  # "", ".", "/", "..": a folder above the output's own
         raise OutputError(f"{str(target)!r} names no folder of its own (the current folder, a parent "
@@ -112,14 +142,28 @@ def _check_replaceable(folder: Path) -> None:
                           "give a folder of its own")
 
 
-# A write the disk refuses (full, over quota, over the file size limit, read-only): one line
 WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
+"""Errors of a write the disk refuses (full, over quota, over the file size limit, read-only):
+reported in one line (:func:`write_error`), exit status 2."""
 _LEFTOVER = re.compile(r"\.(?P<name>.+)\.cardan-(?P<kind>new|old)-(?P<pid>\d+)-[0-9a-f]+")
-_held: dict[str, int] = {}  # lock files this process holds -> nesting depth
+_held: dict[str, int] = {}  # lock files this process holds -> nesting depth (the lock is re-entrant)
 
 
 def write_error(exc: OSError, target: str | os.PathLike) -> OutputError:
-    """A write failure (full disk, quota, file size limit, read-only) as one line."""
+    """A write failure (full disk, quota, file size limit, read-only) as one line.
+
+    Parameters
+    ----------
+    exc : OSError
+        The failure.
+    target : path-like
+        The output it was writing.
+
+    Returns
+    -------
+    OutputError
+        To raise; names the target, the reason and the file.
+    """
     return OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}"
                        + (f" ({exc.filename})" if exc.filename else ""))
 
@@ -191,6 +235,7 @@ def _acquire(path: Path, target: str | os.PathLike) -> int | None:
 
 
 def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (another user's process counts)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -232,6 +277,7 @@ def _remove(path: Path) -> None:
 
 
 def _sibling(target: Path, kind: str) -> Path:
+    """A new hidden sibling of ``target``, ``.NAME.cardan-KIND-PID-TOKEN`` (``kind``: new or old)."""
     return target.with_name(f".{target.name}.cardan-{kind}-{os.getpid()}-{os.urandom(4).hex()}")
 
 
@@ -250,14 +296,29 @@ def _renameat2():
     return function
 
 
-_AT_FDCWD, _RENAME_EXCHANGE = -100, 2
+_AT_FDCWD = -100  # renameat2's "relative to the current folder"
+_RENAME_EXCHANGE = 2  # renameat2's flag: swap the two paths
 
 
 def exchange(a: str | os.PathLike, b: str | os.PathLike) -> bool:
     """Swap two existing paths in one atomic step (Linux ``renameat2(RENAME_EXCHANGE)``).
 
-    Returns False where the system or the file system cannot (the caller falls back to two
-    renames); raises :class:`OSError` for any other failure."""
+    Parameters
+    ----------
+    a, b : path-like
+        The two paths.
+
+    Returns
+    -------
+    bool
+        True when swapped; False where the system or the file system cannot (the caller falls
+        back to two renames).
+
+    Raises
+    ------
+    OSError
+        Any other failure.
+    """
     renameat2 = _renameat2()
     if renameat2 is None:
         return False
@@ -303,6 +364,7 @@ def _fsync_tree(folder: Path) -> None:
 
 
 def _make_parents(target: Path) -> None:
+    """Make the folders above ``target``; :class:`OutputError` when they cannot be made."""
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -358,14 +420,40 @@ def result_files(result: Result) -> list[str]:
 
 
 def write_result_files(result: Result, folder: Path) -> None:
-    """``timeseries.csv`` (when recorded) and ``summary.json`` into an existing folder."""
+    """Write ``timeseries.csv`` (when recorded) and ``summary.json`` into an existing folder.
+
+    Parameters
+    ----------
+    result : Result
+        The run; its table is built here (the one place a run's table is read to be written).
+    folder : Path
+        The folder.
+    """
     if result.table is not None:
         result.table.to_csv(folder / "timeseries.csv", index=False, float_format="%.12g")
     (folder / "summary.json").write_text(dumps(result.summary) + "\n", encoding="utf-8")
 
 
 def write_result(result: Result, out: str | os.PathLike) -> Path:
-    """Write a result folder atomically and return its path."""
+    """Write a run's result folder atomically (:func:`atomic_directory`).
+
+    Parameters
+    ----------
+    result : Result
+        The run.
+    out : path-like
+        The folder, replaced as a whole.
+
+    Returns
+    -------
+    Path
+        ``out``.
+
+    Raises
+    ------
+    OutputError
+        As :func:`atomic_directory`.
+    """
     with atomic_directory(out) as tmp:
         write_result_files(result, tmp)
     return Path(out)
