@@ -6,7 +6,8 @@ Exit status: 0 success; 2 bad input (one line on stderr naming the argument, no 
 output another command is writing, or a disk that refuses the output (full, read-only; the
 previous output is kept); 3 the simulation failed or is physically meaningless (the reason is in
 the summary ``status``); 4 (``cardan sweep``) the sweep stopped before every case ran (rerun the
-command to resume); 130 interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing recorded as
+command to resume); 5 (``cardan run``) the run ended ok but its estimated mean-efficiency error
+exceeds ``--accuracy``; 130 interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing recorded as
 failed, the previous output kept, rerunning resumes a sweep; 141 the reader of the output went
 away (``cardan run --json | head -1``).
 """
@@ -57,7 +58,11 @@ from reference.scene.validation import SceneError
 if TYPE_CHECKING:
     from cardan_exudyn.sweep import SweepSpec
 
-EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for a program the pipe ended
+__all__ = ["EXIT_BROKEN_PIPE", "CORE_COMMANDS", "cmd_run", "cmd_scene", "cmd_sweep", "sweep_spec_from_args",
+           "build_parser", "add_run_parser", "add_sweep_parser", "add_scene_parser", "parse_args", "main"]
+
+EXIT_BROKEN_PIPE = 141
+"""128 + SIGPIPE: what a shell reports for a program whose reader went away."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -141,6 +146,8 @@ def _set_text(s: Summary) -> str:
 
 
 def _print_summary(s: Summary, out: str | None, files: list[str]) -> None:
+    """``cardan run``'s report: one line on stdout for a run that ended ok (then its warnings on
+    stderr and the files written to ``out``), else the status and reason on stderr."""
     if s.status != Status.OK:
         print(f"status: {s.status}: {s.reason}", file=sys.stderr)
         return
@@ -165,7 +172,15 @@ def cmd_scene(args: argparse.Namespace) -> int:
 
 
 def sweep_spec_from_args(args: argparse.Namespace) -> SweepSpec:
-    """The sweep spec of ``cardan sweep``: the SPEC file, with the command-line options applied."""
+    """The sweep spec of ``cardan sweep``: the SPEC file, with the command-line options applied.
+
+    Raises
+    ------
+    SweepError
+        An unreadable or invalid spec (the message names the file).
+    BadInput
+        A ``--grid`` or ``--set`` not of the form ``PATH=VALUE``.
+    """
     # import cost: the sweep package (process pools, Dask hooks) loads for `cardan sweep` only
     from cardan_exudyn.sweep import SweepError, looks_like_path, read_spec_file, spec_from_mapping
 
@@ -326,6 +341,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 
 def _run_command(args: argparse.Namespace) -> int:
+    """Run the parsed command; its exit status, every expected error reported in one line."""
     try:
         with _holding_output(args):
             status = args.func(args)

@@ -16,13 +16,14 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from types import FrameType
 
 __all__ = ["Terminated", "SignalWatch", "interruption", "exit_status", "terminate_raises",
            "watch_signals", "deferred_signals"]
 
 WATCHED = (signal.SIGINT, signal.SIGTERM)
+"""The signals that interrupt a command."""
 
 
 class Terminated(KeyboardInterrupt):
@@ -42,10 +43,12 @@ def exit_status(exc: BaseException) -> int:
 
 
 def _main_thread() -> bool:
+    """Whether this is the main thread, the only one where Python installs and runs handlers."""
     return threading.current_thread() is threading.main_thread()
 
 
 def _raise_terminated(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM's handler within :func:`terminate_raises`."""
     raise Terminated()
 
 
@@ -69,7 +72,9 @@ class SignalWatch:
     def __init__(self) -> None:
         self.signum: int | None = None
 
-    def handler(self, previous):
+    def handler(self, previous: Callable[[int, FrameType | None], object]
+                ) -> Callable[[int, FrameType | None], None]:
+        """A handler that notes the signal, then runs ``previous`` (the handler it replaces)."""
         def record(signum: int, frame: FrameType | None) -> None:
             self.signum = signum
             previous(signum, frame)

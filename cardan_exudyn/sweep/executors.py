@@ -47,12 +47,23 @@ class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C or SIGTERM stopped the sweep: every case finished before is recorded, no case was
     recorded as failed for it, and the same command resumes.
 
-    Attributes: ``done`` and ``total`` cases, ``out`` folder, ``signum`` (the signal)."""
+    Attributes
+    ----------
+    done, total : int
+        Cases recorded, and cases in the sweep.
+    out : path-like
+        The sweep's folder.
+    signum : int
+        The signal that stopped it.
+    """
 
     def __init__(self, done: int, total: int, out: os.PathLike | str, signum: int = signal.SIGINT) -> None:
         super().__init__(f"{done} of {total} cases done (records in {out}); rerun the same command "
                          "to resume")
-        self.done, self.total, self.out, self.signum = done, total, out, signum
+        self.done = done
+        self.total = total
+        self.out = out
+        self.signum = signum
 
 
 def default_workers() -> int:
@@ -64,7 +75,19 @@ def default_workers() -> int:
 
 
 def run_in_process(tasks: Sequence[Task], base: Scene, function: CaseFunction, emit: Emit) -> None:
-    """Run the tasks one after the other in this process."""
+    """Run the tasks one after the other in this process.
+
+    Parameters
+    ----------
+    tasks : sequence of Task
+        Cases or batches (:mod:`~cardan_exudyn.sweep.tasks`).
+    base : Scene
+        The sweep's base scene; each case's overrides apply to it.
+    function : CaseFunction
+        The case function.
+    emit : callable
+        ``emit(records)`` in the driver as each task finishes (:data:`Emit`).
+    """
     for task in tasks:
         emit(run_task(task, base, function))
 
@@ -76,6 +99,13 @@ def run_pool(tasks: Sequence[Task], base: Scene, function: CaseFunction, workers
     A worker that dies (crash, ``os._exit``, out of memory) breaks the pool and every task in
     flight; their cases are rerun one at a time in a fresh process, where a case that kills the
     process is the one running, and is recorded as ``WorkerCrash``.
+
+    Parameters
+    ----------
+    tasks, base, function, emit
+        As for :func:`run_in_process`.
+    workers : int
+        Processes of the pool.
     """
     # spawn, not fork: a worker inherits nothing from the driver (threads, locks, open files)
     context = multiprocessing.get_context("spawn")
@@ -151,6 +181,8 @@ def _pool_round(queue: deque, base: Scene, function: CaseFunction, workers: int,
 
 
 def _run_one_at_a_time(queue: deque, base: Scene, function: CaseFunction, context, emit: Emit) -> None:
+    """Run the cases of ``queue`` one at a time, each in a pool of one process: a case that kills
+    its process is recorded as ``WorkerCrash``, and a fresh pool runs the next."""
     while queue:
         with _pool(1, context) as pool:
             while queue:
@@ -196,6 +228,13 @@ def run_dask(tasks: Sequence[Task], base: Scene, function: CaseFunction, client,
     its worker is recorded. Any other failure of the cluster stops the sweep, recording nothing
     for the tasks in flight.
 
+    Parameters
+    ----------
+    tasks, base, function, emit
+        As for :func:`run_in_process`.
+    client : distributed.Client
+        The cluster (:func:`connect`).
+
     Raises
     ------
     SweepIncomplete
@@ -234,10 +273,13 @@ def run_dask(tasks: Sequence[Task], base: Scene, function: CaseFunction, client,
 
 
 def _killed_batch(future, task: Task, killed: type) -> bool:
+    """Whether ``future`` is a batch whose worker Dask gave up on (``killed``: ``KilledWorker``)."""
     return isinstance(task, Batch) and future.status == "error" and isinstance(future.exception(), killed)
 
 
 def _emit_dask(future, result, task: Task, emit: Emit, killed: type) -> None:
+    """Emit a finished task's records, or a failed case's ``KilledWorker`` record; any other
+    failure stops the sweep (:class:`SweepIncomplete`)."""
     if future.status == "finished":
         emit(result)
         return

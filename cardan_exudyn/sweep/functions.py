@@ -42,11 +42,19 @@ class CaseFunction:
     args: Mapping[str, Any] = field(default_factory=dict)
 
     def __call__(self, scene: Scene, engine: str) -> Any:
+        """``name(scene, engine, **args)``: the case's outputs."""
         return resolve_function(self.name)(scene, engine, **self.args)
 
 
 def function_args(args: Any) -> dict[str, Any]:
-    """``function_args`` checked: a table of keyword names to JSON-able values."""
+    """``function_args`` checked: a table of keyword names to JSON-able values.
+
+    Raises
+    ------
+    SweepError
+        Not a table, a key that is no argument name or one of :data:`CASE_ARGUMENTS`, or a
+        value that is not JSON.
+    """
     if not isinstance(args, Mapping):
         raise SweepError(f"`function_args` must be a table, got {args!r}")
     for name in args:
@@ -69,6 +77,17 @@ def function_name(function: Any) -> str:
     ----------
     function : str or callable
         The name, or a top-level callable.
+
+    Returns
+    -------
+    str
+        ``"module:qualname"``.
+
+    Raises
+    ------
+    SweepError
+        A name that does not import, or a callable that cannot be imported by its name (a
+        lambda, a nested function): worker processes could not run it.
     """
     if isinstance(function, str):
         resolve_function(function)

@@ -31,13 +31,24 @@ from reference.scene.validation import SceneError
 __all__ = ["PLAN_FORMAT", "Case", "Plan", "expand_cases", "base_scene", "make_plan", "plan_difference"]
 
 PLAN_FORMAT = "cardan-sweep/1"
-# quantiles of a random parameter checked against the scene's validation before any case runs
+"""The ``format`` of ``plan.json``; a stored plan of another format is another sweep."""
 CHECKED_QUANTILES = (1e-9, 0.5, 1.0 - 1e-9)
+"""Quantiles of a random parameter checked against the scene's validation before any case runs."""
 
 
 @dataclass(frozen=True)
 class Case:
-    """One run of a sweep: ``function(replace(base, **overrides), engine)``."""
+    """One run of a sweep: ``function(replace(base, **overrides), engine)``.
+
+    Attributes
+    ----------
+    id : str
+        Unique within the sweep; stable across reruns of the same spec.
+    engine : str
+        A key of :data:`cardan_exudyn.engines.ENGINES`.
+    overrides : dict
+        Dotted scene path -> value (in the path's unit).
+    """
 
     id: str
     engine: str
@@ -70,8 +81,11 @@ def expand_cases(spec: SweepSpec) -> list[Case]:
 
 
 def _explicit_cases(cases: Sequence, engine: str) -> list[Case]:
+    """The spec's explicit ``cases``, each with its own id (or its index) and engine (or the
+    spec's ``engine``); :class:`SweepError` for a case that is no table or an id used twice."""
     width = max(4, len(str(len(cases) - 1)))
-    out, seen = [], set()
+    out = []
+    seen = set()
     for i, item in enumerate(cases):
         if not isinstance(item, Mapping):
             raise SweepError(f"`cases[{i}]` must be a table of overrides, got {item!r}")
@@ -105,7 +119,7 @@ def base_scene(spec: SweepSpec) -> Scene:
 
 @dataclass(frozen=True)
 class Plan:
-    """A validated sweep: the spec, the base scene and every case."""
+    """A validated sweep: the spec, the base scene (``fixed`` applied) and every case, in order."""
 
     spec: SweepSpec
     base: Scene
@@ -167,6 +181,7 @@ def make_plan(spec: SweepSpec | Mapping[str, Any]) -> Plan:
 
 
 def _check_scene(base: Scene, overrides: dict[str, Any], what: str) -> None:
+    """``SceneError`` prefixed with ``what`` when ``overrides`` make no valid scene of ``base``."""
     try:
         replace(base, **overrides)
     except SceneError as exc:
@@ -174,21 +189,36 @@ def _check_scene(base: Scene, overrides: dict[str, Any], what: str) -> None:
 
 
 def plan_difference(stored: Mapping[str, Any], new: Mapping[str, Any]) -> str:
-    """What makes a stored ``plan.json`` another sweep than ``new`` (a plan's ``to_dict``); ""
-    when a rerun may resume it: same format, case function, base scene, cases and arguments."""
+    """What makes a stored ``plan.json`` another sweep than ``new``.
+
+    Parameters
+    ----------
+    stored : mapping
+        The content of the folder's ``plan.json``.
+    new : mapping
+        The new plan's :meth:`Plan.to_dict`.
+
+    Returns
+    -------
+    str
+        The first difference, in words; "" when a rerun may resume the stored sweep (same
+        format, case function, base scene, cases and arguments).
+    """
     if stored.get("format") != PLAN_FORMAT:
         return f"plan format {stored.get('format')!r}, expected {PLAN_FORMAT!r}"
     if not _same_function(stored.get("function"), new["function"]):
         return f"case function {stored.get('function')!r} then, {new['function']!r} now"
     if stored.get("base_scene_sha256") != new["base_scene_sha256"]:
         return "the base scene differs (scene, its file, `fixed` or the code that builds it changed)"
-    old_cases, new_cases = stored.get("cases", []), new["cases"]
+    old_cases = stored.get("cases", [])
+    new_cases = new["cases"]
     if len(old_cases) != len(new_cases):
         return f"{len(old_cases)} cases then, {len(new_cases)} now"
     for old, case in zip(old_cases, new_cases, strict=True):
         if old != case:
             return f"case {case['id']}: {old} then, {case} now"
-    old_args, new_args = stored.get("function_args", {}), new.get("function_args", {})
+    old_args = stored.get("function_args", {})
+    new_args = new.get("function_args", {})
     if old_args != new_args:
         return f"case function arguments {old_args} then, {new_args} now"
     return ""

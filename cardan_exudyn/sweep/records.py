@@ -35,16 +35,30 @@ __all__ = ["PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE", "SWEEP_FIL
            "write_text", "interrupted_record", "error_record", "results_table", "statistics",
            "scalar_summary", "summary_outputs"]
 
-PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE = "plan.json", "cases.jsonl", "results.csv", "sweep.json"
+PLAN_FILE = "plan.json"
+CASES_FILE = "cases.jsonl"
+RESULTS_FILE = "results.csv"
+SUMMARY_FILE = "sweep.json"
 SWEEP_FILES = (PLAN_FILE, CASES_FILE, RESULTS_FILE, SUMMARY_FILE)
-# keys of a record that the runner sets; a case function must not return them
+"""The files a sweep writes into its folder (the only ones ``--restart`` deletes)."""
 RECORD_KEYS = ("id", "engine", "overrides", "status", "reason", "error_type", "error", "case_wall_s")
+"""Keys of a record that the runner sets."""
 RESERVED_OUTPUTS = frozenset({"id", "overrides", "error_type", "error", "case_wall_s", "traceback"})
-ERROR = "error"  # the status of a case whose function raised or whose process died
+"""Keys a case function must not return."""
+ERROR = "error"
+"""The status of a case whose function raised or whose process died."""
 
 
 def write_text(path: Path, text: str) -> None:
-    """Write a text file atomically (temporary sibling, fsync, rename)."""
+    """Write a text file atomically (temporary sibling, fsync, rename).
+
+    Parameters
+    ----------
+    path : Path
+        Target file; its folder must exist.
+    text : str
+        Written as UTF-8.
+    """
     atomic_write(path, lambda f: f.write(text.encode("utf-8")))
 
 
@@ -114,11 +128,24 @@ class RecordWriter:
             os.fsync(self._file.fileno())
 
     def close(self) -> None:
+        """Close the file."""
         self._file.close()
 
 
 def existing_records(out: Path, plan: Plan) -> dict[str, dict[str, Any]]:
     """Records already in ``out`` for this plan.
+
+    Parameters
+    ----------
+    out : Path
+        The sweep's folder.
+    plan : Plan
+        The plan about to run.
+
+    Returns
+    -------
+    dict of str to dict
+        Case id -> record (empty for a new sweep).
 
     Raises
     ------
@@ -126,7 +153,8 @@ def existing_records(out: Path, plan: Plan) -> dict[str, dict[str, Any]]:
         ``out`` holds another sweep (a different plan, records without a plan, records of cases
         not in the plan): the message says what differs and suggests ``--restart``.
     """
-    plan_path, cases_path = out / PLAN_FILE, out / CASES_FILE
+    plan_path = out / PLAN_FILE
+    cases_path = out / CASES_FILE
     if not plan_path.exists():
         if cases_path.exists():
             raise SweepError(f"{out} has {CASES_FILE} but no {PLAN_FILE}; use --restart or another --out")
@@ -162,22 +190,36 @@ def locked(out: Path) -> Iterator[None]:
         yield
 
 
-# How Exudyn reported a Python exception escaping a user function: before the interruptions were
-# told apart (issue 18) that was Ctrl-C inside a run, recorded as a failure of the case
 _INTERRUPTED_REASON = "Error in Python USER FUNCTION"
+"""Exudyn's reason for a Python exception escaping a user function."""
 
 
 def interrupted_record(record: Mapping[str, Any]) -> bool:
-    """A record that earlier versions wrote for a case stopped by Ctrl-C (status
-    ``integration_failure``, Exudyn's user-function failure as reason): no result, to run again.
-    The friction update now keeps its own exceptions (recorded as ``error``), so only an
-    interruption ever produced that reason, and none is recorded any more."""
+    """Whether a stored record is a case stopped by Ctrl-C rather than a result: status
+    ``integration_failure`` with Exudyn's user-function failure as reason. The friction update
+    records its own exceptions as ``error``, so only an interruption gives that reason; such a
+    case runs again on resume (records of this kind are read, never written)."""
     return (record.get("status") == Status.INTEGRATION_FAILURE
             and _INTERRUPTED_REASON in str(record.get("reason") or ""))
 
 
 def error_record(case: Case, error_type: str, error: str) -> dict[str, Any]:
-    """The record of a case that produced none (its worker process died)."""
+    """The record of a case that produced none (its worker process died).
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    error_type : str
+        ``"WorkerCrash"`` or ``"KilledWorker"``.
+    error : str
+        What happened, in words.
+
+    Returns
+    -------
+    dict
+        A record with status :data:`ERROR`.
+    """
     return {**case.to_dict(), "status": ERROR, "reason": f"{error_type}: {error}",
             "error_type": error_type, "error": error, "case_wall_s": None}
 
@@ -187,6 +229,13 @@ def results_table(plan: Plan, records: Mapping[str, Mapping[str, Any]]):
 
     A parameter whose value is not a scalar is written as JSON text; an output named like a
     parameter becomes ``result.<name>``.
+
+    Parameters
+    ----------
+    plan : Plan
+        The sweep's plan (the row order and the parameters).
+    records : mapping of str to mapping
+        Case id -> record.
 
     Returns
     -------
@@ -207,6 +256,7 @@ def results_table(plan: Plan, records: Mapping[str, Mapping[str, Any]]):
 
 
 def _row(case: Case, record: Mapping[str, Any], params: Sequence[str]) -> dict[str, Any]:
+    """One row of the results table: id, engine, the case's parameters, the record's outputs."""
     row: dict[str, Any] = {"id": case.id, "engine": record.get("engine", case.engine)}
     row.update({p: _cell(case.overrides.get(p)) for p in params})
     for key, value in record.items():
@@ -216,6 +266,7 @@ def _row(case: Case, record: Mapping[str, Any], params: Sequence[str]) -> dict[s
 
 
 def _cell(value: Any) -> Any:
+    """A value for a CSV cell: lists and tables as JSON text."""
     return json.dumps(to_jsonable(value)) if isinstance(value, (list, tuple, dict)) else value
 
 
@@ -255,6 +306,7 @@ def statistics(table, parameters: Sequence[str] = ()) -> dict[str, dict[str, flo
 
 
 def _describe(x: np.ndarray) -> dict[str, float]:
+    """n, mean, std, min, p05, p50, p95, max of ``x`` (one value: std 0)."""
     q05, q50, q95 = np.quantile(x, [0.05, 0.5, 0.95])
     return {"n": int(x.size), "mean": float(x.mean()),
             "std": float(x.std(ddof=1)) if x.size > 1 else 0.0, "min": float(x.min()),
@@ -262,6 +314,7 @@ def _describe(x: np.ndarray) -> dict[str, float]:
 
 
 def _is_text(value: Any) -> bool:
+    """Strings and booleans: outputs that have no statistics."""
     return isinstance(value, (str, bool))
 
 
@@ -289,6 +342,7 @@ def scalar_summary(summary: Summary | Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _is_scalar(value: Any) -> bool:
+    """None, a string, a boolean or a number: a value :func:`scalar_summary` keeps."""
     return value is None or isinstance(value, (str, bool, int, float, np.generic))
 
 

@@ -71,9 +71,7 @@ from cardan_exudyn.sweep.spec import SweepSpec
 from cardan_exudyn.sweep.tasks import Batch, plan_tasks
 from reference.results.summary import Status
 
-__all__ = ["run_sweep", "environment"]
-
-# packages whose versions head sweep.json
+__all__ = ["run_sweep", "Progress"]
 
 
 def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
@@ -160,9 +158,9 @@ def _prepare(out: Path, plan: Plan, restart: bool) -> dict[str, dict[str, Any]]:
 
 def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, sizes: tuple[int | None, int | None],
              client, progress: bool | None) -> dict[str, Any]:
-    """Run ``todo``, appending each task's records as they arrive; returns how the cases were run
-    (:func:`_dispatch`).
-    ``sizes``: ``workers`` and ``batch_size`` of :func:`run_sweep`."""
+    """Run ``todo``, appending each task's records as they arrive (``records`` is updated too);
+    returns how the cases were run (:func:`_dispatch`). ``sizes``: ``workers`` and
+    ``batch_size`` of :func:`run_sweep`."""
     rerun = {c.id for c in todo}
     failed = sum(r.get("status") != Status.OK for i, r in records.items() if i not in rerun)
     show = sys.stderr.isatty() if progress is None else progress
@@ -268,5 +266,6 @@ class Progress:
             self._bar.update(1)
 
     def close(self) -> None:
+        """Close the bar (nothing without one)."""
         if self._bar is not None:
             self._bar.close()

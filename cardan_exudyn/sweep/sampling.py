@@ -15,6 +15,7 @@ from cardan_exudyn.sweep.checks import MAX_CASES, SweepError, finite_number
 __all__ = ["DISTRIBUTIONS", "SAMPLING_METHODS", "Distribution", "RandomSpec"]
 
 SAMPLING_METHODS = ("random", "lhs")
+"""Independent uniform draws, or a Latin hypercube."""
 DISTRIBUTIONS = {"uniform": ("low", "high"), "loguniform": ("low", "high"),
                  "normal": ("mean", "std", "low", "high")}
 """Each distribution's parameters (for ``normal``, ``low`` and ``high`` truncate it)."""
@@ -47,6 +48,8 @@ class Distribution:
         self._check_ranges()
 
     def _set_parameters(self) -> None:
+        """The given parameters as floats; :class:`SweepError` for one the distribution does not
+        take, or one it needs that is missing."""
         allowed = DISTRIBUTIONS[self.dist]
         for name in ("low", "high", "mean", "std"):
             value = getattr(self, name)
@@ -60,6 +63,8 @@ class Distribution:
             raise SweepError(f"{self.dist!r} needs {list(required)}, missing {missing}")
 
     def _check_ranges(self) -> None:
+        """:class:`SweepError` for a non-positive ``std`` or log-uniform ``low``, ``low >= high``,
+        or a truncated normal with no probability between its bounds."""
         if self.std is not None and self.std <= 0.0:
             raise SweepError(f"`std` must be positive, got {self.std!r}")
         if self.low is not None and self.high is not None and not self.low < self.high:
@@ -71,6 +76,7 @@ class Distribution:
                              f"[{self.low!r}, {self.high!r}]")
 
     def _truncated(self) -> bool:
+        """Whether a normal distribution is cut to [low, high]."""
         return self.low is not None or self.high is not None
 
     def _bounds(self) -> tuple[float, float]:
@@ -80,6 +86,7 @@ class Distribution:
         return lo, hi
 
     def _mass(self) -> float:
+        """Probability of the untruncated normal between the bounds [-]."""
         from scipy.special import ndtr  # scipy loads only for a normal distribution
 
         lo, hi = self._bounds()

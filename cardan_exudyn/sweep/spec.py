@@ -30,8 +30,11 @@ __all__ = ["GRID_FORMS", "SPEC_KEYS", "RANDOM_KEYS", "SweepSpec", "grid_values",
            "random_spec", "spec_from_mapping", "read_spec_file", "load_spec", "looks_like_path"]
 
 GRID_FORMS = ("linspace", "geomspace")
+"""The spaced forms of a grid parameter, ``{linspace = [start, stop, num]}`` (numpy's)."""
 SPEC_KEYS = ("scene", "engine", "function", "function_args", "fixed", "grid", "random", "cases")
+"""The keys of a spec table."""
 RANDOM_KEYS = ("samples", "seed", "method", "parameters")
+"""The keys of its ``[random]`` table."""
 
 
 @dataclass(frozen=True)
@@ -110,6 +113,8 @@ class SweepSpec:
 
 
 def _check_disjoint(spec: SweepSpec) -> None:
+    """:class:`SweepError` for a path set in two of ``fixed``, ``grid`` and ``random``, or an
+    ``engine`` anywhere but the top level, the grid or the cases."""
     random = set(spec.random.parameters) if spec.random else set()
     for a, b, keys in (("fixed", "grid", set(spec.fixed) & set(spec.grid)),
                        ("fixed", "random", set(spec.fixed) & random),
@@ -147,6 +152,7 @@ def grid_values(path: str, spec: Any) -> tuple:
 
 
 def _spaced_values(where: str, spec: Mapping) -> tuple:
+    """The values of ``{linspace|geomspace = [start, stop, num]}`` (``where`` names the key)."""
     if len(spec) != 1 or next(iter(spec)) not in GRID_FORMS:
         raise SweepError(f"{where} must be a list or one of "
                          f"{[f'{{{f} = [start, stop, num]}}' for f in GRID_FORMS]}, got {spec!r}")
@@ -164,8 +170,23 @@ def _spaced_values(where: str, spec: Mapping) -> tuple:
 
 def flatten_paths(table: Mapping[str, Any], is_leaf: Callable[[Any], bool] | None = None,
                   prefix: str = "") -> dict[str, Any]:
-    """Dotted paths of a nested table (so that TOML's unquoted dotted keys mean what they look
-    like); a sub-table for which ``is_leaf`` is true is kept as one value."""
+    """Dotted paths of a nested table, so that TOML's unquoted dotted keys mean what they look like.
+
+    Parameters
+    ----------
+    table : mapping
+        The nested table.
+    is_leaf : callable, optional
+        A sub-table for which ``is_leaf(sub)`` is true is kept as one value (a grid's
+        ``{linspace = ...}``, a distribution).
+    prefix : str
+        Prepended to every path.
+
+    Returns
+    -------
+    dict
+        Dotted path -> value.
+    """
     out = {}
     for key, value in table.items():
         path = f"{prefix}{key}"
@@ -177,14 +198,17 @@ def flatten_paths(table: Mapping[str, Any], is_leaf: Callable[[Any], bool] | Non
 
 
 def _grid_leaf(value: Any) -> bool:
+    """A grid's ``{linspace|geomspace = [...]}``: one value, not a sub-table."""
     return isinstance(value, Mapping) and bool(set(value) & set(GRID_FORMS))
 
 
 def _random_leaf(value: Any) -> bool:
+    """A distribution's table: one value, not a sub-table."""
     return isinstance(value, Mapping) and bool(set(value) & {"dist", "low", "high", "mean", "std"})
 
 
 def _table(data: Mapping, key: str) -> Mapping:
+    """``data[key]`` (empty when missing); :class:`SweepError` unless it is a table."""
     value = data.get(key, {})
     if not isinstance(value, Mapping):
         raise SweepError(f"`{key}` must be a table, got {value!r}")
@@ -208,6 +232,7 @@ def random_spec(data: Mapping[str, Any]) -> RandomSpec:
 
 
 def _distribution(path: str, dist: Any) -> Distribution:
+    """The :class:`Distribution` of parameter ``path`` from its table; errors name the path."""
     if not isinstance(dist, Mapping):
         raise SweepError(f"[random.parameters] \"{path}\" must be a table like "
                          f"{{dist = \"uniform\", low = 0, high = 1}}, got {dist!r}")

@@ -54,10 +54,12 @@ class Batch:
 
     @property
     def engine(self) -> str:
+        """The engine of every case of the batch."""
         return self.cases[0].engine
 
 
 Task = Case | Batch
+"""What a worker runs: one case, or a batch."""
 
 
 def task_cases(task: Task) -> list[Case]:
@@ -82,8 +84,23 @@ def batched_function(function: CaseFunction) -> bool:
 
 
 def batch_size_for(cases: int, workers: int, batch_size: int = BATCH_SIZE) -> int:
-    """Cases per batch: at most ``batch_size``, and small enough that each of ``workers`` gets
-    :data:`BATCHES_PER_WORKER` batches."""
+    """Cases per batch: at most ``batch_size``, and small enough that each worker gets
+    :data:`BATCHES_PER_WORKER` batches.
+
+    Parameters
+    ----------
+    cases : int
+        Cases of one engine to cut into batches.
+    workers : int
+        Processes or Dask threads that run tasks at once.
+    batch_size : int
+        The most cases per batch.
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
     return max(1, min(batch_size, math.ceil(cases / (BATCHES_PER_WORKER * max(workers, 1)))))
 
 
@@ -95,7 +112,9 @@ def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
     Parameters
     ----------
     cases : sequence of Case
+        The plan's cases, in order.
     function : CaseFunction
+        The case function (only the default one is batched).
     workers : int
         Processes or Dask threads that run tasks at once.
     batch_size : int, optional
@@ -118,7 +137,22 @@ def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
 
 def run_task(task: Task, base: Scene,
              function: CaseFunction | str = DEFAULT_FUNCTION) -> list[dict[str, Any]]:
-    """The records of a task's cases, in order (runs where the task is executed)."""
+    """The records of a task's cases, in order (runs where the task is executed).
+
+    Parameters
+    ----------
+    task : Task
+        A case, or a batch (run by :func:`run_batch_cases`).
+    base : Scene
+        The sweep's base scene.
+    function : CaseFunction or str
+        The case function (a batch always runs the default one).
+
+    Returns
+    -------
+    list of dict
+        One record per case (:func:`run_case`).
+    """
     if isinstance(task, Batch):
         return run_batch_cases(task, base)
     return [run_case(task, base, function)]
@@ -164,6 +198,18 @@ def run_batch_cases(batch: Batch, base: Scene) -> list[dict[str, Any]]:
     raises, every case runs again on its own (:func:`run_case`), so that a failure is recorded
     for the case that causes it only. ``case_wall_s`` is the case's share of the batch: its wall
     time (scene builds and the batched run) over its cases.
+
+    Parameters
+    ----------
+    batch : Batch
+        Cases of one engine with a batched pass.
+    base : Scene
+        The sweep's base scene.
+
+    Returns
+    -------
+    list of dict
+        One record per case, in order.
     """
     start = time.perf_counter()
     records: dict[int, dict[str, Any]] = {}
@@ -189,14 +235,16 @@ def run_batch_cases(batch: Batch, base: Scene) -> list[dict[str, Any]]:
 
 def _record(case: Case, outputs: dict[str, Any]) -> dict[str, Any]:
     """The record of a case whose function returned ``outputs`` (``case_wall_s`` set by the caller)."""
-    status, reason = str(outputs.pop("status", Status.OK)), str(outputs.pop("reason", "") or "")
+    status = str(outputs.pop("status", Status.OK))
+    reason = str(outputs.pop("reason", "") or "")
     return {**case.to_dict(), "status": status, "reason": reason, "error_type": None, "error": None,
             "case_wall_s": None, **outputs}
 
 
 def _failure(case: Case, exc: Exception) -> dict[str, Any]:
     """The record of a case whose function raised ``exc``."""
-    error_type, error = type(exc).__name__, str(exc)
+    error_type = type(exc).__name__
+    error = str(exc)
     return {**case.to_dict(), "status": ERROR, "reason": f"{error_type}: {error}",
             "error_type": error_type, "error": error, "case_wall_s": None,
             "traceback": "".join(traceback.format_exception(exc)[-12:])}
