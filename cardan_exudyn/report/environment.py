@@ -15,6 +15,7 @@ __all__ = ["ENVIRONMENT_PACKAGES", "environment"]
 
 ENVIRONMENT_PACKAGES = ("cardan-exudyn", "numpy", "scipy", "exudyn", "distributed", "pandas",
                         "mujoco", "matplotlib")
+"""Packages whose versions head a results file (None for one not installed)."""
 
 
 def environment() -> dict[str, Any]:
@@ -34,6 +35,7 @@ def environment() -> dict[str, Any]:
 
 
 def _cpu_model() -> str:
+    """The CPU's model name (Linux's ``/proc/cpuinfo``), else what ``platform`` says."""
     with contextlib.suppress(OSError):
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
@@ -42,6 +44,7 @@ def _cpu_model() -> str:
 
 
 def _git_commit() -> str | None:
+    """The commit of the source tree this package runs from, None outside a git checkout."""
     try:
         proc = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
                               capture_output=True, text=True, timeout=5)

@@ -25,11 +25,27 @@ def is_number(value: Any) -> bool:
 
 
 def number(value: Any, spec: str = ".4g", missing: str = "-") -> str:
-    """``value`` formatted with ``spec``, or ``missing`` when it is not a finite number."""
+    """``value`` formatted with ``spec``, or ``missing`` when it is not a finite number.
+
+    Parameters
+    ----------
+    value : Any
+        The value.
+    spec : str
+        A format spec (``".4f"``).
+    missing : str
+        What a value that is not a finite number prints as.
+
+    Returns
+    -------
+    str
+    """
     return format(value, spec) if is_number(value) else missing
 
 
 def _cell(value: Any, spec: str | None, missing: str) -> str:
+    """One cell of :func:`markdown_table`: numbers by ``spec`` (floats ``.4g`` without one), text
+    with ``|`` escaped and line ends as blanks."""
     if spec is not None:
         return number(value, spec, missing) if not isinstance(value, str) else value
     if isinstance(value, float) or (not isinstance(value, (str, bool, int)) and is_number(value)):
@@ -56,6 +72,11 @@ def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[st
         Column titles (default: the keys).
     missing : str
         What a value that is not a finite number prints as.
+
+    Returns
+    -------
+    str
+        The table, one line per row, ending in a line end.
     """
     if hasattr(rows, "to_dict") and hasattr(rows, "columns"):  # a DataFrame
         rows = rows.to_dict("records")

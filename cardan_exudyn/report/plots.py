@@ -1,4 +1,5 @@
-"""Plots: functions take data and an optional Axes and return the Figure."""
+"""Plots: functions take data (and, where they draw one panel, an optional Axes) and return the
+Figure; axis labels carry units. Importing this module selects matplotlib's Agg backend."""
 
 from __future__ import annotations
 
@@ -10,8 +11,12 @@ import numpy as np  # noqa: E402
 
 from reference.results.summary import Status  # noqa: E402
 
+__all__ = ["CLASS_COLOURS", "speed_ratio", "data_limits", "efficiency_against_input_angle", "pair_losses",
+           "efficiency_against_paper", "save", "work_precision", "close", "stability_map"]
+
 
 def _axes(ax):
+    """``ax``'s figure and ``ax``, or a new figure with one Axes."""
     if ax is None:
         fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
         return fig, ax
@@ -19,6 +24,7 @@ def _axes(ax):
 
 
 def _against_input_angle(tables: dict[str, object], values, ylabel: str, ax=None):
+    """``values(table)`` against the input angle [deg] modulo 360, one series per table."""
     fig, ax = _axes(ax)
     for label, t in tables.items():
         ax.plot(np.degrees(t["theta_in"]) % 360, values(t), ".", ms=1.5, label=label)
@@ -31,7 +37,19 @@ def _against_input_angle(tables: dict[str, object], values, ylabel: str, ax=None
 
 
 def speed_ratio(tables: dict[str, object], ax=None):
-    """omega_out/omega_in against input angle, one line per labelled table."""
+    """omega_out / omega_in against the input angle.
+
+    Parameters
+    ----------
+    tables : dict of str to DataFrame
+        Label -> time table (``theta_in`` [rad], ``omega_in``, ``omega_out`` [rad/s]).
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     return _against_input_angle(tables, lambda t: t["omega_out"] / t["omega_in"],
                                 "omega_out / omega_in [-]", ax)
 
@@ -59,24 +77,43 @@ def data_limits(values, margin: float = 0.08, min_span: float = 2e-3,
         x = x[(x >= clip[0]) & (x <= clip[1])]
     if x.size == 0:
         return tuple(clip) if clip is not None else (0.0, 1.0)
-    lo, hi = float(x.min()), float(x.max())
-    if hi - lo < min_span:
-        mid = 0.5 * (lo + hi)
-        lo, hi = mid - 0.5 * min_span, mid + 0.5 * min_span
-    pad = margin * (hi - lo)
-    lo, hi = lo - pad, hi + pad
+    low = float(x.min())
+    high = float(x.max())
+    if high - low < min_span:  # centred on the values, so that a constant reads as one
+        mid = 0.5 * (low + high)
+        low = mid - 0.5 * min_span
+        high = mid + 0.5 * min_span
+    pad = margin * (high - low)
+    low -= pad
+    high += pad
     if clip is not None:
-        lo, hi = max(lo, clip[0]), min(hi, clip[1])
-    return lo, hi
+        low = max(low, clip[0])
+        high = min(high, clip[1])
+    return low, high
 
 
 def efficiency_against_input_angle(curves: dict[str, tuple], title: str = "", ax=None,
                                    clip: tuple[float, float] = (-0.5, 1.05)):
     """Instantaneous efficiency of eq. (18) against the input angle (Figures 4, 6, 7 of the paper).
 
-    ``curves``: label -> (input angle [deg], efficiency [-]), one revolution each, so that runs at
-    different speeds are comparable. The y limits follow the data (:func:`data_limits`); eq. (18)
-    is unbounded where the input power changes sign, so they never leave ``clip``.
+    The y limits follow the data (:func:`data_limits`); eq. (18) is unbounded where the input
+    power changes sign, so they never leave ``clip``.
+
+    Parameters
+    ----------
+    curves : dict of str to (array_like, array_like)
+        Label -> (input angle [deg], efficiency [-]), one revolution each, so that runs at
+        different speeds are comparable.
+    title : str
+        Panel title (none when empty).
+    ax : matplotlib Axes, optional
+        Where to draw (default: a new figure).
+    clip : tuple of float
+        Limits the y axis never leaves [-].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     fig, ax = _axes(ax)
     for label, (angle, eta) in curves.items():
@@ -96,8 +133,21 @@ def efficiency_against_input_angle(curves: dict[str, tuple], title: str = "", ax
 
 def pair_losses(angle, losses: dict[str, object], title: str = ""):
     """Power loss of the spider pairs (left) and of the shaft-frame pairs (right) against the
-    input angle [deg], Figure 5; ``losses``: pair name -> power loss [W]. Each panel's y limits
-    follow its data."""
+    input angle (the paper's Figure 5); each panel's y limits follow its data.
+
+    Parameters
+    ----------
+    angle : array_like
+        Input angle [deg].
+    losses : dict of str to array_like
+        Pair name -> power loss [W] at ``angle``.
+    title : str
+        Figure title (none when empty).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
     for ax, pairs in zip(axes, (("input_spider", "spider_output"), ("frame_input", "output_frame")),
                          strict=True):
@@ -120,9 +170,22 @@ def efficiency_against_paper(panels: dict[str, object], x: str, xlabel: str):
     """Mean efficiency against the paper, one panel per parameter set, each with its own y limits
     from its data (:func:`data_limits`): the set's two mean efficiencies as lines (``o-``: one
     minus lost over input work; ``x:``: the time average of eq. (18), where defined) and the
-    paper's values as markers at the same abscissae. ``panels``: set -> DataFrame with ``x``,
-    ``mean_efficiency``, ``mean_instantaneous_efficiency``, ``paper_mean_efficiency``, and
-    ``used_in_fit`` (fitted cases filled, held-out ones open)."""
+    paper's values as markers at the same abscissae (fitted cases filled, held-out ones open).
+
+    Parameters
+    ----------
+    panels : dict of str to DataFrame
+        Parameter set -> rows with ``x``, ``mean_efficiency``, ``mean_instantaneous_efficiency``,
+        ``paper_mean_efficiency`` [-] and ``used_in_fit``.
+    x : str
+        The column on the abscissa.
+    xlabel : str
+        Its label, with its unit.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 4), squeeze=False,
                              constrained_layout=True)
     for ax, (label, df) in zip(axes[0], panels.items(), strict=True):
@@ -144,7 +207,17 @@ def efficiency_against_paper(panels: dict[str, object], x: str, xlabel: str):
 
 
 def save(fig, path, dpi: int = 130) -> None:
-    """Write ``fig`` to ``path`` and close it."""
+    """Write ``fig`` to ``path`` and close it.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : path-like
+        The file (its suffix sets the format).
+    dpi : int
+        Resolution of a raster format.
+    """
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
 
@@ -155,6 +228,20 @@ def work_precision(rows, speed_ratio_level: float, efficiency_level: float):
     Top row: the scene's accuracy measure (speed-ratio error without friction, mean-efficiency
     error with friction) with the target level dashed; bottom row: drive-torque error after the
     first revolution. One line per configuration, points along its step-size ladder.
+
+    Parameters
+    ----------
+    rows : DataFrame
+        The benchmark's rows (``scene``, ``status``, ``config``, ``engine``,
+        ``steps_per_revolution``, ``wall_per_simulated_s`` and the error columns).
+    speed_ratio_level : float
+        Target level of the speed-ratio error [-].
+    efficiency_level : float
+        Target level of the mean-efficiency error [-].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
     """
     scenes = list(dict.fromkeys(rows["scene"]))
     fig, axes = plt.subplots(2, len(scenes), figsize=(4.6 * len(scenes), 7.5), squeeze=False,
@@ -188,19 +275,76 @@ def work_precision(rows, speed_ratio_level: float, efficiency_level: float):
 
 
 def close(fig) -> None:
+    """Close ``fig`` (release its memory)."""
     plt.close(fig)
 
 
 CLASS_COLOURS = {"converged": "#4caf50", "drift": "#ff9800", "self_locking": "#5c8fd6",
                  "integration_failure": "#e53935", "error": "#212121"}
+"""Colour of each class of the stress map's cells."""
+
+
+def _boundary(ax, locks: np.ndarray) -> None:
+    """Black lines on the edges between cells of different reference state (``locks``: the
+    reference self-locks, shape (angles, values))."""
+    rows, cols = locks.shape
+    for i in range(rows):
+        for j in range(cols):
+            if j + 1 < cols and locks[i, j] != locks[i, j + 1]:
+                ax.plot([j + 0.5, j + 0.5], [i - 0.5, i + 0.5], "k", lw=2)
+            if i + 1 < rows and locks[i, j] != locks[i + 1, j]:
+                ax.plot([j - 0.5, j + 0.5], [i + 0.5, i + 0.5], "k", lw=2)
+
+
+def _stability_panel(ax, sel, panel: dict, index: dict[str, int], cmap, classes) -> None:
+    """One panel of :func:`stability_map`: the cells ``sel`` of ``panel``."""
+    from matplotlib.patches import Rectangle
+
+    xs = list(panel["x_values"])
+    angles = list(panel["angles"])
+    grid = np.full((len(angles), len(xs)), np.nan)
+    locks = np.zeros_like(grid, dtype=bool)
+    for _, r in sel.iterrows():
+        i = angles.index(r["angle_deg"])
+        j = xs.index(r["x"])
+        grid[i, j] = index[r["cell_class"]]
+        locks[i, j] = r["reference"] == Status.SELF_LOCKING
+        if locks[i, j]:
+            ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///",
+                                   lw=0, color="k", alpha=0.45))
+        if not r["agrees"]:
+            ax.text(j, i, "!", ha="center", va="center", fontsize=11, fontweight="bold")
+    ax.imshow(grid, cmap=cmap, vmin=-0.5, vmax=len(classes) - 0.5, origin="lower",
+              aspect="auto", zorder=0)
+    _boundary(ax, locks)
+    ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs], fontsize=7)
+    ax.set_yticks(range(len(angles)), [f"{a:g}" for a in angles], fontsize=7)
+    ax.set_xlabel(panel["x_label"])
+    ax.set_ylabel("shaft angle [deg]")
+    ax.set_title(f"{panel['key']}: {panel['title']}", fontsize=9)
 
 
 def stability_map(cells, panels: list[dict], classes):
     """``cardan stress`` map: one panel per slice, shaft angle (rows) against the panel's
     quantity (columns, one cell per value). Colour: Exudyn's class; hatching: the reference
-    self-locks; ``!``: the two disagree; black line: the reference's self-locking boundary."""
+    self-locks; ``!``: the two disagree; black line: the reference's self-locking boundary.
+
+    Parameters
+    ----------
+    cells : DataFrame
+        One row per cell: ``panel``, ``angle_deg`` [deg], ``x``, ``cell_class``, ``reference``
+        (its status) and ``agrees``.
+    panels : list of dict
+        ``key``, ``title``, ``x_label``, ``x_values`` and ``angles`` [deg] of each panel.
+    classes : sequence of str
+        The cell classes, in legend order (keys of :data:`CLASS_COLOURS`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch, Rectangle
+    from matplotlib.patches import Patch
 
     ncols = min(3, len(panels))
     nrows = -(-len(panels) // ncols)
@@ -209,32 +353,7 @@ def stability_map(cells, panels: list[dict], classes):
     cmap = ListedColormap([CLASS_COLOURS[c] for c in classes])
     index = {c: i for i, c in enumerate(classes)}
     for ax, panel in zip(axes.flat, panels, strict=False):
-        sel = cells[cells["panel"] == panel["key"]]
-        xs, angles = list(panel["x_values"]), list(panel["angles"])
-        grid = np.full((len(angles), len(xs)), np.nan)
-        locks = np.zeros_like(grid, dtype=bool)
-        for _, r in sel.iterrows():
-            i, j = angles.index(r["angle_deg"]), xs.index(r["x"])
-            grid[i, j] = index[r["cell_class"]]
-            locks[i, j] = r["reference"] == Status.SELF_LOCKING
-            if locks[i, j]:
-                ax.add_patch(Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///",
-                                       lw=0, color="k", alpha=0.45))
-            if not r["agrees"]:
-                ax.text(j, i, "!", ha="center", va="center", fontsize=11, fontweight="bold")
-        ax.imshow(grid, cmap=cmap, vmin=-0.5, vmax=len(classes) - 0.5, origin="lower",
-                  aspect="auto", zorder=0)
-        for i in range(len(angles)):  # boundary: edges between cells of different reference state
-            for j in range(len(xs)):
-                if j + 1 < len(xs) and locks[i, j] != locks[i, j + 1]:
-                    ax.plot([j + 0.5, j + 0.5], [i - 0.5, i + 0.5], "k", lw=2)
-                if i + 1 < len(angles) and locks[i, j] != locks[i + 1, j]:
-                    ax.plot([j - 0.5, j + 0.5], [i + 0.5, i + 0.5], "k", lw=2)
-        ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs], fontsize=7)
-        ax.set_yticks(range(len(angles)), [f"{a:g}" for a in angles], fontsize=7)
-        ax.set_xlabel(panel["x_label"])
-        ax.set_ylabel("shaft angle [deg]")
-        ax.set_title(f"{panel['key']}: {panel['title']}", fontsize=9)
+        _stability_panel(ax, cells[cells["panel"] == panel["key"]], panel, index, cmap, classes)
     for ax in list(axes.flat)[len(panels):]:
         ax.axis("off")
     handles = [Patch(color=CLASS_COLOURS[c], label=c) for c in classes]
