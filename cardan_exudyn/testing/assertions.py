@@ -157,7 +157,18 @@ def check_values(name: str, values: tuple[Any, Any], scale: float | None,
 
 
 def check_tolerances(rtol: float | None, atol: float | None) -> None:
-    """Refuse a tolerance that is not a finite number >= 0 (a usage error, not a failure)."""
+    """Refuse a tolerance that is not a finite number >= 0 (a usage error, not a failure).
+
+    Parameters
+    ----------
+    rtol, atol : float or None
+        The test's tolerances (None: not given).
+
+    Raises
+    ------
+    ValueError
+        Naming the tolerance and showing what arrived.
+    """
     for name, value in (("rtol", rtol), ("atol", atol)):
         if value is not None and not (is_number(value) and value >= 0):
             raise ValueError(f"`{name}` must be a finite number >= 0 or None, got {value!r}")
@@ -181,7 +192,24 @@ def failed_runs(results: Mapping[str, Result]) -> str:
 
 def failure_message(title: str, checks: Sequence[Check], labels: Sequence[str],
                     estimates: Mapping[str, ErrorEstimate | None]) -> str:
-    """The title, the failed checks as a table, and how the errors were estimated."""
+    """The title, the failed checks as a table, and how the errors were estimated.
+
+    Parameters
+    ----------
+    title : str
+        The first line.
+    checks : sequence of Check
+        Every check made; the failed ones make the table.
+    labels : sequence of str
+        Titles of the two value columns (``"expected"``, an engine).
+    estimates : mapping
+        Engine -> its error estimate (None: none).
+
+    Returns
+    -------
+    str
+        The assertion message.
+    """
     columns = ["quantity", *labels, "difference", "tolerance", "from"]
     formats = {labels[0]: ".8g", labels[1]: ".8g", "difference": "+.3e", "tolerance": ".3e"}
     table = markdown_table([c.row(labels) for c in checks if c.failed], columns, formats)
@@ -242,7 +270,20 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
 def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
     """The scale of a mean value: a work's is the larger of the input and output works (the
     source's, whichever way the power flows; a zero loss has a scale too), any other's its
-    magnitude (None)."""
+    magnitude (None).
+
+    Parameters
+    ----------
+    name : str
+        The mean value (``input_work``, ``loss_work_<pair>``, ...).
+    values : mapping of str to float
+        The base run's mean values (works [J]).
+
+    Returns
+    -------
+    float or None
+        The scale [J] of a work; None: the value's own magnitude.
+    """
     if name.endswith("_work") or name.startswith("loss_work_"):
         return max(abs(values.get(name, 0.0)), abs(values.get("input_work", 0.0)),
                    abs(values.get("output_work", 0.0)))
@@ -250,7 +291,18 @@ def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
 
 
 def check_flow(base: Result, other: Result) -> list[Check]:
-    """A failed check when the two runs' power flows in different directions (empty otherwise)."""
+    """A failed check when the two runs' power flows in different directions.
+
+    Parameters
+    ----------
+    base, other : Result
+        The two runs.
+
+    Returns
+    -------
+    list of Check
+        One failed check, or none when the flows agree.
+    """
     flows = (base.summary.power_flow, other.summary.power_flow)
     if flows[0] == flows[1]:
         return []

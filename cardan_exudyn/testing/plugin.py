@@ -31,9 +31,11 @@ __all__ = ["SceneFactory", "RUNNER", "MARKER", "cardan_scene", "cardan_run"]
 RUNNER = pytest.StashKey["CachingRunner"]()
 """Where the session's runner lives on the config (the fixture and the terminal summary)."""
 MARKER = "cardan_slow"
+"""The marker of tests with slow engine runs (skipped by ``--cardan-skip-slow``)."""
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
+    """The ``--cardan-*`` options."""
     group = parser.getgroup("cardan", "cardan-exudyn (Cardan-joint engine runs)")
     group.addoption("--cardan-skip-slow", action="store_true", default=False,
                     help=f"skip the tests marked {MARKER} (slow engine runs)")
@@ -46,11 +48,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    """Register :data:`MARKER`."""
     config.addinivalue_line("markers", f"{MARKER}: a test with slow engine runs; "
                                        "skipped with --cardan-skip-slow")
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """With ``--cardan-skip-slow``, skip the collected ``items`` marked :data:`MARKER`."""
     if not config.getoption("cardan_skip_slow"):
         return
     skip = pytest.mark.skip(reason=f"{MARKER}: skipped by --cardan-skip-slow")
@@ -99,6 +103,7 @@ def cardan_run(pytestconfig: pytest.Config) -> CachingRunner:
 
 
 def pytest_terminal_summary(terminalreporter: Any, exitstatus: int, config: pytest.Config) -> None:
+    """With ``--cardan-runs``, the session's engine runs as a table at the end of the report."""
     runner = config.stash.get(RUNNER, None)
     if runner is None or not config.getoption("cardan_runs"):
         return

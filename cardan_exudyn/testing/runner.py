@@ -23,7 +23,6 @@ from reference.results.summary import Status
 __all__ = ["RunRecord", "CachingRunner"]
 
 
-
 @dataclass
 class RunRecord:
     """One engine run of a session: what ran (scene name, revolutions, engine, step [s]), how it
@@ -81,7 +80,8 @@ class CachingRunner:
         record = RunRecord(scene.name, scene.revolutions, key[1], result.summary.dt, result.status,
                            result.mean_efficiency, result.summary.wall_time_s)
         if self.cache:
-            self._results[key], self._records[key] = result, record
+            self._results[key] = result
+            self._records[key] = record
             return copy.deepcopy(result)
         self._uncached.append(record)
         return result
@@ -89,7 +89,24 @@ class CachingRunner:
     @staticmethod
     def key(scene: Scene, engine: str | None = None, options: Any = None,
             **option_values: Any) -> tuple[Scene, str, Any]:
-        """``(scene, engine, options)`` with the engine and its options resolved.
+        """``(scene, engine, options)`` with the engine and its options resolved: the cache key.
+
+        Parameters
+        ----------
+        scene : Scene
+            The scene.
+        engine : str, optional
+            A key of :data:`cardan_exudyn.engines.ENGINES` (default: the engine of ``options``,
+            else ``"exudyn"``).
+        options : optional
+            Options of the engine.
+        **option_values
+            Or their fields, as keywords.
+
+        Returns
+        -------
+        tuple
+            ``(scene, engine, options)``; equal tuples are one run.
 
         Raises
         ------

@@ -30,6 +30,10 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
         underscore stands for the dot, so ``numerics__accuracy=1e-4`` is
         ``**{"numerics.accuracy": 1e-4}``. Unit-suffixed names work (``shaft_angle_deg``).
 
+    Returns
+    -------
+    Scene
+
     Raises
     ------
     SceneError
@@ -46,6 +50,7 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
 
 
 def _source(source: str | Path | Scene, root: str | Path | None) -> Scene:
+    """The scene ``source`` names, without changes."""
     if isinstance(source, Scene):
         return source
     if isinstance(source, Path) or (isinstance(source, str) and
@@ -59,4 +64,5 @@ def _source(source: str | Path | Scene, root: str | Path | None) -> Scene:
 
 
 def _label(source: Any) -> str:
+    """How an error message names ``source``."""
     return repr(source.name) if isinstance(source, Scene) else repr(str(source))
