@@ -59,7 +59,8 @@ ENGINES: dict[str, Engine] = {  # the one dispatch table
                      "Exudyn multibody model, generalized-alpha, friction from the joint reactions"),
     "reference": Engine("reference", "reference.engine.solve", "reference.engine.options:ReferenceOptions",
                         "independent numpy/scipy engine: closed-form or dual-number kinematics, "
-                        "minimal-coordinate dynamics, adaptive work quadrature", batch="reference.engine.batch.solve"),
+                        "minimal-coordinate dynamics, adaptive work quadrature",
+                        batch="reference.engine.batch.solve"),
     "mujoco": Engine("mujoco", "cardan_exudyn.mujoco.engine", "cardan_exudyn.mujoco.options:MujocoOptions",
                      "MuJoCo (optional extra): frictionless scenes with a constant load only"),
 }

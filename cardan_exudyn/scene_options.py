@@ -135,7 +135,8 @@ def _named(name: str, labels: list[tuple[str, str]]) -> Scene:
         return scene  # not a name the paper's scenes take (e.g. 92 deg): the override will say why
 
 
-def _drive_overrides(args: argparse.Namespace, changes: dict[str, Any], labels: list[tuple[str, str]]) -> None:
+def _drive_overrides(args: argparse.Namespace, changes: dict[str, Any],
+                     labels: list[tuple[str, str]]) -> None:
     """Add the angle, speed and load overrides and their labels."""
     if args.angle is not None:
         changes["joint.geometry.shaft_angle"] = args.angle * DEG

@@ -139,7 +139,8 @@ def unwrap_counter(counts: np.ndarray,
     jumps = np.flatnonzero(d * direction < -pulses_per_rev / 2.0)
     if jumps.size == 0:
         return c, ()
-    fixed, notes = d.copy(), []
+    fixed = d.copy()
+    notes = []
     for k in jumps:
         near = np.delete(d[max(0, k - 5):k + 6], min(k, 5))
         near = near[near * direction >= -pulses_per_rev / 2.0]

@@ -30,8 +30,8 @@ from rigdata.conditioning import Conditioned, lowpass, window_weights
 from rigdata.record import RigDataError
 from rigdata.transducer import Transducer
 
-__all__ = ["SQRT3", "SQRT12", "noise_level", "Measured", "transducer_pair", "filtered_noise_factor", "instantaneous_efficiency",
-           "uncertainty_budget", "measured_efficiency"]
+__all__ = ["SQRT3", "SQRT12", "noise_level", "Measured", "transducer_pair", "filtered_noise_factor",
+           "instantaneous_efficiency", "uncertainty_budget", "measured_efficiency"]
 
 SQRT3 = math.sqrt(3.0)
 """A rectangular distribution of half width ``a`` has standard deviation ``a / SQRT3``."""
@@ -157,7 +157,8 @@ def instantaneous_efficiency(c: Conditioned, transducers: tuple[Transducer, Tran
     return {"t": c.t, "efficiency": eta, "u": u}
 
 
-def transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | None) -> tuple[Transducer, Transducer]:
+def transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | None
+                    ) -> tuple[Transducer, Transducer]:
     """Input and output transducers from one, a pair or None (the default :class:`Transducer`)."""
     transducers = transducers or Transducer()
     tin, tout = transducers if isinstance(transducers, tuple) else (transducers, transducers)

@@ -167,43 +167,52 @@ def write_lvm(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
     n = t.size
     if not 1 <= segments <= n:
         raise ValueError(f"`segments` must be in [1, {n}], got {segments!r}")
-    dt = _interval(t)
     now = datetime.datetime.now()
     date = metadata.get("Date", now.strftime("%Y/%m/%d"))
     clock = metadata.get("Time", now.strftime("%H:%M:%S.%f"))
-
-    def num(x: float) -> str:
-        return repr(float(x)).replace(".", decimal)
-
     head = {"Writer_Version": "2", "Reader_Version": "2", "Separator": "Tab", "Decimal_Separator": decimal,
             "Multi_Headings": "No", "X_Columns": x_columns, "Time_Pref": "Relative",
             "Operator": metadata.get("Operator", "rigdata"), "Date": date, "Time": clock}
     extra = {k: v for k, v in metadata.items() if k not in head}
     out = ["LabVIEW Measurement\t"] + [f"{k}\t{v}" for k, v in {**head, **extra}.items()]
     out.append("***End_of_Header***\t")
-    names, m = list(columns), len(columns)
     for rows in np.array_split(np.arange(n), segments):
-        out += ["\t",
-                _lvm_row("Channels", [str(m)] + [""] * (m - 1)),
-                _lvm_row("Samples", [str(rows.size)] * m),
-                _lvm_row("Date", [date] * m),
-                _lvm_row("Time", [clock] * m),
-                _lvm_row("Y_Unit_Label", [units[k] for k in names]),
-                _lvm_row("X_Dimension", ["Time"] * m),
-                _lvm_row("X0", [num(t[rows[0]])] * m),
-                _lvm_row("Delta_X", [num(dt)] * m),
-                "***End_of_Header***" + "\t" * (m + 1),
-                "\t".join(["X_Value", *names, "Comment"])]
-        block = {"X_Value": t[rows] if x_columns == "One" else np.full(rows.size, np.nan),
-                 **{k: columns[k][rows] for k in names}}
-        rows_text = _numbers(block, "\t", decimal).rstrip("\n").split("\n")
-        if x_columns == "No":
-            # the X field stays in every row, empty
-            rows_text = ["\t" + line.split("\t", 1)[1] for line in rows_text]
-        out += rows_text
+        out += _lvm_segment(t, columns, units, rows, (date, clock), decimal, x_columns)
     with atomic_open(path, "w", encoding="utf-8", newline="") as f:
         f.write("\r\n".join(out) + "\r\n")
     return Path(path)
+
+
+def _lvm_number(x: float, decimal: str) -> str:
+    """``x`` to its last digit, with the decimal mark ``decimal``."""
+    return repr(float(x)).replace(".", decimal)
+
+
+def _lvm_segment(t: np.ndarray, columns: Mapping[str, np.ndarray], units: Mapping[str, str],
+                 rows: np.ndarray, stamp: tuple[str, str], decimal: str, x_columns: str) -> list[str]:
+    """The lines of one LVM segment: its header (``Channels`` ... ``Delta_X``), the column line
+    and the rows ``rows`` of the columns (``stamp``: the date and time written)."""
+    names = list(columns)
+    m = len(columns)
+    date, clock = stamp
+    lines = ["\t",
+             _lvm_row("Channels", [str(m)] + [""] * (m - 1)),
+             _lvm_row("Samples", [str(rows.size)] * m),
+             _lvm_row("Date", [date] * m),
+             _lvm_row("Time", [clock] * m),
+             _lvm_row("Y_Unit_Label", [units[k] for k in names]),
+             _lvm_row("X_Dimension", ["Time"] * m),
+             _lvm_row("X0", [_lvm_number(t[rows[0]], decimal)] * m),
+             _lvm_row("Delta_X", [_lvm_number(_interval(t), decimal)] * m),
+             "***End_of_Header***" + "\t" * (m + 1),
+             "\t".join(["X_Value", *names, "Comment"])]
+    block = {"X_Value": t[rows] if x_columns == "One" else np.full(rows.size, np.nan),
+             **{k: columns[k][rows] for k in names}}
+    rows_text = _numbers(block, "\t", decimal).rstrip("\n").split("\n")
+    if x_columns == "No":
+        # the X field stays in every row, empty
+        rows_text = ["\t" + line.split("\t", 1)[1] for line in rows_text]
+    return lines + rows_text
 
 
 def write_tdms(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],

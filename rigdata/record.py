@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["CHANNELS", "SHAFTS", "RATE_TOLERANCE", "RigDataError", "ChannelSource", "RigRecord"]
+
 #: Channels a record may hold; SI units. ``angle_*`` come from pulse counts or an angle channel.
 CHANNELS = {
     "torque_in": "N m", "torque_out": "N m",
@@ -32,7 +34,9 @@ class RigDataError(ValueError):
     problem in one line; the CLI prints it and exits with status 2."""
 
     def __init__(self, problem: str, *, file: Any = None, channel: str | None = None) -> None:
-        self.problem, self.file, self.channel = problem, file, channel
+        self.problem = problem
+        self.file = file
+        self.channel = channel
         where = [f"{file}" if file is not None else None,
                  f"channel {channel!r}" if channel is not None else None]
         prefix = ": ".join(w for w in where if w)
@@ -79,6 +83,13 @@ class RigRecord:
         ``file``, ``format``, ``reader`` (name and version), ``sha256`` of the file, the file's
         own header keys (``header``) and, for synthetic files, ``synthetic`` (generator and
         settings as written in the file).
+
+    Raises
+    ------
+    RigDataError
+        On construction: fewer than 4 samples, time not finite, not increasing or not uniform,
+        an unknown or missing channel, a channel of another length or with a non-finite value,
+        sources that do not match the channels.
     """
 
     time: np.ndarray
@@ -88,47 +99,9 @@ class RigRecord:
 
     def __post_init__(self) -> None:
         file = self.provenance.get("file") if isinstance(self.provenance, Mapping) else None
-        t = np.asarray(self.time, dtype=float)
-        if t.ndim != 1 or t.size < 4:
-            raise RigDataError(f"needs at least 4 samples, got {t.size}", file=file, channel="time")
-        if not np.all(np.isfinite(t)):
-            raise RigDataError("time has non-finite values", file=file, channel="time")
-        dt = np.diff(t)
-        if np.any(dt <= 0):
-            i = int(np.argmax(dt <= 0))
-            raise RigDataError(f"time does not increase at sample {i + 1} ({float(t[i])!r} then "
-                               f"{float(t[i + 1])!r})", file=file, channel="time")
-        step = float(np.median(dt))
-        spread = float(np.max(np.abs(dt - step)) / step)
-        if spread > RATE_TOLERANCE:
-            i = int(np.argmax(np.abs(dt - step)))
-            raise RigDataError(
-                f"mixed sampling rates: interval {dt[i]:.6g} s at sample {i + 1} against the median "
-                f"{step:.6g} s (the conditioning needs one rate; resample or split the file)",
-                file=file, channel="time")
-        unknown = set(self.channels) - set(CHANNELS)
-        if unknown:
-            raise RigDataError(f"unknown channels {sorted(unknown)}; expected {sorted(CHANNELS)}",
-                               file=file)
-        for need in ("torque_in", "torque_out"):
-            if need not in self.channels:
-                raise RigDataError("missing (a record needs both torques)", file=file, channel=need)
-        for shaft in SHAFTS:
-            if f"speed_{shaft}" not in self.channels and f"angle_{shaft}" not in self.channels:
-                raise RigDataError(f"missing: neither speed_{shaft} nor angle_{shaft} found",
-                                   file=file, channel=f"speed_{shaft}")
-        channels = {}
-        for name, values in self.channels.items():
-            v = np.asarray(values, dtype=float)
-            if v.shape != t.shape:
-                raise RigDataError(f"has {v.size} samples, time has {t.size}", file=file, channel=name)
-            bad = ~np.isfinite(v)
-            if bad.any():
-                i = int(np.argmax(bad))
-                raise RigDataError(f"{int(bad.sum())} non-finite values (NaN or non-numeric), the "
-                                   f"first at t = {t[i]:.6g} s (sample {i})", file=file, channel=name)
-            v.flags.writeable = False
-            channels[name] = v
+        t = _checked_time(self.time, file)
+        _check_channel_names(self.channels, file)
+        channels = {name: _checked_values(name, values, t, file) for name, values in self.channels.items()}
         if set(self.sources) != set(channels):
             raise RigDataError(f"sources {sorted(self.sources)} do not match channels "
                                f"{sorted(channels)}", file=file)
@@ -171,3 +144,57 @@ class RigRecord:
     def revolutions(self, shaft: str = "in") -> float:
         """Whole and partial revolutions turned by a shaft (absolute value) [-]."""
         return abs(self.turned(shaft)) / (2.0 * math.pi)
+
+
+def _checked_time(time: Any, file: Any) -> np.ndarray:
+    """``time`` as floats: at least 4 samples, finite, increasing, uniform to :data:`RATE_TOLERANCE`;
+    :class:`RigDataError` naming the sample otherwise."""
+    t = np.asarray(time, dtype=float)
+    if t.ndim != 1 or t.size < 4:
+        raise RigDataError(f"needs at least 4 samples, got {t.size}", file=file, channel="time")
+    if not np.all(np.isfinite(t)):
+        raise RigDataError("time has non-finite values", file=file, channel="time")
+    dt = np.diff(t)
+    if np.any(dt <= 0):
+        i = int(np.argmax(dt <= 0))
+        raise RigDataError(f"time does not increase at sample {i + 1} ({float(t[i])!r} then "
+                           f"{float(t[i + 1])!r})", file=file, channel="time")
+    step = float(np.median(dt))
+    spread = float(np.max(np.abs(dt - step)) / step)
+    if spread > RATE_TOLERANCE:
+        i = int(np.argmax(np.abs(dt - step)))
+        raise RigDataError(
+            f"mixed sampling rates: interval {dt[i]:.6g} s at sample {i + 1} against the median "
+            f"{step:.6g} s (the conditioning needs one rate; resample or split the file)",
+            file=file, channel="time")
+    return t
+
+
+def _check_channel_names(channels: Mapping[str, Any], file: Any) -> None:
+    """:class:`RigDataError` for an unknown channel, or a record without both torques and, for each
+    shaft, a speed or an angle."""
+    unknown = set(channels) - set(CHANNELS)
+    if unknown:
+        raise RigDataError(f"unknown channels {sorted(unknown)}; expected {sorted(CHANNELS)}", file=file)
+    for need in ("torque_in", "torque_out"):
+        if need not in channels:
+            raise RigDataError("missing (a record needs both torques)", file=file, channel=need)
+    for shaft in SHAFTS:
+        if f"speed_{shaft}" not in channels and f"angle_{shaft}" not in channels:
+            raise RigDataError(f"missing: neither speed_{shaft} nor angle_{shaft} found",
+                               file=file, channel=f"speed_{shaft}")
+
+
+def _checked_values(name: str, values: Any, t: np.ndarray, file: Any) -> np.ndarray:
+    """Channel ``name`` as read-only floats on the time grid ``t``; :class:`RigDataError` for
+    another length or a non-finite value (naming the first)."""
+    v = np.asarray(values, dtype=float)
+    if v.shape != t.shape:
+        raise RigDataError(f"has {v.size} samples, time has {t.size}", file=file, channel=name)
+    bad = ~np.isfinite(v)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise RigDataError(f"{int(bad.sum())} non-finite values (NaN or non-numeric), the "
+                           f"first at t = {t[i]:.6g} s (sample {i})", file=file, channel=name)
+    v.flags.writeable = False
+    return v

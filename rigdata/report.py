@@ -97,7 +97,8 @@ def figure(v: Validation) -> Any:
     inst = v.measured.instantaneous
     inside = v.conditioned.in_window()
     t = inst["t"][inside]
-    eta, u = inst["efficiency"][inside], inst["u"][inside]
+    eta = inst["efficiency"][inside]
+    u = inst["u"][inside]
     fig, axes = _pyplot().subplots(3, 1, figsize=(9, 10))
     _over_time(axes[0], v, t, eta, u)
     _over_angle(axes[1], v, eta, u)
@@ -194,7 +195,8 @@ def markdown(s: dict) -> str:
 
 def _signals(v: Validation) -> dict[str, np.ndarray]:
     """The conditioned signals with the measured and each engine's instantaneous efficiency."""
-    cond, inst = v.conditioned, v.measured.instantaneous
+    cond = v.conditioned
+    inst = v.measured.instantaneous
     table = {"t": cond.t, "angle_in": cond.angle_in, "speed_in": cond.speed_in,
              "speed_out": cond.speed_out, "torque_in": cond.torque_in, "torque_out": cond.torque_out,
              "efficiency_measured": inst["efficiency"], "efficiency_measured_u": inst["u"]}

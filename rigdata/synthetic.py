@@ -42,8 +42,13 @@ from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
 from rigdata.units import parse_unit
 
+__all__ = ["GENERATOR", "FORMATS", "MAX_SAMPLES", "RigSettings", "Truth", "motor_angle", "true_signals",
+           "measure", "metadata", "record", "write"]
+
 GENERATOR = "rigdata.synthetic 1"
+"""The ``generator`` label of every synthetic file (name and version of this model)."""
 FORMATS = ("csv", "lvm", "tdms")
+"""The file formats :func:`write` writes."""
 
 
 @dataclass(frozen=True)
@@ -79,6 +84,12 @@ class RigSettings:
     speed_channel : {"pulses", "rpm"}
         Pulse counts (the rig's 60 per revolution) or a speed channel in rpm.
     seed : int
+        Seed of every drawn error and of the noise.
+
+    Raises
+    ------
+    TypeError, ValueError
+        A setting of the wrong type or out of range, naming it.
     """
 
     scene: str = "rig"
@@ -97,20 +108,7 @@ class RigSettings:
     seed: int = 1
 
     def __post_init__(self) -> None:
-        for name in ("speed", "input_torque", "revolutions", "rate", "phase", "noise", "lag"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-                raise TypeError(f"`{name}` must be a number, got {value!r:.80}")
-        if not isinstance(self.scene, str):
-            raise TypeError(f"`scene` must be a scene name, got {self.scene!r:.80}")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
-                or not 0 <= self.seed < 2**63:
-            raise ValueError(f"`seed` must be an integer in [0, 2**63), got {self.seed!r:.80}")
-        for name in ("ripple", "offsets", "drifts"):
-            value = getattr(self, name)
-            if (value is not None or name == "ripple") and not _pair_of_numbers(value):
-                none = "" if name == "ripple" else " or None"
-                raise ValueError(f"`{name}` must be two finite numbers [N m]{none}, got {value!r:.80}")
+        self._check_types()
         if not math.isfinite(self.phase):
             raise ValueError(f"`phase` must be finite [rad], got {self.phase!r}")
         angle = self.shaft_angle_deg
@@ -126,6 +124,29 @@ class RigSettings:
                 raise ValueError(f"`{name}` must be >= 0, got {getattr(self, name)!r}")
         if self.speed_channel not in ("pulses", "rpm"):
             raise ValueError(f"`speed_channel` must be 'pulses' or 'rpm', got {self.speed_channel!r}")
+        self._check_size()
+
+    def _check_types(self) -> None:
+        """``TypeError``/``ValueError`` for a setting of the wrong type: a number that is none, a
+        scene that is no name, a seed out of range, a pair that is not two finite numbers."""
+        for name in ("speed", "input_torque", "revolutions", "rate", "phase", "noise", "lag"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+                raise TypeError(f"`{name}` must be a number, got {value!r:.80}")
+        if not isinstance(self.scene, str):
+            raise TypeError(f"`scene` must be a scene name, got {self.scene!r:.80}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
+                or not 0 <= self.seed < 2**63:
+            raise ValueError(f"`seed` must be an integer in [0, 2**63), got {self.seed!r:.80}")
+        for name in ("ripple", "offsets", "drifts"):
+            value = getattr(self, name)
+            if (value is not None or name == "ripple") and not _pair_of_numbers(value):
+                none = "" if name == "ripple" else " or None"
+                raise ValueError(f"`{name}` must be two finite numbers [N m]{none}, got {value!r:.80}")
+
+    def _check_size(self) -> None:
+        """``ValueError`` for a record without a whole revolution after settling, or one of more
+        than :data:`MAX_SAMPLES` samples."""
         if self.revolutions < 1.6:
             raise ValueError(f"`revolutions` must be >= 1.6 (one whole revolution after settling), "
                              f"got {self.revolutions!r}")
@@ -142,13 +163,29 @@ def _pair_of_numbers(value: object) -> bool:
                     and math.isfinite(v) for v in value))
 
 
-#: Most samples a synthetic record may have (the model is evaluated at every one of them).
 MAX_SAMPLES = 1_000_000
+"""Most samples a synthetic record may have (the model is evaluated at every one of them)."""
 
 
 @dataclass(frozen=True)
 class Truth:
-    """The true signals on the sampling grid and the true efficiency."""
+    """The true signals on the sampling grid and the true efficiency.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Sample times [s].
+    angle_in, angle_out : ndarray, shape (n,)
+        Shaft angles [rad].
+    speed_in, speed_out : ndarray, shape (n,)
+        Shaft speeds [rad/s].
+    torque_in, torque_out : ndarray, shape (n,)
+        Drive and brake torques [N m].
+    efficiency : float
+        The reference engine's mean efficiency over whole revolutions [-].
+    brake_torque : float
+        The constant brake torque [N m].
+    """
 
     t: np.ndarray
     angle_in: np.ndarray
@@ -162,9 +199,23 @@ class Truth:
 
 
 def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tuple[np.ndarray, np.ndarray]:
-    """Times [s] and input angles [rad] of a motor with speed ``w0 (1 + e1 cos th + e2 cos 2th)``.
+    """The motion of a motor with speed ``w0 (1 + e1 cos th + e2 cos 2th)``.
 
     The speed is a function of the angle, so the motion repeats every revolution.
+
+    Parameters
+    ----------
+    settings : RigSettings
+        Mean speed ``w0``, ripple ``(e1, e2)``, revolutions, phase.
+    points_per_revolution : int
+        Knots per revolution of the returned history.
+
+    Returns
+    -------
+    t : ndarray
+        Times [s], from 0.
+    angle : ndarray
+        Input angles [rad], from the settings' phase; half a revolution more than recorded.
     """
     e1, e2 = settings.ripple
     total = 2 * math.pi * (settings.revolutions + 0.5)
@@ -195,7 +246,14 @@ def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
 
 
 def true_signals(settings: RigSettings) -> Truth:
-    """Run the reference engine on the rig driven by the motor; sample on the rig's grid."""
+    """Run the reference engine on the rig driven by the motor (:func:`motor_angle`) and loaded by
+    the brake torque that gives the settings' mean input torque; sample on the rig's grid.
+
+    Raises
+    ------
+    ValueError
+        The rig's model does not run (status not ``ok``).
+    """
     t_knots, angle = motor_angle(settings)
     base = named_scene(settings.scene)
     if settings.shaft_angle_deg is not None:
@@ -214,7 +272,10 @@ def true_signals(settings: RigSettings) -> Truth:
                  efficiency=float(result.mean_efficiency), brake_torque=float(brake))
 
 
-def _errors(settings: RigSettings, transducer: Transducer, rng: np.random.Generator) -> tuple:
+def _errors(settings: RigSettings, transducer: Transducer,
+            rng: np.random.Generator) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The accuracy-class offsets and zero drifts (input, output) [N m]: the settings', else drawn
+    uniformly within the transducer's limits."""
     offsets = settings.offsets if settings.offsets is not None else \
         tuple(rng.uniform(-1, 1, 2) * transducer.accuracy_limit)
     drifts = settings.drifts if settings.drifts is not None else \
@@ -222,24 +283,54 @@ def _errors(settings: RigSettings, transducer: Transducer, rng: np.random.Genera
     return tuple(float(x) for x in offsets), tuple(float(x) for x in drifts)
 
 
+def _torque_volts(torque: np.ndarray, offset: float, drift: np.ndarray, settings: RigSettings,
+                  transducer: Transducer, rng: np.random.Generator) -> np.ndarray:
+    """One torque as the acquisition card reads it [V]: the transducer's output filter (first
+    order, causal, bilinear), offset, drift ramp [N m] and noise, scaled by the sensitivity,
+    clipped to the card's range and quantised to its step."""
+    if settings.lag > 0:
+        b, a = signal.bilinear([1.0], [settings.lag, 1.0], fs=settings.rate)
+        torque = signal.lfilter(b, a, torque, zi=signal.lfilter_zi(b, a) * torque[0])[0]
+    measured = torque + offset + drift + rng.normal(0.0, settings.noise, torque.size)
+    volts = np.clip(measured * transducer.sensitivity, -transducer.adc_range, transducer.adc_range)
+    step = 2 * transducer.adc_range / 2 ** transducer.adc_bits
+    return np.round(volts / step) * step
+
+
 def measure(truth: Truth, settings: RigSettings,
             transducer: Transducer | None = None) -> tuple[dict, dict, dict]:
-    """Apply the transducer model. Returns ``(table, units, settings_used)``: raw columns
-    (time [s], torques [V], pulse counts or speeds [rpm]) as a file holds them."""
+    """Apply the transducer model to the true signals.
+
+    Parameters
+    ----------
+    truth : Truth
+        The true signals (:func:`true_signals`).
+    settings : RigSettings
+        Noise, lag, drawn errors (``seed``), speed channel.
+    transducer : Transducer, optional
+        Sensitivity, accuracy, drift and acquisition (default: :class:`Transducer`).
+
+    Returns
+    -------
+    table : dict of str to ndarray
+        Raw columns as a file holds them: ``Time`` [s] from 0, ``Torque In/Out`` [V], and
+        ``Pulses In/Out`` [counts] or ``Speed In/Out`` [rpm].
+    units : dict of str to str
+        Each column's unit.
+    used : dict
+        Every setting, the drawn errors, the encoder start, the true phase and efficiency, the
+        brake torque and the transducer.
+    """
     transducer = transducer or Transducer()
     rng = np.random.default_rng(settings.seed)
     offsets, drifts = _errors(settings, transducer, rng)
     t = truth.t
     ramp = (t - t[0]) / (t[-1] - t[0])
-    table, units = {"Time": t - t[0]}, {"Time": "s"}
+    table = {"Time": t - t[0]}
+    units = {"Time": "s"}
     for k, (name, torque) in enumerate((("In", truth.torque_in), ("Out", truth.torque_out))):
-        if settings.lag > 0:  # the transducer's output filter: first order, causal, bilinear
-            b, a = signal.bilinear([1.0], [settings.lag, 1.0], fs=settings.rate)
-            torque = signal.lfilter(b, a, torque, zi=signal.lfilter_zi(b, a) * torque[0])[0]
-        measured = torque + offsets[k] + drifts[k] * ramp + rng.normal(0.0, settings.noise, t.size)
-        volts = np.clip(measured * transducer.sensitivity, -transducer.adc_range, transducer.adc_range)
-        step = 2 * transducer.adc_range / 2 ** transducer.adc_bits
-        table[f"Torque {name}"] = np.round(volts / step) * step
+        table[f"Torque {name}"] = _torque_volts(torque, offsets[k], drifts[k] * ramp, settings,
+                                                transducer, rng)
         units[f"Torque {name}"] = "V"
     q = transducer.pulse_angle
     encoder_start = rng.uniform(0.0, q)  # where in a pulse interval the counter starts
@@ -262,19 +353,38 @@ def measure(truth: Truth, settings: RigSettings,
 
 
 def metadata(used: dict) -> dict:
-    """The label every synthetic file carries."""
+    """The label every synthetic file carries: ``synthetic``, ``generator``, ``settings`` (JSON of
+    ``used``, :func:`measure`'s) and ``description``."""
     return {"synthetic": "true", "generator": GENERATOR, "settings": json.dumps(used, sort_keys=True),
             "description": "SYNTHETIC rig data: reference-engine joint + transducer model, not a measurement"}
 
 
 def record(settings: RigSettings | None = None, transducer: Transducer | None = None,
            truth: Truth | None = None) -> tuple[RigRecord, dict]:
-    """A synthetic measurement as a record in memory (no file), and the settings used."""
+    """A synthetic measurement as a record in memory (no file).
+
+    Parameters
+    ----------
+    settings : RigSettings, optional
+        Default: :class:`RigSettings`.
+    transducer : Transducer, optional
+        Default: :class:`~rigdata.transducer.Transducer`.
+    truth : Truth, optional
+        The true signals, when already computed for ``settings`` (:func:`true_signals`).
+
+    Returns
+    -------
+    record : RigRecord
+        In SI units, provenance labelled synthetic.
+    used : dict
+        As :func:`measure` returns it.
+    """
     settings = settings or RigSettings()
     transducer = transducer or Transducer()
     truth = truth or true_signals(settings)
     table, units, used = measure(truth, settings, transducer)
-    channels, sources = {}, {}
+    channels = {}
+    sources = {}
     names = {"Torque": "torque", "Pulses": "angle", "Speed": "speed"}
     for column, values in table.items():
         if column == "Time":
@@ -292,8 +402,22 @@ def record(settings: RigSettings | None = None, transducer: Transducer | None = 
 
 def write(path, fmt: str, settings: RigSettings | None = None, transducer: Transducer | None = None,
           truth: Truth | None = None) -> dict:
-    """Write a synthetic measurement file (``csv``: comma and point; ``lvm``: LabVIEW with
-    decimal comma; ``tdms``). Returns the settings used (with the true efficiency)."""
+    """Write a synthetic measurement file, labelled as such (:func:`metadata`).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (replaced atomically).
+    fmt : {"csv", "lvm", "tdms"}
+        ``csv``: comma and point; ``lvm``: LabVIEW with decimal comma; ``tdms``.
+    settings, transducer, truth : optional
+        As for :func:`record`.
+
+    Returns
+    -------
+    dict
+        The settings used, with the drawn errors and the true efficiency (:func:`measure`).
+    """
     if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
         raise TypeError(f"`path` must be a str or path naming the file to write, got {path!r:.80}")
     if not isinstance(fmt, str) or fmt not in FORMATS:

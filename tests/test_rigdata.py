@@ -260,7 +260,7 @@ def test_import_rigdata_is_light():
     code = ("import sys, rigdata; heavy = [m for m in ('scipy', 'pandas', 'rigdata.readers') "
             "if m in sys.modules]; print(heavy); print(rigdata.read.__module__)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.split("\n")[:2] == ["[]", "rigdata.readers"]
+    assert out.split("\n")[:2] == ["[]", "rigdata.readers.dispatch"]
     assert set(rigdata.__all__) <= set(dir(rigdata))
 
 

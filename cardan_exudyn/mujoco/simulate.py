@@ -63,8 +63,18 @@ class Record:
         self.size = 0
 
     def take(self, d: Any, drive_row: int | None, torque: float) -> None:
-        """Append the state of ``d`` (after ``mj_forward`` and ``mj_rnePostConstraint``); the drive
-        torque is the force of constraint row ``drive_row``, else the applied ``torque`` [N m]."""
+        """Append the state of ``d`` as the next row.
+
+        Parameters
+        ----------
+        d : mujoco.MjData
+            After ``mj_forward`` and ``mj_rnePostConstraint`` at the current state.
+        drive_row : int or None
+            The drive equality's constraint row, whose force is the drive torque; None for a
+            torque drive.
+        torque : float
+            The applied drive torque [N m] when ``drive_row`` is None.
+        """
         k = self.size
         bodies = slice(1, 4)
         self.t[k] = d.time

@@ -26,9 +26,11 @@ __all__ = ["ERROR_CONSTANT_SPEED", "ERROR_CONSTANT_GRAVITY", "MIN_STEPS_PER_REVO
            "speed_ratio_error_model", "choose_timestep"]
 
 ERROR_CONSTANT_SPEED = 1.5e-4
-"""``C_H`` of :func:`speed_ratio_error_model` [-]. Measured: docs/mujoco.md#error-model-and-the-automatic-step."""
+"""``C_H`` of :func:`speed_ratio_error_model` [-].
+Measured: docs/mujoco.md#error-model-and-the-automatic-step."""
 ERROR_CONSTANT_GRAVITY = 1e-4
-"""``C_G`` of :func:`speed_ratio_error_model` [1/m]. Measured: docs/mujoco.md#error-model-and-the-automatic-step."""
+"""``C_G`` of :func:`speed_ratio_error_model` [1/m].
+Measured: docs/mujoco.md#error-model-and-the-automatic-step."""
 MIN_STEPS_PER_REVOLUTION = 100
 """Fewest steps per input revolution the automatic step takes."""
 SECONDS_PER_STEP = 1e-4

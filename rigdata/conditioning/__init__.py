@@ -4,8 +4,8 @@
 module: :mod:`~rigdata.conditioning.options` (:class:`Conditioning`),
 :mod:`~rigdata.conditioning.angles` (angles from pulse edges), :mod:`~rigdata.conditioning.filters`
 (zero-phase low-pass, speed of an angle), :mod:`~rigdata.conditioning.window` (whole-revolution
-window, integral weights over it), :mod:`~rigdata.conditioning.phase` (input yoke phase). The choices and their defaults:
-``docs/rigdata.md``.
+window, integral weights over it), :mod:`~rigdata.conditioning.phase` (input yoke phase). The
+choices and their defaults: ``docs/rigdata.md``.
 """
 
 from __future__ import annotations

@@ -167,7 +167,9 @@ def to_record(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str]
     """
     n = _lengths(raw, chosen)
     time, time_info, assumptions = time_axis(raw, chosen, units, n)
-    channels, sources, notes = {}, {}, list(raw.notes)
+    channels = {}
+    sources = {}
+    notes = list(raw.notes)
     for ch, col in chosen.items():
         if ch == "time":
             continue

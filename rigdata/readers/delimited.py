@@ -109,12 +109,14 @@ def layout(lines: list[str], path: Path) -> Layout:
     above = [i for i in range(first) if lines[i].strip()]
     if not above:
         raise RigDataError(f"no header line with column names above the data (line {first + 1})", file=path)
-    header, units_row = above[-1], None
+    header = above[-1]
+    units_row = None
     units = header_fields(lines[header], sep, width)
     if len(above) > 1 and len(units) == width and _units_row(units):
         candidate = header_fields(lines[above[-2]], sep, width)
         if len(candidate) == width and not any(map(is_number, candidate)):
-            header, units_row = above[-2], above[-1]
+            header = above[-2]
+            units_row = above[-1]
     names = header_fields(lines[header], sep, width)
     if len(names) != width or any(map(is_number, names)):
         raise RigDataError(f"no header line with column names above the data: line {header + 1} "
@@ -133,7 +135,8 @@ def preamble(lines: list[str], sep: str | None) -> dict[str, str]:
             continue
         cut = [i for i in (text.find(":"), text.find("=")) if i > 0]
         if cut:
-            key, value = text[:min(cut)].strip(), text[min(cut) + 1:].strip()
+            key = text[:min(cut)].strip()
+            value = text[min(cut) + 1:].strip()
         else:
             parts = [p for p in split(text, sep if sep else "\t") if p]
             if len(parts) != 2:
@@ -153,7 +156,8 @@ def _check_widths(lines: list[str], rows: list[int], lay: Layout, path: Path, en
     if not bad:
         return
     k = bad[0]
-    line, n = rows[k] + 1, counts[k]
+    line = rows[k] + 1
+    n = counts[k]
     if k == len(rows) - 1 and n < lay.width:
         cut = "" if ends_clean else " and no line end"
         raise RigDataError(f"truncated: the last line ({line}) has {n} of {lay.width} fields{cut}; "
@@ -230,7 +234,9 @@ def read_delimited(path: Path, text: str, sha: str) -> RawTable:
     _check_widths(lines, rows, lay, path, text.endswith(("\n", "\r")))
     headers, names, row_units = _headers(lines, lay, path)
     frame = _frame(lines, rows, lay, path)
-    columns, units, text_cells = {}, {}, {}
+    columns = {}
+    units = {}
+    text_cells = {}
     file_lines = [k + 1 for k in rows]
     for i, name in enumerate(names):
         values, cells = _column(frame[i], lay.decimal, file_lines)

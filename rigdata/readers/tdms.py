@@ -46,7 +46,8 @@ def nptdms_warnings() -> Iterator[list[str]]:
         def emit(self, record: logging.LogRecord) -> None:
             messages.append(record.getMessage())
 
-    keep, mute = Keep(logging.WARNING), logging.Filter("rigdata.readers.muted")
+    keep = Keep(logging.WARNING)
+    mute = logging.Filter("rigdata.readers.muted")
     loggers = [logging.getLogger(name) for name in list(logging.root.manager.loggerDict)
                if name.startswith("nptdms")]
     console = getattr(getattr(nptdms.log, "log_manager", None), "console_handler", None)
@@ -121,7 +122,10 @@ def read_tdms(path: Path, data: bytes, sha: str) -> RawTable:
     """
     tdms, loaded, warnings = _load(data, path)
     plain = [c.name for _, c, *_ in loaded]
-    columns, units, text_cells, sampling = {}, {}, {}, {}
+    columns = {}
+    units = {}
+    text_cells = {}
+    sampling = {}
     for group, channel, values, cells, implied in loaded:
         name = channel.name if plain.count(channel.name) == 1 else f"{group}/{channel.name}"
         props = channel.properties
