@@ -47,6 +47,7 @@ def _settings(cls: type, **kwargs: Any) -> Any:
 
 
 def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
+    """``CHANNEL=VALUE`` items of a repeatable option as a dict; :class:`BadInput` otherwise."""
     out = {}
     for item in values or []:
         key, sep, value = item.partition("=")
@@ -57,6 +58,7 @@ def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
 
 
 def _shaft_angle(text: str) -> float:
+    """``--angle``: a shaft angle in [0, 90) deg."""
     value = arguments.number("deg", non_negative=True)(text)
     if value >= 90.0:
         raise argparse.ArgumentTypeError(f"must be below 90 deg (a joint at 90 deg transmits no motion), "
@@ -65,6 +67,7 @@ def _shaft_angle(text: str) -> float:
 
 
 def _read(args: argparse.Namespace) -> rigdata.RigRecord:
+    """The record of ``FILE`` with the file options; a refused option is :class:`BadInput`."""
     try:
         return rigdata.read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
                             units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
@@ -76,6 +79,7 @@ def _read(args: argparse.Namespace) -> rigdata.RigRecord:
 
 
 def _transducers(args: argparse.Namespace) -> tuple[rigdata.Transducer, rigdata.Transducer]:
+    """Both transducers from the options (the rig's two are alike)."""
     t = _settings(rigdata.Transducer, full_scale=args.full_scale, sensitivity=args.sensitivity,
                   pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
                   zero_drift=args.zero_drift)
@@ -83,12 +87,14 @@ def _transducers(args: argparse.Namespace) -> tuple[rigdata.Transducer, rigdata.
 
 
 def _draws(args: argparse.Namespace) -> int:
+    """``--mc``: the Monte Carlo draws, 0 for the GUM only."""
     if args.mc < 0:
         raise BadInput(f"--mc must be >= 0 (0: GUM only), got {args.mc}")
     return args.mc
 
 
 def _conditioning(args: argparse.Namespace) -> rigdata.Conditioning:
+    """The conditioning settings from the options."""
     return _settings(rigdata.Conditioning, cutoff_harmonics=args.cutoff_harmonics,
                      settle_revolutions=args.settle, derivative=args.derivative)
 
@@ -161,6 +167,7 @@ def _scene(args: argparse.Namespace) -> Scene:
 
 
 def _engines(text: str) -> tuple[str, ...]:
+    """``--engines A,B``: engines that take a measured drive (:data:`rigdata.MODEL_ENGINES`)."""
     engines = tuple(e.strip() for e in text.split(",") if e.strip())
     if not engines or any(e not in rigdata.MODEL_ENGINES for e in engines):
         raise BadInput(f"--engines takes reference and/or exudyn, got {text!r}")
@@ -168,6 +175,7 @@ def _engines(text: str) -> tuple[str, ...]:
 
 
 def _progress(args: argparse.Namespace) -> Callable[[str], None]:
+    """Progress lines on stderr, none with ``--json``."""
     def say(line: str) -> None:
         if not args.json:
             print(f"cardan rig validate: {line}", file=sys.stderr, flush=True)
@@ -176,6 +184,7 @@ def _progress(args: argparse.Namespace) -> Callable[[str], None]:
 
 
 def _print_validation(s: dict[str, Any]) -> None:
+    """One line per engine: computed against measured efficiency, their difference, significance."""
     measured = f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}"
     for engine, comp in s["computed"].items():
         cmp = s["comparisons"].get(engine, {})
@@ -226,6 +235,7 @@ def cmd_synthetic(args: argparse.Namespace) -> int:
 
 
 def _file_options(p: argparse.ArgumentParser) -> None:
+    """``FILE`` and how to read it (every rig command but ``synthetic``)."""
     p.add_argument("file", metavar="FILE", help="rig file: delimited text, LabVIEW .lvm or NI .tdms")
     p.add_argument("--format", choices=("auto", "csv", "lvm", "tdms"), default="auto")
     p.add_argument("--map", action="append", metavar="CHANNEL=COLUMN",
@@ -240,6 +250,7 @@ def _file_options(p: argparse.ArgumentParser) -> None:
 
 
 def _measure_options(p: argparse.ArgumentParser) -> None:
+    """Shaft angle, conditioning, transducers, Monte Carlo (``measure``, ``validate``)."""
     p.add_argument("--angle", type=_shaft_angle, default=None,
                    help="shaft angle [deg] (default: validate the scene's, measure 15, the paper's "
                         "rig case)")
@@ -263,6 +274,7 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
 
 
 def _validate_options(p: argparse.ArgumentParser) -> None:
+    """The report folder, the joint, its friction and the engines (``validate``)."""
     p.add_argument("--out", required=True, metavar="DIR", help="report folder (replaced atomically)")
     p.add_argument("--scene", default="rig", metavar="NAME|FILE",
                    help="the joint: a named scene or a scene TOML file (your own joint; may start "
@@ -274,6 +286,7 @@ def _validate_options(p: argparse.ArgumentParser) -> None:
 
 
 def _synthetic_options(p: argparse.ArgumentParser) -> None:
+    """The file to write and the synthetic rig's settings (``synthetic``)."""
     p.add_argument("--out", required=True, metavar="FILE")
     p.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
     p.add_argument("--revolutions", type=arguments.number("rev", positive=True), default=5.0)

@@ -24,8 +24,22 @@ LIMITS = {"time": 1e11, "torque": 1e8, "speed": 1e5, "angle": 1e9}
 
 
 def check_magnitudes(time: np.ndarray, channels: dict[str, np.ndarray], file: object = None) -> None:
-    """:class:`RigDataError` naming the channel, the sample and the limit when a value of ``time``
-    [s] or a channel (SI units, keys such as ``torque_in``) exceeds :data:`LIMITS` in magnitude."""
+    """Refuse values beyond :data:`LIMITS`: a wrong unit or scale, or a corrupt file.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Sample times [s].
+    channels : dict of str to ndarray, shape (n,)
+        Channels in SI units, keys such as ``torque_in`` (the kind is the first word).
+    file : object, optional
+        Named in the error.
+
+    Raises
+    ------
+    RigDataError
+        Naming the channel, the sample and the limit.
+    """
     for name, values in (("time", time), *channels.items()):
         kind = name.split("_")[0]
         limit = LIMITS.get(kind)

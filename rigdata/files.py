@@ -26,6 +26,8 @@ from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 from cardan_exudyn.outputs import atomic_open
 from rigdata.units import split_header
 
+__all__ = ["write_csv", "write_lvm", "write_tdms"]
+
 #: Column names recognised as time by the writers (the first such column is the time axis).
 _TIME_NAMES = ("time", "t", "x_value", "zeit")
 #: LVM header tags the writer sets itself; metadata may not override them.
@@ -116,7 +118,8 @@ def write_csv(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
 
 
 def _lvm_row(key: str, values: list[str]) -> str:
-    # one value under each Y column and an empty field under Comment, as LabVIEW writes them
+    """A segment header row: one value under each Y column and an empty field under Comment, as
+    LabVIEW writes them."""
     return "\t".join([key, *values, ""])
 
 

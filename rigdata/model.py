@@ -24,6 +24,8 @@ from reference.scene.load import Load
 from reference.scene.scene import Scene
 from rigdata.conditioning import Conditioned
 
+__all__ = ["MARGIN_REVOLUTIONS", "measured_scene", "computed_efficiency", "model_sensitivities"]
+
 #: The margin of drive history kept after the window (so the engines find the window's end) [rev].
 MARGIN_REVOLUTIONS = 0.05
 
@@ -91,6 +93,7 @@ def computed_efficiency(result: Result) -> dict[str, Any]:
 
 
 def _series(table: Any) -> dict[str, np.ndarray]:
+    """The curves of Figure 10 from a time table (see :func:`computed_efficiency`)."""
     with np.errstate(divide="ignore", invalid="ignore"):
         p_in = table["power_in"].to_numpy()
         return {"t": table["t"].to_numpy(), "theta_in": table["theta_in"].to_numpy(),

@@ -29,6 +29,8 @@ COLOURS = {"reference": "C0", "exudyn": "C1"}
 
 
 def _limits(eta: np.ndarray, u: np.ndarray) -> tuple[float, float]:
+    """Efficiency axis limits [-]: the k = 2 band's 1st and 99th percentiles, widened to show at
+    least [0.8, 1.05]."""
     finite = np.isfinite(eta) & np.isfinite(u)
     lo = np.percentile((eta - K * u)[finite], 1) if finite.any() else 0.0
     hi = np.percentile((eta + K * u)[finite], 99) if finite.any() else 1.0
@@ -41,6 +43,8 @@ def _series(v: Validation) -> dict[str, dict[str, np.ndarray]]:
 
 
 def _over_time(ax: Any, v: Validation, t: np.ndarray, eta: np.ndarray, u: np.ndarray) -> None:
+    """Figure 10's top panel: the measured efficiency with its band, and the computed ones, over
+    time [s]."""
     ax.fill_between(t, eta - K * u, eta + K * u, color="0.85", label="measured, k = 2 band")
     ax.plot(t, eta, color="k", lw=0.8, label="measured P_out / P_in")
     for engine, series in _series(v).items():
@@ -54,6 +58,7 @@ def _over_time(ax: Any, v: Validation, t: np.ndarray, eta: np.ndarray, u: np.nda
 
 
 def _over_angle(ax: Any, v: Validation, eta: np.ndarray, u: np.ndarray) -> None:
+    """The middle panel: the same over the input yoke angle [deg], every revolution overlaid."""
     cond = v.conditioned
     angle = np.degrees(np.mod(cond.angle_in[cond.in_window()] + cond.phase, 2 * math.pi))
     order = np.argsort(angle)
@@ -70,6 +75,7 @@ def _over_angle(ax: Any, v: Validation, eta: np.ndarray, u: np.ndarray) -> None:
 
 
 def _difference(ax: Any, v: Validation, t: np.ndarray, eta: np.ndarray, u: np.ndarray) -> None:
+    """The bottom panel: measured minus computed over time, against the measurement's band."""
     for engine, series in _series(v).items():
         model = np.interp(t, series["t"], series["efficiency"])
         ax.plot(t, eta - model, color=COLOURS.get(engine, "C2"), lw=0.8,
@@ -93,7 +99,17 @@ def _pyplot() -> Any:
 
 def figure(v: Validation) -> Any:
     """Figure 10: efficiency over time and over input angle, measured with its k = 2 band
-    against computed; and the difference. Returns the matplotlib figure."""
+    against computed; and the difference.
+
+    Parameters
+    ----------
+    v : Validation
+        The validation (its measurement's instantaneous efficiency is computed here if not yet).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     inst = v.measured.instantaneous
     inside = v.conditioned.in_window()
     t = inst["t"][inside]
@@ -108,6 +124,7 @@ def figure(v: Validation) -> Any:
 
 
 def _synthetic_banner(s: dict) -> list[str]:
+    """The report's first lines for synthetic data (true efficiency and phase); none otherwise."""
     if not s.get("synthetic"):
         return []
     settings = json.loads(s["synthetic"].get("settings", "{}"))
@@ -118,6 +135,7 @@ def _synthetic_banner(s: dict) -> list[str]:
 
 
 def _conditioning(s: dict) -> list[str]:
+    """The file, the window, the filter and the yoke phase, in words."""
     c = s["conditioning"]
     return [f"File `{s['file']}` ({s['provenance'].get('format')}), {s['sample_rate']:.6g} Hz, "
             f"{s['duration_s']:.4g} s. Window: {c['revolutions']} whole input revolutions, "
@@ -129,6 +147,7 @@ def _conditioning(s: dict) -> list[str]:
 
 
 def _measured(s: dict) -> list[str]:
+    """The measured efficiency, its Monte Carlo interval and its uncertainty budget."""
     lines = ["## Measured efficiency over whole revolutions", "",
              f"eta = W_out / W_in = **{s['measured_efficiency']:.4f}**, standard uncertainty "
              f"u = {s['measured_efficiency_u']:.4f} (GUM, first order)."]
@@ -150,6 +169,7 @@ def _measured(s: dict) -> list[str]:
 
 
 def _accuracy(s: dict) -> list[str]:
+    """What the transducers' accuracy class does to the measurement, and what would be needed."""
     return ["", f"**What the accuracy class does:** with the torques at "
             f"{s['mean_torque_in']:.3g} N m on transducers of "
             f"{s['transducer_in']['full_scale']:g} N m full scale, class "
@@ -163,6 +183,7 @@ def _accuracy(s: dict) -> list[str]:
 
 
 def _computed(s: dict) -> list[str]:
+    """Each engine's computed efficiency and its comparison with the measurement."""
     rows = []
     for engine, comp in s["computed"].items():
         cmp = s["comparisons"].get(engine, {})

@@ -37,7 +37,8 @@ __all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_sce
 
 #: Engines that take the measured angle drive and load history (MuJoCo takes constant loads only).
 MODEL_ENGINES = ("reference", "exudyn")
-K = 2.0  # coverage factor of the significance test
+K = 2.0
+"""Coverage factor of the significance test."""
 #: Budget rows that are a constant error of the output torque, which the model's load shares.
 CONSTANT_OUTPUT_ERRORS = ("accuracy class, output torque", "resolution (acquisition step), output torque")
 
@@ -64,6 +65,15 @@ def compare(measured: Measured, computed: Mapping[str, Any], sensitivities: Mapp
     difference sees ``c_meas - c_model`` (the drift, a ramp, is left uncorrelated: its share is
     below 1e-3 of the variance). The yoke phase's half-turn ambiguity is a rectangular term of half
     width |difference| / 2.
+
+    Parameters
+    ----------
+    measured : Measured
+        The measured efficiency, its budget and (optionally) its Monte Carlo draws.
+    computed : mapping
+        One engine's :func:`rigdata.model.computed_efficiency` (status ``ok``).
+    sensitivities : mapping of str to float
+        :func:`rigdata.model.model_sensitivities`.
 
     Returns
     -------
@@ -96,8 +106,21 @@ def compare(measured: Measured, computed: Mapping[str, Any], sensitivities: Mapp
 
 
 def accuracy_needed(measured: Measured, target_u: float = 0.01) -> float:
-    """Accuracy class [-] the torque transducers would need for a standard uncertainty of
-    ``target_u`` [-] from the class alone (it scales linearly)."""
+    """Accuracy class the torque transducers would need for a standard uncertainty of
+    ``target_u`` from the class alone (it scales linearly).
+
+    Parameters
+    ----------
+    measured : Measured
+        The measurement (its budget and transducers).
+    target_u : float
+        Standard uncertainty of the efficiency aimed at [-].
+
+    Returns
+    -------
+    float
+        Accuracy class [-, fraction of full scale]; NaN when the class contributes nothing.
+    """
     acc = [b["contribution"] for b in measured.budget if b["quantity"].startswith("accuracy class")]
     total = math.sqrt(sum(a * a for a in acc))
     cls = measured.summary["transducer_in"]["accuracy_class"]

@@ -112,6 +112,17 @@ def time_axis(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str]
               n: int) -> tuple[np.ndarray, dict[str, Any], list[str]]:
     """Sample times [s]: the time column, else the channels' sampling, else the header's rate.
 
+    Parameters
+    ----------
+    raw : RawTable
+        The file's table.
+    chosen : mapping of str to str
+        Channel (and ``"time"``) -> column.
+    units : mapping of str to str
+        Units given by channel or column name, over the file's.
+    n : int
+        Samples of every chosen column.
+
     Returns
     -------
     t : ndarray

@@ -126,7 +126,20 @@ def time_column(columns: Mapping[str, np.ndarray]) -> str | None:
 
 def column_unit(header: str, stated: str | None) -> str | None:
     """Unit of a column: the header annotation, else a unit stated elsewhere (units row, LVM
-    label, TDMS property), else a unit suffix of a time column name (``time_s``)."""
+    label, TDMS property), else a unit suffix of a time column name (``time_s``).
+
+    Parameters
+    ----------
+    header : str
+        The column's header as written.
+    stated : str or None
+        A unit the file states elsewhere.
+
+    Returns
+    -------
+    str or None
+        The unit as written; None when the file states none.
+    """
     bare, unit = split_header(header)
     if unit is None:
         unit = stated
@@ -140,7 +153,28 @@ def column_unit(header: str, stated: str | None) -> str | None:
 
 def channel_unit(raw: RawTable, column: str, channel: str, units: Mapping[str, str]) -> Unit:
     """Unit of ``channel`` read from ``column``: given by channel or column name in ``units``,
-    else as the file states it; a column without one is an error."""
+    else as the file states it.
+
+    Parameters
+    ----------
+    raw : RawTable
+        The file's table (its stated units).
+    column : str
+        The column the channel is read from.
+    channel : str
+        The record channel (``"time"``, ``"torque_in"``, ...): the kind of unit it takes.
+    units : mapping of str to str
+        Units given by channel or column name.
+
+    Returns
+    -------
+    Unit
+
+    Raises
+    ------
+    RigDataError
+        A column without a unit, or a unit unknown, ambiguous or of another quantity.
+    """
     kind = "time" if channel == "time" else channel.split("_")[0]
     given = units.get(channel, units.get(column))
     if given is not None:

@@ -41,7 +41,19 @@ class Layout:
 
 
 def split(line: str, sep: str | None) -> list[str]:
-    """Fields of ``line`` (quotes and blanks around them removed); None splits at blanks."""
+    """Fields of ``line``, quotes and blanks around them removed.
+
+    Parameters
+    ----------
+    line : str
+        One line of the file.
+    sep : str or None
+        The separator; None splits at runs of blanks.
+
+    Returns
+    -------
+    list of str
+    """
     return line.split() if sep is None else [f.strip().strip('"').strip() for f in line.split(sep)]
 
 
@@ -79,7 +91,21 @@ def _units_row(fields: list[str]) -> bool:
 
 
 def header_fields(line: str, sep: str | None, width: int) -> list[str]:
-    """Fields of a header line; blank-separated names may hold single blanks."""
+    """Fields of a header line; blank-separated names may hold single blanks.
+
+    Parameters
+    ----------
+    line : str
+        The header line.
+    sep : str or None
+        The separator (None: blanks).
+    width : int
+        Fields of the data rows.
+
+    Returns
+    -------
+    list of str
+    """
     fields = split(line, sep)
     if sep is None and len(fields) != width:
         # blank-separated files may have names with single blanks, columns apart by two or more
@@ -102,7 +128,24 @@ def _separator(lines: list[str], path: Path) -> tuple[str | None, int, int]:
 
 
 def layout(lines: list[str], path: Path) -> Layout:
-    """Separator, decimal mark, header, units row and first data row of a delimited file."""
+    """Separator, decimal mark, header, units row and first data row of a delimited file.
+
+    Parameters
+    ----------
+    lines : list of str
+        The file's lines.
+    path : Path
+        Named in errors.
+
+    Returns
+    -------
+    Layout
+
+    Raises
+    ------
+    RigDataError
+        No separator that splits the data rows alike, or no header line above them.
+    """
     sep, first, width = _separator(lines, path)
     sample = [f for line in lines[first:first + 50] for f in split(line, sep)]
     decimal = "," if sep != "," and any(COMMA_NUMBER.match(f) for f in sample) else "."
@@ -127,7 +170,19 @@ def layout(lines: list[str], path: Path) -> Layout:
 
 def preamble(lines: list[str], sep: str | None) -> dict[str, str]:
     """Key/value pairs of the lines above the header: ``key: value``, ``key = value`` (with or
-    without a leading ``#``), or two fields apart by the separator. Free text is skipped."""
+    without a leading ``#``), or two fields apart by the separator. Free text is skipped.
+
+    Parameters
+    ----------
+    lines : list of str
+        The lines above the header.
+    sep : str or None
+        The file's separator (None: blanks).
+
+    Returns
+    -------
+    dict of str to str
+    """
     meta = {}
     for line in lines:
         text = line.strip().lstrip("#%;/").strip()

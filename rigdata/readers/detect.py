@@ -87,7 +87,24 @@ def choose_format(path: Path, format: str, head: bytes) -> str:
 
 
 def decode(data: bytes, path: Path) -> str:
-    """Text of a file: UTF-8 (BOM or not), UTF-16 with BOM, else Latin-1; binary refused."""
+    """Text of a file: UTF-8 (BOM or not), UTF-16 with BOM, else Latin-1.
+
+    Parameters
+    ----------
+    data : bytes
+        The file's bytes.
+    path : Path
+        Named in errors.
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    RigDataError
+        Binary content, or unreadable UTF-16.
+    """
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         try:
             return data.decode("utf-16")

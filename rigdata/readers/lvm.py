@@ -101,7 +101,23 @@ def _x_values(names: list[str], data: np.ndarray, k: int, path: Path) -> np.ndar
 
 
 def segment(seg: dict, k: int, x_columns: str, path: Path) -> Segment:
-    """Segment ``k`` (0-based) of what lvm_read returns, checked."""
+    """Segment ``k`` (0-based) of what lvm_read returns, checked.
+
+    Parameters
+    ----------
+    seg : dict
+        lvm_read's segment.
+    k : int
+        Its index.
+    x_columns : {"One", "No"}
+        The header's ``X_Columns``.
+    path : Path
+        Named in errors.
+
+    Returns
+    -------
+    Segment
+    """
     names, data = _segment_data(seg, k, path)
     first = 1 if x_columns == "No" else 0
     y_index = [j for j, name in enumerate(names) if name != "X_Value"]
@@ -147,7 +163,20 @@ def _check_contiguous(prev: Segment, seg: Segment, k: int, dt: float, path: Path
 
 
 def join(segments: list[Segment], path: Path) -> list[str]:
-    """Check that the segments continue one another; notes on what was joined."""
+    """Check that the segments continue one another.
+
+    Parameters
+    ----------
+    segments : list of Segment
+        In file order.
+    path : Path
+        Named in errors.
+
+    Returns
+    -------
+    list of str
+        Notes on what was joined, for the record's provenance.
+    """
     ref = segments[0]
     for k, seg in enumerate(segments):
         _check_segment(seg, k, ref, path)
@@ -177,7 +206,28 @@ def data_rows(lines: list[str], sep: str, width: int, path: Path, ends_clean: bo
 
 def text_cells(lines: list[str], rows: list[int], sep: str, decimal: str,
                positions: Mapping[str, int], columns: Mapping[str, np.ndarray]) -> dict[str, TextCells]:
-    """The text behind the NaN that lvm_read leaves, silently, for cells it cannot read."""
+    """The text behind the NaN that lvm_read leaves, silently, for cells it cannot read.
+
+    Parameters
+    ----------
+    lines : list of str
+        The file's lines.
+    rows : list of int
+        Line indices of the data rows.
+    sep : str
+        The separator.
+    decimal : {".", ","}
+        The decimal mark.
+    positions : mapping of str to int
+        Column name -> field index.
+    columns : mapping of str to ndarray
+        The columns lvm_read returned.
+
+    Returns
+    -------
+    dict of str to TextCells
+        Per column with text cells.
+    """
     cells = {}
     for name, j in positions.items():
         if not np.isnan(columns[name]).any():

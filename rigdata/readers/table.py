@@ -99,7 +99,24 @@ class RawTable:
     notes: tuple[str, ...] = ()
 
     def values(self, column: str, channel: str) -> np.ndarray:
-        """The column's values as floats; a column with text cells is an error for ``channel``."""
+        """The column's values as floats.
+
+        Parameters
+        ----------
+        column : str
+            The column.
+        channel : str
+            The record channel it is read for (named in the error).
+
+        Returns
+        -------
+        ndarray, shape (n,)
+
+        Raises
+        ------
+        RigDataError
+            The column has text cells.
+        """
         cells = self.text_cells.get(column)
         if cells is not None:
             raise RigDataError(f"{cells.describe()} in column {column!r}", file=self.file, channel=channel)
@@ -117,7 +134,19 @@ def is_number(text: str) -> bool:
 
 def cell_value(text: str, decimal: str = ".") -> float:
     """A text cell as a number: the cells :func:`is_number` accepts, with the decimal mark
-    replaced by a point; NaN for any other text (``float`` alone would also take ``"1_0"``)."""
+    replaced by a point; NaN for any other text (``float`` alone would also take ``"1_0"``).
+
+    Parameters
+    ----------
+    text : str
+        The cell.
+    decimal : {".", ","}
+        The file's decimal mark.
+
+    Returns
+    -------
+    float
+    """
     if not is_number(text):
         return math.nan
     try:
