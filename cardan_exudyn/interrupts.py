@@ -89,7 +89,7 @@ def watch_signals() -> Iterator[SignalWatch]:
 
     Only signals with a Python handler are watched (an ignored or default signal is left alone)
     and only in the main thread, where Python runs handlers; the handler still runs, so an
-    interruption also stops the block as before.
+    interruption also stops the block as it would without the watch.
     """
     watch = SignalWatch()
     previous = {}

@@ -26,8 +26,8 @@ PROVENANCE = {
     "sensitivity": "paper section 4.2: torque sensitivity 100 mV/N m",
     "pulses_per_rev": "paper section 4.2: speed sensitivity 60 pulses per rev",
     "accuracy_class": "assumption: accuracy class 0.1 % of full scale (the class of in-line torque "
-                      "transducers of this size; with it the class alone is half of a 0.2 N m reading, "
-                      "as the issue states); a limit, read as a rectangular distribution",
+                      "transducers of this size; with it the class alone is half of a 0.2 N m reading); "
+                      "a limit, read as a rectangular distribution",
     "zero_drift": "assumption: zero drift over one record within +-0.01 N m (0.01 % of full scale: "
                   "a temperature change of about 1 K in a run of seconds at 0.1 %/10 K); a limit "
                   "of a linear ramp over the record, rectangular",

@@ -143,6 +143,18 @@ def _speed(record: RigRecord, shaft: str, angle: np.ndarray, cutoff: float,
     return angular_speed(angle, record.dt, cutoff, options.derivative)
 
 
+def _filtered(record: RigRecord, angles: dict[str, np.ndarray], cutoff: float,
+              options: Conditioning) -> tuple[dict[str, np.ndarray], ...]:
+    """Per shaft: the low-passed angle [rad], the speed [rad/s] (:func:`_speed`) and the low-passed
+    torque [N m], on the record's grid (``cutoff`` [Hz])."""
+    rate = 1.0 / record.dt
+    filtered = {s: lowpass(angles[s], cutoff, rate, options.filter_order) for s in SHAFTS}
+    speeds = {s: _speed(record, s, filtered[s], cutoff, options) for s in SHAFTS}
+    torques = {s: lowpass(record.channels[f"torque_{s}"], cutoff, rate, options.filter_order)
+               for s in SHAFTS}
+    return filtered, speeds, torques
+
+
 def condition(record: RigRecord, shaft_angle: float, options: Conditioning | None = None) -> Conditioned:
     """Condition a record (see the module docstring).
 
@@ -177,11 +189,7 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
         raise RigDataError("the input shaft does not turn", file=record.file, channel="angle_in")
     _shafts_turn_together(record, angles)
     cutoff = options.cutoff_harmonics * mean_speed / (2 * math.pi)
-    rate = 1.0 / record.dt
-    filtered = {s: lowpass(angles[s], cutoff, rate, options.filter_order) for s in SHAFTS}
-    speeds = {s: _speed(record, s, filtered[s], cutoff, options) for s in SHAFTS}
-    torques = {s: lowpass(record.channels[f"torque_{s}"], cutoff, rate, options.filter_order)
-               for s in SHAFTS}
+    filtered, speeds, torques = _filtered(record, angles, cutoff, options)
     t_a, t_b, n = revolution_window(t, angles["in"], edges["in"], options.settle_revolutions, record.file)
     settle_time = options.settle_revolutions * 2 * math.pi / mean_speed
     keep = (t >= min(t_a, t[0] + settle_time) - 1e-12) & (t <= max(t_b, t[-1] - settle_time) + 1e-12)
