@@ -25,8 +25,8 @@ RECORD_SHAPES = {"t": (), "q": (3,), "qd": (3,), "reference": (), "xmat": (3, 3,
 """Per-step shape of each field of :class:`Record`."""
 LAG_ALLOWANCE = 0.01
 """Extra steps, as a fraction of the span's, for a prescribed input to reach the scene's
-revolutions: it lags its reference by a fraction of a step with the recommended settings, by
-0.06 rad with MuJoCo's default ``solref``/``solimp``."""
+revolutions: it lags its reference, by a fraction of a step with the recommended settings, by
+more with soft constraints. Measured: docs/mujoco.md#a-what-mujocos-defaults-give."""
 
 
 class Record:

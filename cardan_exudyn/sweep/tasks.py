@@ -34,11 +34,10 @@ __all__ = ["BATCH_SIZE", "BATCHES_PER_WORKER", "Batch", "Task", "batched_functio
            "plan_tasks", "run_case", "run_batch_cases", "run_task", "task_cases", "task_key"]
 
 BATCH_SIZE = 1000
-"""Most cases in one batch. Memory grows linearly with the batch (the reference engine keeps every
-scene's samples and, unless ``record.timeseries`` is off, its 721 x 72 time table: about 0.4 MB a
-scene, 0.4 GB per 1000, so a batch's peak stays well inside a worker's memory), while the cost per
-case stops falling well before 1000: ``cardan bench --only batch`` measures both (per-sample cost
-against batch size and peak memory per 1000 scenes, docs/bench.md)."""
+"""Most cases in one batch: it bounds a batch's memory, which grows linearly with the batch (a
+scene that records its time table holds 721 x 72 floats, 0.4 MB), while the cost per case stops
+falling well before it. Measured (per-sample cost against batch size, peak memory per 1000
+scenes): docs/bench.md#the-batched-reference-engine."""
 BATCHES_PER_WORKER = 4
 """Batches are cut so that each worker gets at least this many (smaller batches when the sweep is
 small): the last batch to finish does not leave the other workers idle for long, records land and
