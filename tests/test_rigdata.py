@@ -68,22 +68,32 @@ def test_phase_estimate_is_exact_on_exact_speed_ratio(truth):
     assert fit["shaft_angle_fit"] == pytest.approx(BETA, abs=1e-6)
 
 
-def test_conditioning_takes_only_the_derivatives_it_keeps(truth, monkeypatch):
-    """A measured speed channel is the shaft's speed, so its angle is not differentiated, and no
-    acceleration is taken (nothing reads one): with speeds on both shafts no Savitzky-Golay
-    derivative runs, with pulse counts one first derivative per shaft."""
-    real = scipy.signal.savgol_filter
-    orders = []
+def test_conditioning_computes_only_what_it_keeps(truth, monkeypatch):
+    """A measured speed channel is the shaft's speed, so its angle is neither filtered (the input's
+    is kept, the output's read by nothing) nor differentiated, and no acceleration is taken
+    (nothing reads one): with speeds on both shafts no Savitzky-Golay derivative runs and five
+    low-pass passes (input angle, two speeds, two torques); with pulse counts one first
+    derivative per shaft and four passes (two angles, two torques)."""
+    calls = {"savgol": [], "filter": 0}
+    savgol = scipy.signal.savgol_filter
+    sosfiltfilt = scipy.signal.sosfiltfilt
 
-    def counted(*args, **kwargs):
-        orders.append(kwargs.get("deriv", 0))
-        return real(*args, **kwargs)
+    def counted_savgol(*args, **kwargs):
+        calls["savgol"].append(kwargs.get("deriv", 0))
+        return savgol(*args, **kwargs)
 
-    monkeypatch.setattr(scipy.signal, "savgol_filter", counted)
-    condition(perfect(truth, noise=0.0, speed_channel="rpm")[0], BETA)
-    assert orders == []
+    def counted_filter(*args, **kwargs):
+        calls["filter"] += 1
+        return sosfiltfilt(*args, **kwargs)
+
+    monkeypatch.setattr(scipy.signal, "savgol_filter", counted_savgol)
+    monkeypatch.setattr(scipy.signal, "sosfiltfilt", counted_filter)
+    c = condition(perfect(truth, noise=0.0, speed_channel="rpm")[0], BETA)
+    assert calls == {"savgol": [], "filter": 5}
+    assert not hasattr(c, "angle_out") and not hasattr(c, "accel_in")
+    calls.update(savgol=[], filter=0)
     condition(perfect(truth, noise=0.0)[0], BETA)
-    assert orders == [1, 1]
+    assert calls == {"savgol": [1, 1], "filter": 4}
 
 
 def test_instantaneous_uncertainty_is_computed_when_read(truth, monkeypatch):

@@ -7,7 +7,7 @@ Steps (each a parameter of :class:`~rigdata.conditioning.options.Conditioning`):
    shaft frequency (``cutoff_harmonics`` times it): every channel gets the same filter, so
    products such as powers see no relative phase or gain error.
 3. **Speeds**: a measured speed channel, where there is one, filtered; else the speed of the
-   filtered angle (Savitzky-Golay or a smoothing spline).
+   filtered angle (Savitzky-Golay or a smoothing spline). The output angle serves only that.
 4. **Trimming** to whole input revolutions (:mod:`~rigdata.conditioning.window`).
 5. **Input yoke phase** (:mod:`~rigdata.conditioning.phase`), unless given.
 """
@@ -15,6 +15,7 @@ Steps (each a parameter of :class:`~rigdata.conditioning.options.Conditioning`):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -38,8 +39,8 @@ class Conditioned:
     ----------
     t : ndarray, shape (n,)
         Times [s].
-    angle_in, angle_out : ndarray, shape (n,)
-        Filtered shaft angles [rad] (input: from the first pulse, not phase-corrected).
+    angle_in : ndarray, shape (n,)
+        Filtered input angle [rad], from the first pulse, not phase-corrected.
     speed_in, speed_out : ndarray, shape (n,)
         Filtered speeds [rad/s].
     torque_in, torque_out : ndarray, shape (n,)
@@ -64,7 +65,6 @@ class Conditioned:
 
     t: np.ndarray
     angle_in: np.ndarray
-    angle_out: np.ndarray
     speed_in: np.ndarray
     speed_out: np.ndarray
     torque_in: np.ndarray
@@ -133,26 +133,29 @@ def _shafts_turn_together(record: RigRecord, angles: dict[str, np.ndarray]) -> N
                            channel=channel)
 
 
-def _speed(record: RigRecord, shaft: str, angle: np.ndarray, cutoff: float,
+def _speed(record: RigRecord, shaft: str, filtered_angle: Callable[[], np.ndarray], cutoff: float,
            options: Conditioning) -> np.ndarray:
     """The shaft's speed [rad/s]: its measured speed channel filtered, else the speed of its
-    filtered ``angle`` [rad] (no derivative is taken where the channel replaces it)."""
+    filtered angle [rad] (``filtered_angle()``: asked for only then)."""
     measured = record.channels.get(f"speed_{shaft}")
     if measured is not None:
         return lowpass(measured, cutoff, 1.0 / record.dt, options.filter_order)
-    return angular_speed(angle, record.dt, cutoff, options.derivative)
+    return angular_speed(filtered_angle(), record.dt, cutoff, options.derivative)
 
 
 def _filtered(record: RigRecord, angles: dict[str, np.ndarray], cutoff: float,
-              options: Conditioning) -> tuple[dict[str, np.ndarray], ...]:
-    """Per shaft: the low-passed angle [rad], the speed [rad/s] (:func:`_speed`) and the low-passed
-    torque [N m], on the record's grid (``cutoff`` [Hz])."""
+              options: Conditioning) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The low-passed input angle [rad]; per shaft the speed [rad/s] (:func:`_speed`) and the
+    low-passed torque [N m]; on the record's grid (``cutoff`` [Hz]). The output angle is
+    filtered only when its speed is taken from it."""
     rate = 1.0 / record.dt
-    filtered = {s: lowpass(angles[s], cutoff, rate, options.filter_order) for s in SHAFTS}
-    speeds = {s: _speed(record, s, filtered[s], cutoff, options) for s in SHAFTS}
+    angle_in = lowpass(angles["in"], cutoff, rate, options.filter_order)
+    speeds = {"in": _speed(record, "in", lambda: angle_in, cutoff, options),
+              "out": _speed(record, "out", lambda: lowpass(angles["out"], cutoff, rate, options.filter_order),
+                            cutoff, options)}
     torques = {s: lowpass(record.channels[f"torque_{s}"], cutoff, rate, options.filter_order)
                for s in SHAFTS}
-    return filtered, speeds, torques
+    return angle_in, speeds, torques
 
 
 def condition(record: RigRecord, shaft_angle: float, options: Conditioning | None = None) -> Conditioned:
@@ -189,7 +192,7 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
         raise RigDataError("the input shaft does not turn", file=record.file, channel="angle_in")
     _shafts_turn_together(record, angles)
     cutoff = options.cutoff_harmonics * mean_speed / (2 * math.pi)
-    filtered, speeds, torques = _filtered(record, angles, cutoff, options)
+    angle_in, speeds, torques = _filtered(record, angles, cutoff, options)
     t_a, t_b, n = revolution_window(t, angles["in"], edges["in"], options.settle_revolutions, record.file)
     settle_time = options.settle_revolutions * 2 * math.pi / mean_speed
     keep = (t >= min(t_a, t[0] + settle_time) - 1e-12) & (t <= max(t_b, t[-1] - settle_time) + 1e-12)
@@ -200,7 +203,7 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
         ratio = speeds["out"][inside] / speeds["in"][inside]
         phase_fit = estimate_phase(angles["in"][inside], ratio, float(shaft_angle))
     return Conditioned(
-        t=t[keep], angle_in=filtered["in"][keep], angle_out=filtered["out"][keep],
+        t=t[keep], angle_in=angle_in[keep],
         speed_in=speeds["in"][keep], speed_out=speeds["out"][keep],
         torque_in=torques["in"][keep], torque_out=torques["out"][keep],
         raw_torque_in=np.asarray(record.channels["torque_in"])[keep],
