@@ -199,6 +199,10 @@ def override_name(name: str, labels: list[tuple[str, str]], frictionless: bool |
         Override key and its value with unit (empty for a flag), in order.
     frictionless : bool, optional
         Whether the scene is frictionless after the overrides (None: not changed).
+
+    Returns
+    -------
+    str
     """
     parts = name.split("-")
     extra = []

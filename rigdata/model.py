@@ -47,6 +47,11 @@ def measured_scene(c: Conditioned, base: Scene, points_per_revolution: int = 120
         Added to the estimated yoke phase [rad] (pi gives the other solution of the fit).
     load_offset : float
         Added to the measured load [N m] (for the model's sensitivity to the output transducer).
+
+    Returns
+    -------
+    Scene
+        Named ``<base>-measured``, its span the window's whole revolutions.
     """
     t_a, t_b = c.window
     period = (t_b - t_a) / c.revolutions

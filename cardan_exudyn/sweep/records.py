@@ -77,6 +77,11 @@ def read_records(path: str | os.PathLike, *, truncate: bool = False) -> dict[str
     ------
     SweepError
         A complete line that is not a JSON record with a string ``id``.
+
+    Returns
+    -------
+    dict of str to dict
+        Case id -> record.
     """
     path = Path(path)
     if not path.exists():
@@ -355,5 +360,10 @@ def summary_outputs(scene: Scene, engine: str) -> dict[str, Any]:
         The case's scene.
     engine : str
         Engine name of :data:`cardan_exudyn.engines.ENGINES`.
+
+    Returns
+    -------
+    dict
+        :func:`scalar_summary` of the run's summary.
     """
     return scalar_summary(engines.run(scene, engine).summary)

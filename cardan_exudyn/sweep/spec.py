@@ -256,6 +256,15 @@ def spec_from_mapping(data: Mapping[str, Any], base_dir: str | os.PathLike | Non
         The keys of :data:`SPEC_KEYS`.
     base_dir : path, optional
         Folder a relative scene path is taken relative to (the spec file's folder).
+
+    Returns
+    -------
+    SweepSpec
+
+    Raises
+    ------
+    SweepError
+        An unknown key or an invalid value, naming the key.
     """
     unknown = sorted(set(data) - set(SPEC_KEYS))
     if unknown:

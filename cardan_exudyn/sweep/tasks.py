@@ -118,6 +118,11 @@ def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
         Processes or Dask threads that run tasks at once.
     batch_size : int, optional
         Most cases per batch (default :data:`BATCH_SIZE`); 1 runs every case on its own.
+
+    Returns
+    -------
+    list of Task
+        Cases and batches, each engine's in plan order.
     """
     by_engine: dict[str, list[Case]] = {}
     for case in cases:

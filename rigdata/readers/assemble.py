@@ -175,6 +175,16 @@ def to_record(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str]
         Torque transducer output [V/(N m)] for channels in volts.
     pulses_per_rev : int
         Pulses per revolution for channels in pulse counts or pulses/s.
+
+    Returns
+    -------
+    RigRecord
+        In SI units, its provenance saying where every number came from.
+
+    Raises
+    ------
+    RigDataError
+        A channel without a unit, a unit of the wrong kind, a bad time axis, absurd values.
     """
     n = _lengths(raw, chosen)
     time, time_info, assumptions = time_axis(raw, chosen, units, n)

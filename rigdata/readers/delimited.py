@@ -282,6 +282,15 @@ def read_delimited(path: Path, text: str, sha: str) -> RawTable:
         Its decoded text.
     sha : str
         SHA-256 of its bytes.
+
+    Returns
+    -------
+    RawTable
+
+    Raises
+    ------
+    RigDataError
+        No separator or header, rows of another width, a file cut short, cells pandas cannot parse.
     """
     lines = text.splitlines()
     lay = layout(lines, path)

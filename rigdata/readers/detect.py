@@ -61,6 +61,16 @@ def choose_format(path: Path, format: str, head: bytes) -> str:
         A key of :data:`FORMAT_ALIASES`.
     head : bytes
         The file's first bytes.
+
+    Returns
+    -------
+    str
+        ``"csv"``, ``"lvm"`` or ``"tdms"``.
+
+    Raises
+    ------
+    RigDataError
+        Content that contradicts the extension or the format given, or a file cut inside its tag.
     """
     suffix = path.suffix.lower()
     if suffix == ".tdms_index":

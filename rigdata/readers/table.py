@@ -166,6 +166,11 @@ def find_text_cells(raw: Any, numbers: np.ndarray, lines: list[int] | None) -> T
         The same cells as floats, NaN where they are not numbers.
     lines : list of int, optional
         File line (1-based) of every cell, when known.
+
+    Returns
+    -------
+    TextCells or None
+        The cells that are text (None when every cell is a number or empty).
     """
     strings = np.asarray(raw, dtype=object)
     nan = np.flatnonzero(np.isnan(numbers))

@@ -119,6 +119,15 @@ def read_tdms(path: Path, data: bytes, sha: str) -> RawTable:
         Its bytes.
     sha : str
         SHA-256 of its bytes.
+
+    Returns
+    -------
+    RawTable
+
+    Raises
+    ------
+    RigDataError
+        A file cut short or damaged, or without channels.
     """
     tdms, loaded, warnings = _load(data, path)
     plain = [c.name for _, c, *_ in loaded]
