@@ -113,6 +113,11 @@ def filtered_noise_factor(c: Conditioned, order: int, seed: int = 0) -> float:
         Butterworth order of one pass.
     seed : int
         Seed of the noise drawn.
+
+    Returns
+    -------
+    float
+        The standard deviation the low-pass leaves of unit white noise [-].
     """
     noise = np.random.default_rng(seed).standard_normal(c.t.size)
     return float(np.std(lowpass(noise, c.cutoff, 1.0 / c.dt, order)))

@@ -133,6 +133,10 @@ def columns(scene: Scene, record: Record) -> dict[str, np.ndarray]:
         Geometry, load torque, bodies and gravity are read.
     record : Record
         The run's records.
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
     """
     n = record.t.size
     geo = scene.joint.geometry

@@ -70,6 +70,11 @@ def data_limits(values, margin: float = 0.08, min_span: float = 2e-3,
         Smallest span of the limits, in the values' unit.
     clip : tuple of float, optional
         Limits never exceeded (for a quantity that is unbounded somewhere, eq. (18)).
+
+    Returns
+    -------
+    (float, float)
+        The lower and upper limit, in the values' unit.
     """
     x = np.asarray(values, dtype=float).ravel()
     x = x[np.isfinite(x)]
