@@ -27,8 +27,8 @@ from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.outputs import atomic_write
 from cardan_exudyn.sweep.checks import SweepError
 from cardan_exudyn.sweep.plan import Case, Plan, plan_difference
-from reference.scene.scene import Scene
 from reference.results.summary import Status, Summary
+from reference.scene.scene import Scene
 
 __all__ = ["PLAN_FILE", "CASES_FILE", "RESULTS_FILE", "SUMMARY_FILE", "SWEEP_FILES", "RECORD_KEYS",
            "RESERVED_OUTPUTS", "read_records", "RecordWriter", "existing_records", "locked",

@@ -13,12 +13,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from cardan_exudyn.model.error_estimate import ErrorEstimate, error_estimate
 from cardan_exudyn.engines import resolve
 from cardan_exudyn.engines import run as run_engine
-from reference.scene.scene import Scene
+from cardan_exudyn.model.error_estimate import ErrorEstimate, error_estimate
 from reference.results.result import Result
 from reference.results.summary import Status
+from reference.scene.scene import Scene
 
 __all__ = ["RunRecord", "CachingRunner"]
 
