@@ -1,4 +1,5 @@
-"""The window integral across friction's sign jumps (reference/results/quadrature.py)."""
+"""The window integral across friction's sign jumps (reference/results/quadrature.py) and the
+reference engine's adaptive panels (reference/engine/gauss.py)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from reference.engine.gauss import adaptive_gauss, initial_panels
 from reference.engine.options import ReferenceOptions
 from reference.engine.solve import run
 from reference.paper.scenes import named_scene
@@ -107,3 +109,17 @@ def test_a_ramp_the_steps_partly_resolve_is_integrated_as_its_middle():
     exact = t_star - (1.0 - t_star)  # the ramp's two halves cancel
     assert segment_integrals(f, t, [(a, b, ts)]).sum() == pytest.approx(exact, abs=1e-12)
     assert abs(segment_integrals(f, t).sum() - exact) > 1e-4
+
+
+def test_rounding_noise_in_a_sliver_does_not_split_the_panels_forever():
+    """Noise on a panel 1e-9 of the window wide: it closes at the rounding level, within the estimate."""
+    # a friction ramp narrower than the speed's resolution, between its two edges (breakpoints):
+    # its friction is the speed's last digits, which halving the panel does not smooth
+    def integrand(t):
+        sliver = (t >= 0.3) & (t <= 0.3 + 1e-9)
+        return (1.0 + np.where(sliver, 1e-6 * np.sin(1e15 * t), 0.0))[:, None]
+
+    lo, hi = initial_panels(np.array([0.0, 0.3, 0.3 + 1e-9, 1.0]), 0.125)
+    value, info = adaptive_gauss(integrand, lo, hi, 8, 1e-9)
+    assert info["evaluations"] < 1000
+    assert abs(value[0] - 1.0) <= info["error_estimate"][0] + 1e-15

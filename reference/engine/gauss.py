@@ -14,8 +14,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["GROSS_SCALE", "DENSE_WIDTH", "DENSE_NODES", "MAX_OPEN_PANELS", "initial_panels",
-           "adaptive_gauss", "quadrature_summary"]
+__all__ = ["GROSS_SCALE", "DENSE_WIDTH", "DENSE_NODES", "MAX_OPEN_PANELS", "ROUNDING_FLOOR",
+           "initial_panels", "adaptive_gauss", "quadrature_summary"]
 
 
 def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.ndarray]:
@@ -36,6 +36,12 @@ DENSE_NODES = 3
 """History knots alone making panels mostly below ``DENSE_WIDTH`` of the initial width: at most
 ``DENSE_NODES`` Gauss nodes each (smooth between knots, error O(h^7); 9 evaluations per knot, not 24)."""
 MAX_OPEN_PANELS = 20_000
+ROUNDING_FLOOR = 64 * np.finfo(float).eps
+"""A panel whose whole and halves agree to this fraction of the integral's scale is closed
+whatever its width (about 1.4e-14): a difference at the integral's rounding level is the rounding
+of the integrand itself (a friction ramp a few hundred ulp of time wide, where the speed's last
+digits decide the friction), which halving does not reduce; under the width-proportional rule
+alone such a panel splits every round, both halves too, until :data:`MAX_OPEN_PANELS`."""
 
 
 def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray, b: np.ndarray,
@@ -45,7 +51,8 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
 
     Every open panel is integrated with the ``nodes``-point Gauss-Legendre rule as a whole and
     as two halves; it is closed when the two agree within ``rtol * |I[scale_key]| * width /
-    total width`` in every component (the halves' value is kept), otherwise it is split and its
+    total width``, or within ``ROUNDING_FLOOR * |I[scale_key]|``, in every component (the halves'
+    value is kept; their difference goes into the error estimate), otherwise it is split and its
     halves are the next round's panels, whose whole-panel values are already known. All open
     panels of a round are evaluated in one call; the integrand maps times (m,) to values (m, k).
     The scale is at least ``GROSS_SCALE`` times the integral of ``|I[scale_key]|`` and at least
@@ -84,7 +91,7 @@ def adaptive_gauss(integrand: Callable[[np.ndarray], np.ndarray], a: np.ndarray,
         left = both[:a.size]
         right = both[a.size:]
         diff = np.abs(left + right - whole)
-        allowed = rtol * scale * (b - a) / total_width
+        allowed = scale * np.maximum(rtol * (b - a) / total_width, ROUNDING_FLOOR)
         # a non-finite panel (NaN from a locked or failed sample) cannot converge: close it and
         # let the NaN reach the result instead of splitting it every round (2^rounds panels)
         done = (np.all(diff <= allowed[:, None], -1) | (rounds == max_rounds)
