@@ -183,6 +183,46 @@ def test_torque_drive_reverses_and_stops_after_the_turn():
     assert r.summary.status is Status.NO_WHOLE_REVOLUTION  # the angle is not monotonic
 
 
+@pytest.fixture(scope="module")
+def exact_sign_from_rest():
+    """The 8 N m drive from 1e-300 rad/s with friction's exact sign (no ramps)."""
+    scene = torque_scene(8.0, 1e-300)
+    return run(dataclasses.replace(scene, friction=dataclasses.replace(scene.friction, sign_band=0.0)))
+
+
+@pytest.mark.parametrize("speed", [1e-300, 1e-12, 1e-6])
+def test_torque_drive_from_rest_accelerates(speed, exact_sign_from_rest):
+    """8 N m against 2 N m and friction spins the joint up from (almost) rest to the exact-sign efficiency."""
+    # bands sized for the initial speed are all but zero: their share at 1e-6 rad/s is 2e-10 of
+    # the efficiency, the ODE's error at rtol 1e-11 about 3e-11
+    r = run(torque_scene(8.0, speed))
+    s, table = r.summary, r.table
+    assert s.status is Status.OK and exact_sign_from_rest.summary.status is Status.OK
+    assert table["theta_in"].iloc[-1] == pytest.approx(2 * math.pi, rel=1e-12)
+    assert table["omega_in"].iloc[-1] > 100.0
+    assert s.ode_evaluations < 10_000 and s.extras["quadrature"]["evaluations"] < 2_000
+    assert s.mean_efficiency == pytest.approx(exact_sign_from_rest.summary.mean_efficiency, rel=0, abs=1e-9)
+
+
+def test_torque_drive_that_rocks_stops_with_a_reason():
+    """Drive torque = load, no friction, from 1e-3 rad/s: the joint rocks, never turns: incomplete, why."""
+    # it swings between 0 and -0.9 revolutions, 25 s a swing, for the 25,000 s allowed
+    r = run(torque_scene(2.0, 1e-3, name="paper-literal-10deg-frictionless"))
+    assert r.summary.status is Status.INCOMPLETE and r.table is None
+    assert r.summary.ode_evaluations < 100_000
+    assert "raise the drive torque or the initial speed" in r.summary.reason
+    assert r.summary.mean_efficiency is None
+
+
+@pytest.mark.slow
+def test_torque_drive_that_friction_holds_stops_with_a_reason():
+    """2.1 N m against 2 N m and friction, from 1e-3 rad/s: friction holds the joint; incomplete, a reason."""
+    # it creeps inside its sign ramps: 4e-11 revolutions in the first 6 us (about 3 s)
+    r = run(torque_scene(2.1, 1e-3))
+    assert r.summary.status is Status.INCOMPLETE and r.table is None
+    assert "does not overcome the load and friction" in r.summary.reason
+
+
 @pytest.mark.slow
 def test_torque_drive_with_friction_converges_with_the_tolerance():
     """With friction the ODE tolerance controls the mean efficiency: tighter tolerances agree

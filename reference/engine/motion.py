@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.engine.options import ReferenceOptions
+from reference.engine.torque_ode import EvaluationBudget, Stalled, speed_tolerance
 from reference.results.summary import Status
 from reference.scene.drives import AngleDrive, SpeedDrive, TorqueDrive
 from reference.scene.scene import Scene
@@ -54,6 +55,9 @@ class InputMotion:
     periodic : bool
         Every input revolution takes the same time and repeats the first (constant speed and
         constant load).
+    tabulated : bool
+        False when there is no state to tabulate: the integration stopped inside the integrator
+        (self-locking, the evaluation budget) or failed at its first step.
     """
 
     t0: float
@@ -65,6 +69,7 @@ class InputMotion:
     reason: str = ""
     ode_evaluations: int = 0
     periodic: bool = False
+    tabulated: bool = True
 
     def angle(self, t: float) -> float:
         """Input angle [rad] at one instant."""
@@ -96,13 +101,13 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
     target = 2.0 * math.pi * scene.revolutions
     w0 = drive.initial_speed
     t_max = drive.time_allowed(target)  # the span every engine allows
-    count = {"n": 0}
+    budget = EvaluationBudget(scene)
     acceleration = right_hand_side(scene, drive.torque)  # microseconds a call (reference.engine.forward)
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
-        count["n"] += 1
         theta = float(y[0])
         theta_t = float(y[1])
+        budget.spend(t, theta, theta_t)
         theta_tt, locked = acceleration(t, theta, theta_t)
         if locked:
             raise SelfLocking(t, theta)
@@ -113,19 +118,24 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 
     reached.terminal = True
     try:
+        a0 = float(rhs(0.0, np.array([0.0, w0]))[1])
         sol = solve_ivp(rhs, (0.0, t_max), [0.0, w0], method="DOP853", dense_output=True,
                         events=reached, rtol=options.ode_rtol,
-                        atol=[options.ode_atol, options.ode_atol * abs(w0)])
+                        atol=[options.ode_atol, speed_tolerance(options.ode_atol, w0, a0, target)])
     except SelfLocking as exc:
         return InputMotion(0.0, exc.t, lambda t: (np.nan, np.nan, None), drive.torque,
                            status=Status.SELF_LOCKING,
                            reason=(f"friction self-locks at t = {exc.t:.6g} s, input angle "
                                    f"{math.degrees(exc.theta):.6g} deg: no consistent friction"),
-                           ode_evaluations=count["n"])
+                           ode_evaluations=budget.count, tabulated=False)
+    except Stalled as exc:
+        return InputMotion(0.0, exc.t, lambda t: (np.nan, np.nan, None), drive.torque,
+                           status=Status.INCOMPLETE, reason=exc.reason,
+                           ode_evaluations=budget.count, tabulated=False)
     if not sol.success:
         return InputMotion(0.0, float(sol.t[-1]), sol.sol, drive.torque,
                            status=Status.INTEGRATION_FAILURE, reason=sol.message,
-                           ode_evaluations=count["n"])
+                           ode_evaluations=budget.count, tabulated=bool(sol.t[-1] > 0.0))
     t_end = float(sol.t_events[0][0]) if sol.t_events[0].size else float(sol.t[-1])
     dense = sol.sol
 
@@ -133,7 +143,7 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
         y = dense(np.asarray(t, float))
         return y[0], y[1], None
 
-    motion = InputMotion(0.0, t_end, state, drive.torque, ode_evaluations=count["n"])
+    motion = InputMotion(0.0, t_end, state, drive.torque, ode_evaluations=budget.count)
     if not sol.t_events[0].size:
         motion.status = Status.INCOMPLETE
         motion.reason = (f"torque drive turned {abs(sol.y[0, -1]) / (2 * math.pi):.3g} of "

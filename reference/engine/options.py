@@ -30,7 +30,7 @@ class ReferenceOptions:
         input work (scaled by the panel's share of the window).
     ode_rtol, ode_atol : float
         Tolerances of ``solve_ivp`` for torque-driven scenes (atol applies to the angle [rad]
-        and, scaled by the initial speed, to the speed).
+        and, as :func:`reference.engine.torque_ode.speed_tolerance`, to the speed).
     """
 
     samples_per_revolution: int | None = None

@@ -91,7 +91,7 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
     summary.reason = motion.reason
     if scene.drive.kind == "torque":
         summary.ode_evaluations = motion.ode_evaluations
-    if motion.status == Status.SELF_LOCKING:
+    if not motion.tabulated:
         return None
     t = table_times(scene, motion, options)
     columns = table_columns(scene, motion, t)
