@@ -9,7 +9,6 @@ engine (:mod:`reference.engine.batch.quadrature`) uses the same panels, constant
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 import numpy as np
@@ -19,15 +18,22 @@ __all__ = ["GROSS_SCALE", "DENSE_WIDTH", "DENSE_NODES", "MAX_OPEN_PANELS", "ROUN
 
 
 def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.ndarray]:
-    """Panels ``(a, b)`` covering consecutive segments ``edges``, none wider than ``max_width``."""
-    lo = []
-    hi = []
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
-        if b > a:
-            cuts = np.linspace(a, b, max(1, math.ceil((b - a) / max_width - 1e-9)) + 1)
-            lo.append(cuts[:-1])
-            hi.append(cuts[1:])
-    return np.concatenate(lo), np.concatenate(hi)
+    """Panels ``(a, b)`` covering consecutive segments ``edges``, none wider than ``max_width``:
+    each segment cut into equal parts, ``np.linspace``'s cuts (vectorised: a history's samples
+    may make 10^5 segments)."""
+    edges = np.asarray(edges, float)
+    keep = edges[1:] > edges[:-1]
+    a = edges[:-1][keep]
+    b = edges[1:][keep]
+    count = np.maximum(1, np.ceil((b - a) / max_width - 1e-9)).astype(int)
+    owner = np.repeat(np.arange(a.size), count)
+    k = np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count)
+    step = ((b - a) / count)[owner]
+    lo = k * step + a[owner]
+    hi = (k + 1) * step + a[owner]
+    last = k + 1 == count[owner]
+    hi[last] = b[owner[last]]
+    return lo, hi
 
 
 GROSS_SCALE = 1e-3
