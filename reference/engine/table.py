@@ -22,7 +22,8 @@ EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
                  *(f"power_loss_{p}_{part}" for p in PAIR_NAMES for part in ("rotation", "sliding")))
 
 
-def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
+def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray,
+               load: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Result-schema columns at the instants ``t`` (plus :data:`EXTRA_COLUMNS`).
 
     Parameters
@@ -33,6 +34,8 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np
         The input's motion (:func:`reference.engine.motion.input_motion`).
     t : ndarray, shape (n,)
         Instants [s].
+    load : ndarray, shape (n,), or None
+        The output load [N m] at each instant; None: the scene's load at ``t``.
 
     Returns
     -------
@@ -42,7 +45,8 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np
     theta, theta_t, theta_tt = motion.state(t)
     theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
     theta_t = np.broadcast_to(np.asarray(theta_t, float), np.shape(t))
-    load = scene.load.at(np.asarray(t, float))
+    if load is None:
+        load = scene.load.at(np.asarray(t, float))
     cols, _ = dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt, load_torque=load,  # one of the two
                                torque_in=motion.torque_in if theta_tt is None else None)
     return {"t": np.asarray(t, float), **cols}

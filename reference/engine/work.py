@@ -6,7 +6,10 @@ panels that break at every kink of the integrand: the edges of each friction sig
 (relative surface speed = +- the pair's band, :mod:`reference.physics.bands`;
 :func:`reference.engine.breakpoints.sign_breakpoints`) and the knots of an angle or load history.
 Inside a panel the integrand is smooth, so the quadrature converges exponentially; the mean
-efficiency is stable to 1e-8 and better as the panels are refined (tested).
+efficiency is stable to 1e-8 and better as the panels are refined (tested). A load history denser
+than :data:`reference.engine.gauss.HISTORY_SAMPLES_PER_PANEL` samples a panel enters through its
+samples' weights instead (:class:`reference.engine.gauss.HistoryRule`, the integrand interpolated
+in time and in the load), so that its cost does not grow with the samples.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from reference.engine.gauss import (
     DENSE_NODES,
     DENSE_WIDTH,
     GROSS_SCALE,
+    HISTORY_SAMPLES_PER_PANEL,
     adaptive_gauss,
     initial_panels,
     quadrature_summary,
@@ -75,18 +79,21 @@ def window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
 
 def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.ndarray,
                       ends: dict[str, np.ndarray], options: ReferenceOptions,
-                      nodes: int | None = None) -> tuple[np.ndarray, dict]:
+                      nodes: int | None = None, history: bool = False) -> tuple[np.ndarray, dict]:
     """:data:`WORK_KEYS` integrated over the panels ``[lo, hi]`` [s] (:func:`adaptive_gauss`,
-    ``nodes`` per panel, default ``options.gauss_nodes``)."""
-    def integrand(times: np.ndarray) -> np.ndarray:
-        cols = columns_at(scene, motion, times)
+    ``nodes`` per panel, default ``options.gauss_nodes``); ``history``: the load history's
+    samples enter through :class:`reference.engine.gauss.HistoryRule`, not as panel edges."""
+    def integrand(times: np.ndarray, load: np.ndarray | None = None) -> np.ndarray:
+        cols = columns_at(scene, motion, times, load)
         return np.stack([np.asarray(cols[k], float) for k in WORK_KEYS], -1)
 
     # work below a thousandth of the mechanical energy is at the scale's floor (zero input work)
     energy_scale = float(np.max(np.abs(ends["energy_kinetic"])) + np.max(np.abs(ends["energy_potential"])))
+    load = scene.load.evaluator() if history else None
     with np.errstate(invalid="ignore"):
         return adaptive_gauss(integrand, lo, hi, nodes or options.gauss_nodes, options.quadrature_rtol,
-                              scale_floor=GROSS_SCALE * energy_scale)
+                              scale_floor=GROSS_SCALE * energy_scale,
+                              history=None if load is None else (load.time, load.value))
 
 
 def work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
@@ -151,16 +158,19 @@ def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarr
     repeats = n if motion.periodic else 1
     t_end = t_a + period if motion.periodic else t_b
     kinks = sign_breakpoints(scene, motion, t_a, t_end)
-    knots = np.concatenate([motion.knots, scene.load.knots])  # drive and load histories' knots
+    width = period / options.panels_per_revolution
+    # a dense load history enters through its samples' weights (HistoryRule), not as edges
+    samples = scene.load.knots[(scene.load.knots > t_a) & (scene.load.knots < t_end)]
+    history = bool(samples.size > HISTORY_SAMPLES_PER_PANEL * (t_end - t_a) / width)
+    knots = np.concatenate([motion.knots, [] if history else samples])  # the histories' knots
     knots = knots[(knots > t_a) & (knots < t_end)]
-    lo, hi, nodes = _panels(t_a, t_end, kinks, knots, period / options.panels_per_revolution,
-                            options.gauss_nodes)
+    lo, hi, nodes = _panels(t_a, t_end, kinks, knots, width, options.gauss_nodes)
     ends = columns_at(scene, motion, np.array([t_a, t_b]))
-    values, info = _integrate_powers(scene, motion, lo, hi, ends, options, nodes)
+    values, info = _integrate_powers(scene, motion, lo, hi, ends, options, nodes, history)
     work = dict(zip(WORK_KEYS, (repeats * values).tolist(), strict=True))
     out = work_means(work, ends)
     out["quadrature"] = quadrature_summary(info, nodes, options.quadrature_rtol, int(kinks.size),
-                                           int(knots.size), n // repeats)
+                                           int(knots.size), n // repeats, int(samples.size) if history else 0)
     # a locked node makes its panel's values NaN; the self_locking column integrates to > 0
     out["self_locking_nodes"] = bool(work["self_locking"] != 0 or not np.isfinite(out["input_work"]))
     return out
