@@ -5,8 +5,8 @@ solve; on this model numpy on three-vectors costs more than the law itself, so e
 float arithmetic on values read once per evaluation.
 The coupling's hot path reads through :class:`PairReader` (one pass over the pairs; the
 functions below are the same reads one quantity at a time, for the initial state and the tests).
-About half of an evaluation is Exudyn's: one ``GetObjectOutput`` per pair angle and slide
-(1.2-1.4 us each) and one ``SetLoadParameter`` per load (0.9 us).
+About half of an evaluation is Exudyn's ``GetObjectOutput`` and ``SetLoadParameter`` calls
+(measured: docs/engines.md#friction-coupling-measurements).
 
 Reactions
 ---------
@@ -85,8 +85,25 @@ class PairChannel:
 
 
 def pair_channel(mbs: Any, joint: int, ground_first: bool, frame: np.ndarray, slides: bool) -> PairChannel:
-    """The channel of ``joint`` (after ``mbs.Assemble``); ``frame`` the pair frame's columns in
-    global axes (the ground marker's, used when ``ground_first``)."""
+    """The channel of one pair's joint.
+
+    Parameters
+    ----------
+    mbs : exudyn MainSystem
+        Assembled (``mbs.Assemble`` called).
+    joint : int
+        The pair's ``ObjectJointGeneric``.
+    ground_first : bool
+        Whether the joint's first marker is on the ground.
+    frame : ndarray, shape (3, 3)
+        The pair frame's columns in global axes (used when ``ground_first``).
+    slides : bool
+        Whether the pair's slide is read.
+
+    Returns
+    -------
+    PairChannel
+    """
     rows = None
     if ground_first:
         rows = (tuple(float(c) for c in frame[:, 0]), tuple(float(c) for c in frame[:, 1]))
@@ -94,9 +111,22 @@ def pair_channel(mbs: Any, joint: int, ground_first: bool, frame: np.ndarray, sl
 
 
 def read_reactions(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, float, float, float]]:
-    """Per pair the reaction in the pair frame from one read of all multipliers: the force
-    components normal to the axis [N] and the bending moment's two components [N m] (as
-    ``TorqueLocal`` gives them: rotated by 90 deg about the axis, which magnitudes ignore)."""
+    """Per pair the reaction in the pair frame, from one read of all multipliers.
+
+    Parameters
+    ----------
+    mbs : exudyn MainSystem
+        At the current state.
+    channels : list of PairChannel
+        One per pair.
+
+    Returns
+    -------
+    list of (fx, fy, mx, my)
+        Per pair the force components normal to the axis [N] and the bending moment's two
+        components [N m], as ``TorqueLocal`` gives them (rotated by 90 deg about the axis, which
+        magnitudes ignore).
+    """
     ae = mbs.systemData.GetAECoordinates(exu.ConfigurationType.Current).tolist()
     out = []
     for c in channels:
@@ -113,7 +143,20 @@ def read_reactions(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, f
 
 
 def pair_coordinates(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, float]]:
-    """Per pair: the relative rotation angle [rad] and the slide [m] (0 for a pair that is not read)."""
+    """Per pair the relative rotation angle and the slide.
+
+    Parameters
+    ----------
+    mbs : exudyn MainSystem
+        At the current state.
+    channels : list of PairChannel
+        One per pair.
+
+    Returns
+    -------
+    list of (angle, slide)
+        Angle [rad] in ``(-pi, pi]`` and slide [m] (0 for a pair whose slide is not read).
+    """
     get = mbs.GetObjectOutput
     return [(float(get(c.joint, _ROTATION)[2]), float(get(c.joint, _DISPLACEMENT)[2]) if c.slides else 0.0)
             for c in channels]
@@ -121,9 +164,26 @@ def pair_coordinates(mbs: Any, channels: list[PairChannel]) -> list[tuple[float,
 
 def bdf2_speeds(coords: list, h1: float, previous: list, h2: float | None = None,
                 before: list | None = None) -> list[tuple[float, float]]:
-    """Relative angular and sliding speeds: BDF2 of the pair coordinates over the steps ``h1``
-    (``coords`` from ``previous``) and ``h2`` (``previous`` from ``before``); BDF1 without
-    ``before``. Angles are unwrapped."""
+    """Relative angular and sliding speeds: BDF2 of the pair coordinates (BDF1 without ``before``).
+
+    Parameters
+    ----------
+    coords : list of (angle, slide)
+        Per pair at the current step [rad, m] (:func:`pair_coordinates`).
+    h1 : float
+        Step from ``previous`` to ``coords`` [s].
+    previous : list of (angle, slide)
+        At the step before.
+    h2 : float, optional
+        Step from ``before`` to ``previous`` [s].
+    before : list of (angle, slide), optional
+        Two steps back.
+
+    Returns
+    -------
+    list of (omega_rel, slide_rel)
+        Per pair [rad/s, m/s]; angle differences are unwrapped.
+    """
     out = []
     if before is None:
         for (a, s), (a1, s1) in zip(coords, previous, strict=True):
@@ -140,8 +200,22 @@ def bdf2_speeds(coords: list, h1: float, previous: list, h2: float | None = None
 
 
 def initial_speeds(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, float]]:
-    """Per pair: relative angular and sliding speed from the joint's velocity outputs (for the
-    consistent initial state, where no history exists)."""
+    """Per pair the relative speeds from the joint's velocity outputs.
+
+    For the consistent initial state, where no history exists.
+
+    Parameters
+    ----------
+    mbs : exudyn MainSystem
+        At the current state.
+    channels : list of PairChannel
+        One per pair.
+
+    Returns
+    -------
+    list of (omega_rel, slide_rel)
+        Per pair [rad/s, m/s] (0 for a slide that is not read).
+    """
     get = mbs.GetObjectOutput
     return [(float(get(c.joint, _ANGULAR_VELOCITY)[2]),
              float(get(c.joint, _VELOCITY)[2]) if c.slides else 0.0) for c in channels]
@@ -194,9 +268,22 @@ class PairReader:
                       for (a1, s1), (a2, s2) in zip(self._c1, self._c2, strict=True)]
 
     def read(self, t: float | None) -> list[tuple[float, float, float, float]]:
-        """Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])`` at the current
-        state (``t`` None: the initial state, with velocity-level speeds; else BDF2 over the
-        accepted steps, and the coordinates are kept as :attr:`coords`)."""
+        """The law's inputs of every pair at the current state; sets :attr:`regime`.
+
+        One loop on purpose: this runs after every Newton solve, and a pass per quantity costs
+        more than the law.
+
+        Parameters
+        ----------
+        t : float or None
+            Time of the state [s]: speeds by BDF2 over the accepted steps, the coordinates kept
+            as :attr:`coords`; None: the initial state, with velocity-level speeds.
+
+        Returns
+        -------
+        list of (float, float, float, float)
+            Per pair ``|F|`` [N], ``|M|`` [N m], ``omega_rel`` [rad/s], ``slide_rel`` [m/s].
+        """
         if t is None or self._back is None:
             return self._read_plain(t)
         h1 = t - self._t1
@@ -256,9 +343,17 @@ class PairReader:
 class BodyLoads:
     """The merged friction loads of the moving bodies (see the module doc).
 
-    ``contributions``: per pair, ``(body number, node-frame pair point, +1 for body b / -1 for
-    body a)`` for each moving body of the pair; ``axes``: per pair the axis in node frames;
-    ``slides``: per pair whether it carries an axial force.
+    Parameters
+    ----------
+    mbs : exudyn MainSystem
+        The loads are added to it.
+    contributions : list of list of (int, ndarray, int)
+        Per pair, for each moving body of the pair: its body number, the pair point in its node
+        frame [m], shape (3,), and +1 for body b, -1 for body a.
+    axes : list of ndarray, shape (3,)
+        Per pair the unit axis in node frames.
+    slides : list of bool
+        Per pair whether it carries an axial force.
     """
 
     def __init__(self, mbs: Any, contributions: list[list[tuple[int, np.ndarray, int]]],

@@ -71,9 +71,21 @@ class PairLaw:
 
     @classmethod
     def of(cls, kind: str, pair: Any, law: str = "paper") -> PairLaw:
-        """The law of a scene's pair (:class:`reference.scene.joint.Pair`, its ``moment_lever``
-        resolved to a number) of ``kind`` ("revolute" or "cylindrical") under the friction
-        ``law`` ("paper" or "resultant", ``FrictionSettings.law``)."""
+        """The law of a scene's pair.
+
+        Parameters
+        ----------
+        kind : {"revolute", "cylindrical"}
+            The pair's kind.
+        pair : reference.scene.joint.Pair
+            Its ``moment_lever`` resolved to a number [m].
+        law : {"paper", "resultant"}
+            ``FrictionSettings.law``.
+
+        Returns
+        -------
+        PairLaw
+        """
         if law not in ("paper", "resultant"):
             raise ValueError(f"`law` must be 'paper' or 'resultant', got {law!r}")
         return cls(kind == "cylindrical", pair.friction_coefficient, pair.journal_diameter,
@@ -101,7 +113,20 @@ class FrictionLoads(NamedTuple):
 
 
 def ramp_sign(speed: float, band: float) -> float:
-    """Sign of ``speed`` [m/s], a linear ramp of width ``band`` [m/s]; the exact sign for 0."""
+    """Sign of a speed, regularised by a linear ramp.
+
+    Parameters
+    ----------
+    speed : float
+        Relative surface or sliding speed [m/s].
+    band : float
+        Width of the ramp [m/s]; 0: the exact sign.
+
+    Returns
+    -------
+    float
+        In ``[-1, 1]`` [-].
+    """
     if band <= 0.0:
         return float(speed > 0.0) - float(speed < 0.0)
     return max(-1.0, min(1.0, speed / band))
@@ -131,6 +156,10 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
     resultant_band : float or None
         Resultant-slip law: width of the ramp of the slip speed ``hypot(omega_rel d / 2,
         slide_rel)`` [m/s]; None: ``band``.
+
+    Returns
+    -------
+    FrictionLoads
     """
     return FrictionLoads(*magnitude_loads(law, math.hypot(force_x, force_y), math.hypot(moment_x, moment_y),
                                           omega_rel, slide_rel, band, slide_band, resultant_band))
@@ -139,9 +168,23 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
 def magnitude_loads(law: PairLaw, force_n: float, moment_n: float, omega_rel: float, slide_rel: float,
                     band: float, slide_band: float | None = None,
                     resultant_band: float | None = None) -> tuple[float, float, float]:
-    """:func:`pair_loads` from the magnitudes ``force_n`` [N] of the reaction force normal to the
-    axis and ``moment_n`` [N m] of the bending moment: ``(torque, force, sliding_scale)`` as a plain
-    tuple (the coupling's hot path; ``force`` is 0 for a revolute pair)."""
+    """:func:`pair_loads` from the reaction's magnitudes, as a plain tuple (the coupling's hot path).
+
+    Parameters
+    ----------
+    law : PairLaw
+    force_n : float
+        Magnitude of the reaction force normal to the axis [N].
+    moment_n : float
+        Magnitude of the bending moment [N m].
+    omega_rel, slide_rel, band, slide_band, resultant_band : float
+        As for :func:`pair_loads` [rad/s, m/s, m/s, m/s, m/s].
+
+    Returns
+    -------
+    torque, force, sliding_scale : float
+        The fields of :class:`FrictionLoads` [N m, N, N m]; ``force`` is 0 for a revolute pair.
+    """
     radius = 0.5 * law.d
     torque = law.f * law.d * moment_n / law.lever + law.f * radius * force_n
     magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
@@ -165,7 +208,17 @@ def bdf2_weights(h1: float, h2: float) -> tuple[float, float]:
 
     With ``d1 = c_n - c_{n-1}`` over the last step ``h1`` and ``d2 = c_{n-1} - c_{n-2}`` over the
     one before, ``h2``, the derivative at ``t_n`` is ``(w1 d1 - w2 d2) / h1`` (exact for
-    quadratics). Returns ``(w1, w2)``.
+    quadratics).
+
+    Parameters
+    ----------
+    h1, h2 : float or ndarray
+        The last step and the one before [s].
+
+    Returns
+    -------
+    w1, w2 : float or ndarray
+        The weights [-].
     """
     w = h1 / h2
     return (1.0 + 2.0 * w) / (1.0 + w), w * w / (1.0 + w)
@@ -200,6 +253,9 @@ class LawTable:
     def loads(self, inputs: list, older: list | None = None, a: float = 1.0,
               b: float = 0.0) -> tuple[tuple[float, ...], tuple[int, ...], float, float]:
         """The friction on the law's ``inputs`` or, with ``older``, on ``a x - b x_older``.
+
+        One loop with the law inlined on purpose: it runs after every Newton solve, where a call
+        per pair costs more than the law.
 
         Parameters
         ----------

@@ -40,6 +40,25 @@ def first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
 
 
 def stored(model: ExudynModel, key: str) -> np.ndarray:
+    """The stored data of one sensor.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        The solved model.
+    key : str
+        Sensor name in ``model.sensors``.
+
+    Returns
+    -------
+    ndarray, shape (n, 1 + k)
+        Time [s] in column 0, then the sensor's ``k`` values (SI units).
+
+    Raises
+    ------
+    ValueError
+        When the sensor recorded nothing (e.g. a failure in the first step).
+    """
     data = np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
     if data.ndim != 2:  # nothing recorded, e.g. a failure in the first step
         raise ValueError(f"sensor `{key}` recorded no data")
@@ -84,11 +103,27 @@ Kinematics = dict[str, dict[str, np.ndarray]]
 
 def pair_kinematics(model: ExudynModel, states: dict, n: int,
                     positions: Kinematics | None = None) -> Kinematics:
-    """Pair axes, marker points and their velocities (global) for both bodies of each pair, and
-    ``relative`` (``frame_a^T frame_b``, the pair frame of body b in that of body a).
+    """Pair axes, marker points and their velocities (global) for both bodies of each pair.
 
-    ``positions``: an earlier result for the same positions (e.g. before a velocity projection,
-    which keeps them): its position-level entries are taken over and only the velocities computed.
+    Parameters
+    ----------
+    model : ExudynModel
+        The solved model (marker points and pair frames).
+    states : dict
+        :func:`body_states`, per body.
+    n : int
+        Rows to use.
+    positions : dict, optional
+        A result of this function for the same positions (e.g. the one a velocity projection
+        started from, which keeps them): its position-level entries are taken over and only the
+        velocities computed.
+
+    Returns
+    -------
+    dict
+        Per pair: ``frame_a``, ``frame_b`` (n, 3, 3) pair frames, ``pa``, ``pb`` (n, 3) marker
+        points [m], ``va``, ``vb`` (n, 3) their velocities [m/s], ``omega_a``, ``omega_b`` (n, 3)
+        angular velocities [rad/s], and ``relative`` (n, 3, 3), ``frame_a^T frame_b``.
     """
     out = {}
     for name in PAIR_NAMES:
@@ -133,9 +168,24 @@ def _marker_velocity(s: dict | None, p: np.ndarray, n: int) -> tuple[np.ndarray,
 def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarray]:
     """Columns of the result schema from the recorded sensors.
 
-    ``project``: replace the recorded velocities by their projection onto the velocity
-    constraints (:mod:`cardan_exudyn.model.projection`); the largest correction is left in
-    ``model.velocity_correction``. Raises ``ValueError`` when fewer than two steps were recorded.
+    Parameters
+    ----------
+    model : ExudynModel
+        The solved model; its ``pair_kinematics`` (and, when projecting, its
+        ``velocity_correction``) are set.
+    project : bool
+        Replace the recorded velocities by their projection onto the velocity constraints
+        (:mod:`cardan_exudyn.model.projection`).
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        The result schema's columns (SI units).
+
+    Raises
+    ------
+    ValueError
+        When fewer than two steps are recorded.
     """
     states = body_states(model)
     n = min(len(s["t"]) for s in states.values())
@@ -232,8 +282,24 @@ def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
 
 
 def projected_states(model: ExudynModel, states: dict, n: int, kin: dict | None = None) -> dict:
-    """``states`` with velocities projected onto the joint's velocity constraints (``kin``: their
-    :func:`pair_kinematics`, computed when not given)."""
+    """``states`` with velocities projected onto the joint's velocity constraints.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        The solved model; the largest correction [m/s] is left in ``model.velocity_correction``.
+    states : dict
+        :func:`body_states`.
+    n : int
+        Rows to use.
+    kin : dict, optional
+        :func:`pair_kinematics` of ``states``, computed when not given.
+
+    Returns
+    -------
+    dict
+        Per body, as ``states`` (first ``n`` rows), velocities ``v`` and ``omega`` projected.
+    """
     drive = model.scene.drive
     if isinstance(drive, AngleDrive):
         spline = drive.spline()
@@ -263,6 +329,24 @@ def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
                     cylindrical: bool) -> tuple[np.ndarray, np.ndarray]:
     """Relative angular and sliding speed of body b w.r.t. body a of a pair.
 
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Times [s].
+    k : dict
+        One pair's entry of :func:`pair_kinematics`.
+    cylindrical : bool
+        Whether the pair can slide (else the sliding speed is zero).
+
+    Returns
+    -------
+    omega_rel : ndarray, shape (n,)
+        Relative angular speed about the pair axis [rad/s].
+    slide_rel : ndarray, shape (n,)
+        Relative sliding speed along the pair axis [m/s].
+
+    Notes
+    -----
     Index-3 integration keeps positions on the constraint manifold to the Newton tolerance but
     leaves O(h^2) residuals in the velocity constraints (sliding speeds of ~1e-3 m/s in pairs
     that cannot slide). The relative speeds are therefore the second-order backward difference
@@ -295,7 +379,22 @@ def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
 
 
 def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and gravitational potential energy of the three bodies [J]."""
+    """Kinetic and gravitational potential energy of the three bodies.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        Masses, inertias and the scene's gravity.
+    states : dict
+        :func:`body_states`.
+    n : int
+        Rows to use.
+
+    Returns
+    -------
+    kinetic, potential : ndarray, shape (n,)
+        Energies [J].
+    """
     kinetic = np.zeros(n)
     potential = np.zeros(n)
     g = np.asarray(model.scene.gravity)

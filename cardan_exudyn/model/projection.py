@@ -46,8 +46,19 @@ BODIES = ("input", "spider", "output")
 
 
 def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` row by row for ``(n, 3)`` arrays (either may be one ``(3,)`` vector): the same
-    as ``np.cross`` without its axis handling, which costs more than the product on short runs."""
+    """``a x b`` row by row: ``np.cross`` without its axis handling, which costs more than the
+    product on short runs.
+
+    Parameters
+    ----------
+    a, b : ndarray, shape (n, 3) or (3,)
+        Vectors (any unit); a ``(3,)`` vector broadcasts against the rows of the other.
+
+    Returns
+    -------
+    ndarray, shape (n, 3) or (3,)
+        The cross products (unit of ``a`` times unit of ``b``).
+    """
     a = np.asarray(a, float)
     b = np.asarray(b, float)
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -66,11 +77,22 @@ def _skew_rows(rho: np.ndarray, axis: np.ndarray) -> np.ndarray:
 
 def constraint_jacobian(states: dict[str, dict[str, np.ndarray]],
                         pairs: dict[str, dict[str, np.ndarray]]) -> np.ndarray:
-    """Velocity-constraint Jacobian ``J`` (n, 17, 18) of the four pairs at every recorded row.
+    """Velocity-constraint Jacobian of the four pairs at every recorded row.
 
-    Unknowns per body (in :data:`BODIES` order): centre-of-mass velocity (3) then angular
-    velocity (3), global components. ``pairs[name]`` holds ``frame_a`` (n, 3, 3, columns the
-    pair axes of body a), ``pa``, ``pb`` (n, 3); ``states[body]`` holds ``r`` (n, 3).
+    Parameters
+    ----------
+    states : dict
+        Per body ``r``, shape (n, 3): centre-of-mass position [m].
+    pairs : dict
+        Per pair ``frame_a``, shape (n, 3, 3) (columns the pair axes of body a), and ``pa``,
+        ``pb``, shape (n, 3): marker points [m].
+
+    Returns
+    -------
+    ndarray, shape (n, 17, 18)
+        ``J``; the unknowns per body (in :data:`BODIES` order) are the centre-of-mass velocity
+        (3) then the angular velocity (3), global components. Rows are dimensionless (velocity
+        rows) or in m (the lever of an angular velocity in a velocity row).
     """
     n = next(iter(pairs.values()))["pa"].shape[0]
     jac = np.zeros((n, 17, 18))

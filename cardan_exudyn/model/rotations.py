@@ -43,7 +43,20 @@ def rxyz_matrix(psi: np.ndarray) -> np.ndarray:
 
 
 def rxyz_angular_velocity(psi: np.ndarray, psi_t: np.ndarray) -> np.ndarray:
-    """Global angular velocity ``G(psi) psi_t``, shape (n, 3) [rad/s]."""
+    """Global angular velocity ``G(psi) psi_t`` of Rxyz coordinates.
+
+    Parameters
+    ----------
+    psi : ndarray, shape (n, 3) or (3,)
+        Rxyz angles [rad].
+    psi_t : ndarray, shape (n, 3) or (3,)
+        Their rates [rad/s].
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Global angular velocity [rad/s].
+    """
     psi = np.atleast_2d(psi)
     psi_t = np.atleast_2d(psi_t)
     c0 = np.cos(psi[:, 0])
@@ -67,7 +80,20 @@ def rxyz_from_matrix(a: np.ndarray) -> np.ndarray:
 
 
 def rxyz_rates(psi: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Angle rates psi_t with ``G(psi) psi_t = omega`` (global angular velocity)."""
+    """Angle rates ``psi_t`` with ``G(psi) psi_t = omega``.
+
+    Parameters
+    ----------
+    psi : ndarray, shape (3,)
+        Rxyz angles [rad].
+    omega : ndarray, shape (3,)
+        Global angular velocity [rad/s].
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        Angle rates [rad/s].
+    """
     c0 = np.cos(psi[0])
     c1 = np.cos(psi[1])
     s0 = np.sin(psi[0])
@@ -77,12 +103,40 @@ def rxyz_rates(psi: np.ndarray, omega: np.ndarray) -> np.ndarray:
 
 
 def rxyz_frame(psi: np.ndarray, psi_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrices and global angular velocities of Rxyz coordinates, shapes (n, 3, 3), (n, 3)."""
+    """Rotation matrices and global angular velocities of Rxyz coordinates.
+
+    Parameters
+    ----------
+    psi : ndarray, shape (n, 3)
+        Rxyz angles [rad].
+    psi_t : ndarray, shape (n, 3)
+        Their rates [rad/s].
+
+    Returns
+    -------
+    a : ndarray, shape (n, 3, 3)
+        Rotation matrices, body to global.
+    omega : ndarray, shape (n, 3)
+        Global angular velocities [rad/s].
+    """
     return rxyz_matrix(psi), rxyz_angular_velocity(psi, psi_t)
 
 
 def rxyz_frame_one(psi, psi_t) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`rxyz_frame` of one state with scalar math (for the per-Newton-solve friction update)."""
+    """:func:`rxyz_frame` of one state with scalar math (for the per-Newton-solve friction update).
+
+    Parameters
+    ----------
+    psi, psi_t : sequence of float, length 3
+        Rxyz angles [rad] and their rates [rad/s].
+
+    Returns
+    -------
+    a : ndarray, shape (3, 3)
+        Rotation matrix, body to global.
+    omega : ndarray, shape (3,)
+        Global angular velocity [rad/s].
+    """
     c0, c1, c2 = math.cos(psi[0]), math.cos(psi[1]), math.cos(psi[2])
     s0, s1, s2 = math.sin(psi[0]), math.sin(psi[1]), math.sin(psi[2])
     a = np.array([
@@ -102,7 +156,22 @@ def rxyz_frame_one(psi, psi_t) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ep_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrices and global angular velocities of Euler parameters, shapes (n, 3, 3), (n, 3)."""
+    """Rotation matrices and global angular velocities of Euler parameters.
+
+    Parameters
+    ----------
+    p : ndarray, shape (n, 4)
+        Euler parameters ``(e0, e1, e2, e3)``, ``e0`` the scalar part [-].
+    p_t : ndarray, shape (n, 4)
+        Their rates [1/s].
+
+    Returns
+    -------
+    a : ndarray, shape (n, 3, 3)
+        Rotation matrices, body to global.
+    omega : ndarray, shape (n, 3)
+        Global angular velocities [rad/s].
+    """
     p = np.atleast_2d(p)
     p_t = np.atleast_2d(p_t)
     e0, e1, e2, e3 = p.T
@@ -124,7 +193,20 @@ def ep_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ep_frame_one(p, p_t) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`ep_frame` of one state with scalar math."""
+    """:func:`ep_frame` of one state with scalar math.
+
+    Parameters
+    ----------
+    p, p_t : sequence of float, length 4
+        Euler parameters [-] and their rates [1/s].
+
+    Returns
+    -------
+    a : ndarray, shape (3, 3)
+        Rotation matrix, body to global.
+    omega : ndarray, shape (3,)
+        Global angular velocity [rad/s].
+    """
     e0, e1, e2, e3 = float(p[0]), float(p[1]), float(p[2]), float(p[3])
     d0, d1, d2, d3 = float(p_t[0]), float(p_t[1]), float(p_t[2]), float(p_t[3])
     a = np.array([
@@ -161,7 +243,20 @@ def ep_from_matrix(a: np.ndarray) -> np.ndarray:
 
 
 def ep_rates(p: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Rates p_t with ``G(p) p_t = omega`` (global) and ``p . p_t = 0`` (unit p): ``G^T omega / 4``."""
+    """Rates ``p_t`` with ``G(p) p_t = omega`` and ``p . p_t = 0`` (unit p): ``G^T omega / 4``.
+
+    Parameters
+    ----------
+    p : ndarray, shape (4,)
+        Unit Euler parameters [-].
+    omega : ndarray, shape (3,)
+        Global angular velocity [rad/s].
+
+    Returns
+    -------
+    ndarray, shape (4,)
+        Euler parameter rates [1/s].
+    """
     e0, e1, e2, e3 = p
     g = 2.0 * np.array([[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]])
     return 0.25 * g.T @ np.asarray(omega, dtype=float)
@@ -181,8 +276,22 @@ def _rotvec_coefficients(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def rotvec_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrices and global angular velocities of rotation vectors with local angular
-    velocities as rates, shapes (n, 3, 3), (n, 3)."""
+    """Rotation matrices and global angular velocities of rotation vectors.
+
+    Parameters
+    ----------
+    p : ndarray, shape (n, 3)
+        Rotation vectors [rad].
+    p_t : ndarray, shape (n, 3)
+        Local angular velocities [rad/s] (the RotVecLG node's velocity coordinates).
+
+    Returns
+    -------
+    a : ndarray, shape (n, 3, 3)
+        Rotation matrices, body to global.
+    omega : ndarray, shape (n, 3)
+        Global angular velocities [rad/s].
+    """
     p = np.atleast_2d(p)
     p_t = np.atleast_2d(p_t)
     x, y, z = p.T
@@ -201,7 +310,20 @@ def rotvec_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 
 def rotvec_frame_one(p, p_t) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`rotvec_frame` of one state with scalar math."""
+    """:func:`rotvec_frame` of one state with scalar math.
+
+    Parameters
+    ----------
+    p, p_t : sequence of float, length 3
+        Rotation vector [rad] and local angular velocity [rad/s].
+
+    Returns
+    -------
+    a : ndarray, shape (3, 3)
+        Rotation matrix, body to global.
+    omega : ndarray, shape (3,)
+        Global angular velocity [rad/s].
+    """
     x, y, z = float(p[0]), float(p[1]), float(p[2])
     phi = math.sqrt(x * x + y * y + z * z)
     if phi == 0.0:
@@ -229,11 +351,22 @@ def rotvec_from_matrix(a: np.ndarray) -> np.ndarray:
 
 
 def rotvec_rates(p: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Rates of a RotVecLG node: the local angular velocity ``A(nu)^T omega``."""
+    """Rates of a RotVecLG node: the local angular velocity ``A(nu)^T omega``.
+
+    Parameters
+    ----------
+    p : ndarray, shape (3,)
+        Rotation vector ``nu`` [rad].
+    omega : ndarray, shape (3,)
+        Global angular velocity [rad/s].
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        Local angular velocity [rad/s].
+    """
     a, _ = rotvec_frame_one(p, np.zeros(3))
     return a.T @ np.asarray(omega, dtype=float)
-
-
 
 
 @dataclass(frozen=True)
@@ -288,7 +421,7 @@ class WholeTurns:
 
     @property
     def count(self) -> int:
-        """Whole revolutions removed up to now."""
+        """Whole revolutions removed so far."""
         return self.counts[-1] if self.counts else self.start
 
     def reset(self) -> None:
@@ -297,7 +430,20 @@ class WholeTurns:
         self.counts.clear()
 
     def remove(self, coordinate: float, t: float) -> float:
-        """``coordinate`` [rad] less its nearest whole revolutions (recorded at time ``t`` [s])."""
+        """``coordinate`` less its nearest whole revolutions, recording the change.
+
+        Parameters
+        ----------
+        coordinate : float
+            Angle coordinate [rad].
+        t : float
+            Time of the state [s].
+
+        Returns
+        -------
+        float
+            The coordinate within ``[-pi, pi]`` [rad].
+        """
         k = round(coordinate / TWO_PI)
         if k == 0:
             return coordinate
@@ -311,7 +457,20 @@ class WholeTurns:
         return counts[np.searchsorted(np.asarray(self.times, dtype=float), t, side="right")]
 
     def angle(self, t: np.ndarray, coordinate: np.ndarray) -> np.ndarray:
-        """The continuous angle [rad] of states with coordinates ``coordinate`` at times ``t``."""
+        """The continuous angle of recorded states.
+
+        Parameters
+        ----------
+        t : ndarray, shape (n,)
+            Times of the states [s].
+        coordinate : ndarray, shape (n,)
+            Their angle coordinates [rad].
+
+        Returns
+        -------
+        ndarray, shape (n,)
+            Continuous angle [rad].
+        """
         return coordinate + TWO_PI * self.at(t)
 
 
