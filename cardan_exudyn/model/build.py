@@ -119,10 +119,25 @@ def pair_geometry(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 def assembled_state(scene: Scene, theta: float, omega: float) -> dict[str, dict[str, np.ndarray]]:
     """Orientation, angular velocity, frame origin and its velocity of each body at an input state.
 
-    ``A`` rotates node coordinates to global ones; ``origin`` is the body's canonical-frame origin
-    [m] and ``velocity`` its velocity [m/s] (both zero for the ideal joint, whose bodies turn
-    about the joint centre).
+    Parameters
+    ----------
+    scene : Scene
+        The joint.
+    theta : float
+        Input shaft angle [rad].
+    omega : float
+        Input shaft speed [rad/s].
 
+    Returns
+    -------
+    dict
+        Per moving body: ``A``, shape (3, 3), rotating node coordinates to global ones;
+        ``omega``, shape (3,), angular velocity [rad/s]; ``origin``, shape (3,), the body's
+        canonical-frame origin [m] and ``velocity`` its velocity [m/s] (both zero for the ideal
+        joint, whose bodies turn about the joint centre).
+
+    Notes
+    -----
     Ideal joint: closed-form vector geometry (written here independently of
     ``reference.physics.kinematics``): the output yoke axis is normal to the output shaft axis and the
     input yoke axis; the relative rates follow from the velocity loop
@@ -458,8 +473,14 @@ def add_sensors(model: ExudynModel, reactions: bool = True) -> None:
     """Internal (in-memory) sensors for node states, pair reactions and the drive force.
 
     Every sensor is stored at every step and costs time: the eight reaction sensors are most of
-    the recording cost of a frictionless run, and are left out with ``reactions=False`` (their
-    table columns are then NaN).
+    the recording cost of a frictionless run.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        The model being built; its ``sensors`` are filled.
+    reactions : bool
+        Whether the pair reactions are recorded (else their table columns are NaN).
     """
     out = exu.OutputVariableType
 

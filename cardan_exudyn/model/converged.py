@@ -48,9 +48,19 @@ class ConvergedCoupling(FrictionCoupling):
         self._accepted: list[tuple] = []  # the last accepted steps' friction (flat)
 
     def initialise(self, solver: Any, settings: Any) -> tuple[np.ndarray, list] | None:
-        """Friction consistent with the initial state, the first accepted state; call after
-        ``solver.InitializeSolver`` with the run's ``settings``. Returns
-        :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
+        """Friction consistent with the initial state, the first accepted state.
+
+        Parameters
+        ----------
+        solver : exudyn.MainSolverImplicitSecondOrder
+            Initialised (``solver.InitializeSolver`` called).
+        settings : exudyn.SimulationSettings
+            The run's settings.
+
+        Returns
+        -------
+        (friction, inputs) or None
+            :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
         """
         start = self.consistent_start(solver, settings)
         if start is not None:
@@ -58,9 +68,20 @@ class ConvergedCoupling(FrictionCoupling):
         return start
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function after a solve at time ``t`` [s] of system ``mbs``:
-        :meth:`update`, an exception kept
+        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
         (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
+
+        Parameters
+        ----------
+        mbs : exudyn MainSystem
+            The system just solved.
+        t : float
+            Time of the solve [s].
+
+        Returns
+        -------
+        list of float
+            Exudyn's ``[error, -1]``: a positive error repeats the step's solve.
         """
         try:
             return self.update(t)
@@ -76,8 +97,14 @@ class ConvergedCoupling(FrictionCoupling):
         return error
 
     def iterate(self, t: float, counted: bool = False) -> tuple[list[float], tuple | None]:
-        """One evaluation of the fixed point of the step at ``t`` [s] (``counted``:
-        :meth:`new_step` was already called for it).
+        """One evaluation of the fixed point of a step.
+
+        Parameters
+        ----------
+        t : float
+            Time of the step [s].
+        counted : bool
+            Whether :meth:`new_step` was already called for this evaluation.
 
         Returns
         -------

@@ -203,8 +203,16 @@ class FrictionCoupling:
 
         Exudyn computes the initial accelerations and reactions from the initial state and the
         loads in place; the friction loads are iterated with them (Broyden) until consistent,
-        so that the first recorded row and the first step include friction. Call after
-        ``solver.InitializeSolver``.
+        so that the first recorded row and the first step include friction.
+
+        Parameters
+        ----------
+        solver : exudyn.MainSolverImplicitSecondOrder
+            Initialised (``solver.InitializeSolver`` called).
+        settings : exudyn.SimulationSettings
+            The run's settings.
+        max_iterations : int
+            Broyden iterations before the start is declared self-locking.
 
         Returns
         -------
@@ -288,8 +296,17 @@ class FrictionCoupling:
         return True
 
     def change(self, friction: tuple, before: tuple) -> float:
-        """Largest change [N m] between two flat friction states ``friction`` and ``before``, forces
-        weighted by ``d / 2``.
+        """Largest change between two friction states, forces weighted by ``d / 2``.
+
+        Parameters
+        ----------
+        friction, before : tuple of float
+            Flat ``(M_z, F_z)`` per pair [N m, N].
+
+        Returns
+        -------
+        float
+            The largest weighted change [N m].
         """
         return max((w * abs(a - b) for w, a, b in zip(self._flat_weight, friction, before, strict=True)),
                    default=0.0)
@@ -376,6 +393,10 @@ def friction_pairs(model: Any, bands: dict[str, Any]) -> list[PairData]:
         The model being built (its joints added).
     bands : dict of str to (float, float, float)
         Each pair's sign ramps [m/s] (:func:`reference.physics.bands.sign_bands`).
+
+    Returns
+    -------
+    list of PairData
     """
     scene = model.scene
     out = []
@@ -389,8 +410,20 @@ def friction_pairs(model: Any, bands: dict[str, Any]) -> list[PairData]:
 
 
 def body_contributions(model: Any, name: str) -> list[tuple[int, Any, int]]:
-    """The moving bodies of pair ``name`` in ``model`` that carry its friction: ``(body, marker
-    position in the body [m], sign)``, -1 for body ``a`` and +1 for body ``b``.
+    """The moving bodies of a pair that carry its friction.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        The model being built (bodies and markers added).
+    name : str
+        One of :data:`reference.scene.joint.PAIR_NAMES`.
+
+    Returns
+    -------
+    list of (int, ndarray, int)
+        Per moving body its body number, the marker position in the body [m], shape (3,), and
+        -1 for body ``a``, +1 for body ``b``.
     """
     return [(model.bodies[body], local, role) for role, body, local in
             zip((-1, 1), PAIR_BODIES[name], model.marker_local[name], strict=True) if body != "ground"]

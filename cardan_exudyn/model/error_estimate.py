@@ -158,8 +158,19 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
 
 def ratio_error(numerator: float, denominator: float, numerator_error: float,
                 denominator_error: float) -> float:
-    """First-order error of ``numerator / denominator`` (and of one minus it) from the errors
-    ``numerator_error`` and ``denominator_error`` of the two, in the ratio's units.
+    """First-order error of ``numerator / denominator`` (and of one minus it).
+
+    Parameters
+    ----------
+    numerator, denominator : float
+        The two values (same unit, e.g. J).
+    numerator_error, denominator_error : float
+        Their absolute errors (same unit).
+
+    Returns
+    -------
+    float
+        The ratio's absolute error [-].
     """
     d = abs(denominator)
     return numerator_error / d + abs(numerator) * denominator_error / d ** 2
@@ -196,8 +207,20 @@ def quadrature_estimate(result: Result) -> ErrorEstimate:
 
 
 def half_step_scene(scene: Scene, dt: float, table: bool) -> Scene:
-    """``scene`` at half the step ``dt`` [s], keeping the rows of a table at ``dt`` (every second
-    step), recording a table only when ``table``.
+    """A scene at half a run's step, its table rows at the run's.
+
+    Parameters
+    ----------
+    scene : Scene
+        The run's scene.
+    dt : float
+        The run's step [s].
+    table : bool
+        Whether a table is recorded (every second step, the rows at ``dt``).
+
+    Returns
+    -------
+    Scene
     """
     every = 2 * scene.record.every if table else 1
     return replace(scene, **{"numerics.dt": 0.5 * dt, "record.every": every,
@@ -222,6 +245,10 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
         ``run(scene, engine, options) -> Result`` for the rerun.
     skip_revolutions : float
         Input revolutions [-] left out of the columns' changes.
+
+    Returns
+    -------
+    ErrorEstimate
 
     Raises
     ------
@@ -254,9 +281,22 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
 
 
 def row_changes(coarse: Any, fine: Any, dt: float, skip_revolutions: float = 0.0) -> dict[str, float]:
-    """Largest change of each column between two tables ``coarse`` and ``fine`` (pandas) with the
-    same rows, after the first ``skip_revolutions`` [-]; empty when their times differ by more than
-    a millionth of ``dt`` [s].
+    """Largest change of each column between two tables with the same rows.
+
+    Parameters
+    ----------
+    coarse, fine : pandas.DataFrame
+        The tables (result schema columns, ``t`` and ``theta_in`` among them).
+    dt : float
+        The coarse step [s]: the rows' times must agree to a millionth of it.
+    skip_revolutions : float
+        Input revolutions [-] left out at the start.
+
+    Returns
+    -------
+    dict of str to float
+        Per column (``t`` aside) the largest absolute change (column units); empty when the
+        times differ.
     """
     n = min(len(coarse), len(fine))
     t_coarse = coarse["t"].to_numpy(float)[:n]

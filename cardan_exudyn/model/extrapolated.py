@@ -62,11 +62,23 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         self._predicted_regime: tuple = ()  # the regime the step was solved with
 
     def initialise(self, solver: Any, settings: Any) -> tuple[Any, list] | None:
-        """The probe interval for the run's ``settings`` (at least :data:`PROBES_PER_REVOLUTION`
-        probes per revolution at the drive's top speed, at most every :data:`PROBE_EVERY`-th step),
-        then the consistent initial friction, whose inputs and regime start the extrapolation; call
-        after ``solver.InitializeSolver``. Returns
-        :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
+        """The probe interval, then the consistent initial friction.
+
+        The interval gives at least :data:`PROBES_PER_REVOLUTION` probes per revolution at the
+        drive's top speed, at most every :data:`PROBE_EVERY`-th step; the initial friction's
+        inputs and regime start the extrapolation.
+
+        Parameters
+        ----------
+        solver : exudyn.MainSolverImplicitSecondOrder
+            Initialised (``solver.InitializeSolver`` called).
+        settings : exudyn.SimulationSettings
+            The run's settings.
+
+        Returns
+        -------
+        (friction, inputs) or None
+            :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
         """
         ti = settings.timeIntegration
         speed = self.model.scene.drive.max_speed()
@@ -82,9 +94,20 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return start
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function after a solve at time ``t`` [s] of system ``mbs``:
-        :meth:`update`, an exception kept
+        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
         (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
+
+        Parameters
+        ----------
+        mbs : exudyn MainSystem
+            The system just solved.
+        t : float
+            Time of the solve [s].
+
+        Returns
+        -------
+        list of float
+            Exudyn's ``[error, -1]``: a positive error repeats the step's solve.
         """
         try:
             return self.update(t)

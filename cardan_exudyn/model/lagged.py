@@ -23,15 +23,32 @@ class LaggedCoupling(FrictionCoupling):
     iterates = False
 
     def initialise(self, solver: Any, settings: Any) -> None:
-        """Friction consistent with the initial state (it acts in the first step); call after
-        ``solver.InitializeSolver`` with the run's ``settings``.
+        """Friction consistent with the initial state (it acts in the first step).
+
+        Parameters
+        ----------
+        solver : exudyn.MainSolverImplicitSecondOrder
+            Initialised (``solver.InitializeSolver`` called).
+        settings : exudyn.SimulationSettings
+            The run's settings.
         """
         self.consistent_start(solver, settings)
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function after a solve at time ``t`` [s] of system ``mbs``:
-        :meth:`update`, an exception kept
+        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
         (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
+
+        Parameters
+        ----------
+        mbs : exudyn MainSystem
+            The system just solved.
+        t : float
+            Time of the solve [s].
+
+        Returns
+        -------
+        list of float
+            Exudyn's ``[error, -1]``: a positive error repeats the step's solve.
         """
         try:
             return self.update(t)

@@ -18,8 +18,7 @@ What is extrapolated, and what is taken from the fine run (:data:`EXTRAPOLATED`,
 
 The force-level histories (drive torque, reactions: the Lagrange multipliers) carry
 generalized-alpha's start-up oscillation, which alternates in sign from step to step and decays
-over about a revolution. Taking every other row of the fine run aliases it (measured at 35 deg, 50
-steps per revolution: the mean input torque 9x worse than the coarse run's). Those columns
+over about a revolution. Taking every other row of the fine run aliases it. Those columns
 (:data:`FILTERED`) are therefore smoothed on each run's own grid by the three-point filter
 ``(x[i-1] + 2 x[i] + x[i+1]) / 4`` (first and last rows kept), which removes the alternating
 part and adds ``h^2 x'' / 4 + O(h^4)`` to a smooth history: a ``c h^2`` term of the same form in
@@ -28,9 +27,7 @@ both runs, which the extrapolation removes with the integrator's own.
 With the velocity projection the speeds of both runs are already exact; their combination stays
 exact (they are not filtered). The relative speeds are backward differences of the relative
 coordinates (BDF2, BDF1 in the second row): their first rows keep a first-order error, like every
-start-up row. Measured
-(``docs/bench.md``, "Velocity projection"): the steady drive-torque error at 35 deg falls from
-2.1e-3 (100 steps per revolution) and 5.3e-4 (200) to 9.1e-6 for the combination.
+start-up row. Measured: docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not.
 
 Friction: the mean efficiency is first order where the pairs' sign ramps are not resolved by the
 step, so an extrapolation at order 2 can make it worse; :func:`refusal` refuses the combination
@@ -85,7 +82,19 @@ def smooth(x: np.ndarray) -> np.ndarray:
 def extrapolate(fine: np.ndarray, coarse: np.ndarray, ratio: float = 2.0, order: int = 2) -> np.ndarray:
     """``x_fine + (x_fine - x_coarse) / (ratio^order - 1)``: exact for an error ``c h^order``.
 
-    ``fine`` and ``coarse`` are the histories on the same rows, ``ratio`` the step ratio [-].
+    Parameters
+    ----------
+    fine, coarse : ndarray, shape (n,)
+        A history of the fine and the coarse run on the same rows (any unit).
+    ratio : float
+        Step ratio coarse / fine [-].
+    order : int
+        Order of the error in the step.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The extrapolated history (the unit of ``fine``).
     """
     factor = 1.0 / (ratio ** order - 1.0)
     fine = np.asarray(fine, float)

@@ -62,10 +62,22 @@ def end_time(scene: Scene, start: float) -> float:
 
 
 def steps_for_span(span: float, dt: float) -> int:
-    """Fewest whole steps of at most ``dt`` [s] (to rounding) that cover ``span`` [s].
+    """Fewest whole steps of at most ``dt`` (to rounding) that cover ``span``.
 
-    Why not the nearest count: it would stop short of the span by up to half a step, and a span
-    of exactly ``1 + skip`` revolutions would then average less than one revolution.
+    Not the nearest count: it would stop short of the span by up to half a step, and a span of
+    exactly ``1 + skip`` revolutions would then average less than one revolution.
+
+    Parameters
+    ----------
+    span : float
+        Time to cover [s].
+    dt : float
+        Largest step [s].
+
+    Returns
+    -------
+    int
+        At least 1.
     """
     return max(1, math.ceil(span / dt - 1e-9))
 
@@ -239,17 +251,38 @@ def torque_step_hint(scene: Scene) -> str:
 
 
 def reusable(model: ExudynModel, reactions: bool) -> bool:
-    """Whether :func:`solve` can integrate ``model`` again: no friction coupling (its state belongs
-    to one run) and the reaction sensors when ``reactions`` asks for them.
+    """Whether :func:`solve` can integrate a model again.
+
+    Parameters
+    ----------
+    model : ExudynModel
+        A model solved before.
+    reactions : bool
+        Whether the next run records the reactions.
+
+    Returns
+    -------
+    bool
+        True with no friction coupling (its state belongs to one run) and the reaction sensors
+        when ``reactions`` asks for them.
     """
     recorded = f"{PAIR_NAMES[0]}_force" in model.sensors
     return model.friction is None and (recorded or not reactions)
 
 
 def run_once(scene: Scene, options: ExudynOptions) -> Result:
-    """One Exudyn run of ``scene`` at its own step (given, or
-    :func:`~cardan_exudyn.model.stepsize.choose_step`'s) with ``options``: its table (when the scene
-    records one) and summary, means included.
+    """One Exudyn run of a scene at its own step.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``numerics.dt``, or :func:`~cardan_exudyn.model.stepsize.choose_step`'s step.
+    options : ExudynOptions
+
+    Returns
+    -------
+    Result
+        The table (when the scene records one) and the summary, means included.
     """
     summary, columns, origin = run_columns(scene, options)
     return result_of(scene, summary, columns, origin)
@@ -257,6 +290,11 @@ def run_once(scene: Scene, options: ExudynOptions) -> Result:
 
 def run_columns(scene: Scene, options: ExudynOptions) -> tuple[Summary, dict[str, np.ndarray] | None, float]:
     """One run as :func:`run_once` does it, before the table.
+
+    Parameters
+    ----------
+    scene : Scene
+    options : ExudynOptions
 
     Returns
     -------
@@ -284,6 +322,13 @@ def run_model(scene: Scene, options: ExudynOptions, model: ExudynModel | None = 
         Solved again instead of a new build (:func:`solve`).
     means : bool
         False: the summary's means are left out (a caller that takes them from other columns).
+
+    Returns
+    -------
+    summary, columns, origin
+        As :func:`run_columns`.
+    model : ExudynModel or None
+        The solved model; None when the loop did not close.
     """
     wall_start = time.perf_counter()
     summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=engine_version(),

@@ -40,8 +40,19 @@ NODE_ERROR = {"Rxyz": (0.0, 1.0), "RotVecLG": (0.0, 2.0), "EP": (0.045, 2.2)}
 
 
 def error_coefficient(shaft_angle: float, node_type: str = "Rxyz") -> float:
-    """``K`` [-] of the speed-ratio error ``K h^2`` at ``shaft_angle`` [rad] for the node type of
-    spider and output (:data:`NODE_ERROR`).
+    """``K`` of the speed-ratio error ``K h^2``.
+
+    Parameters
+    ----------
+    shaft_angle : float
+        [rad].
+    node_type : str
+        Node type of spider and output (:data:`NODE_ERROR`).
+
+    Returns
+    -------
+    float
+        ``K`` [1/rad^2].
     """
     constant, factor = NODE_ERROR[node_type]
     t = math.tan(shaft_angle)
@@ -61,19 +72,39 @@ def steps_per_revolution(shaft_angle: float, accuracy: float, node_type: str = "
         Target relative error of the speed ratio [-].
     node_type : str
         Node type of spider and output (:data:`NODE_ERROR`).
+
+    Returns
+    -------
+    int
     """
     return int(max(kinematic_steps(shaft_angle, accuracy, node_type), MIN_STEPS_PER_REVOLUTION))
 
 
 def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
-    """Time step [s] of a single run of ``scene`` and a sentence saying how it was chosen: the given
-    ``numerics.dt``, else the speed ratio's (:func:`steps_per_revolution`) at the drive's top speed.
+    """Time step of a single run: the given ``numerics.dt``, else the speed ratio's
+    (:func:`steps_per_revolution`) at the drive's top speed.
 
     With a constant-speed drive the step divides one revolution exactly, so that averages over
-    whole revolutions need no interpolation at the window ends. ``node_type``: of spider and output.
+    whole revolutions need no interpolation at the window ends.
 
-    Raises :class:`SceneError` (:func:`refuse`, before anything runs) when no step is given and
-    ``numerics.accuracy`` on the speed ratio needs more than :data:`MAX_STEPS_PER_REVOLUTION`.
+    Parameters
+    ----------
+    scene : Scene
+    node_type : str
+        Node type of spider and output (:data:`NODE_ERROR`).
+
+    Returns
+    -------
+    dt : float
+        Time step [s].
+    why : str
+        How it was chosen, for ``summary.dt_choice``.
+
+    Raises
+    ------
+    SceneError
+        (:func:`refuse`, before anything runs) when no step is given and ``numerics.accuracy`` on
+        the speed ratio needs more than :data:`MAX_STEPS_PER_REVOLUTION`.
     """
     if scene.numerics.dt is not None:
         return scene.numerics.dt, "given"
@@ -278,8 +309,21 @@ def plan_steps(scene: Scene, loss_fraction: float, node_type: str = "Rxyz",
 
 
 def kinematic_steps(shaft_angle: float, accuracy: float, node_type: str = "Rxyz") -> float:
-    """Steps per revolution for a relative speed-ratio error ``accuracy`` [-] at ``shaft_angle``
-    [rad], not capped (may be huge); :data:`MIN_STEPS_PER_REVOLUTION` where ``K`` is 0.
+    """Steps per revolution for a relative speed-ratio error, not capped (may be huge).
+
+    Parameters
+    ----------
+    shaft_angle : float
+        [rad].
+    accuracy : float
+        Target relative error of the speed ratio [-].
+    node_type : str
+        Node type of spider and output (:data:`NODE_ERROR`).
+
+    Returns
+    -------
+    float
+        Steps per input revolution; :data:`MIN_STEPS_PER_REVOLUTION` where ``K`` is 0.
     """
     k = error_coefficient(shaft_angle, node_type)
     if k == 0.0:
@@ -288,19 +332,44 @@ def kinematic_steps(shaft_angle: float, accuracy: float, node_type: str = "Rxyz"
 
 
 def richardson(fine: float, coarse: float, ratio: float, order: int) -> float:
-    """Richardson estimate [-] of the error of ``fine`` from ``coarse`` at ``ratio`` times its
-    step, for an error of order ``order``: ``|fine - coarse| / (ratio**order - 1)``.
+    """Richardson estimate of the error of ``fine``: ``|fine - coarse| / (ratio**order - 1)``.
+
+    Parameters
+    ----------
+    fine, coarse : float
+        The value at the fine and at the coarse step (any unit).
+    ratio : float
+        Step ratio coarse / fine [-].
+    order : int
+        Order of the error in the step.
+
+    Returns
+    -------
+    float
+        The error estimate (the unit of ``fine``).
     """
     return abs(fine - coarse) / (ratio ** order - 1.0)
 
 
 def predicted_errors(scene: Scene, node_type: str = "Rxyz") -> dict[str, float] | None:
-    """A-priori errors [-] of a run at the scene's given ``numerics.dt``, before anything runs:
-    ``{"speed-ratio": ..., "mean-efficiency": ...}``, the speed-ratio model and the
-    mean-efficiency model at the largest loss fraction (1; 0 without friction, where nothing is
-    lost); None without a given step. Named apart because a run's error estimate covers the mean
-    efficiency only: a frictionless run is exact there at any step. ``node_type``: of spider and
-    output."""
+    """A-priori errors of a run at the scene's given ``numerics.dt``, before anything runs.
+
+    Named apart because a run's error estimate covers the mean efficiency only: a frictionless
+    run is exact there at any step.
+
+    Parameters
+    ----------
+    scene : Scene
+    node_type : str
+        Node type of spider and output (:data:`NODE_ERROR`).
+
+    Returns
+    -------
+    dict or None
+        ``{"speed-ratio": ..., "mean-efficiency": ...}`` [-]: the speed-ratio model and the
+        mean-efficiency model at the largest loss fraction (1; 0 without friction, where nothing
+        is lost); None without a given step.
+    """
     if scene.numerics.dt is None:
         return None
     steps = revolution_period(scene) / scene.numerics.dt
