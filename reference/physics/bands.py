@@ -6,8 +6,7 @@ surface speed (``omega_rel d / 2``) or sliding speed. Every engine replaces it b
 move (the spider pairs at 0 deg, the axial direction of the ideal joint) is decided by
 rounding-level speeds. Inside the ramp the friction is smaller than Coulomb's, so the band must
 be small against the speeds the pair actually has. A fixed band in m/s is not: the speeds scale
-with the input speed (at 1 rpm the paper's spider pairs rub at 0.03 mm/s RMS, below a 1 mm/s band
-nearly all the time, and the mean efficiency was 0.998 where the exact sign gives 0.991).
+with the input speed (measured: docs/paper.md#friction-at-every-speed).
 
 So by default each band is relative (``FrictionSettings.sign_band_relative``, default 1e-3,
 :data:`reference.scene.settings.DEFAULT_SIGN_BAND_RELATIVE`): ``band = sign_band_relative * v_char``,
@@ -25,7 +24,7 @@ exact-sign value as ``sign_band_relative`` shrinks, at every speed (``docs/paper
 at every speed").
 
 ``FrictionSettings.sign_band`` [m/s], when given, is one absolute band for every pair (0: the
-exact sign), as before.
+exact sign).
 
 Under the resultant-slip law (``FrictionSettings.law = "resultant"``) one Coulomb force opposes
 the pair's slip velocity ``v = (omega_rel d / 2, v_slide)`` and is regularised as a vector,
@@ -122,8 +121,23 @@ def profile_angles() -> np.ndarray:
 
 def speeds_from_profile(scene: Scene, omega_rel: dict[str, np.ndarray],
                         slide_rel: dict[str, np.ndarray]) -> dict[str, PairSpeeds]:
-    """:func:`characteristic_speeds` from the pairs' relative angular [rad/s] and sliding [m/s]
-    speeds at the :func:`profile_angles` for an input turning at 1 rad/s (per pair, shape (360,))."""
+    """:func:`characteristic_speeds` from the pairs' relative speeds over the speed profile.
+
+    Parameters
+    ----------
+    scene : Scene
+        Journal diameters and the nominal speed (:func:`nominal_speed`).
+    omega_rel : dict of str to ndarray, shape (PROFILE_SAMPLES,)
+        Per pair the relative angular speed [rad/s] at the :func:`profile_angles` for an input
+        turning at 1 rad/s.
+    slide_rel : dict of str to ndarray, shape (PROFILE_SAMPLES,)
+        Per pair the relative sliding speed [m/s] there.
+
+    Returns
+    -------
+    dict of str to PairSpeeds
+        Per pair [m/s].
+    """
     w = nominal_speed(scene)
 
     def rms(v: np.ndarray) -> float:
@@ -140,8 +154,20 @@ def needs_speeds(scene: Scene) -> bool:
 
 
 def bands_from_speeds(scene: Scene, speeds: dict[str, PairSpeeds] | None) -> dict[str, PairBands]:
-    """:func:`sign_bands` from the characteristic speeds (None where :func:`needs_speeds` is
-    False): the rule of that function, for a caller that computed the speeds itself."""
+    """:func:`sign_bands` from characteristic speeds a caller computed itself.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its friction settings.
+    speeds : dict of str to PairSpeeds or None
+        :func:`characteristic_speeds` [m/s]; None where :func:`needs_speeds` is False.
+
+    Returns
+    -------
+    dict of str to PairBands
+        Per pair [m/s].
+    """
     return dict(zip(PAIR_NAMES, _from_speeds(scene, speeds), strict=True))
 
 

@@ -122,33 +122,88 @@ def cos(x: Dual) -> Dual:
 def atan2(y: Dual, x: Dual) -> Dual:
     """Dual angle whose sine and cosine are proportional to ``y`` and ``x``.
 
-    The real part is ``arctan2(y, x)`` in (-pi, pi]; the dual part ``(x y' - y x') / (x^2 + y^2)``
-    does not change when ``y`` and ``x`` are multiplied by one dual number with positive real
-    part, so ``atan2(k sin t, k cos t) = t`` for the dual angle ``t``.
+    The dual part ``(x y' - y x') / (x^2 + y^2)`` does not change when ``y`` and ``x`` are
+    multiplied by one dual number with positive real part, so ``atan2(k sin t, k cos t) = t`` for
+    the dual angle ``t``.
+
+    Parameters
+    ----------
+    y, x : Dual
+        Of one shape.
+
+    Returns
+    -------
+    Dual
+        Angle ``arctan2(y, x)`` in (-pi, pi] [rad] + eps slide [m].
     """
     return Dual(np.arctan2(y.re, x.re), (x.re * y.du - y.re * x.du) / (x.re**2 + y.re**2))
 
 
 def dot(u: Dual, v: Dual) -> Dual:
-    """Dot product over the last axis; of two lines: ``cos`` of their dual angle (eq. (13))."""
+    """Dot product over the last axis; of two lines: ``cos`` of their dual angle (eq. (13)).
+
+    Parameters
+    ----------
+    u, v : Dual, shape (..., 3)
+        Dual vectors.
+
+    Returns
+    -------
+    Dual, shape (...)
+    """
     return Dual(np.einsum("...i,...i->...", u.re, v.re),
                 np.einsum("...i,...i->...", u.re, v.du) + np.einsum("...i,...i->...", u.du, v.re))
 
 
 def cross(u: Dual, v: Dual) -> Dual:
-    """Cross product over the last axis; ``V x S`` is the rate of a line ``S`` moving with ``V``."""
+    """Cross product over the last axis; ``V x S`` is the rate of a line ``S`` moving with ``V``.
+
+    Parameters
+    ----------
+    u, v : Dual, shape (..., 3)
+        Dual vectors.
+
+    Returns
+    -------
+    Dual, shape (..., 3)
+    """
     return Dual(np.cross(u.re, v.re), np.cross(u.re, v.du) + np.cross(u.du, v.re))
 
 
 def matvec(m: Dual, v: Dual) -> Dual:
-    """Matrix (..., 3, 3) times vector (..., 3), broadcast over the leading axes."""
+    """Matrix times vector, broadcast over the leading axes.
+
+    Parameters
+    ----------
+    m : Dual, shape (..., 3, 3)
+        Dual matrices.
+    v : Dual or ndarray, shape (..., 3)
+        Vectors (an array: zero dual part).
+
+    Returns
+    -------
+    Dual, shape (..., 3)
+    """
     v = as_dual(v)
     return Dual(np.einsum("...ij,...j->...i", m.re, v.re),
                 np.einsum("...ij,...j->...i", m.re, v.du) + np.einsum("...ij,...j->...i", m.du, v.re))
 
 
 def stack(items: Sequence[Dual], axis: int = -1) -> Dual:
-    """Stack duals of one shape along a new axis (``numpy.stack``)."""
+    """Stack duals of one shape along a new axis (``numpy.stack``).
+
+    Parameters
+    ----------
+    items : sequence of Dual or array_like
+        Of one shape ``s``.
+    axis : int
+        Position of the new axis.
+
+    Returns
+    -------
+    Dual
+        Shape ``s`` with ``len(items)`` inserted at ``axis``.
+    """
     items = [as_dual(x) for x in items]
     return Dual(np.stack([x.re for x in items], axis), np.stack([x.du for x in items], axis))
 
@@ -219,9 +274,20 @@ def displacement(m: Dual) -> tuple[np.ndarray, np.ndarray]:
 
 
 def solve(a: Dual, b: Dual) -> Dual:
-    """Solution ``x`` of ``a x = b`` for dual matrices (..., n, n) and vectors (..., n).
+    """Solution ``x`` of ``a x = b``.
 
     ``a.re x.re = b.re``, then ``a.re x.du = b.du - a.du x.re`` (the eps part of ``a x = b``).
+
+    Parameters
+    ----------
+    a : Dual, shape (..., n, n)
+        Dual matrices, real part regular.
+    b : Dual or ndarray, shape (..., n)
+        Right-hand sides.
+
+    Returns
+    -------
+    Dual, shape (..., n)
     """
     b = as_dual(b)
     x_re = np.linalg.solve(a.re, b.re[..., None])[..., 0]

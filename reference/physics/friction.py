@@ -129,14 +129,35 @@ def pair_friction(pair: Pair, kind: str, fx: Any, fy: Any, mx: Any, my: Any, ome
                   law: str = "paper") -> tuple[np.ndarray, np.ndarray]:
     """Friction torque about and force along the pair axis, acting on body ``b`` of the pair.
 
-    Parameters are arrays over time samples (or scalars): the reaction components normal to the
-    axis in any frame whose z is the pair axis, and the relative angular and sliding speed of
-    ``b`` with respect to ``a``; the ramp widths [m/s] of the rotation's sign (``sign_band``, in
-    surface speed), of the sliding's (``slide_band``; None: ``sign_band``) and of the resultant
-    slip (``resultant_band``; None: ``sign_band``); ``law`` ``"paper"`` (eqs. (3), (5), one sign
-    per direction) or ``"resultant"`` (one Coulomb force against the resultant slip, see the
-    module doc). A revolute pair gets no axial force (its sliding is constrained) and does not
-    slide. A pair with zero coefficient gets zeros.
+    A revolute pair gets no axial force (its sliding is constrained) and does not slide. A pair
+    with zero coefficient gets zeros.
+
+    Parameters
+    ----------
+    pair : Pair
+        Friction coefficient, journal diameter and moment lever.
+    kind : {"revolute", "cylindrical"}
+        The pair's kind.
+    fx, fy : array_like
+        Reaction force components normal to the axis, in any frame whose z is the pair axis [N].
+    mx, my : array_like
+        Bending moment components in that frame [N m].
+    omega_rel, slide_rel : array_like
+        Angular [rad/s] and sliding [m/s] speed of ``b`` relative to ``a`` (all six broadcast).
+    sign_band : float
+        Width of the rotation's sign ramp, in surface speed [m/s].
+    slide_band : float, optional
+        Width of the sliding's sign ramp [m/s]; None: ``sign_band``.
+    resultant_band : float, optional
+        Width of the resultant slip's ramp [m/s]; None: ``sign_band``.
+    law : {"paper", "resultant"}
+        Eqs. (3), (5), one sign per direction; or one Coulomb force against the resultant slip
+        (module doc).
+
+    Returns
+    -------
+    torque, force : ndarray
+        Friction torque about [N m] and force along [N] the pair axis on body ``b``.
     """
     if kind not in ("revolute", "cylindrical"):
         raise ValueError(f"unknown pair kind {kind!r}")

@@ -5,8 +5,8 @@ Two sources give the same :class:`JointMotion`:
 - the ideal joint (no mounting errors): the closed form of :mod:`reference.physics.kinematics`; every
   body turns about the joint centre O and no pair slides;
 - a joint with mounting errors (:class:`reference.scene.joint.MountingErrors`): the dual-number RCCC
-  loop of :mod:`reference.physics.rccc` from the Denavit-Hartenberg parameters. The bodies' frames now
-  translate, the pair axes no longer meet, and the cylindrical pairs slide.
+  loop of :mod:`reference.physics.rccc` from the Denavit-Hartenberg parameters. The bodies' frames
+  translate, the pair axes do not meet, and the cylindrical pairs slide.
 
 ``method="auto"`` takes the closed form when the joint is ideal (it is exact there and cheaper)
 and the loop otherwise; ``"loop"`` forces the loop, which for the ideal joint agrees with the
@@ -30,6 +30,8 @@ from numpy.typing import ArrayLike
 
 from reference.physics import kinematics, rccc
 from reference.scene.joint import PAIR_NAMES, Geometry, Joint
+
+__all__ = ["METHODS", "JointMotion", "ideal_pair_origins", "loop_motion", "joint_motion"]
 
 METHODS = ("auto", "closed_form", "loop")
 
@@ -99,8 +101,24 @@ def _loop(joint: Joint, theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.nda
 
 def loop_motion(params: rccc.DHParameters, positions: rccc.LoopPositions, rates: rccc.LoopRates,
                 axial) -> JointMotion:
-    """The joint's motion from the loop's solved positions and rates (``axial``: the pairs'
-    axial positions, one set or one per sample)."""
+    """The joint's motion from the loop's solved positions and rates.
+
+    Parameters
+    ----------
+    params : reference.physics.rccc.DHParameters
+        The loop.
+    positions : reference.physics.rccc.LoopPositions
+        Its solved positions at the samples.
+    rates : reference.physics.rccc.LoopRates
+        Its solved rates there.
+    axial : sequence of 4 float, or ndarray, shape (..., 4)
+        The pairs' axial positions [m] (:func:`reference.physics.rccc.axial_positions`), one set
+        or one per sample.
+
+    Returns
+    -------
+    JointMotion
+    """
     frames = rccc.pair_frames(params, positions, axial)
     return JointMotion(
         bodies=rccc.body_motions(params, positions, rates),
@@ -125,6 +143,11 @@ def joint_motion(joint: Joint, theta: ArrayLike, theta_t: ArrayLike, theta_tt: A
         Input angle [rad], speed [rad/s], acceleration [rad/s^2].
     method : {"auto", "closed_form", "loop"}
         See the module documentation; ``"closed_form"`` refuses a joint with errors.
+
+    Returns
+    -------
+    JointMotion
+        Arrays of the broadcast shape of the inputs.
 
     Raises
     ------

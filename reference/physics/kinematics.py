@@ -28,6 +28,10 @@ import numpy as np
 
 from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 
+__all__ = ["rot_x", "rot_y", "rot_z", "output_angle", "speed_ratio", "speed_ratio_slope",
+           "output_motion", "spider_motion", "BodyMotion", "body_motions", "pair_frames_in_body_a",
+           "pair_frames", "relative_speeds"]
+
 
 def rot_x(angle: np.ndarray) -> np.ndarray:
     """Rotation matrices about x [-], shape ``angle.shape + (3, 3)``."""
@@ -86,12 +90,38 @@ def output_angle(theta: np.ndarray, beta: float) -> np.ndarray:
 
 
 def speed_ratio(theta: np.ndarray, beta: float) -> np.ndarray:
-    """Hooke's speed ratio ``omega_out / omega_in = cos b / (1 - sin^2 b cos^2 theta)`` [-]."""
+    """Hooke's speed ratio ``omega_out / omega_in = cos b / (1 - sin^2 b cos^2 theta)``.
+
+    Parameters
+    ----------
+    theta : ndarray
+        Input shaft angle [rad].
+    beta : float
+        Shaft angle [rad].
+
+    Returns
+    -------
+    ndarray
+        The ratio [-], shape of ``theta``.
+    """
     return np.cos(beta) / (1.0 - np.sin(beta) ** 2 * np.cos(theta) ** 2)
 
 
 def speed_ratio_slope(theta: np.ndarray, beta: float) -> np.ndarray:
-    """Derivative of :func:`speed_ratio` with respect to the input angle [1/rad]."""
+    """Derivative of :func:`speed_ratio` with respect to the input angle.
+
+    Parameters
+    ----------
+    theta : ndarray
+        Input shaft angle [rad].
+    beta : float
+        Shaft angle [rad].
+
+    Returns
+    -------
+    ndarray
+        ``d ratio / d theta`` [1/rad], shape of ``theta``.
+    """
     d = 1.0 - np.sin(beta) ** 2 * np.cos(theta) ** 2
     return -np.cos(beta) * np.sin(beta) ** 2 * np.sin(2.0 * theta) / d**2
 
@@ -106,6 +136,11 @@ def output_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
         Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
     beta : float
         Shaft angle [rad].
+
+    Returns
+    -------
+    theta_out, omega_out, alpha_out : ndarray
+        [rad], [rad/s], [rad/s^2], shape of ``theta``.
     """
     ratio = speed_ratio(theta, beta)
     return (output_angle(theta, beta), ratio * theta_t,
@@ -118,6 +153,13 @@ def spider_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
 
     ``gamma = atan2(sin b sin theta, cos b)`` [rad] (``|gamma| <= b``); its rate is
     ``h(theta) theta_t`` with ``h = sin b cos b cos theta / (1 - sin^2 b cos^2 theta)``.
+
+    Parameters
+    ----------
+    theta, theta_t, theta_tt : ndarray
+        Input angle [rad], speed [rad/s] and acceleration [rad/s^2], same shape.
+    beta : float
+        Shaft angle [rad].
 
     Returns
     -------

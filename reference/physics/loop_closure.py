@@ -24,6 +24,8 @@ import numpy as np
 from reference.physics import dual
 from reference.physics.dual import Dual
 
+__all__ = ["MIN_BRANCH_SEPARATION", "E_Z", "LoopClosureError", "angle_listing", "solve_wrapped"]
+
 MIN_BRANCH_SEPARATION = 1e-6
 """Smallest ``sin`` of the half-angle between the two branches' ``theta_4`` that is solved [-].
 
@@ -36,6 +38,13 @@ E_Z = Dual(np.array([0.0, 0.0, 1.0]))
 
 class LoopClosureError(ValueError):
     """The loop cannot close, or its two branches meet, at some input angles.
+
+    Parameters
+    ----------
+    message : str
+        What failed, for the user.
+    angles : ndarray
+        The offending input angles [rad].
 
     Attributes
     ----------

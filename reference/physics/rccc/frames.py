@@ -66,9 +66,23 @@ def _joint_frames(params: DHParameters, positions: LoopPositions) -> Dual:
 
 
 def joint_frames(params: DHParameters, positions: LoopPositions) -> tuple[np.ndarray, np.ndarray]:
-    """The D-H frames ``F_1..F_4``: rotations (..., 4, 3, 3) [-] and origins (..., 4, 3) [m].
+    """The D-H frames ``F_1..F_4``.
 
     ``F_k`` is fixed in link k - 1, body ``a`` of joint k; its z axis is the joint axis.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
+
+    Returns
+    -------
+    rotation : ndarray, shape (..., 4, 3, 3)
+        Axes (columns) in global components [-].
+    origin : ndarray, shape (..., 4, 3)
+        Origins [m].
     """
     return dual.displacement(_joint_frames(params, positions))
 
@@ -100,6 +114,15 @@ def pair_frames(params: DHParameters, positions: LoopPositions,
     Body ``b`` carries the bearing of the ``spider_output`` (output yoke) and ``output_frame``
     (frame) pairs; it is also the point Exudyn's joint reactions refer to.
 
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
+    axial : sequence of 4 float, or ndarray, shape (..., 4)
+        The pairs' axial positions [m].
+
     Returns
     -------
     dict of str to (rotation (..., 3, 3) [-], origin (..., 3) [m])
@@ -118,12 +141,37 @@ def joint_screws(params: DHParameters, positions: LoopPositions) -> Dual:
 
     The direction is each pair's z axis of :func:`reference.physics.kinematics.pair_frames` [-]; the
     moment is about the global origin [m].
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
+
+    Returns
+    -------
+    Dual, shape (..., 4, 3)
     """
     return dual.matvec(_joint_frames(params, positions), E_Z)
 
 
 def pair_axes(params: DHParameters, positions: LoopPositions) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each pair's axis: unit direction [-] and its point closest to the origin [m], (..., 3) each."""
+    """Each pair's axis.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
+
+    Returns
+    -------
+    dict of str to (ndarray, ndarray)
+        Per pair the unit direction [-] and its point closest to the origin [m], shape (..., 3)
+        each.
+    """
     screws = joint_screws(params, positions)
     return {p: (screws.re[..., k, :], dual.line_point(screws[..., k, :]))
             for k, p in enumerate(PAIR_NAMES)}
@@ -134,6 +182,18 @@ def body_poses(params: DHParameters, positions: LoopPositions) -> dict[str, Body
 
     For the ideal joint these are the rotations of :func:`reference.physics.kinematics.body_motions`
     and all origins are the joint centre.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
+
+    Returns
+    -------
+    dict of str to BodyPose
+        Rotation, shape (..., 3, 3) [-], and origin, shape (..., 3) [m], per body.
     """
     links = _joint_frames(params, positions) @ dual.rot_z(positions.dual_angles())
     rotation, origin = dual.displacement(links)

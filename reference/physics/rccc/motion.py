@@ -128,7 +128,21 @@ def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t: ArrayL
 
 def solve_motion(params: DHParameters, theta1: ArrayLike, theta1_t: ArrayLike, theta1_tt: ArrayLike,
                  branch: str = "hooke") -> tuple[LoopPositions, LoopRates]:
-    """:func:`solve_positions` and :func:`solve_rates` in one call (same arguments)."""
+    """:func:`solve_positions` and :func:`solve_rates` in one call.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    theta1, theta1_t, theta1_tt : array_like
+        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
+    branch : {"hooke", "flipped"}
+        Assembly branch.
+
+    Returns
+    -------
+    LoopPositions, LoopRates
+    """
     positions = solve_positions(params, theta1, branch)
     return positions, solve_rates(params, positions, theta1_t, theta1_tt)
 
@@ -139,6 +153,20 @@ def body_motions(params: DHParameters, positions: LoopPositions,
 
     Link k's velocity screw is ``V_k = sum_{j<=k} (theta_j_t + eps s_j_t) S_j``; its real part is
     the angular velocity, its dual part the velocity of the body point at the global origin.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions.
+    rates : LoopRates
+        Its solved rates.
+
+    Returns
+    -------
+    dict of str to BodyMotion
+        Global components, arrays of the samples' shape.
     """
     screws = joint_screws(params, positions)
     joint_rates = Dual(rates.theta_t, rates.s_t)
@@ -160,7 +188,20 @@ def body_motions(params: DHParameters, positions: LoopPositions,
 
 
 def pair_motions(positions: LoopPositions, rates: LoopRates) -> dict[str, PairMotion]:
-    """Relative rotation (b relative to a, about the pair axis, from ``theta_1 = 0``) and slide."""
+    """Relative rotation (b relative to a, about the pair axis, from ``theta_1 = 0``) and slide.
+
+    Parameters
+    ----------
+    positions : LoopPositions
+        The loop's solved positions.
+    rates : LoopRates
+        Its solved rates.
+
+    Returns
+    -------
+    dict of str to PairMotion
+        Angle [rad], speed [rad/s], acceleration [rad/s^2], slide [m] and its rates, per pair.
+    """
     angle = positions.theta - positions.reference
     return {p: PairMotion(angle[..., k], rates.theta_t[..., k], rates.theta_tt[..., k],
                           positions.s[..., k], rates.s_t[..., k], rates.s_tt[..., k])
@@ -173,6 +214,18 @@ def output_motion(positions: LoopPositions,
 
     Measured like :func:`reference.physics.kinematics.output_angle`: from the output's position at
     ``theta_1 = 0``; it is minus the ``output_frame`` pair's rotation (ground relative to output).
+
+    Parameters
+    ----------
+    positions : LoopPositions
+        The loop's solved positions.
+    rates : LoopRates
+        Its solved rates.
+
+    Returns
+    -------
+    angle, speed, acceleration : ndarray
+        [rad], [rad/s], [rad/s^2].
     """
     pair = pair_motions(positions, rates)["output_frame"]
     return -pair.angle, -pair.speed, -pair.acceleration
@@ -183,6 +236,18 @@ def spider_motion(positions: LoopPositions,
     """Spider angle ``gamma`` relative to the input about the input yoke [rad] and its rates.
 
     The ``input_spider`` pair's rotation, as :func:`reference.physics.kinematics.spider_motion`.
+
+    Parameters
+    ----------
+    positions : LoopPositions
+        The loop's solved positions.
+    rates : LoopRates
+        Its solved rates.
+
+    Returns
+    -------
+    gamma, gamma_t, gamma_tt : ndarray
+        [rad], [rad/s], [rad/s^2].
     """
     pair = pair_motions(positions, rates)["input_spider"]
     return pair.angle, pair.speed, pair.acceleration

@@ -18,6 +18,24 @@ LINK_NAMES = ("input", "spider", "output", "ground")
 
 
 def finite_number(name: str, value) -> float:
+    """``value`` as a float, refused unless it is a finite real number.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, for the message.
+    value : object
+        What arrived.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        Not a number (a bool counts as none), or not finite.
+    """
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"`{name}` must be a number, got {value!r}")
     if not math.isfinite(value):
@@ -26,6 +44,24 @@ def finite_number(name: str, value) -> float:
 
 
 def four_numbers(name: str, values) -> tuple[float, float, float, float]:
+    """``values`` as four floats, one per link (:func:`finite_number` each).
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, for the message.
+    values : sequence
+        What arrived.
+
+    Returns
+    -------
+    tuple of 4 float
+
+    Raises
+    ------
+    ValueError
+        Not a sequence of four finite numbers.
+    """
     if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)) \
             or len(values) != 4:
         raise ValueError(f"`{name}` must be a sequence of 4 numbers (one per link), got {values!r}")
@@ -81,7 +117,21 @@ class DHParameters:
 
     def with_errors(self, a: Sequence[float] = (0.0,) * 4, alpha: Sequence[float] = (0.0,) * 4,
                     s1: float = 0.0) -> DHParameters:
-        """These parameters with errors added: offsets ``a`` [m], twists ``alpha`` [rad], ``s1`` [m]."""
+        """These parameters with errors added.
+
+        Parameters
+        ----------
+        a : sequence of 4 float
+            Link offset errors [m].
+        alpha : sequence of 4 float
+            Link twist errors [rad].
+        s1 : float
+            Slide error of the revolute pair [m].
+
+        Returns
+        -------
+        DHParameters
+        """
         d_a = four_numbers("a", a)
         d_alpha = four_numbers("alpha", alpha)
         d_s1 = finite_number("s1", s1)

@@ -61,6 +61,26 @@ class LoopPositions:
 
 
 def sample_array(name: str, value, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    """``value`` as a finite float array, broadcast to ``shape`` when given.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, for the message.
+    value : array_like
+        What arrived.
+    shape : tuple of int, optional
+        The shape of the solved input angles.
+
+    Returns
+    -------
+    ndarray
+
+    Raises
+    ------
+    ValueError
+        Not numeric, not finite, or not broadcastable to ``shape``.
+    """
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -83,9 +103,23 @@ def _solve(params: DHParameters, theta1: np.ndarray, branch: str, where: str) ->
 
 @functools.lru_cache(maxsize=256)
 def at_zero(params: DHParameters, branch: str) -> tuple[np.ndarray, np.ndarray]:
-    """Joint angles (4,) [rad] and slides (4,) [m] at ``theta_1 = 0`` on a branch (cached).
+    """Joint angles and slides at ``theta_1 = 0`` on a branch (cached).
 
     Every solve and every pair-frame evaluation of a parameter set needs them; solved once.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    branch : {"hooke", "flipped"}
+        Assembly branch.
+
+    Returns
+    -------
+    theta : ndarray, shape (4,)
+        Joint angles [rad], read-only.
+    s : ndarray, shape (4,)
+        Joint slides [m], read-only.
     """
     angles = _solve(params, np.zeros(1), branch, "the reference input angle")
     theta = angles.re[0].copy()
@@ -125,8 +159,22 @@ def _check_windings(params: DHParameters, branch: str) -> None:
 
 def winding_jumps(raw: np.ndarray, reference: np.ndarray, theta1: np.ndarray) -> np.ndarray:
     """Joint angles jumping a quarter turn or more between neighbours against the Cardan joint's
-    windings, (..., m - 1, 3): ``raw`` (..., m, 4) the wrapped loop solution at the input angles
-    ``theta1`` (m,) [rad], ``reference`` (..., 4) its value at 0 (any True: not a double crank)."""
+    windings.
+
+    Parameters
+    ----------
+    raw : ndarray, shape (..., m, 4)
+        The wrapped loop solution at the input angles [rad].
+    reference : ndarray, shape (..., 4)
+        Its value at ``theta_1 = 0`` [rad].
+    theta1 : ndarray, shape (m,)
+        The input angles [rad].
+
+    Returns
+    -------
+    ndarray of bool, shape (..., m - 1, 3)
+        Per interval and joint 2..4 whether it jumps (any True: not a double crank).
+    """
     nominal = reference[..., None, :] + WINDING * theta1[:, None]
     deviation = np.remainder(raw - nominal + np.pi, 2.0 * np.pi) - np.pi
     return np.abs(np.diff(deviation[..., 1:], axis=-2)) > 0.5 * np.pi
@@ -164,10 +212,21 @@ def solve_positions(params: DHParameters, theta1: ArrayLike, branch: str = "hook
 
 
 def continuous_angles(wrapped: np.ndarray, reference: np.ndarray, theta1: np.ndarray) -> np.ndarray:
-    """Joint angles continuous in ``theta_1`` (:mod:`reference.physics.rccc`), shape (..., 4) [rad].
+    """Joint angles continuous in ``theta_1`` (:mod:`reference.physics.rccc`).
 
-    ``wrapped`` (..., 4): the loop's solution in (-pi, pi]; ``reference`` (4,) or (..., 4): its
-    value at ``theta_1 = 0`` on the same branch; ``theta1`` (...): the input angles [rad].
+    Parameters
+    ----------
+    wrapped : ndarray, shape (..., 4)
+        The loop's solution in (-pi, pi] [rad].
+    reference : ndarray, shape (4,) or (..., 4)
+        Its value at ``theta_1 = 0`` on the same branch [rad].
+    theta1 : ndarray, shape (...)
+        The input angles [rad].
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Continuous joint angles [rad], the first equal to ``theta1``.
     """
     nominal = reference + WINDING * theta1[..., None]
     theta = nominal + np.remainder(wrapped - nominal + np.pi, 2.0 * np.pi) - np.pi
@@ -177,6 +236,13 @@ def continuous_angles(wrapped: np.ndarray, reference: np.ndarray, theta1: np.nda
 
 def loop_closure_residual(params: DHParameters, positions: LoopPositions) -> tuple[float, float]:
     """Largest deviation of ``prod_k Z(theta_hat_k) X(alpha_hat_k)`` from the identity.
+
+    Parameters
+    ----------
+    params : DHParameters
+        The loop.
+    positions : LoopPositions
+        Its solved positions.
 
     Returns
     -------
