@@ -18,6 +18,8 @@ from reference.scene.mapping import UNIT_ALIASES, scene_from_dict, scene_to_dict
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError, SceneTypeError
 
+__all__ = ["read_toml", "load_scene", "scene_from_mapping"]
+
 try:
     import tomllib
 except ModuleNotFoundError:  # Python 3.10

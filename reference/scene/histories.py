@@ -138,11 +138,23 @@ def _turning_points(spline: Any) -> np.ndarray:
 
 
 def first_turn(spline: Any, angle: float) -> float | None:
-    """First time at which the spline has moved ``angle`` (> 0) either way from its value at the
-    first breakpoint, refined to rounding; None if it never moves that far within its span.
+    """First time at which the spline has moved ``angle`` either way from its start.
 
     Between consecutive breakpoints and interior extrema the spline is monotone, so the first
     such point where ``|s - s(x0)|`` reaches ``angle`` brackets exactly one crossing.
+
+    Parameters
+    ----------
+    spline : scipy.interpolate.PPoly
+        Cubic pieces of an angle history [rad] over time [s].
+    angle : float
+        Angle to turn [rad], > 0.
+
+    Returns
+    -------
+    float or None
+        The time [s], refined to rounding; None if the spline never moves that far within its
+        span.
     """
     from scipy.optimize import brentq  # scipy.optimize takes ~0.5 s to import
 

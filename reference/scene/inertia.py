@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+__all__ = ["skew", "shift_inertia_to_com", "rotate_inertia", "inertia_problems"]
+
 
 def skew(v: np.ndarray) -> np.ndarray:
     """Cross-product matrix of a 3-vector: ``skew(a) @ b == np.cross(a, b)``."""
@@ -37,7 +39,20 @@ def shift_inertia_to_com(inertia: np.ndarray, mass: float, com: np.ndarray) -> n
 
 
 def rotate_inertia(inertia: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """Express an inertia tensor in other axes: ``R J R^T`` with R mapping old to new coordinates."""
+    """Express an inertia tensor in other axes: ``R J R^T``.
+
+    Parameters
+    ----------
+    inertia : ndarray, shape (3, 3)
+        Inertia tensor in the old axes [kg m^2].
+    rotation : ndarray, shape (3, 3)
+        ``R``, mapping old to new coordinates [-].
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        The tensor in the new axes [kg m^2].
+    """
     r = np.asarray(rotation, dtype=float)
     return r @ np.asarray(inertia, dtype=float) @ r.T
 
@@ -47,6 +62,18 @@ def inertia_problems(inertia: np.ndarray, rtol: float = 1e-9) -> list[str]:
 
     Checks symmetry, positive definiteness and the triangle inequality on the principal
     moments (J1 <= J2 + J3 for every permutation).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3, 3)
+        The tensor [kg m^2].
+    rtol : float
+        Tolerance of the symmetry and triangle checks, relative to the largest entry [-].
+
+    Returns
+    -------
+    list of str
+        One sentence per problem.
     """
     j = np.asarray(inertia, dtype=float)
     if j.shape != (3, 3):

@@ -45,6 +45,9 @@ from reference.scene.validation import (
     vector,
 )
 
+__all__ = ["BODY_NAMES", "PAIR_NAMES", "PAIR_KIND", "PAIR_BODIES", "Body", "GEOMETRY_LEVER", "Pair",
+           "Pairs", "Geometry", "ERROR_NAMES", "MountingErrors", "Joint"]
+
 BODY_NAMES = ("input", "spider", "output")
 """The moving bodies, in chain order."""
 PAIR_NAMES = ("frame_input", "input_spider", "spider_output", "output_frame")

@@ -14,6 +14,11 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["RPM", "DEG", "MAX_STEPS", "MAX_STEPS_PER_REVOLUTION", "MAX_MAGNITUDE", "SceneError",
+           "SceneTypeError", "require_scene", "require_instance", "is_sequence", "finite", "positive",
+           "non_negative", "vector", "float_array", "check_history", "set_field", "check_steps",
+           "refuse_steps_per_revolution"]
+
 RPM = 2.0 * math.pi / 60.0
 """One revolution per minute [rad/s]."""
 DEG = math.pi / 180.0
@@ -47,8 +52,26 @@ class SceneTypeError(SceneError, TypeError):
 
 
 def require_scene(value: Any, name: str = "scene") -> Any:
-    """``value`` when it is a :class:`reference.scene.scene.Scene`; :class:`SceneTypeError` naming
-    ``name`` otherwise (the check of every public function that takes a scene)."""
+    """``value`` when it is a :class:`reference.scene.scene.Scene` (the check of every public
+    function that takes a scene).
+
+    Parameters
+    ----------
+    value : Any
+        What arrived.
+    name : str
+        The argument's name, for the message.
+
+    Returns
+    -------
+    Scene
+        ``value``.
+
+    Raises
+    ------
+    SceneTypeError
+        Not a scene.
+    """
     if type(value).__name__ != "Scene" or not hasattr(value, "drive"):  # no import: scene.py imports this
         hint = " (a named scene: reference.named_scene(name); a file: reference.load_scene(path))" \
             if isinstance(value, (str, bytes)) else ""
@@ -57,8 +80,29 @@ def require_scene(value: Any, name: str = "scene") -> Any:
 
 
 def require_instance(name: str, value: Any, cls: type | tuple[type, ...], what: str) -> Any:
-    """``value`` when it is an instance of ``cls``; :class:`SceneTypeError` naming ``name`` and
-    ``what`` it must be otherwise."""
+    """``value`` when it is an instance of ``cls``.
+
+    Parameters
+    ----------
+    name : str
+        The field's name, for the message.
+    value : Any
+        What arrived.
+    cls : type or tuple of type
+        The types allowed.
+    what : str
+        What it must be, for the message (e.g. "a Drive").
+
+    Returns
+    -------
+    Any
+        ``value``.
+
+    Raises
+    ------
+    SceneTypeError
+        Not an instance of ``cls``.
+    """
     if not isinstance(value, cls):
         raise SceneTypeError(f"`{name}` must be {what}, got {type(value).__name__} {value!r:.80}")
     return value
@@ -99,7 +143,20 @@ def finite(name: str, value: Any) -> float:
 
 
 def positive(name: str, value: Any) -> float:
-    """:func:`finite`, and > 0 (unit unchanged)."""
+    """:func:`finite`, and > 0.
+
+    Parameters
+    ----------
+    name : str
+        Field name for the message.
+    value : Any
+        A number in the field's SI unit.
+
+    Returns
+    -------
+    float
+        The value, unit unchanged.
+    """
     value = finite(name, value)
     if value <= 0.0:
         raise SceneError(f"`{name}` must be positive, got {value!r}")
@@ -107,7 +164,20 @@ def positive(name: str, value: Any) -> float:
 
 
 def non_negative(name: str, value: Any) -> float:
-    """:func:`finite`, and >= 0 (unit unchanged)."""
+    """:func:`finite`, and >= 0.
+
+    Parameters
+    ----------
+    name : str
+        Field name for the message.
+    value : Any
+        A number in the field's SI unit.
+
+    Returns
+    -------
+    float
+        The value, unit unchanged.
+    """
     value = finite(name, value)
     if value < 0.0:
         raise SceneError(f"`{name}` must be >= 0, got {value!r}")
@@ -145,8 +215,25 @@ def vector(name: str, value: Any, shape: tuple[int, ...]) -> tuple:
 
 
 def float_array(name: str, value: Any) -> np.ndarray | None:
-    """A sequence as a float array (None when ``value`` is not a sequence); a sample that is not
-    a number is a :class:`SceneError` naming ``name``."""
+    """A sequence as a float array.
+
+    Parameters
+    ----------
+    name : str
+        Field name for the message.
+    value : Any
+        A list, tuple or array of numbers (any unit), or anything else.
+
+    Returns
+    -------
+    ndarray or None
+        The values, unit unchanged; None when ``value`` is not a sequence.
+
+    Raises
+    ------
+    SceneTypeError
+        A sample is not a number.
+    """
     if not is_sequence(value):
         return None
     try:
@@ -194,13 +281,35 @@ def check_history(t: np.ndarray | None, values: np.ndarray | None, raw_time: Any
 
 
 def set_field(obj: Any, name: str, value: Any) -> None:
-    """Store a validated value on a frozen dataclass (from its ``__post_init__``)."""
+    """Store a validated value on a frozen dataclass (from its ``__post_init__``).
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        Frozen.
+    name : str
+        The field.
+    value : Any
+        Its validated value.
+    """
     object.__setattr__(obj, name, value)
 
 
 def check_steps(steps: float, what: str) -> None:
-    """Raise :class:`SceneError` when ``steps`` (any number, inf and NaN included) exceeds
-    :data:`MAX_STEPS`; ``what`` says what needs them (e.g. "2 revolutions at dt = 1e-12 s")."""
+    """Refuse more than :data:`MAX_STEPS` steps.
+
+    Parameters
+    ----------
+    steps : float
+        Steps asked for (inf and NaN refused too).
+    what : str
+        What needs them, for the message (e.g. "2 revolutions at dt = 1e-12 s").
+
+    Raises
+    ------
+    SceneError
+        Beyond :data:`MAX_STEPS`.
+    """
     if not steps <= MAX_STEPS:
         raise SceneError(f"{what} needs {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed: give a "
                          "larger `numerics.dt` (or `numerics.accuracy`) or fewer `revolutions`")
@@ -208,10 +317,24 @@ def check_steps(steps: float, what: str) -> None:
 
 def refuse_steps_per_revolution(steps: float, revolutions: float, seconds_per_step: float,
                                 why: str) -> None:
-    """Raise :class:`SceneError` when ``steps`` per input revolution exceed
-    :data:`MAX_STEPS_PER_REVOLUTION`: the steps of ``revolutions`` input revolutions and their run
-    time at ``seconds_per_step`` [s], in one line; ``why`` says what needs them (e.g. "a
-    speed-ratio error of 0.001 at 89.9 deg")."""
+    """Refuse more than :data:`MAX_STEPS_PER_REVOLUTION` steps per input revolution.
+
+    Parameters
+    ----------
+    steps : float
+        Steps per input revolution asked for.
+    revolutions : float
+        Input revolutions of the run, for the predicted total.
+    seconds_per_step : float
+        Wall time of one step [s], for the predicted run time.
+    why : str
+        What needs them, for the message (e.g. "a speed-ratio error of 0.001 at 89.9 deg").
+
+    Raises
+    ------
+    SceneError
+        Beyond the limit, with the predicted steps and run time in one line.
+    """
     if steps <= MAX_STEPS_PER_REVOLUTION:
         return
     total = steps * revolutions
