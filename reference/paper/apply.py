@@ -44,8 +44,21 @@ def lever_changes(values: dict[str, Any]) -> dict[str, Any]:
 
 
 def body_changes(scene: Scene, values: dict[str, Any]) -> dict[str, Any]:
-    """Scene changes (dotted path -> value) for the bodies' centres of mass in ``values``:
-    ``input_eccentricity`` [m] and ``spider_com_offset`` [m] (None or absent: Table 1's)."""
+    """Scene changes for the bodies' centres of mass.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene the changes apply to (its bodies).
+    values : dict of str to Any
+        Parameter values; ``input_eccentricity`` [m] and ``spider_com_offset`` [m] are read
+        (None or absent: Table 1's).
+
+    Returns
+    -------
+    dict of str to Any
+        Dotted scene path -> value (SI units), for :func:`reference.scene.mapping.replace`.
+    """
     changes: dict[str, Any] = {}
     if values.get("input_eccentricity") is not None:
         body = scene.joint.input

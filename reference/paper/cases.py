@@ -15,8 +15,21 @@ def case_key(case: dict[str, Any]) -> str:
 
 
 def in_fit(case: dict[str, Any], fit: list[str] | tuple[str, ...]) -> bool:
-    """Whether ``case`` is one of the fit cases ``fit`` (:func:`case_key` keys) or the same scene
-    (angle and speed) as one: the speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case."""
+    """Whether a case is one of the fit cases or the same scene (angle and speed) as one.
+
+    The speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case.
+
+    Parameters
+    ----------
+    case : dict of str to Any
+        One of :func:`paper_cases` (``shaft_angle_deg`` [deg], ``speed_rpm`` [rpm]).
+    fit : list or tuple of str
+        :func:`case_key` keys.
+
+    Returns
+    -------
+    bool
+    """
     scene = (float(case["shaft_angle_deg"]), float(case["speed_rpm"]))
     return any((float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
 

@@ -23,12 +23,24 @@ LOCAL_AXES = {
 
 
 def com_from_static_moments(static_moments: np.ndarray, mass: float) -> np.ndarray:
-    """Centre of mass [m] from Table 1's static moments ``S_k`` [kg m] and the mass [kg], read as
-    S_k = m * (distance of the centre of mass from axis k).
+    """Centre of mass from Table 1's static moments, read as ``S_k = m d_k`` with ``d_k`` the
+    distance of the centre of mass from axis k.
 
     Solves d_k^2 = r^2 - r_k^2 for the squared coordinates; a coordinate whose square comes out
     slightly negative from rounding in Table 1 is set to zero. Signs are taken positive (the
     table gives none).
+
+    Parameters
+    ----------
+    static_moments : ndarray, shape (3,)
+        ``S_k`` [kg m].
+    mass : float
+        [kg].
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        Centre of mass in the body's local axes [m].
     """
     d2 = (np.asarray(static_moments, dtype=float) / mass) ** 2
     r2 = 0.5 * d2.sum()
