@@ -25,8 +25,18 @@ __all__ = ["after_revolutions", "whole_revolution_window", "cumulative", "window
 
 
 def after_revolutions(theta_in: np.ndarray, skip_revolutions: float) -> np.ndarray:
-    """Mask, shape of ``theta_in``, of the rows after the first ``skip_revolutions`` [-] of the
-    input angle ``theta_in`` [rad] (either sense).
+    """Mask of the rows after the first revolutions of the input (either sense).
+
+    Parameters
+    ----------
+    theta_in : ndarray, shape (n,)
+        Input angle [rad].
+    skip_revolutions : float
+        Revolutions [-] left out at the start.
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
     """
     theta = np.asarray(theta_in, float)
     return np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
@@ -58,8 +68,22 @@ def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tu
 
 
 def cumulative(y: np.ndarray, t: np.ndarray, breaks: Sequence[tuple[int, int, float]] = ()) -> np.ndarray:
-    """Integral of ``y dt`` from the first row to each row, shape of ``t``: trapezoidal, except
-    across the friction jumps ``breaks`` (:func:`reference.results.quadrature.jump_breaks`).
+    """Integral of ``y dt`` from the first row to each row: trapezoidal, except across the
+    friction jumps.
+
+    Parameters
+    ----------
+    y : ndarray, shape (n,)
+        The integrand (e.g. a power [W]).
+    t : ndarray, shape (n,)
+        Time [s].
+    breaks : sequence of (int, int, float)
+        The friction jumps (:func:`reference.results.quadrature.jump_breaks`).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The running integral (e.g. a work [J]), 0 at the first row.
     """
     out = np.zeros(np.shape(t), float)
     out[1:] = np.cumsum(segment_integrals(y, t, breaks))
@@ -79,6 +103,11 @@ def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
         The window's ends [rad]; the integral is interpolated linearly in ``theta`` there.
     breaks : sequence of (int, int, float)
         The friction jumps integrated across (:func:`cumulative`).
+
+    Returns
+    -------
+    float
+        The integral (unit of ``y`` times s).
     """
     cum = cumulative(np.asarray(y, float), np.asarray(t, float), breaks)
     th = np.asarray(theta, float)
@@ -90,8 +119,21 @@ def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
 
 
 def window_duration(t: np.ndarray, theta: np.ndarray, theta_0: float, theta_1: float) -> float:
-    """Time [s] between the instants where ``theta`` (monotonic, [rad]) passes ``theta_0`` and
-    ``theta_1`` [rad], interpolated linearly in ``theta``; ``t`` the rows' time [s].
+    """Time between the instants where ``theta`` passes ``theta_0`` and ``theta_1``.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        The rows' time [s].
+    theta : ndarray, shape (n,)
+        A monotonic angle [rad] (the input angle).
+    theta_0, theta_1 : float
+        The window's ends [rad]; the instants are interpolated linearly in ``theta``.
+
+    Returns
+    -------
+    float
+        The duration [s].
     """
     th = np.asarray(theta, float)
     if th[-1] < th[0]:
@@ -207,8 +249,19 @@ def flow_means(columns: Mapping[str, np.ndarray], works: Mapping[str, float], in
 
 
 def window_rows(theta: np.ndarray, theta_0: float, theta_1: float) -> np.ndarray:
-    """Mask of the rows whose values enter the window's integrals: those of ``theta`` (monotonic,
-    [rad]) between ``theta_0`` and ``theta_1`` and the row on either side that brackets an end.
+    """Mask of the rows whose values enter the window's integrals.
+
+    Parameters
+    ----------
+    theta : ndarray, shape (n,)
+        A monotonic angle [rad] (the input angle).
+    theta_0, theta_1 : float
+        The window's ends [rad].
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        The rows between the ends and the row on either side that brackets an end.
     """
     sign = 1.0 if theta_1 >= theta_0 else -1.0
     th = sign * np.asarray(theta, float)
@@ -222,8 +275,20 @@ def window_rows(theta: np.ndarray, theta_0: float, theta_1: float) -> np.ndarray
 
 
 def pair_loss_works(columns: Mapping[str, np.ndarray], integral: Any) -> dict[str, float]:
-    """``loss_work_<pair>`` and its axial-friction part ``loss_work_<pair>_sliding`` [J] of the pairs
-    whose columns are in ``columns``, with ``integral(y)`` the window's integral of ``y dt``.
+    """Each pair's loss work and its axial-friction part.
+
+    Parameters
+    ----------
+    columns : mapping of str to ndarray, shape (n,)
+        Result-schema columns; the pairs whose ``power_loss_<pair>`` (and friction force and
+        slide speed) are present count.
+    integral : callable
+        ``integral(y)``: the window's integral of ``y dt``.
+
+    Returns
+    -------
+    dict of str to float
+        ``loss_work_<pair>`` and ``loss_work_<pair>_sliding`` [J].
     """
     out = {}
     for p in PAIR_NAMES:

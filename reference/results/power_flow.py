@@ -99,6 +99,10 @@ def classify_works(input_work: float, output_work: float, loss_work: float,
         energy [J]: works below ``WORK_FLOOR * energy_scale`` count as zero (0: only exact zeros
         do).
 
+    Returns
+    -------
+    FlowVerdict
+
     References
     ----------
     Eq. (18) of the paper, integrated over the window, for the direction the work flows.
@@ -113,36 +117,57 @@ def classify_works(input_work: float, output_work: float, loss_work: float,
     if w_loss < -floor:
         return FlowVerdict(None, None, None, problem=f"friction generates work ({works})",
                            excess_work=-w_loss)
+    verdict = _by_direction(w_in, w_out, w_loss, floor, works)
+    return _in_range(verdict, w_in, w_out, works)
+
+
+def _by_direction(w_in: float, w_out: float, w_loss: float, floor: float, works: str) -> FlowVerdict:
+    """The verdict the works' signs give (a work within ``floor`` [J] of zero counts as zero)."""
     if w_in > floor and w_out > floor:
-        verdict = FlowVerdict(PowerFlow.INPUT_TO_OUTPUT, 1.0 - w_loss / w_in, w_out / w_in)
-    elif w_in < -floor and w_out < -floor:
-        verdict = FlowVerdict(PowerFlow.OUTPUT_TO_INPUT, 1.0 - w_loss / -w_out, w_in / w_out,
-                              note=f"power flows from the output to the input ({works}): the "
-                                   "efficiency is that of this direction, 1 - W_loss / (-W_out)")
-    elif w_in >= -floor and w_out <= floor and w_loss > floor:
-        verdict = FlowVerdict(PowerFlow.NONE, 0.0, 0.0,
-                              note=f"neither shaft takes net work ({works}): nothing is "
-                                   "transmitted, the efficiency is 0")
-    elif w_in >= -floor and w_out <= floor:
+        return FlowVerdict(PowerFlow.INPUT_TO_OUTPUT, 1.0 - w_loss / w_in, w_out / w_in)
+    if w_in < -floor and w_out < -floor:
+        return FlowVerdict(PowerFlow.OUTPUT_TO_INPUT, 1.0 - w_loss / -w_out, w_in / w_out,
+                           note=f"power flows from the output to the input ({works}): the "
+                                "efficiency is that of this direction, 1 - W_loss / (-W_out)")
+    if w_in >= -floor and w_out <= floor and w_loss > floor:
+        return FlowVerdict(PowerFlow.NONE, 0.0, 0.0,
+                           note=f"neither shaft takes net work ({works}): nothing is "
+                                "transmitted, the efficiency is 0")
+    if w_in >= -floor and w_out <= floor:
         return FlowVerdict(PowerFlow.NONE, None, None,
                            note=f"no work is transmitted or lost ({works}): the efficiency is "
                                 "undefined")
-    else:
-        return FlowVerdict(None, None, None,
-                           problem=f"the shafts take out work that nobody supplies ({works})",
-                           excess_work=max(-w_in, 0.0) + max(w_out, 0.0))
+    return FlowVerdict(None, None, None,
+                       problem=f"the shafts take out work that nobody supplies ({works})",
+                       excess_work=max(-w_in, 0.0) + max(w_out, 0.0))
+
+
+def _in_range(verdict: FlowVerdict, w_in: float, w_out: float, works: str) -> FlowVerdict:
+    """``verdict``, or a problem when its mean efficiency is outside [0, 1]."""
     eta = verdict.mean_efficiency
-    if not 0.0 <= eta <= 1.0:
-        source = w_in if verdict.power_flow == PowerFlow.INPUT_TO_OUTPUT else -w_out
-        return verdict._replace(mean_efficiency=None, work_ratio=None, problem=(
-            f"mean efficiency {eta:.6g} is outside [0, 1] ({verdict.power_flow}: {works})"),
-            excess_work=max(-eta, eta - 1.0) * source)
-    return verdict
+    if eta is None or 0.0 <= eta <= 1.0:
+        return verdict
+    source = w_in if verdict.power_flow == PowerFlow.INPUT_TO_OUTPUT else -w_out
+    return verdict._replace(mean_efficiency=None, work_ratio=None, problem=(
+        f"mean efficiency {eta:.6g} is outside [0, 1] ({verdict.power_flow}: {works})"),
+        excess_work=max(-eta, eta - 1.0) * source)
 
 
 def source_power(flow: PowerFlow | str | None, power_in: np.ndarray, power_out: np.ndarray) -> np.ndarray:
-    """Power the source shaft feeds into the joint [W]: ``P_in``, or ``-P_out`` when the power
-    flows from the output to the input."""
+    """Power the source shaft feeds into the joint.
+
+    Parameters
+    ----------
+    flow : PowerFlow, str or None
+        The window's power flow.
+    power_in, power_out : ndarray, shape (n,)
+        Input and output power [W].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        ``P_in``, or ``-P_out`` when the power flows from the output to the input [W].
+    """
     if flow == PowerFlow.OUTPUT_TO_INPUT:
         return -np.asarray(power_out, float)
     return np.asarray(power_in, float)

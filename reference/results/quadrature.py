@@ -15,7 +15,7 @@ per revolution, where the crossings of a symmetric joint fall on rows) may lie i
 ramp, where its value belongs to neither side: it is left out and the two steps around it are
 integrated as one; so are the rows of a ramp the steps partly resolve (:data:`RAMP_GROWTH`).
 Measured on the reference engine's exact rows: docs/accuracy.md#step-model-constants
-(``tests/test_reference_quadrature.py`` pins the improvement).
+(``tests/test_reference_quadrature.py`` pins the gain over the plain trapezoid).
 """
 
 from __future__ import annotations
@@ -120,11 +120,27 @@ def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float
 
 def segment_integrals(y: np.ndarray, t: np.ndarray,
                       breaks: Sequence[tuple[int, int, float]] = ()) -> np.ndarray:
-    """Integral of ``y dt`` over each step (shape ``t.size - 1``): the trapezoid, except across
-    the ``breaks`` of :func:`jump_breaks`, where each side of the crossing follows the straight
-    line through the row on its side and the next one beyond it (a constant at the table's ends).
-    A jump is then integrated exactly to second order, and so is a sign ramp that the steps
-    resolve (where the trapezoid was right): either way the error stays O(h^2)."""
+    """Integral of ``y dt`` over each step: the trapezoid, except across the friction jumps.
+
+    Across a break each side of the crossing follows the straight line through the row on its
+    side and the next one beyond it (a constant at the table's ends). A jump is then integrated
+    exactly to second order, and so is a sign ramp that the steps resolve (where the trapezoid
+    is right too): either way the error stays O(h^2).
+
+    Parameters
+    ----------
+    y : ndarray, shape (n,)
+        The integrand (e.g. a power [W]).
+    t : ndarray, shape (n,)
+        Time [s].
+    breaks : sequence of (int, int, float)
+        :func:`jump_breaks`: rows ``a < b`` and the crossing instant [s].
+
+    Returns
+    -------
+    ndarray, shape (n - 1,)
+        Per step the integral (e.g. a work [J]).
+    """
     y = np.asarray(y, float)
     t = np.asarray(t, float)
     seg = 0.5 * np.diff(t) * (y[:-1] + y[1:])

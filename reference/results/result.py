@@ -18,13 +18,22 @@ class DeferredTable:
 
     Why: importing pandas costs about 0.4 s, ten times a short run's solve; a run whose table
     nobody writes or returns should not pay it.
+
+    Parameters
+    ----------
+    columns : mapping of str to ndarray, shape (n,)
+        The run's columns, every step.
+    every : int
+        Keep every ``every``-th row.
+    names : list of str
+        The columns kept, in table order.
     """
 
     def __init__(self, columns: Mapping[str, np.ndarray], every: int, names: list[str]) -> None:
         self._columns = {c: columns[c][::every] for c in names}
 
     def build(self) -> Any:
-        """The table as a pandas DataFrame, every ``every``-th row."""
+        """The table as a pandas DataFrame."""
         import pandas as pd  # import cost: see the class docstring
 
         return pd.DataFrame(self._columns)

@@ -256,7 +256,15 @@ class Summary:
         self.pair_sliding_loss_work.clear()
 
     def fail(self, status: Status | str, reason: str) -> None:
-        """End the run with ``status`` and ``reason`` and forget its means."""
+        """End the run and forget its means.
+
+        Parameters
+        ----------
+        status : Status or str
+            Why it ended (not ``ok``).
+        reason : str
+            What happened, in one sentence.
+        """
         self.status = Status(status)
         self.reason = reason
         self.clear_means()
@@ -285,8 +293,8 @@ class Summary:
     def from_dict(cls, data: Mapping[str, Any]) -> Summary:
         """Inverse of :meth:`to_dict`; also reads versions 1 (no version key) and 2, whose
         efficiencies it takes again from their works by version 3's rules (:meth:`upgrade`).
-        An ``accuracy`` or ``friction`` table with keys this version does not know stays, as it
-        was, in :attr:`extras`."""
+        An ``accuracy`` or ``friction`` table with keys this version does not know stays
+        unchanged in :attr:`extras`."""
         names = {f.name for f in fields(cls)} - {"pair_loss_work", "pair_sliding_loss_work", "extras",
                                                  *_RECORDS}
         summary = cls(status=Status(data["status"]))
@@ -298,7 +306,7 @@ class Summary:
                 record = _RECORDS[key].from_dict(value)
             if record is not None:
                 setattr(summary, key, record)
-            elif key in _RECORDS:  # a shape this version does not know: kept as it was
+            elif key in _RECORDS:  # a shape this version does not know: kept unchanged
                 summary.extras[key] = value
             elif key in names:
                 setattr(summary, key, list(value) if key == "warnings" else value)
