@@ -1,11 +1,9 @@
 """Velocity projection of recorded Exudyn states onto the joint's velocity constraints.
 
-Why
----
 Generalized-alpha with index-3 constraints keeps the *positions* on the constraint manifold to
 the Newton tolerance, but its velocities come from the Newmark update and miss the velocity
 constraints by ``O(h^2)``: that is the whole of Exudyn's error in ``omega_out / omega_in``
-(``cardan bench`` measures it; at 35 deg and 200 steps per revolution 1.4e-4). Projecting the
+(measured: docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not). Projecting the
 recorded velocities onto the velocity constraints at the recorded positions removes that part:
 
 - with a prescribed input (constant speed or angle history) the joint has no degree of freedom
@@ -16,12 +14,8 @@ recorded velocities onto the velocity constraints at the recorded positions remo
   consistent velocity in the kinetic-energy metric (the usual velocity projection of index-3
   integrators).
 
-What it is not
---------------
 It is post-processing: the projected velocities do not feed back into the integration, so the
-drive torque, the reactions and the friction (which the step loop computes from its own states)
-keep the integrator's ``O(h^2)`` error. ``cardan bench`` therefore measures the drive-torque and
-mean-efficiency errors of every configuration next to the speed-ratio error.
+drive torque, the reactions and the friction keep the integrator's ``O(h^2)`` error.
 
 The constraint rows are the time derivatives of the pair constraints of
 ``ObjectJointGeneric`` (relative displacement normal to the axis, or all of it for the revolute;
