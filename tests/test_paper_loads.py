@@ -61,13 +61,17 @@ def test_a_scene_not_stored_is_solved():
     assert named_scene("paper-27deg").load.torque == solve_mean_input_load(other)
 
 
-def test_building_a_named_scene_runs_no_engine():
-    """``named_scene("paper-10deg")`` in a fresh interpreter imports no engine module."""
-    code = ("import json, sys, reference; s = reference.named_scene('paper-10deg'); "
+@pytest.mark.parametrize("name", ["paper-10deg", "paper-10deg-frictionless"])
+def test_building_a_named_scene_runs_no_engine(name):
+    """A stored or frictionless named scene built in a fresh interpreter imports no engine module."""
+    code = ("import json, sys, reference; s = reference.named_scene(%r); " % name +
             "print(json.dumps([s.load.torque, sorted(m for m in sys.modules "
             "if m.startswith('reference.engine'))]))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     torque, engine = json.loads(proc.stdout)
     assert engine == []
-    assert torque == STORED["paper-physical-10deg-2000rpm"]["torque"]
+    if name == "paper-10deg":
+        assert torque == STORED["paper-physical-10deg-2000rpm"]["torque"]
+    else:
+        assert torque == 2.0  # frictionless: the mean input torque is the load

@@ -77,13 +77,13 @@ def solve_mean_input_load(scene: Scene) -> float:
     SceneError
         The drive is not a constant speed, or the reference engine's run fails (the joint locks).
     """
-    from reference.engine.solve import run  # the paper's data sit below the engine; imported on use
-
     target = scene.load.torque
     if not isinstance(scene.drive, SpeedDrive) or not scene.load.constant:
         raise SceneError("`torque_reading` 'mean_input' needs a constant-speed drive and a constant load")
     if not scene.has_friction or target == 0.0:
         return target
+    from reference.engine.solve import run  # the paper's data sit below the engine; imported on use
+
     loads = [target]
     torques = []
     for _ in range(2):
