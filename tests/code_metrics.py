@@ -198,5 +198,64 @@ def report(root: Path = ROOT) -> str:
     return "\n".join(lines)
 
 
+def summary_line(path: Path) -> str:
+    """The first line of a module's docstring ("" when it has none)."""
+    doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
+    return doc.strip().splitlines()[0] if doc.strip() else ""
+
+
+def tree(root: Path = ROOT) -> str:
+    """The installed packages as a tree: every package and module with its lines and the first
+    line of its docstring."""
+    out: list[str] = []
+    for pkg in PACKAGES:
+        for path in sorted((root / pkg).rglob("*.py"),
+                           key=lambda p: (p.parent.relative_to(root).parts, p.name != "__init__.py", p.name)):
+            rel = path.relative_to(root)
+            depth = len(rel.parts) - 1
+            if path.name == "__init__.py":
+                label = f"{rel.parent.name}/"
+                depth -= 1
+            else:
+                label = path.name
+            lines = len(path.read_text(encoding="utf-8").splitlines())
+            out.append(f"{'    ' * depth}{label:<{36 - 4 * depth}} {lines:>4}  {summary_line(path)[:90]}")
+    return "\n".join(out)
+
+
+def figures_at(revision: str, root: Path = ROOT) -> dict[str, float]:
+    """:func:`figures` of the product code at a git ``revision`` (extracted to a temporary folder)."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        archive = subprocess.run(["git", "-C", str(root), "archive", revision, *PACKAGES],
+                                 capture_output=True, check=True).stdout
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+        return figures(Path(tmp))
+
+
+def compare(revision: str, root: Path = ROOT) -> str:
+    """The headline figures at ``revision`` and in the working tree, side by side."""
+    before = figures_at(revision, root)
+    after = figures(root)
+    rows = [f"{'figure':<30} {revision[:12]:>12} {'now':>10}"]
+    rows += [f"{k:<30} {before[k]:>12} {after[k]:>10}" for k in after]
+    return "\n".join(rows)
+
+
+USAGE = """usage: python tests/code_metrics.py [ROOT]      sizes, lengths, cycles of the product code
+       python tests/code_metrics.py --tree        the packages' tree with lines and summaries
+       python tests/code_metrics.py --since REV   headline figures at git REV and now"""
+
+
 if __name__ == "__main__":
-    print(report(Path(sys.argv[1]).resolve() if len(sys.argv) > 1 else ROOT))
+    args = sys.argv[1:]
+    if args[:1] == ["--tree"]:
+        print(tree())
+    elif args[:1] == ["--since"] and len(args) == 2:
+        print(compare(args[1]))
+    elif args and args[0].startswith("-"):
+        sys.exit(USAGE)
+    else:
+        print(report(Path(args[0]).resolve() if args else ROOT))
