@@ -14,6 +14,7 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run as engine_run
 from cardan_exudyn.report import plots
 from cardan_exudyn.studies.reproduce import compute as rep
+from cardan_exudyn.studies.reproduce.command import reproduce
 from cardan_exudyn.studies.reproduce import report as report
 from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
 from reference.paper.parameter_sets import PARAMETER_SETS, parameter_set
@@ -69,7 +70,7 @@ def no_drawing(monkeypatch):
 @pytest.fixture(scope="module")
 def quick_report(tmp_path_factory):
     out = tmp_path_factory.mktemp("reproduce") / "quick"
-    assert rep.reproduce(out, quick=True, workers=1, progress=False).success
+    assert reproduce(out, quick=True, workers=1, progress=False).success
     return out
 
 
@@ -140,7 +141,7 @@ def test_interrupted_reproduce_resumes(tmp_path, monkeypatch, no_drawing):
     first = Counting(interrupt_at=4)
     monkeypatch.setattr(rep.engines, "run", first)
     with pytest.raises(KeyboardInterrupt):
-        rep.reproduce(out, quick=True, workers=1, progress=False)
+        reproduce(out, quick=True, workers=1, progress=False)
     assert sorted(_records(out)) == sorted(QUICK_IDS[:3])
     assert not (out / "report.md").exists()
     stray = out / rep.RUNS_DIR / rep.FILES_DIR / "paper-literal-0deg-2000rpm-interrupted"
@@ -148,7 +149,7 @@ def test_interrupted_reproduce_resumes(tmp_path, monkeypatch, no_drawing):
 
     second = Counting()
     monkeypatch.setattr(rep.engines, "run", second)
-    result = rep.reproduce(out, quick=True, workers=1, progress=False)
+    result = reproduce(out, quick=True, workers=1, progress=False)
     assert result.success and result.reused == 3 and result.sweep["run_now"] == 6
     assert second.names == [f"paper-{p}-{c}" for p in ("literal", "matched")
                             for c in ("0deg-2000rpm", "10deg-2000rpm", "10deg-500rpm")]
@@ -160,13 +161,13 @@ def test_interrupted_reproduce_resumes(tmp_path, monkeypatch, no_drawing):
 
     third = Counting()
     monkeypatch.setattr(rep.engines, "run", third)
-    assert rep.reproduce(out, quick=True, workers=1, progress=False).success
+    assert reproduce(out, quick=True, workers=1, progress=False).success
     assert third.names == []
     assert pd.read_csv(out / "results.csv").equals(rows)
 
     fourth = Counting()
     monkeypatch.setattr(rep.engines, "run", fourth)
-    assert rep.reproduce(out, quick=True, workers=1, progress=False, restart=True).success
+    assert reproduce(out, quick=True, workers=1, progress=False, restart=True).success
     assert len(fourth.names) == 9
     assert "earlier invocation" not in (out / "report.md").read_text()
     assert len(list((out / rep.RUNS_DIR / rep.FILES_DIR).iterdir())) == 9
@@ -213,7 +214,7 @@ def test_two_workers_give_the_same_report(quick_report, tmp_path, no_drawing):
     the case function): the same numbers, summaries and histories (what the figures are drawn
     from) as in one process, and the same figure files."""
     out = tmp_path / "rep"
-    assert rep.reproduce(out, quick=True, workers=2, progress=False).success
+    assert reproduce(out, quick=True, workers=2, progress=False).success
     sweep = json.loads((out / rep.RUNS_DIR / "sweep.json").read_text())
     assert sweep["executor"] == {"kind": "processes", "workers": 2}
     a = pd.read_csv(quick_report / "results.csv").drop(columns="wall_time_s")

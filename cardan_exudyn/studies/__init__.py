@@ -19,7 +19,7 @@ from __future__ import annotations
 __all__ = ["COMMANDS"]
 
 COMMANDS: dict[str, str] = {
-    "reproduce": "reproduce.compute", "bench": "bench.command", "stress": "stress.command",
+    "reproduce": "reproduce.command", "bench": "bench.command", "stress": "stress.command",
     "study": "study.compute", "calibrate": "calibrate.compute", "compare": "compare.command",
     "tolerance": "tolerance.compute", "accuracy": "accuracy.compute",
 }

@@ -1,10 +1,12 @@
-"""``cardan reproduce``."""
+"""``cardan reproduce``: the command (:mod:`.command`), the runs (:mod:`.compute`) and the report
+(:mod:`.report`)."""
 
 from __future__ import annotations
 
 from reference.lazy import lazy_face
 
 _LAZY = {
+    "command": "cardan_exudyn.studies.reproduce.command",
     "compute": "cardan_exudyn.studies.reproduce.compute",
     "report": "cardan_exudyn.studies.reproduce.report",
 }

@@ -1,73 +1,28 @@
-"""``cardan reproduce``: the paper's results with friction, under its three parameter sets, as a
-report.
+"""The runs of ``cardan reproduce``: the paper's eleven cases under each parameter set of
+:data:`reference.paper.paper.PARAMETER_SETS`, as one sweep of :mod:`cardan_exudyn.sweep`.
 
-For each parameter set of :data:`reference.paper.parameter_sets.PARAMETER_SETS` (``physical``, the default:
-every open value a dimension or physical quantity inside its plausible range; ``literal``: the
-paper read literally, kept as evidence; ``matched``: fitted to the paper's numbers with values
-that are not plausible dimensions) the report has
+The sweep's base scene is ``paper_scene(10 deg, 2000 rpm)`` of the ``physical`` set; each case's
+overrides are the leaves in which its own scene (:func:`reference.paper.paper.paper_scene`, any
+parameter set) differs from the base, and :func:`paper_runs` checks that the runner rebuilds
+exactly that scene. Case ids read like ``matched-table2-35deg-2000rpm``. The sweep lives in
+``OUT/runs/``: a rerun runs only the cases without a record, a case that fails is recorded with its
+status and reason, and the cases can run in worker processes.
 
-- Table 2 (0 to 35 deg at 2000 rpm) and the speed study (500, 1000, 2000 rpm at 10 deg) next to
-  the paper, with both mean-efficiency definitions (one minus lost over input energy over whole
-  revolutions, and the time average of eq. (18)), each number with its engine, engine version,
-  step and estimated error; the cases the set was fitted to are marked, and its errors against
-  the paper (RMS and largest) are summarised for the fitted and the held-out cases apart;
-- the set's parameter table (value, plausible range, inside it or not, fitted or not, reason),
-  and the envelope of each paper number over the plausible box when it is stored;
-- the per-pair loss breakdown (share of the input work lost in each pair);
-- the time histories of Figures 4 (efficiency at 10 deg), 5 (power loss per pair at 10 deg),
-  6 (efficiency at several angles) and 7 (efficiency at several speeds, against the input angle);
-- the energy balance residual of every run, and the assumption register.
-
-This module runs the cases and registers the command; :mod:`.reproduce_report` writes the report.
-
-How the runs are made
----------------------
-The runs (the eleven cases under each parameter set: 33; 9 with ``--quick``) are one sweep of
-:mod:`cardan_exudyn.sweep` with an explicit case list, in ``OUT/runs/``. The base scene is
-``paper_scene(10 deg, 2000 rpm)`` of the ``physical`` set; each case's overrides are the
-leaf-by-leaf difference between its own scene (:func:`reference.paper.scenes.paper_scene`, any parameter
-set) and the base, and :func:`paper_runs` checks that the runner rebuilds exactly that scene
-(the ``physical`` set's output load, solved per case for a mean input torque of 2 N m, is one
-such leaf). Case ids read like ``matched-table2-35deg-2000rpm``. So the cases can run in worker
-processes (``workers``), a rerun of an interrupted ``cardan reproduce`` runs only the cases
-without a record (a rerun of a finished one redraws the report from the records; ``restart``
-runs everything again), a case that fails or raises is recorded with its status and reason
-while the report is written from the others, and progress is the sweep runner's bar.
-
-Besides each run's numbers (the record: a few scalars, :func:`run_numbers`), the report needs the
-engine's full summary (``summaries.json``) and, for Figures 4-7, time histories. The case function
-:func:`paper_case_outputs` writes both into a folder of its own, ``OUT/runs/files/<scene
-name>-<random token>/`` (``summary.json`` and ``history.npz`` with the columns of
-:data:`HISTORY_COLUMNS`, each written to a temporary name, fsync'ed and renamed), and returns that
-folder's name in its record (``files``). Why this way:
-
-- records stay small (about 1.4 kB each): the histories were about 12,700 rows x 6 columns for
-  22 runs, which in the records would be about 1.6 MB of JSON in ``cases.jsonl`` and a text cell
-  of up to 180 kB per case in the sweep's ``results.csv`` (as ``.npz`` files: 0.9 MB);
-  recomputing them after the sweep would run 14 of the 22 scenes twice;
-- the files are complete before the function returns, so a record in ``cases.jsonl`` (which the
-  runner writes after the function returns) implies its files exist: a resumed run finds the
-  files of every recorded case; a random token keeps two runs of one scene (Table 2's 10 deg case
-  is the speed study's 2000 rpm case) and a rerun of a failed case apart; folders no record names
-  (a case interrupted after writing them) are deleted once every case has a record;
-- the folder reaches the case function as its argument ``files`` (the sweep's
-  ``function_args``), which the runner sends with the function's name to every worker, in this
-  process or a spawned one: the folder is no part of a scene (in it, it would change the scene
-  and its hash whenever the report folder moves), and it is part of the sweep's plan, so a
-  report folder moved elsewhere takes ``--restart``. Without it the function writes nothing and
-  returns the numbers, so it also serves ``cardan sweep --function
-  cardan_exudyn.studies.reproduce.compute:paper_case_outputs``;
-- ``.npz`` keeps float64 exactly (whether a CSV reads back bit for bit depends on the pandas
-  version's parser), so the figures are drawn from exactly the engine's numbers.
+Each case writes the engine's full summary (``summary.json``) and its time history
+(``history.npz``, the columns of :data:`HISTORY_COLUMNS`) into a folder of its own,
+``OUT/runs/files/<scene name>-<random token>/``, and names that folder in its record (``files``).
+Why files beside the records: the records stay a few scalars (a history is thousands of rows);
+the files are complete (written to a temporary name and renamed) before the record is, so a
+recorded case has its files; ``.npz`` keeps float64 exactly, so the figures are drawn from the
+engine's numbers; the folder reaches the case function as an argument (``function_args``), not as
+part of the scene, whose hash would change with the report folder's place.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shutil
-import sys
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -76,10 +31,7 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn import engines
-from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, count, out_folder
-from cardan_exudyn.jsonable import dumps
-from cardan_exudyn.outputs import atomic_directory, atomic_write
-from cardan_exudyn.report.format import number
+from cardan_exudyn.io import atomic_write, dumps
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
 from reference.paper.cases import paper_cases
 from reference.paper.parameter_sets import DEFAULT_PARAMETER_SET, PARAMETER_SETS
@@ -92,15 +44,18 @@ from reference.scene.scene import Scene
 
 __all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_OVERRIDES",
            "PaperRun", "Reproduction", "run_numbers", "paper_case_outputs", "selected_cases",
-           "base_scene", "paper_runs", "sweep_spec", "reproduce", "register", "handler",
-           "outcome_lines"]
+           "base_scene", "paper_runs", "sweep_spec", "run_cases"]
 
-RUNS_DIR, FILES_DIR = "runs", "files"
+RUNS_DIR = "runs"
+"""The sweep's folder inside the report folder."""
+FILES_DIR = "files"
+"""The cases' own files inside :data:`RUNS_DIR`."""
 CASE_FUNCTION = "cardan_exudyn.studies.reproduce.compute:paper_case_outputs"
 HISTORY_COLUMNS = ("t", "theta_in", "efficiency", "power_in", *(f"power_loss_{pair}" for pair in PAIR_NAMES))
 QUICK_OVERRIDES = {"numerics.accuracy": 1e-4, "revolutions": 1.0}
 HISTORY_ANGLES = (0.0, 10.0, 20.0, 35.0)
-BASE_ANGLE_DEG, BASE_SPEED_RPM = 10.0, 2000.0
+BASE_ANGLE_DEG = 10.0
+BASE_SPEED_RPM = 2000.0
 
 
 def run_numbers(result: Result) -> dict[str, Any]:
@@ -323,12 +278,23 @@ class Reproduction:
     sweep : dict
         The sweep's summary (``OUT/runs/sweep.json``): ``run_now``, ``wall_time_s`` [s],
         ``executor``, ...
+    summaries : list of dict
+        The engine summary of every run, in report order (a stand-in naming the status and the
+        case for a run that raised).
+    histories : dict
+        Parameter set -> label (``10deg``, ``angle <a> deg``, ``speed <n> rpm``) -> time history
+        (the columns of :data:`HISTORY_COLUMNS`, SI units).
+    quick : bool
+        The runs are ``--quick``'s.
     """
 
     out: Path
     runs: list[PaperRun]
     records: dict[str, dict[str, Any]]
     sweep: dict[str, Any]
+    summaries: list[dict[str, Any]]
+    histories: dict[str, dict[str, Any]]
+    quick: bool = False
 
     @property
     def failed(self) -> list[PaperRun]:
@@ -346,18 +312,16 @@ class Reproduction:
         return len(self.runs) - self.sweep["run_now"]
 
 
-def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
+def run_cases(out: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
               restart: bool = False, retry_failed: bool = False,
               progress: bool | None = None) -> Reproduction:
-    """Run the paper's cases under every parameter set through the sweep runner and write the
-    report into ``out``.
+    """Run (or resume) the cases in ``out/runs/`` and collect their records and files.
 
     Parameters
     ----------
     out : path
-        Report folder, replaced atomically when the report is complete; the sweep (plan,
-        records, per-run files) lives in ``out/runs/`` and is kept, so that a rerun of an
-        interrupted invocation runs only the cases without a record.
+        The report folder; the sweep (plan, records, per-run files) lives in ``out/runs/`` and
+        is kept, so that a rerun of an interrupted invocation runs only the cases without a record.
     quick : bool
         Three cases per set (0 and 10 deg at 2000 rpm, 500 rpm), accuracy 1e-4, one revolution.
     workers : int, optional
@@ -371,8 +335,7 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
     Returns
     -------
     Reproduction
-        The runs, their records and the sweep's summary; ``success`` is False when a run failed
-        (the report covers the others).
+        Every run with its record, summary and history; ``success`` is False when a run failed.
 
     Raises
     ------
@@ -382,13 +345,8 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
         runs, a recorded case's files are missing (the records are kept; ``restart`` helps).
     cardan_exudyn.sweep.executors.SweepInterrupted
         Ctrl-C or SIGTERM (a :class:`KeyboardInterrupt`): the runs finished before it are
-        recorded in ``out/runs``, none as failed, the report folder is as it was; the same call
-        (command) runs only the missing runs (``docs/outputs.md``).
+        recorded in ``out/runs``, none as failed; the same call runs only the missing runs.
     """
-    # pandas and matplotlib (about 1 s) load only to write a report: `cardan` imports this module
-    # to register the command
-    from cardan_exudyn.studies.reproduce import report as reproduce_report
-
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {str(out)!r} exists and is not a folder")
@@ -398,56 +356,6 @@ def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
     sweep = run_sweep(sweep_spec(runs, quick, files.resolve()), folder_runs, workers=workers,
                       restart=restart, retry_failed=retry_failed, progress=progress)
     records = read_records(folder_runs / CASES_FILE)
-    rows = [reproduce_report.case_row(r.case, r.parameters, records[r.id]) for r in runs]
     summaries, histories = _collect(runs, records, files)
     _remove_unreferenced(files, records)
-    result = Reproduction(out, runs, records, sweep)
-    with atomic_directory(out) as folder:
-        reproduce_report.write_report(folder, rows, histories, quick, sweep["wall_time_s"],
-                                      result.reused, RUNS_DIR)
-        (folder / "summaries.json").write_text(dumps(summaries) + "\n", encoding="utf-8")
-        os.replace(folder_runs, folder / RUNS_DIR)
-    return result
-
-
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cardan reproduce`` to the ``cardan`` subcommands."""
-    p = subparsers.add_parser("reproduce", help="reproduce the paper's studies into a report folder")
-    p.add_argument("--out", metavar="DIR", default="reports/reproduce", help="report folder")
-    p.add_argument("--quick", action="store_true", help="fewer scenes and a coarser accuracy")
-    p.add_argument("--workers", type=count("--workers"), metavar="N",
-                   help="local processes (default: all cores; 1 runs in this process)")
-    p.add_argument("--restart", action="store_true",
-                   help="discard the runs recorded in OUT/runs and run every case again")
-    p.add_argument("--retry-failed", action="store_true", help="rerun the cases recorded as failed")
-    p.set_defaults(func=handler)
-
-
-def handler(args: argparse.Namespace) -> int:
-    """Run ``cardan reproduce``; exit 3 when a run failed (the report covers the others)."""
-    out_folder(args.out)
-    try:
-        result = reproduce(args.out, quick=args.quick, workers=args.workers, restart=args.restart,
-                           retry_failed=args.retry_failed)
-    except SweepError as exc:
-        raise BadInput(str(exc)) from None
-    for line in outcome_lines(result):
-        print(line, file=sys.stderr)
-    return EXIT_OK if result.success else EXIT_FAILED
-
-
-def outcome_lines(result: Reproduction) -> list[str]:
-    """What ``cardan reproduce`` says at the end: each failed run, then where the report is."""
-    lines = [f"  {run.id}: {result.records[run.id]['status']}: {result.records[run.id].get('reason')}"
-             for run in result.failed]
-    sweep, out = result.sweep, result.out
-    executor = sweep["executor"]
-    how = (f" in {number(sweep['wall_time_s'], '.1f')} s, {executor['kind']}"
-           + (f", {executor['workers']} workers" if executor.get("workers", 1) > 1 else "")
-           if sweep["run_now"] else "")
-    earlier = (f"; {result.reused} from earlier records in {out}/{RUNS_DIR}, --restart runs them again"
-               if result.reused else "")
-    lines.append(f"wrote {out}/report.md ({len(result.runs)} runs, "
-                 f"{len(result.runs) - len(result.failed)} ok; {sweep['run_now']} run now{how}"
-                 f"{earlier})")
-    return lines
+    return Reproduction(out, runs, records, sweep, summaries, histories, quick)

@@ -1,5 +1,6 @@
-"""The report of ``cardan reproduce``: ``results.csv``, ``assumptions.csv``, the figures and
-``report.md``, from the rows and time histories of the runs (:mod:`.reproduce` makes them).
+"""The report of ``cardan reproduce``: ``results.csv``, ``assumptions.csv``, the figures,
+``summaries.json`` and ``report.md``, from the runs' records and time histories
+(:mod:`cardan_exudyn.studies.reproduce.compute` makes them).
 
 Every number in the report is computed from ``reference/paper/data/paper.toml`` by the code in this
 repository; the only values copied from the paper are in the column ``paper_mean_efficiency``.
@@ -7,6 +8,7 @@ repository; the only values copied from the paper are in the column ``paper_mean
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -14,11 +16,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
-from reference.paper.cases import envelope, in_fit
-from reference.paper.data import assumption_register, stated_values
-from reference.paper.parameter_sets import (
+from cardan_exudyn.studies.reproduce.compute import RUNS_DIR, Reproduction
+from reference.scene.joint import PAIR_NAMES
+from reference.paper.paper import (
     DEFAULT_PARAMETER_SET,
     LEVER_DIMENSIONS,
     PARAMETER_SETS,
@@ -28,7 +31,7 @@ from reference.paper.parameter_sets import (
 from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES
 
-__all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_report",
+__all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_reproduction", "write_report",
            "draw_figures", "report_text", "error_summary", "parameter_rows", "steady_revolution"]
 
 # the numbers of a run, in the order of the report's results.csv (after difference_to_paper)
@@ -147,6 +150,16 @@ def write_report(folder: Path, rows: Sequence[Mapping[str, Any]] | pd.DataFrame,
     (folder / "report.md").write_text(text, encoding="utf-8")
 
 
+def write_reproduction(result: Reproduction) -> Path:
+    """Write the report folder ``result.out`` (replaced atomically): the report of
+    :func:`write_report`, ``summaries.json``, and the sweep's ``runs/`` moved into it."""
+    rows = [case_row(r.case, r.parameters, result.records[r.id]) for r in result.runs]
+    with atomic_directory(result.out) as folder:
+        write_report(folder, rows, result.histories, result.quick, result.sweep["wall_time_s"],
+                     result.reused, RUNS_DIR)
+        (folder / "summaries.json").write_text(dumps(result.summaries) + "\n", encoding="utf-8")
+        os.replace(result.out / RUNS_DIR, folder / RUNS_DIR)
+    return result.out
 
 
 def steady_revolution(history: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
