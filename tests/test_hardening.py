@@ -270,14 +270,14 @@ def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
 def test_tolerance_out_failure_keeps_previous_study(tmp_path, monkeypatch):
     """`cardan tolerance montecarlo`: the report fails after the samples table is written; the
     previous study folder stays, the sweep records (resumable by design) are kept."""
-    import cardan_exudyn.studies.tolerance.compute as tolerance
+    import cardan_exudyn.studies.tolerance.report as tolerance
 
     out = tmp_path / "mc"
     _previous(out / "study")
     def plots(*args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(tolerance, "_plots", plots)
+    monkeypatch.setattr(tolerance, "monte_carlo_plots", plots)
     status = main(["tolerance", "montecarlo", "--name", "rig-matched", "--engine", "reference",
                    "--revolutions", "1", "--samples", "3", "--workers", "1", "--out", str(out)])
     assert status == 130

@@ -246,7 +246,8 @@ def test_dask_cluster_runs_batches_with_the_local_results(tmp_path):
 def test_tolerance_study_runs_in_batches_and_equals_single_runs(tmp_path, batches):
     """`cardan tolerance montecarlo`'s study goes through the sweep's batches, and its samples
     equal the single-scene engine's."""
-    from cardan_exudyn.studies.tolerance.compute import default_distributions, monte_carlo
+    from cardan_exudyn.studies.tolerance.command import monte_carlo
+    from cardan_exudyn.studies.tolerance.montecarlo import default_distributions
 
     scene = replace(named_scene("rig-matched"), revolutions=1)
     summary = monte_carlo(scene, "reference", 8, 1, out=tmp_path / "mc", workers=1, progress=False)

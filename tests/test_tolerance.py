@@ -7,18 +7,12 @@ import pandas as pd
 import pytest
 
 from cardan_exudyn.cli import main
-from cardan_exudyn.studies.tolerance.compute import (
-    MATCH_FACTOR,
-    correlation_ratio,
-    law_verdicts,
-    monte_carlo,
-    paper_case,
-    sensitivities,
-    verdict_line,
-)
-from reference.paper.parameter_sets import RENAMED_SETS
-from reference.paper.scenes import named_scene
-from reference.scene.mapping import replace
+from cardan_exudyn.studies.tolerance.command import monte_carlo
+from cardan_exudyn.studies.tolerance.montecarlo import correlation_ratio, sensitivities
+from cardan_exudyn.studies.tolerance.paper_case import MATCH_FACTOR, law_verdicts, paper_case
+from cardan_exudyn.studies.tolerance.report import verdict_line
+from reference.paper.paper import RENAMED_SETS, named_scene
+from reference.scene.scene import replace
 
 # the set fitted to the paper's numbers (formerly "calibrated"), whose measurements these tests hold
 MATCHED = RENAMED_SETS["calibrated"]

@@ -41,7 +41,8 @@ from cardan_exudyn.report.environment import environment
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.bench.report import header
 from cardan_exudyn.studies.bench.targets import paper_scenes
-from cardan_exudyn.studies.tolerance.compute import default_distributions, monte_carlo
+from cardan_exudyn.studies.tolerance.command import monte_carlo
+from cardan_exudyn.studies.tolerance.montecarlo import default_distributions
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene, rig_scene
@@ -88,7 +89,7 @@ def study_scene() -> Scene:
 
 def tolerance_scenes(samples: int, seed: int = SEED) -> list[Scene]:
     """``samples`` rig scenes (matched set) with the six mounting errors drawn as the tolerance
-    study draws them: :func:`cardan_exudyn.studies.tolerance.compute.default_distributions` (Section 4.2's
+    study draws them: :func:`cardan_exudyn.studies.tolerance.montecarlo.default_distributions` (Section 4.2's
     tolerances, uniform with both signs), Latin hypercube, ``seed``."""
     base = replace(rig_scene(parameters="matched", errors=True), **{"record.timeseries": False})
     distributions = {p: Distribution(**d) for p, d in default_distributions().items()}
