@@ -412,7 +412,7 @@ def test_compare_with_failed_engines_prints_no_number(capsys):
 
 def test_calibrate_failed_case_prints_status(monkeypatch, capsys):
     """`cardan calibrate`: a held-out case whose run failed shows its status, exit 3."""
-    import cardan_exudyn.studies.calibrate.compute as calibrate
+    import cardan_exudyn.studies.calibrate.command as calibrate
 
     rows = [{"case": "table2:0:2000", "used_in_fit": True, "paper": 0.99, "model": 0.98,
              "difference": -0.01, "status": "ok", "reason": ""},

@@ -20,7 +20,7 @@ __all__ = ["COMMANDS"]
 
 COMMANDS: dict[str, str] = {
     "reproduce": "reproduce.command", "bench": "bench.command", "stress": "stress.command",
-    "study": "study.compute", "calibrate": "calibrate.compute", "compare": "compare.command",
+    "study": "study.compute", "calibrate": "calibrate.command", "compare": "compare.command",
     "tolerance": "tolerance.command", "accuracy": "accuracy.compute",
 }
 """Modules of this package that register a subcommand, in the order ``cardan --help`` lists them."""

@@ -19,7 +19,6 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.report.format import markdown_table
 from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, box_space
 from reference.paper.cases import case_key, paper_cases
 
@@ -27,12 +26,10 @@ METHOD = ("every combination of the discrete options; the continuous box by its 
           "a bounded local optimisation (scipy.optimize.minimize, L-BFGS-B, forward-difference "
           "gradient, step 1e-6 of each range) from the best corner per case and direction; a local "
           "search that can miss an extreme inside the box")
-ENVELOPE_COLUMNS = ["case", "paper", "lowest", "highest", "reachable", "closest", "limited by"]
-ENVELOPE_FORMATS = {"paper": ".3f", "lowest": ".4f", "highest": ".4f", "closest": ".4f"}
 BOUND_TOL = 1e-6
 """A parameter within this share of its range from a bound is at the bound."""
 
-__all__ = ["METHOD", "envelope_study", "envelope_text"]
+__all__ = ["METHOD", "BOUND_TOL", "corner_scan", "refine", "at_bounds", "envelope_study", "case_envelope"]
 
 
 def corner_scan(model: CaseModel, space: Space, combinations: list[dict[str, str]],
@@ -149,43 +146,3 @@ def case_envelope(model: CaseModel, space: Space, points: list[dict[str, Any]], 
         u, choices = where["lowest" if paper < row["lowest"] else "highest"]
         row["limiting"] = at_bounds(model, space, case, u, choices)
     return row
-
-
-def envelope_text(result: Mapping[str, Any]) -> str:
-    """The report of :func:`envelope_study`: the table, what to paste into ``[envelope]`` of the
-    data file, and what would have to change for each number outside the envelope."""
-    rows = [{**r, "reachable": "yes" if r["reachable"] else "no",
-             "limited by": "; ".join(map(_limit, r.get("limiting", []))) + _choices(r)}
-            for r in result["cases"]]
-    lines = [f"engine {result['engine']}; method: {result['method']}", "",
-             markdown_table(rows, ENVELOPE_COLUMNS, ENVELOPE_FORMATS).rstrip(),
-             "", "paste into reference/paper/data/paper.toml:", "[envelope]",
-             'command = "cardan calibrate --envelope"', f'method = "{result["method"]}"']
-    for r in result["cases"]:
-        lines.append(f'[envelope.cases."{r["case"]}"]')
-        lines.append(f"lowest = {r['lowest']:.6f}")
-        lines.append(f"highest = {r['highest']:.6f}")
-        for key in ("lowest_at", "highest_at"):
-            lines.append(f"{key} = {{ " + ", ".join(f"{n} = {_toml(v)}" for n, v in r[key].items()) + " }")
-    lines.append(f"\n{result['corners']} corners, {result['runs']} engine runs, "
-                 f"{result['wall_time_s']:.0f} s")
-    return "\n".join(lines) + "\n"
-
-
-def _limit(x: Mapping[str, Any]) -> str:
-    if x["bound"] == "lower" and x["value"] == 0.0:  # a distance: zero is a physical limit
-        return f"{x['name']} at zero (a distance, cannot go lower)"
-    return (f"{x['name']} at its {x['bound']} bound ({x['value']:.4g}; d eta/d x outwards "
-            f"{x['slope_outwards']:+.3g} /m)")
-
-
-def _choices(row: Mapping[str, Any]) -> str:
-    if row.get("reachable", True) or "limiting" not in row:
-        return ""
-    at = row["lowest_at"] if row["paper"] < row["lowest"] else row["highest_at"]
-    picked = {k: v for k, v in at.items() if isinstance(v, str)}
-    return (" [" + ", ".join(f"{k} = {v}" for k, v in picked.items()) + "]") if picked else ""
-
-
-def _toml(v: Any) -> str:
-    return f'"{v}"' if isinstance(v, str) else f"{v:.6g}"
