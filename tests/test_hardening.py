@@ -235,7 +235,7 @@ def test_run_out_interrupted_keeps_previous(tmp_path, monkeypatch, stop):
 
 def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
     """`cardan compare --out`: interrupted while drawing the plots, after the tables."""
-    import cardan_exudyn.studies.compare.command as compare
+    import cardan_exudyn.studies.compare.report as compare
 
     out = tmp_path / "cmp"
     _previous(out)

@@ -1,4 +1,4 @@
-"""``cardan compare``."""
+"""``cardan compare``: the command (:mod:`.command`) and its report folder (:mod:`.report`)."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ from reference.lazy import lazy_face
 
 _LAZY = {
     "command": "cardan_exudyn.studies.compare.command",
+    "report": "cardan_exudyn.studies.compare.report",
 }
 
 __all__ = list(_LAZY)
