@@ -30,15 +30,12 @@ from cardan_exudyn.comparison import compare
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.outputs import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
-from reference.engine.options import ReferenceOptions
-from reference.paper.scenes import named_scene
-from reference.results.result import Result
-from reference.results.summary import OptionsError, Status, Summary
+from reference.engine.solve import ReferenceOptions
+from reference.paper.paper import named_scene
+from reference.results.schema import OptionsError, Result, Status, Summary
 from reference.scene.files import load_scene
 from reference.scene.joint import Body
-from reference.scene.load import Load
-from reference.scene.mapping import replace, scene_from_dict
-from reference.scene.scene import Scene
+from reference.scene.scene import Load, Scene, replace, scene_from_dict
 from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
 from rigdata.readers import read
@@ -435,8 +432,8 @@ CASES: tuple[Case, ...] = (
          out="folder", match="at most 1024"),
     Case("bench-repeats-huge", "cli", "1e12 timed repeats", ("bench", "--repeats", "1e12"),
          match="at most 1000"),
-    Case("accuracy-seed-negative", "cli", "negative seed of the cell draw", ("accuracy", "--seed", "-1"),
-         match="--seed: must be >= 0"),
+    Case("stress-workers-zero", "cli", "zero workers for the map",
+         ("stress", "--workers", "0", "--out", "{out}"), match="must be >= 1"),
     Case("rig-mc-huge", "cli", "1e9 Monte Carlo draws (out of memory)",
          ("rig", "measure", "{d}/rig.csv", "--mc", "1e9"), files=_RIG_FILE,
          match="--mc: must be at most 100000"),
@@ -523,9 +520,20 @@ CASES: tuple[Case, ...] = (
          match="--set must be one of"),
     Case("calibrate-engine", "cli", "an engine a fit cannot use", ("calibrate", "--engine", "mujoco"),
          match="--engine must be one of"),
-    Case("study-unknown", "cli", "unknown study", ("study", "warp"), match="invalid choice"),
-    Case("study-out-parent-file", "cli", "--out inside an existing file (refused before the study runs)",
-         ("study", "coupling", "--quick", "--out", "{out}/sub"), out="file", match="not a folder"),
+    Case("bench-scene-option-and-scenes", "cli", "a scene of the user's and a subset of the default ones",
+         ("bench", "--name", "paper-10deg", "--scenes", "friction-10deg"), match="--scenes"),
+    Case("bench-dt", "cli", "a step, which every configuration sets itself",
+         ("bench", "--name", "paper-10deg", "--dt", "1e-4"), match="unrecognized arguments: --dt"),
+    Case("bench-angle-alone", "cli", "a scene option without the scene it would change",
+         ("bench", "--angle", "20"), match="--angle applies to the scene of --scene or --name"),
+    Case("stress-angle", "cli", "a shaft angle, which every cell sets itself",
+         ("stress", "--angle", "20", "--out", "{out}"), out="folder",
+         match="unrecognized arguments: --angle"),
+    Case("stress-scene-unknown", "cli", "a scene name that does not exist",
+         ("stress", "--name", "paper-nothing", "--quick", "--out", "{out}"), out="folder",
+         match="paper-nothing"),
+    Case("stress-out-parent-file", "cli", "--out inside an existing file (refused before the map runs)",
+         ("stress", "--quick", "--out", "{out}/sub"), out="file", match="not a folder"),
     Case("rig-map-channel", "cli", "--map to a channel that does not exist",
          ("rig", "measure", "{d}/rig.csv", "--map", "foo=bar"), files=_RIG_FILE, match="mapping"),
     Case("rig-seed-negative", "cli", "negative Monte Carlo seed",

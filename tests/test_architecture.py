@@ -28,9 +28,10 @@ FORBIDDEN = {
 }
 MAX_MODULE_LINES = 600
 MAX_FUNCTION_LINES = 60
-# modules that may print: the command line and the study commands' handlers
-MAY_PRINT = re.compile(r"^(cardan_exudyn\.cli|cardan_exudyn\.studies\..*|rigdata\.cli)$")
-ENGINE_RUN_MODULES = {"cardan_exudyn.model.accuracy", "reference.engine.solve", "cardan_exudyn.mujoco.engine"}
+# modules that may print: the command line and the study commands (their computations return
+# data, their reports write files)
+MAY_PRINT = re.compile(r"^(cardan_exudyn\.cli|cardan_exudyn\.studies\.\w+\.command|rigdata\.cli)$")
+ENGINE_RUN_MODULES = {"cardan_exudyn.model.solve", "reference.engine.solve", "cardan_exudyn.mujoco.engine"}
 
 
 def imported_roots(path: Path) -> set[str]:
@@ -72,6 +73,13 @@ def test_only_the_cli_imports_studies(graph):
     offenders = {m: sorted(filter(is_job, deps)) for m, deps in graph.items()
                  if not is_job(m) and any(map(is_job, deps))}
     assert offenders == {}
+
+
+def test_the_product_never_imports_the_benchmarks():
+    """``tests/benchmarks`` (the research tooling, not installed) is imported by no product module."""
+    offenders = {str(p.relative_to(ROOT)) for pkg in PACKAGES for p in (ROOT / pkg).rglob("*.py")
+                 if "benchmarks" in imported_roots(p)}
+    assert offenders == set()
 
 
 def test_metrics_see_a_cycle(tmp_path):

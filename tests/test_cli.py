@@ -116,8 +116,8 @@ def test_reader_that_goes_away_ends_quietly():
     assert err == ""
 
 
-@pytest.mark.parametrize("command", ["run", "scene", "sweep", "compare", "calibrate", "study",
-                                     "tolerance"])
+@pytest.mark.parametrize("command", ["run", "scene", "sweep", "reproduce", "bench", "stress", "compare",
+                                     "calibrate", "tolerance"])
 def test_every_command_has_help(command, capsys):
     """Core and study commands are all registered: `--help` prints their usage, exit 0."""
     with pytest.raises(SystemExit) as stop:

@@ -14,11 +14,11 @@ import pytest
 
 from cardan_exudyn import run
 from cardan_exudyn.model.build import build_model
-from reference.paper.scenes import named_scene
+from reference.paper.paper import named_scene
 from reference.physics.bands import characteristic_speeds, sign_bands
 from reference.physics.friction import friction_from_columns, pair_friction, regularised_sign
 from reference.scene.joint import PAIR_KIND, PAIR_NAMES, Pair
-from reference.scene.mapping import replace
+from reference.scene.scene import replace
 
 
 def _scene(coupling: str, **changes):
@@ -205,40 +205,3 @@ def test_self_locking_is_a_status_not_a_number(coupling):
     assert result.summary.status == "self_locking"
     assert "loop gain" in result.summary.reason
     assert result.mean_efficiency is None and not result.success
-
-
-
-
-def test_sign_band_does_not_change_the_0deg_result():
-    """At 0 deg no spider pair moves: every band, the exact sign included, gives the same mean
-    efficiency up to the friction fixed-point tolerance (1e-6 relative; measured: identical).
-    The ideal joint's cylindrical pairs get no axial friction (they cannot slide); before, the
-    exact sign of their solver-noise slide speeds switched the full axial force and the run
-    stopped as self-locking."""
-    from cardan_exudyn.studies.study.compute import sign_band_study
-
-    rows = sign_band_study(["paper-0deg"], [0.0, 1e-6, 1e-3, 1e-1])
-    etas = [r["mean_efficiency"] for r in rows]
-    assert all(r["status"] == "ok" for r in rows)
-    tolerance = named_scene("paper-0deg").friction.tolerance
-    assert max(etas) - min(etas) <= tolerance
-
-
-def test_converged_coupling_beats_lagged_at_every_step():
-    """`cardan study coupling --quick`: at 100, 200, 400 steps per revolution the converged
-    scheme's error of mean efficiency is below the lagged scheme's (measured 1.0e-3, 3.7e-4,
-    3.4e-4 against 6.8e-3, 3.4e-3, 1.5e-3), and the lagged one falls at first order. (The
-    converged one fell by 7.8 over the ladder while the table's trapezoid was first order across
-    friction's sign jumps; integrated across them, what is left at 200-800 steps is the dip of
-    this 1 mm/s ramp, which the steps only partly resolve: 3.6e-4 at 800, 6.8e-7 at 1600.)"""
-    from cardan_exudyn.studies.study.compute import COUPLING_QUICK, coupling_study
-
-    rows = coupling_study(COUPLING_QUICK["names"], COUPLING_QUICK["ladder"])
-    err = {(r["coupling"], r["steps_per_revolution"]): abs(r["error"]) for r in rows}
-    for n in COUPLING_QUICK["ladder"]:
-        assert err[("converged", n)] < err[("lagged", n)], n
-    # first order: the error falls by last / first over the ladder, within a factor 2 either way
-    # (order 0.5 to 1.5 over the ladder: neither flat nor second order; measured 4.5 for 4)
-    first, last = COUPLING_QUICK["ladder"][0], COUPLING_QUICK["ladder"][-1]
-    fall = err[("lagged", first)] / err[("lagged", last)]
-    assert 0.5 * (last / first) < fall < 2.0 * (last / first), fall

@@ -165,7 +165,7 @@ def test_cases_cover_every_entry_point():
     counts = {e: sum(c.entry == e for c in CASES) for e in ENTRY_POINTS}
     assert all(n >= 5 for n in counts.values()), counts
     commands = {c.argv[0] if c.argv[0] != "rig" else f"rig {c.argv[1]}" for c in CASES if c.argv}
-    assert {"run", "scene", "compare", "sweep", "tolerance", "reproduce", "bench", "calibrate", "study",
+    assert {"run", "scene", "compare", "sweep", "tolerance", "reproduce", "bench", "stress", "calibrate",
             "rig inspect", "rig measure", "rig validate", "rig synthetic"} <= commands
 
 
@@ -248,22 +248,6 @@ def test_compare_out_interrupted_keeps_previous(tmp_path, monkeypatch):
     status = main(["compare", "--name", "rig-literal-frictionless", "--engines", "reference,exudyn",
                    "--revolutions", "1", "--out", str(out)])
     assert status == 130
-    _intact(out)
-
-
-def test_study_out_failure_keeps_previous(tmp_path, monkeypatch):
-    """`cardan study --out`: the plot fails after the CSV and JSON are written."""
-    import cardan_exudyn.studies.study.compute as studies
-
-    out = tmp_path / "study"
-    _previous(out)
-    rows = [{"scene": "s", "coupling": "lagged", "steps_per_revolution": 100, "mean_efficiency": 0.5,
-             "error": math.nan, "observed_order": math.nan, "wall_time_s": 0.1,
-             "friction_evaluations_per_step": 1.0, "status": "ok"}]
-    monkeypatch.setattr(studies, "coupling_study", lambda *a, **k: rows)
-    monkeypatch.setattr(studies, "_plot_coupling", lambda rows, path: 1 / 0)
-    with pytest.raises(ZeroDivisionError):
-        main(["study", "coupling", "--quick", "--out", str(out)])
     _intact(out)
 
 

@@ -1,8 +1,8 @@
-"""A lean start: ``cardan run`` and ``cardan --help`` import only what they use (issue 19).
+"""A lean start: ``cardan run`` and ``cardan --help`` import only what they use.
 
 Each check runs in a fresh interpreter, so that what this test session has imported already
 (pandas, scipy, Exudyn, ...) cannot hide an import. The timing itself is a benchmark figure
-(:func:`cardan_exudyn.studies.bench.startup.import_cost`), not a test.
+(``tests/benchmarks/startup.py``, :func:`benchmarks.startup.import_cost`), not a test.
 """
 
 from __future__ import annotations
@@ -17,9 +17,7 @@ import pytest
 
 from cardan_exudyn.scene_options import DEFAULT_SCENE
 from cardan_exudyn.studies import COMMANDS
-from cardan_exudyn.studies.bench.startup import SCENE_MARKER, import_cost, parse_importtime
-from reference.paper.data import paper_data
-from reference.paper.scenes import named_scene
+from reference.paper.paper import named_scene
 
 HEAVY = ("pandas", "matplotlib", "scipy", "dask", "distributed", "mujoco", "exudyn", "tqdm")
 """Third-party packages a run loads only when it needs them (tables, plots, the engines)."""
@@ -155,45 +153,6 @@ def test_window_times_agree_with_brentq(t0, ripple):
         expected = brentq(offset, lo, hi, args=(motion, theta), xtol=1e-15, rtol=rtol)
         # both stop within their tolerance of the root, so within twice it of each other
         assert abs(time_at_angle(motion, theta, lo, hi) - expected) <= 2 * (1e-15 + rtol * lo)
-
-
-SAMPLE = f"""import time: self [us] | cumulative | imported package
-import time:       100 |        100 |   _io
-import time:       900 |       1000 | site
-import time:       500 |      50000 |   numpy
-import time:       200 |      60000 | cardan_exudyn.cli
-{SCENE_MARKER}
-import time:       300 |       7000 |     reference.physics.rccc
-import time:       400 |      12000 | reference.engine.solve
-import time:        50 |         50 | numpy.ma
-"""
-
-
-def test_parse_importtime_sums_top_level_entries_per_phase():
-    """Only indent-0 entries count (their cumulative time holds the nested ones), split at the
-    marker; the header line is skipped."""
-    before, after = parse_importtime(SAMPLE)
-    assert before == {"site": 1000, "cardan_exudyn.cli": 60000}
-    assert after == {"reference.engine.solve": 12000, "numpy.ma": 50}
-    assert parse_importtime(SAMPLE.replace(SCENE_MARKER, "other line"))[1] == {}
-
-
-def test_import_cost_measures_cardan_run():
-    """One measured run: the phases, their largest imports and the numpy floor are reported."""
-    cost = import_cost(1)
-    assert cost["import_ms"] == cost["runs_ms"][0] > 0
-    assert "cardan_exudyn.cli" in [name for name, _ in cost["top"]]
-    # a named scene is data: building it imports no engine
-    assert not [name for name, _ in cost["scene_top"] if name.startswith("reference.engine")]
-    assert cost["baseline_ms"] > 0
-    assert cost["through_scene_ms"] >= cost["import_ms"]  # equal when the scene imports nothing
-    assert cost["target_ms"] == 150.0 and cost["repeats"] == 1
-
-
-@pytest.mark.parametrize("repeats", [0, -1, 1.5, True])
-def test_import_cost_refuses_bad_repeats(repeats):
-    with pytest.raises(ValueError, match="`repeats` must be a positive integer"):
-        import_cost(repeats)
 
 
 WHOLE_RUN = """

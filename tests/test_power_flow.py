@@ -31,15 +31,14 @@ from hypothesis import strategies as st
 
 from cardan_exudyn import run as run_engine
 from cardan_exudyn.cli import main
-from cardan_exudyn.studies.stress.map import cell_class
+from cardan_exudyn.studies.stress.classify import cell_class
 from cardan_exudyn.sweep.records import scalar_summary
 from cardan_exudyn.testing.assertions import check_flow
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.results.power_flow import PowerFlow, classify_works, sign_changes
-from reference.results.result import Result
-from reference.results.summary import SCHEMA_VERSION, Status, Summary
-from reference.scene.mapping import replace
+from reference.results.schema import SCHEMA_VERSION, Result, Status, Summary
+from reference.scene.scene import replace
 from reference.scene.validation import DEG, RPM
 
 MIRROR = np.diag([1.0, 1.0, -1.0])

@@ -1,17 +1,15 @@
-"""Studies: jobs built on the engines, each a ``cardan`` subcommand.
+"""Studies: jobs built on the engines, each a ``cardan`` subcommand in a subpackage of its own.
 
-The modules named in :data:`COMMANDS` register their subcommand: ``register(subparsers)`` adds
-its parser and sets ``func`` to a handler ``(args) -> exit status``. The other modules are their
-parts (``bench_*``, ``stress_*``, ``longrun_*``, ``reproduce_report``) or research scripts behind
-a document (``mujoco_settings``: ``docs/mujoco.md``). Only :mod:`cardan_exudyn.cli` imports this
+Each subpackage's ``command`` module registers its subcommand: ``register(subparsers)`` adds its
+parser and sets ``func`` to a handler ``(args) -> exit status``; the command prints, its
+computation returns data, its report writes files. Only :mod:`cardan_exudyn.cli` imports this
 package; library code never does.
 
-- ``reproduce``: the paper's studies, the main report; ``calibrate``: the calibrated set;
+- ``reproduce``: the paper's studies, the main report; ``calibrate``: the parameter sets' fits
+  and the envelope of the plausible box;
 - ``compare``: the ``cardan compare`` report over :mod:`cardan_exudyn.comparison`;
 - ``tolerance``: mounting errors, the paper's case and Monte Carlo;
-- ``friction_numerics``: ``cardan study`` (friction coupling error against step, sign band);
-- ``bench``: run time against error; ``stress``: stability map and long runs;
-- ``accuracy_grid``: ``cardan accuracy``, the honesty of the mean-efficiency error estimate.
+- ``bench``: run time against error of a scene; ``stress``: the stability map of a scene.
 """
 
 from __future__ import annotations
@@ -20,7 +18,6 @@ __all__ = ["COMMANDS"]
 
 COMMANDS: dict[str, str] = {
     "reproduce": "reproduce.command", "bench": "bench.command", "stress": "stress.command",
-    "study": "study.compute", "calibrate": "calibrate.command", "compare": "compare.command",
-    "tolerance": "tolerance.command", "accuracy": "accuracy.compute",
+    "calibrate": "calibrate.command", "compare": "compare.command", "tolerance": "tolerance.command",
 }
 """Modules of this package that register a subcommand, in the order ``cardan --help`` lists them."""

@@ -1,12 +1,12 @@
-"""What ``cardan bench`` runs: its fixed scenes (:func:`bench_scene`) and every engine
-configuration on its ladder of steps per revolution (:func:`configurations`).
+"""What ``cardan bench`` runs: its default scenes (:func:`bench_scene`, :func:`fixed_scenes`)
+and every engine configuration on its ladder of steps per revolution (:func:`configurations`).
 
-Exudyn: the engine's defaults and the "tuned" Newton settings; on friction scenes the three
-friction couplings (converged, extrapolated, and the paper's lagged one); on frictionless scenes
-the velocity projection and the projection with Richardson extrapolation; the other node types
-(full bench). MuJoCo: RK4 at two constraint time constants (frictionless scenes only, when the
-optional extra is installed); the reference engine: its quadrature tolerance and table samples.
-A configuration carries any scene changes it needs (:class:`Config`, ``changes``).
+Exudyn: the engine's defaults and the "tuned" Newton settings; with friction the three friction
+couplings (converged, extrapolated, and the paper's lagged one); without friction the velocity
+projection and the projection with Richardson extrapolation; the other node types (full bench).
+MuJoCo: RK4 at two constraint time constants (frictionless scenes without mounting errors, when
+the optional extra is installed); the reference engine: its quadrature tolerance and table
+samples. A configuration carries any scene changes it needs (:class:`Config`, ``changes``).
 """
 
 from __future__ import annotations
@@ -19,17 +19,16 @@ from typing import Any
 
 from cardan_exudyn import engines
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
-from reference.engine.options import ReferenceOptions
-from reference.paper.scenes import named_scene, paper_errors
-from reference.results.result import Result
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
-from reference.scene.settings import COUPLINGS
+from reference.engine.solve import ReferenceOptions
+from reference.paper.paper import named_scene, paper_errors
+from reference.results.schema import Result
+from reference.scene.scene import Scene, replace
 
 __all__ = ["SCENES", "MOUNTING_ERROR_SCENES", "ENGINE_NAMES", "EXUDYN_DEFAULT", "EXUDYN_TUNED",
-           "FULL_LADDER", "QUICK_LADDER", "BenchError", "Progress", "quiet", "Config", "bench_scene",
-           "is_friction_scene", "frictionless_twin_scene", "frictionless_twin_config",
-           "exudyn_settings", "configurations", "simulated_time"]
+           "FULL_LADDER", "QUICK_LADDER", "QUICK_FULL_LADDER", "BenchError", "Progress", "quiet",
+           "Config", "bench_scene", "fixed_scenes", "frozen_changes", "exudyn_settings",
+           "exudyn_configs", "mujoco_configs", "reference_configs", "configurations",
+           "simulated_time"]
 
 SCENES = {
     "frictionless-10deg": "paper-literal-10deg-frictionless",
@@ -39,8 +38,9 @@ SCENES = {
     "friction-35deg": "paper-literal-35deg",
     "friction-errors-10deg": "paper-physical-10deg",
 }
-"""The fixed scene set: key -> named scene (all at 2000 rpm, the paper's masses, load and gravity).
-The ``-errors-`` scenes get Section 4.2's mounting tolerances on top (:data:`MOUNTING_ERROR_SCENES`)."""
+"""The default scene set: key -> named scene (all at 2000 rpm, the paper's masses, load and
+gravity). The ``-errors-`` scenes get Section 4.2's mounting tolerances on top
+(:data:`MOUNTING_ERROR_SCENES`)."""
 
 MOUNTING_ERROR_SCENES = frozenset({"frictionless-errors-10deg", "friction-errors-10deg"})
 """Scenes with the paper's Section 4.2 tolerances (:func:`reference.paper.scenes.paper_errors`: offsets
@@ -52,7 +52,7 @@ ENGINE_NAMES = ("exudyn", "mujoco", "reference")
 """The engines the bench compares (keys of :data:`cardan_exudyn.engines.ENGINES`), in its order."""
 
 # "tuned": modified Newton with one Jacobian per step and a relative Newton tolerance of 1e-8
-# (the speed-ratio and efficiency errors do not change: the bench shows it); "default": the
+# (the speed-ratio and efficiency errors do not change: tests/test_bench.py); "default": the
 # engine's defaults (full Newton, 1e-10). Both without the engine's own error estimate: a given
 # step with friction would otherwise add a companion run at twice the step (half again the cost,
 # friction runs only), and the bench measures every error against the reference itself.
@@ -61,13 +61,14 @@ EXUDYN_TUNED = ExudynOptions(modified_newton=True, jacobian_every_step=True,
                              newton_relative_tolerance=1e-8, error_estimate=False)
 
 # Steps (Exudyn, MuJoCo) or table samples (reference) per input revolution. Exudyn's full ladder
-# is denser between 200 and 800, where the friction scenes reach the 1e-4 efficiency level.
+# is denser between 200 and 800, where the paper's friction scenes reach an efficiency error of
+# 1e-4.
 FULL_LADDER = {"exudyn": (25, 50, 100, 200, 300, 400, 600, 800, 1600),
                "mujoco": (20, 25, 30, 40, 60, 100, 200), "reference": (36, 360)}
 QUICK_LADDER = {"exudyn": (50, 200, 800), "mujoco": (25, 60), "reference": (36,)}
-# Configurations that run the whole quick ladder (the others its first two steps): the
-# frictionless twin of the friction-cost target and the one-solve coupling, which needs the
-# finest step to reach the efficiency level at 35 deg.
+# Configurations that run the whole quick ladder (the others its first two steps): the tuned
+# Newton settings, against which every other configuration's cost reads, and the one-solve
+# coupling, which needs the finest step for an efficiency error of 1e-4 at 35 deg.
 QUICK_FULL_LADDER = ("exudyn tuned", "exudyn tuned extrapolated")
 
 Progress = Callable[[str], None]
@@ -79,7 +80,7 @@ def quiet(text: str) -> None:
 
 
 class BenchError(ValueError):
-    """Bad bench input (unknown scene key, engine, bad repeats)."""
+    """Bad bench input (unknown scene key or engine, bad repeats)."""
 
 
 def bench_scene(key: str) -> Scene:
@@ -99,23 +100,19 @@ def bench_scene(key: str) -> Scene:
     return scene
 
 
-def is_friction_scene(key: str) -> bool:
-    """True for the bench's scene keys with friction (``friction-...``)."""
-    return key.startswith("friction-")
+def fixed_scenes(keys: Iterable[str] | None = None) -> dict[str, Scene]:
+    """The default scenes named by ``keys`` (keys of :data:`SCENES`; None: all), in that order.
 
-
-def frictionless_twin_scene(key: str) -> str:
-    """The frictionless scene key at the same geometry as the friction scene key ``key``."""
-    return key.replace("friction-", "frictionless-", 1)
-
-
-def frictionless_twin_config(label: str) -> str:
-    """The frictionless configuration a friction configuration's cost is compared with: the same
-    label without its friction coupling (``"exudyn tuned lagged"`` -> ``"exudyn tuned"``)."""
-    for coupling in COUPLINGS:
-        if label.endswith(" " + coupling):
-            return label[:-len(coupling) - 1]
-    return label
+    Raises
+    ------
+    BenchError
+        An unknown key.
+    """
+    keys = list(SCENES) if keys is None else list(keys)
+    unknown = [k for k in keys if k not in SCENES]
+    if unknown:
+        raise BenchError(f"`--scenes` must be among {list(SCENES)}, got {unknown}")
+    return {key: bench_scene(key) for key in dict.fromkeys(keys)}
 
 
 def frozen_changes(changes: Mapping[str, Any] | Iterable[tuple[str, Any]]) -> tuple[tuple[str, Any], ...]:
@@ -243,20 +240,21 @@ def reference_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[C
             for rtol in ((1e-6,) if quick else (1e-9, 1e-6, 1e-4)) for n in ladder["reference"]]
 
 
-def configurations(scene_key: str, quick: bool = False,
+def configurations(scene: Scene, quick: bool = False,
                    engines: Iterable[str] = ENGINE_NAMES) -> list[Config]:
-    """Every configuration benchmarked on the scene ``scene_key`` of :data:`SCENES`.
+    """Every configuration benchmarked on ``scene``: the friction configurations when it has
+    friction, the frictionless ones otherwise.
 
-    MuJoCo runs the frictionless scenes without mounting errors only (it has no friction
-    proportional to the reactions, and the bench compares it on the kinematic target).
+    MuJoCo runs frictionless scenes without mounting errors only: it has no friction
+    proportional to the reactions, and its joints are the ideal joint's.
     """
     engines = set(engines)
     ladder = QUICK_LADDER if quick else FULL_LADDER
-    friction = is_friction_scene(scene_key)
+    friction = scene.has_friction
     out: list[Config] = []
     if "exudyn" in engines:
         out += exudyn_configs(friction, quick, ladder)
-    if "mujoco" in engines and not friction and scene_key not in MOUNTING_ERROR_SCENES:
+    if "mujoco" in engines and not friction and not scene.joint.errors.any:
         out += mujoco_configs(quick, ladder)
     if "reference" in engines:
         out += reference_configs(quick, ladder)

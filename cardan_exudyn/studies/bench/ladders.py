@@ -1,11 +1,12 @@
 """The work-precision runs of ``cardan bench``: every configuration of every scene, its errors
 against the reference engine and its wall time.
 
-The errors (:func:`run_errors`) are against the reference engine, which is exact for prescribed
-motion: largest error of ``omega_out / omega_in`` against Hooke's law, largest drive-torque error
-over the whole run and after the first revolution (the generalized-alpha start-up transient is
-in the first), the mean-efficiency error (friction scenes; without friction every engine reports
-exactly 1) and the mean-input-torque error. The wall time is the median of ``repeats`` calls of
+The errors (:func:`run_errors`) are against the reference engine at its default (tightest)
+settings, which is exact for prescribed motion (to its ODE tolerance for a torque drive): largest
+error of ``omega_out / omega_in`` against the exact ratio, largest drive-torque error over the
+whole run and after the first revolution (the generalized-alpha start-up transient is in the
+first), the mean-efficiency error (with friction; without friction every engine reports exactly
+1) and the mean-input-torque error. The wall time is the median of ``repeats`` calls of
 the engine's run (model build, solve and the result table: what a caller pays), per simulated
 second; the repeats run in rounds over all configurations, so that a change in the machine's
 load hits every configuration alike.
@@ -15,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,7 +29,6 @@ from cardan_exudyn.studies.bench.configs import (
     BenchError,
     Config,
     Progress,
-    bench_scene,
     configurations,
     quiet,
     simulated_time,
@@ -37,10 +37,8 @@ from reference.engine.motion import InputMotion, input_motion
 from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
-from reference.results.result import Result
-from reference.results.summary import Summary
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from reference.results.schema import Result, Summary
+from reference.scene.scene import Scene, replace
 
 __all__ = ["ERROR_KEYS", "Yardstick", "yardstick", "run_errors", "cost_counters", "Job",
            "bench_jobs", "timed_run", "work_precision"]
@@ -90,7 +88,8 @@ def run_errors(scene: Scene, result: Result, yard: Yardstick) -> dict[str, float
     if not result.success or result.table is None:
         return out
     out.update(table_errors(scene, result.table, yard))
-    summary, exact = result.summary, yard.summary
+    summary = result.summary
+    exact = yard.summary
     if scene.has_friction:
         out["mean_efficiency_error"] = abs(summary.mean_efficiency - exact.mean_efficiency)
     out["mean_torque_in_error"] = abs(summary.mean_torque_in - exact.mean_torque_in) / abs(
@@ -121,11 +120,11 @@ def table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[str
 def cost_counters(summary: Summary) -> dict[str, Any]:
     """The engine's own cost counters, flattened: steps, Newton iterations, Jacobians, friction
     evaluations per step (Exudyn with friction), quadrature panels (reference)."""
-    friction = summary.friction
+    friction = summary.extras.get("friction") or {}
     quadrature = summary.extras.get("quadrature")
     return {"steps": summary.steps, "newton_iterations": summary.newton_iterations,
             "jacobian_evaluations": summary.jacobian_evaluations,
-            "friction_evaluations_per_step": friction.mean_iterations_per_step if friction else None,
+            "friction_evaluations_per_step": friction.get("mean_iterations_per_step"),
             "quadrature_panels": quadrature.get("panels") if isinstance(quadrature, dict) else None}
 
 
@@ -141,24 +140,25 @@ class Job:
     record: dict[str, Any] | None = None
 
 
-def bench_jobs(scene_keys: Iterable[str], quick: bool, engines: Iterable[str]) -> list[Job]:
-    """Every configuration of every scene, with the scene's yardstick."""
+def bench_jobs(scenes: Mapping[str, Scene], quick: bool, engines: Iterable[str]) -> list[Job]:
+    """Every configuration of every scene (key -> scene), with the scene's yardstick."""
     jobs = []
-    for key in scene_keys:
-        base = bench_scene(key)
+    for key, base in scenes.items():
         yard = yardstick(base)
         jobs += [Job(key, config, config.scene(base), yard)
-                 for config in configurations(key, quick, engines)]
+                 for config in configurations(base, quick, engines)]
     return jobs
 
 
 def timed_run(config: Config, scene: Scene) -> tuple[Result | None, str, float]:
     """The result (None when the run raised), the error it raised and the wall time [s]."""
     start = time.perf_counter()
+    result = None
+    error = ""
     try:
-        result, error = config.run(scene), ""
+        result = config.run(scene)
     except Exception as exc:  # a configuration that cannot run is recorded as a row, not a crash
-        result, error = None, f"{type(exc).__name__}: {exc}"
+        error = f"{type(exc).__name__}: {exc}"
     return result, error, time.perf_counter() - start
 
 
@@ -185,15 +185,15 @@ def finished_row(job: Job) -> dict[str, Any]:
             "runs_timed": len(job.walls)}
 
 
-def work_precision(scene_keys: Iterable[str], quick: bool, repeats: int,
+def work_precision(scenes: Mapping[str, Scene], quick: bool, repeats: int,
                    engines: Iterable[str] = ENGINE_NAMES,
                    progress: Progress | None = None) -> pd.DataFrame:
     """Run every configuration of every scene ``repeats`` times (in rounds); one row per config.
 
     Parameters
     ----------
-    scene_keys : iterable of str
-        Keys of :data:`~cardan_exudyn.studies.bench.configs.SCENES`.
+    scenes : mapping of str to Scene
+        The scenes by the key their rows carry in ``scene``.
     quick : bool
         The short ladders.
     repeats : int
@@ -210,7 +210,7 @@ def work_precision(scene_keys: Iterable[str], quick: bool, repeats: int,
         counters, ``simulated_s`` [s], ``wall_s`` [s], ``wall_per_simulated_s`` [-].
     """
     say = progress or quiet
-    jobs = bench_jobs(scene_keys, quick, engines)
+    jobs = bench_jobs(scenes, quick, engines)
     start = time.perf_counter()
     for round_ in range(repeats):
         for i, job in enumerate(jobs):

@@ -1,7 +1,6 @@
-"""The results folder of ``cardan bench``: ``bench.csv`` and ``audit.csv`` opening with an
-environment header, ``targets.csv``, ``ladders.csv`` (every friction run next to its frictionless
-twin), ``bench.json``, ``report.md`` and the log-log work-precision plot ``work_precision.png``
-(a panel per scene), written atomically."""
+"""The results folder of ``cardan bench``: ``bench.csv`` opening with an environment header,
+``bench.json``, ``report.md`` and the log-log work-precision plot ``work_precision.png`` (a panel
+per scene), written atomically."""
 
 from __future__ import annotations
 
@@ -12,59 +11,35 @@ from typing import Any
 
 import pandas as pd
 
-from cardan_exudyn.jsonable import dumps
-from cardan_exudyn.outputs import atomic_directory
-from cardan_exudyn.report import plots
-from cardan_exudyn.report.format import markdown_table, number
-from cardan_exudyn.studies.bench.result import BenchResult
-from cardan_exudyn.studies.bench.targets import (
-    EFFICIENCY_TARGET,
-    SPEED_RATIO_TARGET,
-    TARGETS,
-    friction_ladders,
-)
+from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.report.format import markdown_table
+from cardan_exudyn.studies.bench.result import BenchResult, accuracy_measure, at_accuracy
+from reference.results.schema import Status
 
-__all__ = ["header", "write_bench", "bench_command", "report_markdown"]
+__all__ = ["ROW_COLUMNS", "MEASURE_LABELS", "header", "table", "bench_command", "intro",
+           "accuracy_section", "rows_section", "report_markdown", "work_precision_figure",
+           "write_bench"]
 
-TARGET_COLUMNS = ["target", "scene", "variant", "measured", "limit", "met", "exudyn", "other", "detail"]
-AUDIT_COLUMNS = ["item", "removal", "without_s", "with_s", "with_over_without", "saved_share"]
-AUDIT_FORMATS = {"without_s": ".4f", "with_s": ".4f", "with_over_without": ".2f", "saved_share": ".0%"}
-LADDER_COLUMNS = ["config", "steps_per_revolution", "status", "mean_efficiency_error",
-                  "wall_per_simulated_s", "frictionless_wall_per_simulated_s", "cost_ratio"]
-LADDER_FORMATS = {"steps_per_revolution": "d", "cost_ratio": ".2f"}
 ROW_COLUMNS = ["scene", "config", "steps_per_revolution", "status", "wall_per_simulated_s",
                "speed_ratio_error", "torque_in_error", "torque_in_error_steady",
                "mean_efficiency_error", "mean_torque_in_error", "newton_iterations",
                "friction_evaluations_per_step"]
+MEASURE_LABELS = {"mean_efficiency_error": "mean-efficiency error",
+                  "speed_ratio_error": "max speed-ratio error"}
+ACCURACY_COLUMNS = ["scene", "config", "accuracy", "steps_per_revolution", "error",
+                    "wall_per_simulated_s", "fastest_wall_per_simulated_s"]
+ACCURACY_FORMATS = {"accuracy": "g", "steps_per_revolution": ".0f", "error": ".2g",
+                    "wall_per_simulated_s": ".3g", "fastest_wall_per_simulated_s": ".3g"}
+MARKERS = {"exudyn": "o", "mujoco": "s", "reference": "^"}
 
 
-def header(env: Mapping[str, Any]) -> str:
-    """The ``#`` lines that open every results file: date, commit, CPU, Python and packages."""
-    lines = [f"# cardan bench, {env['date']}", f"# commit {env['commit']}",
+def header(env: Mapping[str, Any], title: str = "cardan bench") -> str:
+    """The ``#`` lines that open a results file: ``title`` and date, commit, CPU, Python and
+    packages of the environment ``env`` (:func:`cardan_exudyn.report.environment.environment`)."""
+    lines = [f"# {title}, {env['date']}", f"# commit {env['commit']}",
              f"# cpu {env['cpu']} ({env['cpu_count']} logical), {env['platform']}",
              f"# python {env['python']}, " + ", ".join(f"{k} {v}" for k, v in env["packages"].items())]
     return "\n".join(lines) + "\n"
-
-
-def write_bench(result: BenchResult, out: str | os.PathLike) -> Path:
-    """Write the results folder ``out`` (replaced as a whole, atomically); returns its path."""
-    head = header(result.environment)
-    with atomic_directory(out) as tmp:
-        rows = result.rows.drop(columns=["options"])
-        (tmp / "bench.csv").write_text(head + rows.to_csv(index=False, float_format="%.6g"),
-                                       encoding="utf-8")
-        pd.DataFrame(result.targets).to_csv(tmp / "targets.csv", index=False, float_format="%.4g")
-        friction_ladders(result.rows).to_csv(tmp / "ladders.csv", index=False, float_format="%.6g")
-        if result.audit is not None:
-            (tmp / "audit.csv").write_text(head + result.audit.to_csv(index=False, float_format="%.4g"),
-                                           encoding="utf-8")
-        data = {**result.summary(), "rows": result.rows.to_dict(orient="records")}
-        (tmp / "bench.json").write_text(dumps(data) + "\n", encoding="utf-8")
-        fig = plots.work_precision(result.rows, SPEED_RATIO_TARGET, EFFICIENCY_TARGET)
-        fig.savefig(tmp / "work_precision.png", dpi=120)
-        plots.close(fig)
-        (tmp / "report.md").write_text(report_markdown(result), encoding="utf-8")
-    return Path(out)
 
 
 def table(frame: pd.DataFrame, columns: Sequence[str], formats: Mapping[str, str] | None = None) -> str:
@@ -81,104 +56,118 @@ def bench_command(settings: Mapping[str, Any]) -> str:
         parts.append("--quick")
     if settings.get("repeats") is not None:
         parts.append(f"--repeats {settings['repeats']}")
-    for key in ("scenes", "engines"):
-        if settings.get(key):
-            parts.append(f"--{key} {','.join(settings[key])}")
-    for key in ("audit", "paper", "startup"):
-        if settings.get(key) is False:
-            parts.append(f"--no-{key}")
-    if settings.get("paper", True) and settings.get("paper_steps") is not None:
-        parts.append(f"--paper-steps {settings['paper_steps']} "
-                     f"--paper-coupling {settings['paper_coupling']}")
+    options = list(settings.get("scene_options") or [])
+    if options:
+        parts += options
+    elif settings.get("scenes"):
+        parts.append(f"--scenes {','.join(settings['scenes'])}")
+    if settings.get("engines"):
+        parts.append(f"--engines {','.join(settings['engines'])}")
     return " ".join(parts)
 
 
-def intro(result: BenchResult) -> str:
-    """Title, environment and how to read the numbers."""
+def intro(result: BenchResult, title: str = "cardan bench", command: str | None = None) -> str:
+    """Title, environment, how to read the numbers, and the ``command`` that ran them (none:
+    not said)."""
     env = result.environment
-    return (f"# cardan bench{' (quick)' if result.settings.get('quick') else ''}\n"
+    return (f"# {title}{' (quick)' if result.settings.get('quick') else ''}\n"
             f"{env['date']}, commit `{env['commit']}`, {env['cpu']} ({env['cpu_count']} logical "
             f"CPUs), Python {env['python']}, "
             + ", ".join(f"{k} {v}" for k, v in env["packages"].items() if v) + ".\n"
             f"Median of {result.settings.get('repeats')} runs per configuration, run in rounds; "
             f"whole bench {result.wall_s:.0f} s. Wall time is the engine's `run` call (build, solve, "
             "result table) per simulated second. Errors against the reference engine (exact for "
-            "prescribed motion). Machines here are shared: compare ratios within this run, not "
-            "absolute times across runs.\n")
+            "prescribed motion). Machines are often shared: compare ratios within this run, not "
+            "absolute times across runs.\n" + (f"\n`{command}`\n" if command else ""))
 
 
-def targets_section(result: BenchResult) -> str:
-    """The targets table, the command that produced it and what each target means."""
-    out = f"## Targets\n`{bench_command(result.settings)}`\n\n"
-    if result.targets:
-        targets = pd.DataFrame(result.targets)
-        targets["met"] = targets["met"].map({True: "yes", False: "**no**"})
-        out += table(targets, TARGET_COLUMNS)
-    return out + "\nTargets: " + "; ".join(f"**{k}**: {v}" for k, v in TARGETS.items()) + ".\n"
+def _scenes_lines(result: BenchResult) -> str:
+    """One line per scene: its key, name and description."""
+    return "".join(f"- `{key}`: {scene.name}" + (f" ({scene.description})" if scene.description else "")
+                   + "\n" for key, scene in result.scenes.items())
 
 
-def paper_section(paper: Mapping[str, Any]) -> str:
-    """One line per engine of the paper scenes' timing."""
-    out = "\n## The paper's eleven scenes (summary only, one after the other)\n"
-    for engine, part in paper.items():
-        out += (f"- {engine} ({part['config']}): {part['wall_s']:.2f} s (median of "
-                f"{part['repeats']}; all: {', '.join(f'{w:.2f}' for w in part['walls_s'])}), "
-                f"largest mean-efficiency error {number(part['max_error'], '.2g')}, not ok: "
-                f"{part['failed']}" + _steps(part) + "\n")
-    return out
-
-
-def _steps(part: Mapping[str, Any]) -> str:
-    """``; steps/rev: ...`` per scene where the scenes' steps differ (an automatic step)."""
-    steps = [s for s in part.get("steps_per_revolution") or [] if s is not None]
-    return f"; steps/rev: {', '.join(str(s) for s in steps)}" if len(set(steps)) > 1 else ""
-
-
-def ladders_section(rows: pd.DataFrame) -> str:
-    """Per friction scene: every Exudyn configuration's ladder, its efficiency error and its cost
-    over the frictionless twin at the same step (what the friction-cost target reads)."""
-    ladders = friction_ladders(rows)
-    if ladders.empty:
+def accuracy_section(result: BenchResult) -> str:
+    """Per scene and configuration, the cheapest step at the scene's ``numerics.accuracy``."""
+    rows = pd.DataFrame(at_accuracy(result))
+    if rows.empty:
         return ""
-    out = ("\n## Friction ladders: error against cost, per coupling\n"
-           f"The friction-cost target reads the cheapest step with an error <= {EFFICIENCY_TARGET:g}; "
-           "`cost_ratio` is the wall time over the same configuration without its coupling on the "
-           "frictionless twin scene at the same step.\n")
-    for scene, part in ladders.groupby("scene", sort=False):
-        out += f"\n### {scene}\n" + table(part, LADDER_COLUMNS, LADDER_FORMATS)
-    return out
+    return ("\n## The cheapest run of each configuration at the scene's accuracy\n"
+            "The error bounded by the scene's `numerics.accuracy`: the mean-efficiency error with "
+            "friction, the speed-ratio error without. An empty `steps_per_revolution`: no step of "
+            "the ladder reaches the accuracy.\n\nScenes:\n\n" + _scenes_lines(result) + "\n"
+            + markdown_table(rows, ACCURACY_COLUMNS, ACCURACY_FORMATS, missing=""))
 
 
-def startup_section(startup: Mapping[str, Any]) -> str:
-    """The import cost of ``cardan run`` and its most expensive top-level imports."""
-    out = (f"\n## Import cost of `cardan run` up to the engine\n"
-           f"{number(startup.get('import_ms'), '.0f')} ms (median of {startup.get('repeats')} "
-           f"fresh interpreters under `python -X importtime`): "
-           f"{number(startup.get('import_ms'), '.0f')} ms before the scene is built, "
-           f"{number(startup.get('scene_build_ms'), '.0f')} ms while it is built. Largest "
-           f"top-level imports [ms]: "
-           + ", ".join(f"`{name}` {ms:.0f}" for name, ms in startup.get("top") or []) + ".\n")
-    return out
-
-
-def audit_section(audit: pd.DataFrame) -> str:
-    """The skip audit's table and its scene."""
-    return ("\n## What each skip saves (Exudyn)\n" + table(audit, AUDIT_COLUMNS, AUDIT_FORMATS)
-            + f"\nScene: {audit['scene'].iloc[0]}.\n")
+def rows_section(rows: pd.DataFrame) -> str:
+    """The work-precision table and the plot."""
+    return ("\n## Work-precision table\n" + table(rows, ROW_COLUMNS, {"steps_per_revolution": "d"})
+            + "\n![work-precision](work_precision.png)\n")
 
 
 def report_markdown(result: BenchResult) -> str:
-    """``report.md``: environment, targets, paper scenes, import cost, friction ladders, skip
-    audit, the work-precision table and plot."""
-    out = [intro(result), targets_section(result)]
-    if result.paper:
-        out.append(paper_section(result.paper))
-    if result.startup:
-        out.append(startup_section(result.startup))
-    out.append(ladders_section(result.rows))
-    if result.audit is not None:
-        out.append(audit_section(result.audit))
-    out += ["\n## Work-precision table\n",
-            table(result.rows, ROW_COLUMNS, {"steps_per_revolution": "d"}),
-            "\n![work-precision](work_precision.png)\n"]
-    return "".join(out)
+    """``report.md``: environment, the cheapest run at the accuracy, the work-precision table and
+    plot."""
+    return (intro(result, command=bench_command(result.settings)) + accuracy_section(result)
+            + rows_section(result.rows))
+
+
+def _panel(ax: Any, sel: pd.DataFrame, key: str, label: str) -> None:
+    """One line per configuration of ``sel``: ``key`` against the wall time, log-log."""
+    for config, part in sel.groupby("config", sort=False):
+        part = part.sort_values("steps_per_revolution")
+        y = part[key].astype(float).clip(lower=1e-16)
+        if not y.notna().any():
+            continue
+        ax.loglog(part["wall_per_simulated_s"], y, marker=MARKERS.get(part["engine"].iloc[0], "o"),
+                  ms=4, lw=1, label=config)
+    ax.set_xlabel("wall time per simulated second [s]")
+    ax.set_ylabel(label)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=6)
+
+
+def work_precision_figure(rows: pd.DataFrame, panels: Mapping[str, tuple[str, float]]) -> Any:
+    """Error against wall time per simulated second, log-log, one column per scene.
+
+    Top row: the scene's measure with its level dashed; bottom row: the drive-torque error after
+    the first revolution. One line per configuration, points along its step ladder.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        Work-precision rows.
+    panels : mapping of str to (str, float)
+        Scene key -> (error column of the top row, its level [-]), in the order of the columns.
+    """
+    from cardan_exudyn.report.plots import plt  # import cost: matplotlib only when a plot is drawn
+
+    fig, axes = plt.subplots(2, len(panels), figsize=(4.6 * len(panels), 7.5), squeeze=False,
+                             constrained_layout=True)
+    for j, (scene, (measure, level)) in enumerate(panels.items()):
+        sel = rows[(rows["scene"] == scene) & (rows["status"] == Status.OK)]
+        _panel(axes[0][j], sel, measure, MEASURE_LABELS.get(measure, measure))
+        axes[0][j].axhline(level, color="k", ls="--", lw=0.8)
+        axes[0][j].set_title(scene)
+        _panel(axes[1][j], sel, "torque_in_error_steady", "drive-torque error after rev. 1 (rel.)")
+    return fig
+
+
+def write_bench(result: BenchResult, out: str | os.PathLike) -> Path:
+    """Write the results folder ``out`` (replaced as a whole, atomically); returns its path."""
+    from cardan_exudyn.report.plots import close  # import cost, as above
+
+    panels = {key: (accuracy_measure(scene), scene.numerics.accuracy)
+              for key, scene in result.scenes.items()}
+    with atomic_directory(out) as tmp:
+        rows = result.rows.drop(columns=["options"])
+        (tmp / "bench.csv").write_text(header(result.environment)
+                                       + rows.to_csv(index=False, float_format="%.6g"), encoding="utf-8")
+        data = {**result.summary(), "rows": result.rows.to_dict(orient="records")}
+        (tmp / "bench.json").write_text(dumps(data) + "\n", encoding="utf-8")
+        fig = work_precision_figure(result.rows, panels)
+        fig.savefig(tmp / "work_precision.png", dpi=120)
+        close(fig)
+        (tmp / "report.md").write_text(report_markdown(result), encoding="utf-8")
+    return Path(out)
+

@@ -1,37 +1,51 @@
-"""The whole of ``cardan bench`` in one call (:func:`run_bench`) and what it returns
-(:class:`BenchResult`)."""
+"""The whole of ``cardan bench`` in one call (:func:`run_bench`), what it returns
+(:class:`BenchResult`), and its reading: the cheapest run of each configuration at the scene's
+accuracy (:func:`cheapest`, :func:`at_accuracy`)."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from cardan_exudyn.report.environment import environment
-from cardan_exudyn.studies.bench.audit import skip_audit
-from cardan_exudyn.studies.bench.configs import (
-    ENGINE_NAMES,
-    SCENES,
-    BenchError,
-    Progress,
-    frictionless_twin_scene,
-    is_friction_scene,
-)
+from cardan_exudyn.studies.bench.configs import ENGINE_NAMES, BenchError, Progress, fixed_scenes
 from cardan_exudyn.studies.bench.ladders import work_precision
-from cardan_exudyn.studies.bench.startup import import_cost
-from cardan_exudyn.studies.bench.targets import (
-    PAPER_EXUDYN_COUPLING,
-    PAPER_EXUDYN_STEPS,
-    evaluate_targets,
-    paper_scenes_timing,
-)
-from reference.results.summary import Status
-from reference.scene.settings import COUPLINGS
+from reference.results.schema import Status
+from reference.scene.scene import Scene
 
-__all__ = ["BenchResult", "check_inputs", "check_paper", "run_bench"]
+__all__ = ["BenchResult", "accuracy_measure", "cheapest", "at_accuracy", "check_inputs", "run_bench"]
+
+
+def accuracy_measure(scene: Scene) -> str:
+    """The error column that ``numerics.accuracy`` bounds for ``scene``: the mean-efficiency
+    error with friction, the speed-ratio error without (every engine reports an efficiency of
+    exactly 1 there)."""
+    return "mean_efficiency_error" if scene.has_friction else "speed_ratio_error"
+
+
+def cheapest(rows: pd.DataFrame, levels: Mapping[str, float]) -> pd.Series | None:
+    """The ok row with the least wall time per simulated second whose every error column of
+    ``levels`` is at most its level (a NaN error never is); None when no row qualifies.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        Work-precision rows (:func:`~cardan_exudyn.studies.bench.ladders.work_precision`).
+    levels : mapping of str to float
+        Error column -> largest acceptable value [-].
+    """
+    ok = (rows["status"] == Status.OK) & rows["wall_per_simulated_s"].notna()
+    for column, level in levels.items():
+        ok &= rows[column].astype(float) <= level
+    ok_rows = rows[ok.to_numpy()]
+    if ok_rows.empty:
+        return None
+    return ok_rows.loc[ok_rows["wall_per_simulated_s"].idxmin()]
 
 
 @dataclass
@@ -41,65 +55,77 @@ class BenchResult:
     Attributes
     ----------
     rows : pandas.DataFrame
-        The work-precision rows, one per configuration.
-    targets : list of dict
-        :func:`cardan_exudyn.studies.bench.targets.evaluate_targets`.
-    paper : dict or None
-        The paper scenes' timing, None when not run.
-    startup : dict or None
-        The import cost of ``cardan run``
-        (:func:`cardan_exudyn.studies.bench.startup.import_cost`), None when not measured.
-    audit : pandas.DataFrame or None
-        The skip audit, None when not run.
+        The work-precision rows, one per configuration and step.
+    scenes : dict of str to Scene
+        The scenes benchmarked, by the key their rows carry in ``scene``.
     environment : dict
         Versions, CPU, date and commit.
     settings : dict
-        ``quick``, ``repeats``, ``scenes``, ``engines``, ``audit``, ``paper``, ``startup``,
-        ``paper_steps``, ``paper_coupling``.
+        ``quick``, ``repeats``, ``scenes`` (the keys), ``engines``, and ``scene_options`` (the
+        scene options given on the command line, empty for the default scenes).
     wall_s : float
         Wall time of the whole bench [s].
     """
 
     rows: pd.DataFrame
-    targets: list[dict[str, Any]]
-    paper: dict[str, Any] | None
-    audit: pd.DataFrame | None
+    scenes: dict[str, Scene]
     environment: dict[str, Any]
-    startup: dict[str, Any] | None = None
     settings: dict[str, Any] = field(default_factory=dict)
     wall_s: float = 0.0
 
     def summary(self) -> dict[str, Any]:
-        """What ``--json`` prints: environment, targets, paper timing, audit, best per scene."""
-        best = []
-        for (scene, config), sel in self.rows.groupby(["scene", "config"], sort=False):
-            ok = sel[sel["status"] == Status.OK]
-            best.append({"scene": scene, "config": config, "runs": len(sel), "ok": len(ok),
-                         "fastest_wall_per_simulated_s": float(ok["wall_per_simulated_s"].min())
-                         if not ok.empty else None})
+        """What ``--json`` prints: environment, settings, wall time, and per scene and
+        configuration the runs, how many ended ok, the fastest and the cheapest at the scene's
+        accuracy (:func:`at_accuracy`)."""
         return {"environment": self.environment, "settings": self.settings, "wall_s": self.wall_s,
-                "targets": self.targets, "paper_scenes": self.paper, "startup": self.startup,
-                "audit": None if self.audit is None else self.audit.to_dict(orient="records"),
-                "configurations": best}
+                "configurations": at_accuracy(self)}
 
 
-def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
-                 repeats: int | None, quick: bool) -> tuple[list[str], list[str], int]:
-    """The scene keys, engines and repeats of a bench run (defaults filled in; each friction
-    scene's frictionless twin added before it).
+def _best_record(scene: str, config: str, sel: pd.DataFrame, measure: str,
+                 level: float) -> dict[str, Any]:
+    """One configuration's entry of :func:`at_accuracy`."""
+    ok = sel[sel["status"] == Status.OK]
+    fastest = ok["wall_per_simulated_s"].min() if not ok.empty else np.nan
+    row = cheapest(sel, {measure: level})
+    record = {"scene": scene, "config": config, "runs": len(sel), "ok": len(ok),
+              "fastest_wall_per_simulated_s": float(fastest) if np.isfinite(fastest) else None,
+              "measure": measure, "accuracy": level, "steps_per_revolution": None, "error": None,
+              "wall_per_simulated_s": None}
+    if row is not None:
+        record.update(steps_per_revolution=int(row["steps_per_revolution"]), error=float(row[measure]),
+                      wall_per_simulated_s=float(row["wall_per_simulated_s"]))
+    return record
+
+
+def at_accuracy(result: BenchResult) -> list[dict[str, Any]]:
+    """Per scene and configuration, the cheapest step whose error on the scene's measure
+    (:func:`accuracy_measure`) is within the scene's ``numerics.accuracy``.
+
+    Returns
+    -------
+    list of dict
+        ``scene``, ``config``, ``runs``, ``ok``, ``fastest_wall_per_simulated_s`` [-] (any ok
+        run, None without one), ``measure``, ``accuracy`` [-], and of the cheapest run at the
+        accuracy ``steps_per_revolution``, ``error`` [-] and ``wall_per_simulated_s`` [-] (None
+        when no step of the ladder reaches it).
+    """
+    out = []
+    if result.rows.empty:
+        return out
+    for (key, config), sel in result.rows.groupby(["scene", "config"], sort=False):
+        scene = result.scenes[key]
+        out.append(_best_record(key, config, sel, accuracy_measure(scene), scene.numerics.accuracy))
+    return out
+
+
+def check_inputs(engines: Iterable[str], repeats: int | None, quick: bool) -> tuple[list[str], int]:
+    """The engines and repeats of a bench run (default repeats filled in: 3, quick 1).
 
     Raises
     ------
     BenchError
-        For an unknown scene key or engine, or repeats that are not a positive integer.
+        For an unknown engine, or repeats that are not a positive integer.
     """
-    keys = list(scenes) if scenes is not None else list(SCENES)
-    unknown = [k for k in keys if k not in SCENES]
-    if unknown:
-        raise BenchError(f"`--scenes` must be among {list(SCENES)}, got {unknown}")
-    # a friction scene's cost is read against its frictionless twin at the same step
-    keys = list(dict.fromkeys(twin for k in keys for twin in (
-        (frictionless_twin_scene(k), k) if is_friction_scene(k) else (k,))))
     engines = list(engines)
     bad = [e for e in engines if e not in ENGINE_NAMES]
     if bad:
@@ -107,76 +133,42 @@ def check_inputs(scenes: Iterable[str] | None, engines: Iterable[str],
     repeats = repeats if repeats is not None else (1 if quick else 3)
     if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
         raise BenchError(f"`--repeats` must be a positive integer, got {repeats!r}")
-    return keys, engines, repeats
+    return engines, repeats
 
 
-def check_paper(steps: int | str, coupling: str) -> None:
-    """Check the paper timing's Exudyn steps per revolution (or ``"auto"``) and coupling.
-
-    Raises
-    ------
-    BenchError
-        Steps that are not a positive integer, or an unknown coupling.
-    """
-    if steps != "auto" and (isinstance(steps, bool) or not isinstance(steps, int) or steps < 1):
-        raise BenchError(f"`--paper-steps` must be a positive integer or 'auto', got {steps!r}")
-    if coupling not in COUPLINGS:
-        raise BenchError(f"`--paper-coupling` must be one of {list(COUPLINGS)}, got {coupling!r}")
-
-
-def run_bench(quick: bool = False, repeats: int | None = None, scenes: Iterable[str] | None = None,
-              engines: Iterable[str] = ENGINE_NAMES, audit: bool = True, paper: bool = True,
-              progress: Progress | None = None, startup: bool = True,
-              paper_steps: int | str = PAPER_EXUDYN_STEPS,
-              paper_coupling: str = PAPER_EXUDYN_COUPLING) -> BenchResult:
-    """The whole bench: work-precision runs, the paper scenes' timing, the import cost of
-    ``cardan run``, the skip audit, and the targets from all of them.
+def run_bench(scenes: Mapping[str, Scene] | None = None, quick: bool = False,
+              repeats: int | None = None, engines: Iterable[str] = ENGINE_NAMES,
+              progress: Progress | None = None,
+              scene_options: Iterable[str] = ()) -> BenchResult:
+    """Every engine configuration on every scene, errors against the reference engine and wall
+    times (:func:`~cardan_exudyn.studies.bench.ladders.work_precision`).
 
     Parameters
     ----------
+    scenes : mapping of str to Scene, optional
+        The scenes by key (default: the default set,
+        :func:`~cardan_exudyn.studies.bench.configs.fixed_scenes`).
     quick : bool
-        Short ladders, one repeat by default, a shorter audit without the fast module.
+        Short ladders, one repeat by default.
     repeats : int, optional
         Timed runs per configuration (default 3, quick 1).
-    scenes : iterable of str, optional
-        Keys of :data:`~cardan_exudyn.studies.bench.configs.SCENES` (default all).
     engines : iterable of str
-        Engines to run; the paper timing needs Exudyn and the reference, the audit Exudyn.
-    audit, paper, startup : bool
-        Run the skip audit, the paper scenes' timing, the import-cost measurement.
+        Engines to run (of :data:`~cardan_exudyn.studies.bench.configs.ENGINE_NAMES`).
     progress : callable, optional
-        Called with one line of text per finished piece of work.
-    paper_steps : int or "auto"
-        Exudyn's steps per revolution in the paper scenes' timing (``"auto"``: each scene's own
-        step for the target accuracy).
-    paper_coupling : str
-        Exudyn's friction coupling there (one of :data:`reference.scene.settings.COUPLINGS`).
+        Called with one line of text per finished run.
+    scene_options : iterable of str
+        The command-line scene options the scenes came from, recorded in the settings.
 
     Raises
     ------
     BenchError
-        Bad scenes, engines, repeats, paper steps or coupling.
+        Bad engines or repeats, or a scene the reference engine cannot solve.
     """
-    keys, engines, repeats = check_inputs(scenes, engines, repeats, quick)
-    check_paper(paper_steps, paper_coupling)
+    engines, repeats = check_inputs(engines, repeats, quick)
+    scenes = dict(fixed_scenes() if scenes is None else scenes)
     start = time.perf_counter()
     env = environment()
-    rows = work_precision(keys, quick, repeats, engines, progress)
-    paper_result = None
-    if paper and "exudyn" in engines and "reference" in engines:
-        paper_result = paper_scenes_timing(repeats=repeats, exudyn_steps=paper_steps,
-                                           exudyn_coupling=paper_coupling, progress=progress)
-    startup_result = None
-    if startup:
-        startup_result = import_cost(repeats=3 if quick else 5)
-        if progress:
-            progress("import cost of cardan run measured")
-    audit_table = None
-    if audit and "exudyn" in engines:
-        audit_table = skip_audit(repeats=3 if quick else 7, progress=progress, fast_module=not quick)
-    targets = evaluate_targets(rows, paper_result, startup_result)
-    settings = {"quick": quick, "repeats": repeats, "scenes": keys, "engines": engines,
-                "audit": audit, "paper": paper, "startup": startup, "paper_steps": paper_steps,
-                "paper_coupling": paper_coupling}
-    return BenchResult(rows, targets, paper_result, audit_table, env, startup_result, settings,
-                       time.perf_counter() - start)
+    rows = work_precision(scenes, quick, repeats, engines, progress)
+    settings = {"quick": quick, "repeats": repeats, "scenes": list(scenes), "engines": engines,
+                "scene_options": list(scene_options)}
+    return BenchResult(rows, scenes, env, settings, time.perf_counter() - start)

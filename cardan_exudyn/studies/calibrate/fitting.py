@@ -18,11 +18,15 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import run
-from reference.paper.apply import apply_parameters
-from reference.paper.cases import case_key, paper_cases
-from reference.paper.parameter_sets import parameter_set, plausible_box
-from reference.paper.scenes import paper_scene
-from reference.scene.mapping import replace
+from reference.paper.paper import (
+    apply_parameters,
+    case_key,
+    paper_cases,
+    paper_scene,
+    parameter_set,
+    plausible_box,
+)
+from reference.scene.scene import replace
 from reference.scene.validation import SceneError
 
 FIT_ENGINES = ("reference", "exudyn")

@@ -32,8 +32,9 @@ def write_result(out: str | Path, name: str, result: Mapping[str, Any], text: st
 
 
 def fit_text(result: Mapping[str, Any]) -> str:
-    """The report of :func:`~cardan_exudyn.studies.calibrate.fit.calibrate`: what to paste into the data file, every combination's
-    RMS, the table of the eleven cases and the statistics."""
+    """The report of :func:`~cardan_exudyn.studies.calibrate.fit.calibrate`'s ``result``: what
+    to paste into the data file, every combination's RMS, the table of the eleven cases and the
+    statistics."""
     stored = parameter_set(result["set"])["values"]
     lines = [f"parameter set {result['set']}, engine {result['engine']}; fit cases "
              f"{', '.join(result['fit_cases'])}", f"method: {result['method']}", "",
@@ -67,9 +68,11 @@ def _toml_raw(x: Any) -> str:
         return '"' + x.replace("\\", "\\\\").replace('"', '\\"') + '"'
     return _toml(x)
 
+
 def envelope_text(result: Mapping[str, Any]) -> str:
-    """The report of :func:`~cardan_exudyn.studies.calibrate.envelope.envelope_study`: the table, what to paste into ``[envelope]`` of the
-    data file, and what would have to change for each number outside the envelope."""
+    """The report of :func:`~cardan_exudyn.studies.calibrate.envelope.envelope_study`'s
+    ``result``: the table, what to paste into ``[envelope]`` of the data file, and what would
+    have to change for each number outside the envelope."""
     rows = [{**r, "reachable": "yes" if r["reachable"] else "no",
              "limited by": "; ".join(map(_limit, r.get("limiting", []))) + _choices(r)}
             for r in result["cases"]]

@@ -1,17 +1,17 @@
-"""``cardan stress``."""
+"""``cardan stress``: the command (:mod:`.command`), the map's panels (:mod:`.panels`), one cell
+measured (:mod:`.cell`) and classified (:mod:`.classify`), the map (:mod:`.map`) and the report
+folder (:mod:`.report`)."""
 
 from __future__ import annotations
 
 from reference.lazy import lazy_face
 
 _LAZY = {
+    "cell": "cardan_exudyn.studies.stress.cell",
+    "classify": "cardan_exudyn.studies.stress.classify",
     "command": "cardan_exudyn.studies.stress.command",
-    "longrun": "cardan_exudyn.studies.stress.longrun",
-    "longrun_measures": "cardan_exudyn.studies.stress.longrun_measures",
-    "longrun_plan": "cardan_exudyn.studies.stress.longrun_plan",
-    "longrun_report": "cardan_exudyn.studies.stress.longrun_report",
-    "longrun_summary": "cardan_exudyn.studies.stress.longrun_summary",
     "map": "cardan_exudyn.studies.stress.map",
+    "panels": "cardan_exudyn.studies.stress.panels",
     "report": "cardan_exudyn.studies.stress.report",
 }
 

@@ -1,182 +1,71 @@
-"""``cardan stress``'s parts and report folder: the stability map (:mod:`.stress_map`) and the
-long runs (:mod:`.longrun`), run and written into one folder.
-
-The library measures and reports; the verdicts on the long runs' measurements (each tolerance with
-its reason) are the tests of ``tests/test_longrun.py``, and bad input at every entry point is
-``tests/test_hardening.py``. A part that raised in the harness is the command's only problem.
-"""
+"""The report folder of ``cardan stress``: ``report.md``, ``map_cells.csv`` (every cell with its
+measurements, class, category and explanation), ``stability_map.png`` and ``stress.json``,
+written atomically with the map's sweeps (``runs/``) moved into it (:func:`write_stress`)."""
 
 from __future__ import annotations
 
 import math
 import os
-import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from cardan_exudyn.jsonable import dumps
-from cardan_exudyn.outputs import atomic_directory, check_output_folder
+from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.report.format import markdown_table
-from cardan_exudyn.studies.stress.longrun import LongRuns, long_runs
-from cardan_exudyn.studies.stress.longrun_report import markdown as long_markdown
-from cardan_exudyn.studies.stress.longrun_report import write_long
-from cardan_exudyn.studies.stress.map import (
-    BASE_SCENE,
-    CLASSES,
-    DEFAULT_RPM,
-    DEFAULT_STEPS,
-    PANEL_FRICTION,
-    X_LABELS,
-    Panel,
-    StressMap,
-    as_float,
-    run_map,
-)
-from reference.results.summary import Status
+from cardan_exudyn.studies.stress.classify import CLASSES, as_float
+from cardan_exudyn.studies.stress.map import StressMap
+from cardan_exudyn.studies.stress.panels import DEFAULT_RPM, DEFAULT_STEPS, PANEL_FRICTION, X_LABELS, Panel
+from reference.results.schema import Status
 
-PARTS = ("map", "long")
-#: Where the parts that left ``cardan stress`` now live.
-MOVED_PARTS = {"inputs": "the bad-input table is `pytest tests/test_hardening.py` (a source checkout)"}
+__all__ = ["SYMBOLS", "TESTS", "problems", "summary", "write_stress", "class_mark", "error_mark",
+           "panel_table", "map_markdown", "plot_map"]
+
+TESTS = ("The map's classification, cells either side of the self-locking boundary and this "
+         "command are tested by `pytest tests/test_stress.py` (a source checkout).")
+
+
+def problems(stress: StressMap) -> list[str]:
+    """What makes the command exit 3: map cells that raised in the harness."""
+    n = int((stress.cells["cell_class"] == "error").sum())
+    return [f"{n} map cells raised in the harness"] if n else []
+
+
+def summary(stress: StressMap, wall_s: float) -> dict[str, Any]:
+    """The content of ``stress.json`` (without the environment): the map's wall time [s], the
+    problems, the counts of :meth:`StressMap.counts`, the scene, ``quick`` and the sweeps."""
+    return {"wall_s": {"map": wall_s}, "problems": problems(stress),
+            "map": {**stress.counts(), "scene": stress.scene, "quick": stress.quick,
+                    "sweeps": stress.sweeps}}
+
+
+def write_stress(stress: StressMap, out: str | os.PathLike, wall_s: float) -> Path:
+    """The report folder ``out`` (replaced atomically), with the sweeps of ``out/runs`` moved in."""
+    out = Path(out)
+    env = environment()
+    found = problems(stress)
+    sections = [f"# Stress report{' (--quick)' if stress.quick else ''}", "",
+                f"{env['date']}, commit `{env['commit']}`, {env['cpu']} ({env['cpu_count']} logical "
+                f"CPUs), exudyn {env['packages'].get('exudyn')}; wall time map {wall_s:.1f} s.", "",
+                ("**Problems:** " + "; ".join(found)) if found
+                else "No problems: no map cell raised in the harness.", "", TESTS, "",
+                map_markdown(stress), "![stability map](stability_map.png)", ""]
+    with atomic_directory(out) as folder:
+        stress.cells.to_csv(folder / "map_cells.csv", index=False)
+        plots.save(plot_map(stress), folder / "stability_map.png")
+        (folder / "report.md").write_text("\n".join(sections), encoding="utf-8")
+        (folder / "stress.json").write_text(dumps({**summary(stress, wall_s), "environment": env})
+                                            + "\n", encoding="utf-8")
+        if (out / "runs").exists():
+            os.replace(out / "runs", folder / "runs")
+    return out
+
+
 SYMBOLS = {"converged": "C", "drift": "D", "self_locking": "L", "integration_failure": "F",
            "error": "E"}
-TESTS = ("The verdicts are tests: `pytest tests/test_longrun.py` holds the long runs' measurements to "
-         "stated tolerances (`-m slow` for the quick and full variants), `pytest tests/test_hardening.py` "
-         "feeds every entry point bad input, `pytest tests/test_stress.py` checks the map's classes.")
-
-
-class StressError(ValueError):
-    """Bad input to the stress command (unknown part)."""
-
-
-def parse_parts(text: str | None) -> tuple[str, ...]:
-    """The parts named by ``--only`` (``None``: all of :data:`PARTS`)."""
-    if text is None:
-        return PARTS
-    parts = tuple(p.strip() for p in text.split(",") if p.strip())
-    moved = [f"`{p}`: {MOVED_PARTS[p]}" for p in parts if p in MOVED_PARTS]
-    if moved:
-        raise StressError(f"--only: no longer a part of cardan stress: {'; '.join(moved)}")
-    unknown = sorted(set(parts) - set(PARTS))
-    if unknown or not parts:
-        raise StressError(f"--only must be a comma-separated subset of {list(PARTS)}, got {text!r}")
-    return parts
-
-
-@dataclass
-class StressReport:
-    """What ``cardan stress`` ran: the map, the long runs, wall time per part [s]."""
-
-    map: StressMap | None = None
-    long: LongRuns | None = None
-    wall_s: dict[str, float] = field(default_factory=dict)
-
-    def problems(self) -> list[str]:
-        """What makes the command exit 3: map cells or long-run cases that raised in the harness."""
-        out = []
-        if self.map is not None:
-            n = int((self.map.cells["cell_class"] == "error").sum())
-            if n:
-                out.append(f"{n} map cells raised in the harness")
-        if self.long is not None:
-            out += [f"long run: {name} raised in the harness ({reason})"
-                    for name, reason in self.long.errors()]
-        return out
-
-    def summary(self) -> dict[str, Any]:
-        """The content of ``stress.json`` (without the environment)."""
-        out: dict[str, Any] = {"wall_s": self.wall_s, "problems": self.problems()}
-        if self.map is not None:
-            out["map"] = {**self.map.counts(), "quick": self.map.quick, "sweeps": self.map.sweeps}
-        if self.long is not None:
-            out["long"] = self.long.summary
-        return out
-
-
-def run_stress(out: str | os.PathLike, *, quick: bool = False, parts: Sequence[str] = PARTS,
-               workers: int | None = None, restart: bool = False, progress: bool | None = None,
-               say: Callable[[str], None] | None = None) -> StressReport:
-    """Run the chosen parts and write the report folder ``out`` atomically.
-
-    Parameters
-    ----------
-    out : path
-        Report folder; the map's sweeps live in ``out/runs`` and are kept, so a rerun resumes.
-    quick : bool
-        The coarse map and the quick long runs (CI variant).
-    parts : sequence of str
-        Subset of :data:`PARTS`.
-    workers, restart, progress
-        The map's sweeps, as :func:`cardan_exudyn.sweep.run_sweep`.
-    say : callable, optional
-        Called with a line of text as each part starts and each long run ends.
-
-    Raises
-    ------
-    cardan_exudyn.outputs.OutputError
-        ``out`` cannot be a folder; raised before anything runs.
-    """
-    say = say or (lambda text: None)
-    out = check_output_folder(out)
-    runs = out / "runs"
-    report = StressReport()
-    if "map" in parts:
-        start = time.perf_counter()
-        say("stability map ...")
-        report.map = run_map(runs, quick, workers=workers, restart=restart, progress=progress)
-        report.wall_s["map"] = time.perf_counter() - start
-    if "long" in parts:
-        start = time.perf_counter()
-        say("long runs ...")
-        report.long = long_runs(quick=quick, progress=say)
-        report.wall_s["long"] = time.perf_counter() - start
-    with atomic_directory(out) as folder:
-        write_report(report, folder, quick)
-        if runs.exists():
-            os.replace(runs, folder / "runs")
-    return report
-
-
-def write_report(report: StressReport, folder: Path, quick: bool) -> None:
-    """``report.md``, ``stress.json`` and each part's files into the existing ``folder``."""
-    env = environment()
-    walls = ", ".join(f"{k} {v:.1f} s" for k, v in report.wall_s.items())
-    sections = [f"# Stress report{' (--quick)' if quick else ''}", "",
-                f"{env['date']}, commit `{env['commit']}`, {env['cpu']} ({env['cpu_count']} logical "
-                f"CPUs), exudyn {env['packages'].get('exudyn')}; wall time {walls}.", ""]
-    problems = report.problems()
-    sections += (["**Problems:** " + "; ".join(problems), ""] if problems
-                 else ["No problems: no map cell and no long run raised in the harness.", ""])
-    sections += [TESTS, ""]
-    if report.map is not None:
-        report.map.cells.to_csv(folder / "map_cells.csv", index=False)
-        plots.save(plot_map(report.map), folder / "stability_map.png")
-        sections += [map_markdown(report.map), "![stability map](stability_map.png)", ""]
-    if report.long is not None:
-        write_long(report.long, folder)
-        sections += [long_markdown(report.long), ""]
-    (folder / "report.md").write_text("\n".join(sections), encoding="utf-8")
-    (folder / "stress.json").write_text(dumps({**report.summary(), "environment": env}) + "\n",
-                                        encoding="utf-8")
-
-
-def summary_lines(report: StressReport, out: str | os.PathLike) -> list[str]:
-    """What ``cardan stress`` prints when it is done: the map's classes, the long runs' statuses."""
-    lines = []
-    if report.map is not None:
-        counts = report.map.counts()
-        lines.append("map: " + ", ".join(f"{v} {k}" for k, v in counts["classes"].items())
-                     + f"; {counts['disagreements']} of {counts['cells']} cells disagree with the "
-                     f"reference")
-    if report.long is not None:
-        lines.append(f"long runs: {report.long.status_line()} (verdicts: pytest tests/test_longrun.py)")
-    lines.append(f"report: {out}/report.md")
-    return lines
 
 
 def class_mark(r: pd.Series) -> str:
@@ -206,11 +95,12 @@ def panel_table(cells: pd.DataFrame, panel: Panel, mark: Callable[[pd.Series], s
     return markdown_table(rows, columns, headers=headers).rstrip("\n")
 
 
-def _map_intro(counts: dict[str, Any]) -> list[str]:
+def _map_intro(counts: dict[str, Any], scene: str) -> list[str]:
+    """The map section's head: what a cell is, the legend, the counts."""
     return [
         "## Stability map",
         "",
-        f"{counts['cells']} cells, each one revolution of `{BASE_SCENE}` (2 N m load) at constant "
+        f"{counts['cells']} cells, each one revolution of `{scene}` at constant "
         f"input speed from the assembled start; reference engine (72 samples per revolution, "
         f"quadrature rtol 1e-8) and Exudyn (default options) at the cell's step and at half of it. "
         f"Unless a panel varies it: {DEFAULT_RPM:g} rpm, {DEFAULT_STEPS} steps per revolution, "
@@ -229,6 +119,7 @@ def _map_intro(counts: dict[str, Any]) -> list[str]:
 
 
 def _disagreements(cells: pd.DataFrame) -> list[str]:
+    """The table of every cell where Exudyn and the reference disagree (none: nothing)."""
     bad = cells[~cells["agrees"]].copy()
     if not len(bad):
         return []
@@ -243,7 +134,7 @@ def _disagreements(cells: pd.DataFrame) -> list[str]:
 def map_markdown(stress: StressMap) -> str:
     """The map's report section: legend, one grid per panel, every disagreement listed."""
     counts = stress.counts()
-    parts = _map_intro(counts)
+    parts = _map_intro(counts, stress.scene)
     for panel in stress.panels:
         parts += [f"### {panel.key}: shaft angle x {X_LABELS[panel.x]} ({panel.title})", "",
                   panel_table(stress.cells, panel), ""]

@@ -1,4 +1,4 @@
-"""What the long runs (:mod:`.longrun`) run: the scenes, the variants (:data:`FULL`,
+"""What the long runs (:mod:`.runs`) run: the scenes, the variants (:data:`FULL`,
 :data:`QUICK`), the Exudyn cases of the energy study, and the model of generalized-alpha's
 energy loss the measurements are compared with.
 """
@@ -9,22 +9,19 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from benchmarks.longrun.measures import damping_coefficient
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step
-from cardan_exudyn.studies.stress.longrun_measures import damping_coefficient
-from reference.paper.scenes import named_scene
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from reference.paper.paper import named_scene
+from reference.scene.scene import Scene, replace
 
 #: The engine whose long runs are measured, and the one measuring it (no time steps to drift).
 ENGINE, REFERENCE = "exudyn", "reference"
 DRIFT_SCENE = "paper-literal-10deg-2000rpm"
-# The step of the drift runs, the same for every node type: the automatic step of the default
-# (Rxyz) nodes at 10 deg for a speed-ratio error of 1e-5 (the default accuracy until issue 18),
-# given, so that it stays the step the figures below were measured at. The automatic step for EP
-# and RotVecLG nodes at that accuracy is finer (480 and 220 steps per revolution,
-# stepsize.NODE_ERROR); one common step keeps the drift figures comparable and EP's run affordable
-# (480 would triple its 2000 revolutions).
+# The step of the drift runs, the same for every node type: the automatic step of Rxyz nodes at 10
+# deg for a speed-ratio error of 1e-5, given, so that the figures of docs/benchmarks.md stay
+# comparable. One common step keeps the node types comparable and EP's run affordable (its own
+# automatic step at that accuracy, 480 steps per revolution, would triple its 2000 revolutions).
 DRIFT_STEPS_PER_REVOLUTION = 156
 ENERGY_SPEED_RPM = 2000.0
 RHO_LADDER_STEPS = 200               # steps per revolution of the spectral-radius ladder
@@ -176,8 +173,7 @@ def settings(plan: LongRunPlan) -> dict[str, Any]:
         "drift_steps_per_revolution": DRIFT_STEPS_PER_REVOLUTION,
         "drift_dt_s": drift_scene(1).numerics.dt,
         "drift_dt_choice": ("given: the automatic step of Rxyz nodes at 10 deg for a speed-ratio "
-                            "error of 1e-5 (the default accuracy until issue 18), the same for "
-                            "every node type"),
+                            "error of 1e-5, the same for every node type"),
         "spectral_radius": DEFAULT_RHO,
         "friction_coupling": "converged",
         "startup_revolutions_excluded": STARTUP_REVOLUTIONS,

@@ -1,12 +1,12 @@
 """Numerical studies of the friction model: coupling schemes against step size, and the sign band.
 
-``cardan study coupling``: for each scene and each coupling scheme (lagged, converged), the mean
+``python tests/benchmarks coupling``: for each scene and each coupling scheme (lagged, converged), the mean
 efficiency at a ladder of step sizes, its error against a run of the converged scheme with a
 step four times finer than the finest of the ladder, the observed order between neighbouring
 steps, and the cost (wall time, Newton iterations, friction evaluations per step), measured side
 by side in one process.
 
-``cardan study sign-band``: the mean efficiency at 0 and 10 deg against the width of the
+``python tests/benchmarks sign-band``: the mean efficiency at 0 and 10 deg against the width of the
 regularised sign, from far below the numerical noise of the relative speeds to far above it.
 """
 
@@ -27,10 +27,13 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
-from reference.paper.scenes import named_scene
-from reference.results.summary import Status
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from reference.paper.paper import named_scene
+from reference.results.schema import Status
+from reference.scene.scene import Scene, replace
+
+__all__ = ["COUPLING_DEFAULT", "COUPLING_QUICK", "BAND_DEFAULT", "BAND_QUICK", "efficiency_row",
+           "step", "coupling_study", "ladder_rows", "sign_band_study", "run_study", "markdown",
+           "plot_coupling", "plot_band", "write_study", "register", "handler"]
 
 Progress = Callable[[str], None]
 
@@ -72,8 +75,8 @@ def efficiency_row(scene: Scene) -> dict[str, Any]:
     out = {"status": s.status.value, "reason": s.reason, "wall_time_s": wall, "steps": s.steps,
            "newton_iterations": s.newton_iterations, "mean_efficiency": _value(s.mean_efficiency),
            "mean_instantaneous_efficiency": _value(s.mean_instantaneous_efficiency)}
-    if s.friction is not None:
-        out["friction_evaluations_per_step"] = s.friction.mean_iterations_per_step
+    if "friction" in s.extras:
+        out["friction_evaluations_per_step"] = s.extras["friction"]["mean_iterations_per_step"]
     return out
 
 
@@ -147,7 +150,7 @@ def sign_band_study(names: Sequence[str], bands: Sequence[float], revolutions: f
 
 
 def run_study(kind: str, quick: bool = False, progress: Progress | None = None) -> list[dict[str, Any]]:
-    """The rows of ``cardan study KIND`` (``coupling`` or ``sign-band``), at the default or the
+    """The rows of the study ``kind`` (``coupling`` or ``sign-band``), at the default or the
     quick (``quick``) scenes and ladder."""
     if kind == "coupling":
         spec = COUPLING_QUICK if quick else COUPLING_DEFAULT
@@ -163,7 +166,7 @@ def markdown(rows: Sequence[Mapping[str, Any]], columns: Sequence[str]) -> str:
     return markdown_table(rows, columns, FORMATS)
 
 
-def _plot_coupling(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
+def plot_coupling(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
     """Error of mean efficiency against steps per revolution and against wall time, log-log."""
     # import cost: matplotlib only when a study is written
     from cardan_exudyn.report.plots import plt, save
@@ -192,7 +195,7 @@ def _plot_coupling(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
     save(fig, path, dpi=120)
 
 
-def _plot_band(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
+def plot_band(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
     """Mean efficiency against the sign band, one line per scene."""
     # import cost: matplotlib only when a study is written
     from cardan_exudyn.report.plots import plt, save
@@ -212,9 +215,9 @@ def _plot_band(rows: Sequence[Mapping[str, Any]], path: Path) -> None:
 
 def write_study(kind: str, rows: Sequence[Mapping[str, Any]], out: str | Path) -> Path:
     """Write ``rows`` as CSV, JSON, a markdown table and a plot into ``out`` (atomically)."""
-    import pandas as pd  # import cost: this module registers a CLI command
+    import pandas as pd  # import cost: pandas when a study is written
 
-    plot = _plot_coupling if kind == "coupling" else _plot_band
+    plot = plot_coupling if kind == "coupling" else plot_band
     with atomic_directory(out) as tmp:
         tmp = Path(tmp)
         pd.DataFrame(rows).to_csv(tmp / f"{kind}.csv", index=False)
@@ -224,20 +227,22 @@ def write_study(kind: str, rows: Sequence[Mapping[str, Any]], out: str | Path) -
     return Path(out)
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``cardan study`` to the ``cardan`` subcommands."""
-    p = subparsers.add_parser("study", help="numerical studies of the friction model")
-    p.add_argument("kind", choices=("coupling", "sign-band"),
-                   help="coupling: error of mean efficiency against step size for the lagged and "
-                        "converged schemes; sign-band: mean efficiency against the sign band")
+HELP = {"coupling": "error of mean efficiency against step size for the lagged and converged "
+                    "friction couplings",
+        "sign-band": "mean efficiency against the width of the regularised sign"}
+
+
+def register(subparsers: argparse._SubParsersAction, name: str) -> None:
+    """Add the study ``name`` (``coupling`` or ``sign-band``) to the benchmarks' subcommands."""
+    p = subparsers.add_parser(name, help=HELP[name], description=HELP[name])
     p.add_argument("--out", metavar="DIR", help="write CSV, JSON, markdown and a plot here")
     p.add_argument("--quick", action="store_true", help="one scene, a short ladder")
     p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
-    p.set_defaults(func=handler)
+    p.set_defaults(func=handler, kind=name)
 
 
 def handler(args: argparse.Namespace) -> int:
-    """``cardan study``: exit 0 when every run ended ok, 3 otherwise."""
+    """Run the study ``args.kind``: exit 0 when every run ended ok, 3 otherwise."""
     out_folder(args.out)
     rows = run_study(args.kind, args.quick, progress=_say)
     if args.out:
@@ -251,4 +256,5 @@ def handler(args: argparse.Namespace) -> int:
 
 
 def _say(message: str) -> None:
+    """A progress line on stderr."""
     print(f"  {message}", file=sys.stderr, flush=True)

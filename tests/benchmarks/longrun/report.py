@@ -2,7 +2,7 @@
 (:func:`write_long`), and the markdown section of the measured figures (:func:`markdown`).
 
 The report shows the measurements; the tolerances they are held to are the tests of
-``tests/test_longrun.py``, which the section names.
+``tests/benchmarks/test_longrun.py``, which the section names.
 """
 
 from __future__ import annotations
@@ -16,11 +16,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.ticker import NullFormatter, ScalarFormatter
 
-from cardan_exudyn.jsonable import to_jsonable
-from cardan_exudyn.report import plots
-from cardan_exudyn.report.format import markdown_table, number
-from cardan_exudyn.studies.stress.longrun import LongRuns
-from cardan_exudyn.studies.stress.longrun_plan import (
+from benchmarks.longrun.plan import (
     DEFAULT_RHO,
     DISSIPATION_MODEL,
     DRIFT_SCENE,
@@ -31,7 +27,11 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     STARTUP_REVOLUTIONS,
     model_loss,
 )
-from cardan_exudyn.studies.stress.longrun_summary import rho_ladder, step_ladder
+from benchmarks.longrun.runs import LongRuns
+from benchmarks.longrun.summary import rho_ladder, step_ladder
+from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.report import plots
+from cardan_exudyn.report.format import markdown_table, number
 
 NODE_COLOURS = {"Rxyz": "C0", "EP": "C1", "RotVecLG": "C2"}
 
@@ -176,8 +176,8 @@ MEASURE_LABELS = (("position_violation_m", "marker distance [m]"),
                   ("rotvec_norm_max", "abs(nu), RotVecLG [rad]"),
                   ("input_angle_error_rad", "theta_in - omega t [rad]"),
                   ("balance_residual_j", "W_in - W_out - W_loss - dE per revolution [J]"))
-TESTS = ("`tests/test_longrun.py` holds these measurements to stated tolerances, each with its reason: "
-         "the position constraints and the Euler parameters' norm within Newton's tolerance in every "
+TESTS = ("`tests/benchmarks/test_longrun.py` holds these measurements to stated tolerances, each with its "
+         "reason: the position constraints and the Euler parameters' norm within Newton's tolerance in every "
          "revolution; the velocity residuals and the energy-balance residual as large in the last "
          "window as in the first (periodic, not growing); rotation matrices orthogonal and rotation "
          "vectors within pi to rounding; the input's angle coordinate within pi (the post-step wrap "
@@ -185,7 +185,7 @@ TESTS = ("`tests/test_longrun.py` holds these measurements to stated tolerances,
          "running all its revolutions; no trend of the per-revolution efficiency; an energy loss per "
          "revolution of order h^3 that follows c(rho); the default settings' energy drift within a "
          "margin of the model; the reference engine's drift per revolution at the level of its "
-         "tolerance. `pytest tests/test_longrun.py` runs a short variant, `-m slow` the quick and "
+         "tolerance. `pytest tests/benchmarks/test_longrun.py` runs a short variant, `-m slow` the quick and "
          "full ones.")
 
 

@@ -1,11 +1,11 @@
-"""Long runs (``cardan_exudyn.studies.stress.longrun``): drift over thousands of revolutions with
+"""Long runs (``benchmarks.longrun.runs``): drift over thousands of revolutions with
 friction, and energy conservation of the free-spinning frictionless joint.
 
 The library measures; the verdicts are here: :data:`TOLERANCES` holds each tolerance with its
-reason (measured values with a margin, see ``cardan_exudyn/studies/stress/longrun.py``), and every
-verdict test runs on each variant of the study: a short one in the default suite (5 revolutions
-with friction for each node type, 8 free-spinning revolutions at 35 deg, the reference engine
-for 1; about 8 s), the quick one of ``cardan stress --quick`` and the full one (2000 / 1000
+reason (measured values with a margin, see ``docs/benchmarks.md``), and every verdict test runs
+on each variant of the study: a short one in the default suite (5 revolutions with friction for
+each node type, 8 free-spinning revolutions at 35 deg, the reference engine for 1; about 8 s),
+the quick one of ``python tests/benchmarks longrun --quick`` and the full one (2000 / 1000
 revolutions, about 21 minutes) with ``-m slow``.
 """
 
@@ -22,12 +22,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cardan_exudyn import ExudynOptions
-from cardan_exudyn.engines import run as run_engine
-from cardan_exudyn.model.options import NODE_TYPES
-from cardan_exudyn.model.stepsize import MIN_STEPS_PER_REVOLUTION, efficiency_error
-from cardan_exudyn.studies.stress.longrun import LongRuns, long_runs, simulate
-from cardan_exudyn.studies.stress.longrun_measures import (
+from benchmarks.longrun.measures import (
     algorithmic_damping,
     at_revolutions,
     damping_coefficient,
@@ -36,7 +31,7 @@ from cardan_exudyn.studies.stress.longrun_measures import (
     per_revolution_max,
     revolution_index,
 )
-from cardan_exudyn.studies.stress.longrun_plan import (
+from benchmarks.longrun.plan import (
     DEFAULT_RHO,
     DISSIPATION_MODEL,
     DRIFT_SCENE,
@@ -50,9 +45,14 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     energy_plan,
     model_loss,
 )
-from cardan_exudyn.studies.stress.longrun_report import markdown, write_long
-from reference.paper.scenes import named_scene
-from reference.scene.mapping import replace
+from benchmarks.longrun.report import markdown, write_long
+from benchmarks.longrun.runs import LongRuns, long_runs, simulate
+from cardan_exudyn import ExudynOptions
+from cardan_exudyn.engines import run as run_engine
+from cardan_exudyn.model.options import NODE_TYPES
+from cardan_exudyn.model.stepsize import MIN_STEPS_PER_REVOLUTION, efficiency_error
+from reference.paper.paper import named_scene
+from reference.scene.scene import replace
 
 
 class Tolerance(NamedTuple):
@@ -187,7 +187,7 @@ def test_revolution_helpers():
 
 
 def test_harness_errors_are_reported():
-    """A run that raised is named by ``errors()`` (what `cardan stress` exits 3 for)."""
+    """A run that raised is named by ``errors()`` (what `python tests/benchmarks longrun` exits 3 for)."""
     summary = {"drift": {"Rxyz": {"status": "ok"}, "EP": {"status": "error", "reason": "ValueError: x"}},
                "energy": {"cases": [{"case": "c", "status": "ok"}, {"case": "d", "status": "error",
                                                                      "reason": "KeyError: y"}]}}
@@ -348,7 +348,7 @@ def test_write_long_and_markdown(runs, tmp_path):
     assert len(back) == len(runs.drift)
     text = markdown(runs)
     assert text.startswith("## Long runs")
-    for needle in ("Drift", "Energy", "What the tests check", "tests/test_longrun.py",
+    for needle in ("Drift", "Energy", "What the tests check", "tests/benchmarks/test_longrun.py",
                    f"{runs.summary['drift']['EP']['efficiency']['mean']:.7f}"):
         assert needle in text, needle
     assert not re.search(r"\bnan\b", text, re.IGNORECASE)

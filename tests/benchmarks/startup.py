@@ -1,4 +1,4 @@
-"""The import cost of ``cardan run`` before its scene is built (issue 19: at most 150 ms).
+"""The import cost of ``cardan run`` before its scene is built (target: at most 150 ms).
 
 :func:`import_cost` runs, in fresh interpreters under ``python -X importtime``, what ``cardan
 run`` does before it hands the scene to an engine: import :mod:`cardan_exudyn.cli`, parse the
@@ -12,7 +12,7 @@ interpreter's start-up and the editable install's finder are part of every ``car
 the figures are medians over the runs.
 
 Python's own bytecode cache decides much of it: without one every module of the project is
-compiled from source at each start (this machine's sessions set ``PYTHONDONTWRITEBYTECODE``). By
+compiled from source at each start (an environment may set ``PYTHONDONTWRITEBYTECODE``). By
 default the runs share a private cache folder (``PYTHONPYCACHEPREFIX``) warmed by one run that is
 not counted, as an installed ``cardan`` has; ``bytecode_cache=False`` measures the environment
 as it is. The machine's load moves every figure by tens of ms: ``baseline_ms`` (start-up and
@@ -34,7 +34,7 @@ __all__ = ["IMPORT_TARGET_MS", "STARTUP_CODE", "BASELINE_CODE", "SCENE_MARKER", 
            "import_cost"]
 
 IMPORT_TARGET_MS = 150.0
-"""Issue 19's target for the import cost of ``cardan run`` before its engine runs [ms]."""
+"""The target for the import cost of ``cardan run`` before its engine runs [ms]."""
 
 SCENE_MARKER = "cardan-bench-startup: scene"
 """The line written to stderr between the parse and the scene build."""

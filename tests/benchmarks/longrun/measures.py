@@ -1,4 +1,4 @@
-"""Measurements of the long runs (:mod:`.longrun`), from arrays alone: per step (constraint
+"""Measurements of the long runs (:mod:`.runs`), from arrays alone: per step (constraint
 violations of the pairs, health of the rotation coordinates), per revolution (maxima, values at
 whole revolutions, work integrals), statistics (trends, first and last windows), the energy of
 a free-spinning run, and the numerical damping of generalized-alpha.

@@ -1,4 +1,4 @@
-"""``cardan bench --only batch``: the batched reference engine measured (issue 20).
+"""The batched reference engine measured.
 
 - per-sample cost against batch size: the rig scene (matched set) with Section 4.2 tolerances
   drawn as ``cardan tolerance montecarlo`` draws them (:func:`tolerance_scenes`), batches of 1,
@@ -14,71 +14,55 @@
 - a torque-driven paper scene with friction at ``rtol`` 1e-8, wall time per simulated revolution
   (:func:`torque_drive`; the reference engine's forward dynamics, :mod:`reference.engine.forward`).
 
-Library code returns data (:func:`run_batch_bench`); :func:`write_batch_bench` writes the folder
-and :func:`handler` prints.
+All of them in one call: :func:`run_batch_bench`; the targets: :mod:`.targets`.
 """
 
 from __future__ import annotations
 
-import argparse
 import gc
 import json
 import math
 import tempfile
 import time
 import tracemalloc
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from benchmarks.batch.targets import MONTE_CARLO_SAMPLES, batch_targets
+from benchmarks.targets.paper import paper_scenes
 from cardan_exudyn import engines
-from cardan_exudyn.jsonable import dumps
-from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.environment import environment
-from cardan_exudyn.report.format import markdown_table, number
-from cardan_exudyn.studies.bench.report import header
-from cardan_exudyn.studies.bench.targets import paper_scenes
+from cardan_exudyn.studies.bench.configs import Progress, quiet
 from cardan_exudyn.studies.tolerance.command import monte_carlo
 from cardan_exudyn.studies.tolerance.montecarlo import default_distributions
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
-from reference.engine.options import ReferenceOptions
-from reference.paper.scenes import named_scene, rig_scene
-from reference.results.summary import Status
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from reference.engine.solve import ReferenceOptions
+from reference.paper.paper import named_scene, rig_scene
+from reference.results.schema import Status
+from reference.scene.scene import Scene, replace
 
-__all__ = ["SIZES", "QUICK_SIZES", "MONTE_CARLO_SAMPLES", "MONTE_CARLO_TARGET_S", "PAPER_BATCH_TARGET_S",
-           "DASK_SAMPLES", "TORQUE_TARGET_S", "torque_drive", "tolerance_scenes", "cost_by_batch_size",
-           "paper_batch", "batch_memory",
-           "monte_carlo_target", "dask_equal", "run_batch_bench", "batch_targets", "write_batch_bench",
-           "report_markdown", "handler"]
+__all__ = ["SIZES", "QUICK_SIZES", "TORQUE_DRIVE", "DASK_SAMPLES", "QUICK",
+           "FULL", "SEED", "study_scene", "tolerance_scenes", "cost_by_batch_size", "paper_batch",
+           "torque_drive", "batch_memory", "monte_carlo_target", "dask_equal", "run_batch_bench"]
+
 
 SIZES = (1, 10, 100, 1000)
+"""Batch sizes of the cost table."""
 QUICK_SIZES = (1, 10)
-MONTE_CARLO_SAMPLES = 10_000       # the issue's tolerance study
-MONTE_CARLO_TARGET_S = 30.0        # ... in at most this wall time on this 2-core machine [s]
-PAPER_BATCH_TARGET_S = 0.1         # the eleven paper scenes in one batch [s]
-TORQUE_TARGET_S = 0.2              # a torque-driven paper scene with friction, per revolution [s]
 TORQUE_DRIVE = {"scene": "paper-physical-10deg", "torque": 2.05, "initial_speed": 209.44, "rtol": 1e-8}
 """The torque-drive target's scene: 10 deg, started at 2000 rpm under about the drive torque the
 prescribed-speed scene needs at its 2 N m mean input torque reading."""
-DASK_SAMPLES = 1000                # the Dask comparison's samples (the issue's 100,000: --dask-samples)
+DASK_SAMPLES = 1000
+"""Samples of the Dask comparison (``--dask-samples``; docs/benchmarks.md has a 100,000 run)."""
 QUICK = {"samples": 40, "dask_samples": 16, "memory_sizes": [2, 10], "checked": 4}
 FULL = {"samples": MONTE_CARLO_SAMPLES, "dask_samples": DASK_SAMPLES, "memory_sizes": [100, 1000],
         "checked": 20}
-AGREEMENT = 2.0 * ReferenceOptions().quadrature_rtol
-"""Batched and single (or Dask and in-process) mean efficiencies agree when within this [-]: the
-quadrature accepts each work integral to ``quadrature_rtol`` of the input work, and the efficiency
-``1 - W_loss / W_in`` takes the error of both (where the batched pass adapts differently)."""
-SEED = 1  # the study's default seed (`cardan tolerance montecarlo --seed`)
-Progress = Callable[[str], None]
-
-
-def _quiet(text: str) -> None:
-    """No progress lines."""
+SEED = 1
+"""The tolerance study's default seed (``cardan tolerance montecarlo --seed``)."""
 
 
 def study_scene() -> Scene:
@@ -104,7 +88,7 @@ def _timed_batch(scenes: Sequence[Scene]) -> tuple[float, list]:
 
 
 def cost_by_batch_size(sizes: Sequence[int] = SIZES, seed: int = SEED,
-                       progress: Progress = _quiet) -> pd.DataFrame:
+                       progress: Progress = quiet) -> pd.DataFrame:
     """Wall time of one :func:`cardan_exudyn.engines.run_batch` per batch size, scenes built
     before the clock starts.
 
@@ -144,7 +128,8 @@ def paper_batch(repeats: int = 3) -> dict[str, Any]:
     """The paper's eleven scenes (literal set, summary only) in one batch: median wall time [s]
     and the largest mean-efficiency difference [-] from single runs."""
     scenes = paper_scenes()
-    walls, results = [], []
+    walls = []
+    results = []
     for _ in range(repeats):
         wall, results = _timed_batch(scenes)
         walls.append(wall)
@@ -163,7 +148,8 @@ def torque_drive(repeats: int = 3) -> dict[str, Any]:
                                                     "initial_speed": t["initial_speed"]},
                     **{"record.timeseries": False})
     options = ReferenceOptions(ode_rtol=t["rtol"], ode_atol=t["rtol"])
-    walls, result = [], engines.run(scene, "reference", options)
+    walls = []
+    result = engines.run(scene, "reference", options)  # untimed: imports and first-call costs
     for _ in range(repeats):
         start = time.perf_counter()
         result = engines.run(scene, "reference", options)
@@ -180,7 +166,8 @@ def batch_memory(sizes: Sequence[int] = (100, 1000), seed: int = SEED) -> dict[s
     returns) at two sizes, and what 1000 scenes take: the peak at the smaller size plus the
     growth per scene between the two [MB] (one size alone would mix the per-run working memory,
     which does not grow with the batch, into the per-scene cost)."""
-    peaks, kept = [], []
+    peaks = []
+    kept = []
     for size in sizes:
         batch = tolerance_scenes(size, seed)
         gc.collect()
@@ -193,7 +180,8 @@ def batch_memory(sizes: Sequence[int] = (100, 1000), seed: int = SEED) -> dict[s
             del results
         finally:
             tracemalloc.stop()
-    (n0, n1), (p0, p1) = sizes, peaks
+    n0, n1 = sizes
+    p0, p1 = peaks
     per_scene = (p1 - p0) / (n1 - n0)
     return {"sizes": list(sizes), "peak_mb": peaks, "retained_mb": kept, "per_scene_mb": per_scene,
             "per_1000_mb": p0 + per_scene * (1000 - n0)}
@@ -258,7 +246,8 @@ def dask_equal(samples: int, out: Path, workers: int = 2) -> dict[str, Any]:
     start = time.perf_counter()
     run_sweep(spec, out / "in-process", workers=1, progress=False)
     local_s = time.perf_counter() - start
-    a, b = (pd.read_csv(out / name / "results.csv") for name in ("dask", "in-process"))
+    a = pd.read_csv(out / "dask" / "results.csv")
+    b = pd.read_csv(out / "in-process" / "results.csv")
     timing = ["case_wall_s", "wall_time_s"]
     equal = a.drop(columns=timing).equals(b.drop(columns=timing))
     ok = (a["status"] == Status.OK) & (b["status"] == Status.OK)
@@ -270,7 +259,7 @@ def dask_equal(samples: int, out: Path, workers: int = 2) -> dict[str, Any]:
 
 def run_batch_bench(quick: bool = False, sizes: Sequence[int] | None = None, samples: int | None = None,
                     dask_samples: int | None = None, workers: int | None = None,
-                    progress: Progress = _quiet) -> dict[str, Any]:
+                    progress: Progress = quiet) -> dict[str, Any]:
     """Every measurement of this module (quick: a smaller study, batches of 1 and 10).
 
     Parameters
@@ -310,104 +299,3 @@ def run_batch_bench(quick: bool = False, sizes: Sequence[int] | None = None, sam
     result["wall_s"] = time.perf_counter() - start
     result["targets"] = batch_targets(result)
     return result
-
-
-def batch_targets(result: dict[str, Any]) -> list[dict[str, Any]]:
-    """The issue's targets measured here: ``target``, ``measured``, ``limit``, ``met`` (None
-    when the run was smaller than the target's), ``detail``."""
-    paper = result["paper"]
-    rows = [{"target": "paper_batch", "measured": paper["wall_s"], "limit": PAPER_BATCH_TARGET_S,
-             "met": paper["wall_s"] <= PAPER_BATCH_TARGET_S and paper["failed"] == 0,
-             "detail": f"{paper['scenes']} scenes, median of {len(paper['walls_s'])}; largest difference "
-                       f"from single runs {number(paper['max_difference'], '.2g')}"}]
-    torque = result.get("torque")
-    if torque:
-        rows.append({"target": "torque_drive", "measured": torque["per_revolution_s"],
-                     "limit": TORQUE_TARGET_S,
-                     "met": torque["per_revolution_s"] <= TORQUE_TARGET_S and torque["status"] == Status.OK,
-                     "detail": f"{torque['scene']}, {torque['torque']:g} N m from "
-                               f"{torque['initial_speed']:g} rad/s, rtol {torque['rtol']:g}: "
-                               f"{torque['status']}, mean efficiency "
-                               f"{number(torque['mean_efficiency'], '.6g')}, {torque['ode_evaluations']} "
-                               f"right-hand sides, median of {len(torque['walls_s'])}"})
-    if result.get("monte_carlo"):
-        rows.append(_monte_carlo_row(result["monte_carlo"]))
-    dask = result.get("dask")
-    if dask:
-        detail = dask.get("skipped") or (f"{dask['samples']} samples: Dask {dask['dask_s']:.3g} s, "
-                                         f"in-process {dask['in_process_s']:.3g} s")
-        met = None if "skipped" in dask else bool(dask["same_statuses"]
-                                                  and dask["max_difference"] <= AGREEMENT)
-        rows.append({"target": "dask_equal", "measured": dask.get("max_difference"), "limit": AGREEMENT,
-                     "met": met, "detail": detail + f"; every column identical: {dask.get('equal')}"})
-    return rows
-
-
-def _monte_carlo_row(mc: dict[str, Any]) -> dict[str, Any]:
-    """The Monte Carlo target: met only when measured at its full size."""
-    projected = mc["wall_s"] * MONTE_CARLO_SAMPLES / mc["samples"]
-    full = mc["samples"] >= MONTE_CARLO_SAMPLES
-    return {"target": "montecarlo", "measured": mc["wall_s"], "limit": MONTE_CARLO_TARGET_S,
-            "met": (mc["wall_s"] <= MONTE_CARLO_TARGET_S and mc["max_difference"] <= AGREEMENT)
-            if full else None,
-            "detail": f"{mc['samples']} samples ({number(mc['per_sample_ms'], '.3g')} ms each; "
-                      f"{MONTE_CARLO_SAMPLES} at this rate: {projected:.3g} s); statuses "
-                      f"{mc['status_counts']}; batches {mc['batching']}; {mc['checked']} samples "
-                      f"against single runs: largest difference "
-                      f"{number(mc['max_difference'], '.2g')}"}
-
-
-COST_FORMATS = {"batch_size": "d", "wall_s": ".3g", "per_sample_ms": ".3g", "ok": "d", "speedup": ".3g"}
-TARGET_COLUMNS = ["target", "measured", "limit", "met", "detail"]
-
-
-def report_markdown(result: dict[str, Any]) -> str:
-    """``report.md``: the command, the targets, the cost table, the memory."""
-    s, env, mem = result["settings"], result["environment"], result["memory"]
-    command = (f"cardan bench --only batch{' --quick' if s['quick'] else ''} --sizes "
-               f"{','.join(map(str, s['sizes']))} --samples {s['samples']} "
-               f"--dask-samples {s['dask_samples']}")
-    targets = [{**t, "met": {True: "yes", False: "**no**", None: "not measured"}[t["met"]]}
-               for t in result["targets"]]
-    return (f"# cardan bench: the batched reference engine\n{env['date']}, commit `{env['commit']}`, "
-            f"{env['cpu']} ({env['cpu_count']} logical CPUs); whole run {result['wall_s']:.0f} s.\n\n"
-            f"`{command}`\n\n## Targets\n"
-            + markdown_table(targets, TARGET_COLUMNS, {"measured": ".3g", "limit": "g"})
-            + "\n## Per-sample cost against batch size\nRig scene (matched set) with Section 4.2's "
-              "tolerances drawn as `cardan tolerance montecarlo` draws them; one "
-              "`cardan_exudyn.engines.run_batch` per size, scenes built before the clock. The sweep "
-              f"cuts batches of at most {result['batch_size_constant']} "
-              "(`cardan_exudyn.sweep.BATCH_SIZE`).\n\n"
-            + markdown_table(result["cost"], list(COST_FORMATS), COST_FORMATS)
-            + f"\nPeak memory of one batch (tracemalloc): {mem['peak_mb'][0]:.3g} MB for "
-              f"{mem['sizes'][0]} scenes, {mem['peak_mb'][1]:.3g} MB for {mem['sizes'][1]}: "
-              f"{1e3 * mem['per_scene_mb']:.3g} kB more per scene, {mem['per_1000_mb']:.3g} MB for 1000 "
-              f"scenes (the peak includes garbage awaiting Python's cycle collector); the results "
-              f"returned hold {mem['retained_mb'][1]:.3g} MB for {mem['sizes'][1]} scenes.\n")
-
-
-def write_batch_bench(result: dict[str, Any], out: str | Path) -> Path:
-    """The folder ``out`` (replaced atomically): ``batch.csv`` (cost against batch size, opening
-    with the environment header), ``batch_targets.csv``, ``batch.json``, ``report.md``."""
-    with atomic_directory(Path(out)) as tmp:
-        (tmp / "batch.csv").write_text(header(result["environment"]) + pd.DataFrame(result["cost"]).to_csv(
-            index=False, float_format="%.6g"), encoding="utf-8")
-        pd.DataFrame(result["targets"]).to_csv(tmp / "batch_targets.csv", index=False, float_format="%.4g")
-        (tmp / "batch.json").write_text(dumps(result) + "\n", encoding="utf-8")
-        (tmp / "report.md").write_text(report_markdown(result), encoding="utf-8")
-    return Path(out)
-
-
-def handler(args: argparse.Namespace, progress: Progress | None = None) -> int:
-    """``cardan bench --only batch``: the measurements, the folder (``--out``), the targets table
-    (or ``--json``) on stdout."""
-    result = run_batch_bench(quick=args.quick, sizes=args.sizes, samples=args.samples,
-                             dask_samples=args.dask_samples, workers=args.workers,
-                             progress=progress or _quiet)
-    if args.out:
-        write_batch_bench(result, args.out)
-    if args.json:
-        print(dumps(result))
-        return 0
-    print(report_markdown(result))
-    return 0

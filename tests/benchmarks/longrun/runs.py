@@ -1,94 +1,35 @@
-"""Long runs: drift over thousands of revolutions, and energy conservation.
+"""The long runs: (a) drift over thousands of revolutions with friction, per node type, and (b)
+energy conservation of the free-spinning frictionless joint.
 
 Entry point: :func:`long_runs` (``quick=True``: about 20-30 s). The pieces: what runs
-(:mod:`.longrun_plan`), the measurements (:mod:`.longrun_measures`), the headline figures
-(:mod:`.longrun_summary`), the files and the report section (:mod:`.longrun_report`). The library
-measures; the verdicts (each tolerance with its reason) are ``tests/test_longrun.py``. Results of
-the full variant are quoted here.
+(:mod:`.plan`), the measurements (:mod:`.measures`), the headline figures (:mod:`.summary`), the
+files and the report section (:mod:`.report`). This package measures; the verdicts (each
+tolerance with its reason) are ``tests/benchmarks/test_longrun.py``; the measured figures and what
+they mean are in ``docs/benchmarks.md`` (*Long runs*).
 
-(a) Drift with friction
------------------------
-The paper's scene with friction (``paper-10deg-2000rpm``: 10 deg, 2000 rpm, f1 = 0.42,
-f2 = 0.20, 2 N m, gravity on, converged friction coupling) for 2000 input
-revolutions (``FULL``) with each node type of the spider and the output (``ExudynOptions(node_type=...)``),
-all at ``DRIFT_STEPS_PER_REVOLUTION`` = 156 steps per revolution (``dt = 1.923e-4 s``; the
-automatic step of the default Rxyz nodes). Per revolution: the largest violation of the pair
-constraints at position level (marker distance [m], axis misalignment [rad]) and at velocity
-level (constrained relative velocity [m/s] and angular velocity [rad/s]); the rotation
-coordinates' health; the input angle against ``omega t``; the input, output and lost work and
-the change of mechanical energy over the revolution, hence each revolution's efficiency and the
-residual of its energy balance. The first revolution is a start-up (``STARTUP_REVOLUTIONS``).
+(a) The paper's scene with friction (:data:`.plan.DRIFT_SCENE`, converged coupling) with each
+node type of the spider and the output, all at :data:`.plan.DRIFT_STEPS_PER_REVOLUTION`. Per
+revolution: the largest violation of the pair constraints at position level (marker distance
+[m], axis misalignment [rad]) and at velocity level (constrained relative velocity [m/s] and
+angular velocity [rad/s]); the rotation coordinates' health (``| |p| - 1 |`` of Euler
+parameters, ``|nu|`` of rotation vectors, orthogonality of every rotation matrix); the input
+angle against ``omega t``; the input, output and lost work and the change of mechanical energy
+over the revolution, hence each revolution's efficiency and the residual of its energy balance.
+The first revolution is a start-up (:data:`.plan.STARTUP_REVOLUTIONS`).
 
-What "rotation-parameter drift" means per node type, and what the tests check:
+(b) The paper's frictionless joint driven by a torque of 0 (free spinning), no load, gravity on,
+from 2000 rpm: the total mechanical energy at each whole input revolution (the same input angle
+every time, so the periodic O(h^2) error within a revolution does not enter) relative to its
+start, for the default settings, a step ladder and a spectral-radius ladder
+(:func:`.plan.energy_plan`), compared with generalized-alpha's numerical damping
+``K c(rho) h^3`` (:data:`.plan.DISSIPATION_MODEL`); the reference engine (no time steps) runs the
+same scene as the yardstick of an integrator that does not dissipate.
 
-- ``EP``: the Euler parameters carry the algebraic constraint ``|p|^2 = 1``, solved by Newton
-  like the joints; ``| |p| - 1 |`` shows whether it is kept (Exudyn's rotation matrix is the
-  unnormalised formula, so a norm error would show as a non-orthogonal frame as well).
-- ``RotVecLG``: the rotation vector has no constraint; what matters is its size (Exudyn's update
-  lets ``|nu|`` reach the singular 2 pi; the model's post-step wrap keeps it within pi, so the
-  per-revolution maximum must not exceed pi) and ``A = exp(skew(nu))`` (orthogonal by
-  construction: its orthogonality error shows rounding only).
-- ``Rxyz``: ``A = Rx Ry Rz`` is orthogonal by construction, so its orthogonality error shows
-  rounding only. The input's first angle is the input angle (every node type keeps an Rxyz
-  input); the model's post-step hook keeps it, and every other Rxyz angle, within [-pi, pi] by
-  taking out whole revolutions, which it records for the input so that ``theta_in`` is the
-  continuous angle (``cardan_exudyn.model.build._wrap_rotations``). The coordinate therefore
-  rounds at 4.4e-16 rad at most (``input_angle_spacing_rad``), and its wander from ``omega t``
-  (the velocity-level drive holds the speed, nothing holds the angle) is the same rounding
-  pattern every revolution: linear, 7.3e-12 rad per 1000 revolutions, 1.5e-11 after 2000.
-
-Before that wrap the input angle was unbounded (12,566 rad after 2000 revolutions, rounding at
-1.8e-12 rad per step) and wandered by 7e-8 rad over 2000 revolutions, and **RotVecLG failed** at
-revolution 268 (t = 8.04 s, with and without friction): the spider's rotation vector passes the
-identity at every whole input revolution, and the step grid lands exactly there; Exudyn's
-``CompositionRotationVector`` (``w = pi - 2 atan2(x, sqrt(|1 - x^2|))``, ``x = cos(w/2)``) resolves
-angles near zero only in steps of about 3e-8 rad (it returns 0, 3.0e-8, 4.2e-8, ...), so at that
-step the input-spider pair was misaligned by the input's wander ``theta_in - 2 pi k`` (1e-11 rad
-after 30 revolutions, 1.3e-9 after 267), and once Newton could not accept that it could not
-represent the rotation that would remove it. The misalignment at those steps is now the wrapped
-coordinate's wander, 1.5e-11 rad after 2000 revolutions (linear; by extrapolation it would reach
-Newton's tolerance of 1e-10 after about 13,000 revolutions).
-
-Measured (full variant, with the wrap; EP's figures are from before it, whose only effect on EP is
-at rounding): Rxyz and EP keep positions on the constraints to rounding (4.3e-17 m, 4.5e-16 rad)
-for 2000 revolutions, their velocity residuals are periodic to 7 digits, ``| |p| - 1 |`` stays at
-2.2e-16, and the per-revolution efficiency has a scatter of 1.5e-8 and no trend (Rxyz: mean
-0.4757875, -8e-11 +- 6e-10 per 1000 revolutions). RotVecLG runs all 2000 revolutions (with
-friction 7.1 Newton iterations and 2.9 friction evaluations per step): positions 3.2e-17 m, axis
-misalignment 1.5e-11 rad (the identity steps above), velocity residuals and energy-balance
-residual periodic (last window / first window 1 - 3e-7, 1 + 1e-7), per-revolution efficiency mean
-0.4757889 (1.4e-6 above Rxyz's at this step), scatter 5.2e-8, trend 7e-10 +- 2e-9 per 1000
-revolutions. Its larger scatter comes from the same identity steps: at about a third of them
-(which ones depends on the rounding of the coordinates) the quantised composition leaves a
-velocity error, 2e-6 of the speed ratio, that decays over a few steps.
-
-The whole history of every step is kept in memory (node-state sensors, the friction log) and
-post-processed once per run with :func:`cardan_exudyn.model.postprocess.postprocess` (the engine's own
-definitions): 312,000 steps per run peak at about 1 GB, affordable; keeping every n-th step
-(``record.every``) would miss the per-step maxima and coarsen the per-revolution work
-integrals, and running in chunks would restart the integrator and the friction iteration at every
-chunk boundary, i.e. change the very run whose drift is measured.
-
-(b) Energy conservation
------------------------
-The paper's frictionless joint (10 and 35 deg) driven by a torque of 0 (free spinning), no
-load, gravity on (potential energy is in the table), from 2000 rpm, for
-1000 revolutions. The total mechanical energy is read at each whole input
-revolution (the same input angle every time, so the periodic O(h^2) error of the energy within a
-revolution, 1e-5 to 7e-4 of it, does not enter) relative to its start. Generalized-alpha with a
-spectral radius below one dissipates: its damping ratio on the linear oscillator is
-``c(rho) (Omega h)^3`` (:func:`.longrun_measures.algorithmic_damping`), and the measured loss per revolution
-follows ``K c(rho) h^3`` within 1.3 % over a step ladder (h^2.98 to h^3.03) and spectral radii
-0.3 to 0.9 (``longrun_plan.DISSIPATION_MODEL``); the tests hold the default settings to that model with
-a margin. The default settings are what a user gets without options: the engine's automatic step
-at the default ``numerics.accuracy`` and the default spectral radius. Since the default accuracy is
-1e-3 (issue 18) that step is the floor of 100 steps per revolution at both angles (it was 156 and
-741 at 1e-5), the ladder's first rung, so the ladder runs it once, as the default case
-(``longrun_plan.energy_plan``). A spectral radius of 1 is refused by ``ExudynOptions``; 0.99 fails within 14
-revolutions at 200 steps per revolution (index-3 constraints without numerical damping). The
-reference engine (no time steps; DOP853 at rtol 1e-11 on the one degree of freedom) runs the same
-scene for 20 revolutions: its drift per revolution is the yardstick
-of an integrator that does not dissipate.
+Every step of a run is kept in memory (node-state sensors, the friction log) and post-processed
+once with :func:`cardan_exudyn.model.postprocess.postprocess` (the engine's own definitions):
+keeping every n-th step would miss the per-step maxima and coarsen the per-revolution work
+integrals, and running in chunks would restart the integrator and the friction iteration at
+every chunk boundary, changing the very run whose drift is measured.
 """
 
 from __future__ import annotations
@@ -103,12 +44,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn.engines import run
-from cardan_exudyn.model.build import ExudynModel
-from cardan_exudyn.model.options import ExudynOptions
-from cardan_exudyn.model.postprocess import body_states, mechanical_energy, postprocess, stored
-from cardan_exudyn.model.solve import solve
-from cardan_exudyn.studies.stress.longrun_measures import (
+from benchmarks.longrun.measures import (
     at_revolutions,
     energy_measures,
     pair_violations,
@@ -117,7 +53,7 @@ from cardan_exudyn.studies.stress.longrun_measures import (
     rotation_health,
     whole_revolutions,
 )
-from cardan_exudyn.studies.stress.longrun_plan import (
+from benchmarks.longrun.plan import (
     DRIFT_SCENE,
     DRIFT_STEPS_PER_REVOLUTION,
     ENGINE,
@@ -130,12 +66,15 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     energy_plan,
     energy_scene,
 )
-from cardan_exudyn.studies.stress.longrun_summary import summarise
-from reference.engine.options import ReferenceOptions
-from reference.results.means import cumulative
-from reference.results.summary import Status
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from benchmarks.longrun.summary import summarise
+from cardan_exudyn.engines import run
+from cardan_exudyn.model.build import ExudynModel
+from cardan_exudyn.model.options import ExudynOptions
+from cardan_exudyn.model.postprocess import body_states, mechanical_energy, postprocess, stored
+from cardan_exudyn.model.solve import solve
+from reference.engine.solve import ReferenceOptions
+from reference.results.schema import Status, cumulative
+from reference.scene.scene import Scene, replace
 
 Say = Callable[[str], None]
 #: An energy case: label, function, its arguments but the label, engine, spectral radius, steps.
@@ -166,7 +105,7 @@ def simulate(scene: Scene, options: ExudynOptions,
                "dt_choice": solved.dt_reason, "newton_iterations": int(solved.solver.it.newtonStepsCount),
                "solve_wall_time_s": solved.wall_time_s, "wall_time_s": time.perf_counter() - wall_start}
     if model.friction is not None:
-        summary["friction"] = model.friction.diagnostics().to_dict()
+        summary["friction"] = model.friction.summary()
     return summary, model, cols
 
 
@@ -353,7 +292,7 @@ def _energy_frame(info: dict[str, Any], relative: np.ndarray, steps: int | None)
 
 
 def energy_cases(plan: LongRunPlan, angle: float) -> list[EnergyCase]:
-    """The energy cases at one shaft angle [deg]: Exudyn's (:func:`.longrun_plan.energy_plan`)
+    """The energy cases at one shaft angle [deg]: Exudyn's (:func:`.plan.energy_plan`)
     and the reference engine's."""
     cases = [(case_label(ENGINE, angle, steps, rho), energy_case_exudyn,
               (angle, plan.energy_revolutions, steps, rho), ENGINE, rho, steps)
@@ -385,13 +324,19 @@ def long_runs(quick: bool = False, progress: Say | None = None,
     Parameters
     ----------
     quick : bool
-        The :data:`~.longrun_plan.QUICK` variant (20 revolutions with friction for Rxyz and EP,
+        The :data:`~.plan.QUICK` variant (20 revolutions with friction for Rxyz and EP,
         20 free-spinning revolutions at 35 deg with a short ladder, the reference engine for 2)
-        instead of :data:`~.longrun_plan.FULL`; the first/last windows shrink to a quarter of the run.
+        instead of :data:`~.plan.FULL`; the first/last windows shrink to a quarter of the run.
     progress : callable, optional
         Called with a line of text as each run starts and ends.
     plan : LongRunPlan, optional
         Another variant (overrides ``quick``).
+
+    Returns
+    -------
+    LongRuns
+        The per-revolution drift rows, the relative energy per revolution of every energy case,
+        and the summary (:func:`.summary.summarise`).
     """
     plan = plan or (QUICK if quick else FULL)
     say = progress or (lambda text: None)

@@ -1,4 +1,4 @@
-"""The skip audit of ``cardan bench``: what each thing the Exudyn build leaves out (or each solver
+"""The skip audit: what each thing the Exudyn build leaves out (or each solver
 choice) saves, measured as pairs of runs that differ in that item only.
 
 Items the engine's options or the scene can switch run through :func:`cardan_exudyn.engines.run`;
@@ -29,10 +29,9 @@ from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, SCENES, Progress, quiet, simulated_time
-from reference.paper.scenes import named_scene
-from reference.results.summary import Status
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from reference.paper.paper import named_scene
+from reference.results.schema import Status
+from reference.scene.scene import Scene, replace
 
 __all__ = ["AUDIT_SCENE", "Tweak", "Clock", "AuditItem", "run_wall", "solve_only", "audit_items",
            "skip_audit"]

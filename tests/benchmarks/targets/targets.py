@@ -1,56 +1,47 @@
-"""The speed targets of ``cardan bench`` (:data:`TARGETS`), evaluated side by side from one bench
-run (:func:`evaluate_targets`), the friction-cost ladders (:func:`friction_ladders`), and the
-timing of the paper's eleven scenes with Exudyn and the reference engine
-(:func:`paper_scenes_timing`).
+"""The speed targets of the project (:data:`TARGETS`), evaluated side by side from one bench run
+(:func:`evaluate_targets`), and the friction-cost ladders (:func:`friction_ladders`): every
+Exudyn run on a friction scene next to its frictionless twin at the same step.
+
+Measured: ``docs/benchmarks.md`` (*Speed targets*).
 """
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn import engines
-from cardan_exudyn.model.options import ExudynOptions
+from benchmarks.startup import IMPORT_TARGET_MS
 from cardan_exudyn.report.format import number
-from cardan_exudyn.studies.bench.configs import (
-    EXUDYN_TUNED,
-    SCENES,
-    Progress,
-    frictionless_twin_config,
-    frictionless_twin_scene,
-    is_friction_scene,
-    quiet,
-)
-from cardan_exudyn.studies.bench.ladders import yardstick
-from cardan_exudyn.studies.bench.startup import IMPORT_TARGET_MS
-from reference.engine.options import ReferenceOptions
-from reference.paper.cases import paper_cases
-from reference.paper.scenes import paper_scene
-from reference.results.result import Result
-from reference.results.summary import Status
-from reference.scene.mapping import replace
-from reference.scene.scene import Scene
+from cardan_exudyn.studies.bench.configs import SCENES
+from cardan_exudyn.studies.bench.result import cheapest
+from reference.results.schema import Status
+from reference.scene.scene import COUPLINGS
 
 __all__ = ["SPEED_RATIO_TARGET", "EFFICIENCY_TARGET", "FRICTION_COST_TARGET", "KINEMATICS_TARGET",
            "PAPER_EXUDYN_TARGET_S", "PAPER_REFERENCE_TARGET_S", "STARTUP_TARGET_MS", "TARGETS",
-           "PAPER_EXUDYN_STEPS", "PAPER_EXUDYN_COUPLING", "PAPER_REFERENCE_OPTIONS", "paper_exudyn_scene",
-           "KINEMATICS_SCENES", "cheapest", "evaluate_targets", "friction_ladders",
-           "startup_target", "paper_scenes", "paper_scenes_timing"]
+           "KINEMATICS_SCENES", "is_friction_scene", "frictionless_twin_scene",
+           "frictionless_twin_config", "select", "best", "evaluate_targets", "friction_ladders",
+           "paper_targets", "startup_target"]
 
-SPEED_RATIO_TARGET = 2e-5      # equal-accuracy level of the kinematic target [-]
-EFFICIENCY_TARGET = 1e-4       # mean-efficiency accuracy of the friction targets [-]
-FRICTION_COST_TARGET = 1.5     # friction run / frictionless run at the same step [-]
-KINEMATICS_TARGET = 1.0        # Exudyn / MuJoCo wall time per simulated second [-]
-PAPER_EXUDYN_TARGET_S = 2.0    # the eleven paper scenes with Exudyn [s]
-PAPER_REFERENCE_TARGET_S = 0.5  # ... with the reference engine [s]
-STARTUP_TARGET_MS = IMPORT_TARGET_MS  # import cost of `cardan run` before its engine runs [ms]
+SPEED_RATIO_TARGET = 2e-5
+"""Equal-accuracy level of the kinematic target: largest speed-ratio error [-]."""
+EFFICIENCY_TARGET = 1e-4
+"""Mean-efficiency accuracy of the friction and paper targets [-]."""
+FRICTION_COST_TARGET = 1.5
+"""Friction run over the frictionless run at the same step, wall time per simulated second [-]."""
+KINEMATICS_TARGET = 1.0
+"""Exudyn over MuJoCo, wall time per simulated second at equal accuracy [-]."""
+PAPER_EXUDYN_TARGET_S = 2.0
+"""The eleven paper scenes with Exudyn, one after the other [s]."""
+PAPER_REFERENCE_TARGET_S = 0.5
+"""The eleven paper scenes with the reference engine [s]."""
+STARTUP_TARGET_MS = IMPORT_TARGET_MS
+"""Import cost of ``cardan run`` before its engine runs [ms]."""
 KINEMATICS_SCENES = ("frictionless-35deg", "frictionless-10deg")
-"""Scenes of the kinematic target (the issue's is the 35 deg one; 10 deg is shown beside it)."""
+"""Scenes of the kinematic target (35 deg the target's, 10 deg shown beside it)."""
 TARGETS = {
     "kinematics": f"frictionless: Exudyn's cheapest run with a speed-ratio error <= "
                   f"{SPEED_RATIO_TARGET:g} and a drive-torque error after rev. 1 no larger than "
@@ -66,13 +57,6 @@ TARGETS = {
     "startup": f"import cost of `cardan run` up to its engine dispatch (the scene's build included) "
                f"<= {STARTUP_TARGET_MS:g} ms",
 }
-# The paper scenes' Exudyn run: the one-solve coupling, each scene at the step the engine plans
-# for `numerics.accuracy` = EFFICIENCY_TARGET (what a user asking for 1e-4 gets, pilot run
-# included); a fixed number of steps per revolution instead is a choice made knowing the errors.
-# Both are parameters of `paper_scenes_timing` and of `cardan bench --paper-steps/--paper-coupling`.
-PAPER_EXUDYN_STEPS: int | str = "auto"
-PAPER_EXUDYN_COUPLING = "extrapolated"
-PAPER_REFERENCE_OPTIONS = ReferenceOptions(samples_per_revolution=36, quadrature_rtol=1e-6)
 
 
 def select(rows: pd.DataFrame, **values: Any) -> pd.DataFrame:
@@ -83,16 +67,23 @@ def select(rows: pd.DataFrame, **values: Any) -> pd.DataFrame:
     return rows[mask]
 
 
-def cheapest(rows: pd.DataFrame, levels: Mapping[str, float]) -> pd.Series | None:
-    """The ok row with the least wall time per simulated second whose every error column of
-    ``levels`` is at most its level (a NaN error never is); None when no row qualifies."""
-    ok = (rows["status"] == Status.OK) & rows["wall_per_simulated_s"].notna()
-    for column, level in levels.items():
-        ok &= rows[column].astype(float) <= level
-    ok_rows = rows[ok.to_numpy()]
-    if ok_rows.empty:
-        return None
-    return ok_rows.loc[ok_rows["wall_per_simulated_s"].idxmin()]
+def is_friction_scene(key: str) -> bool:
+    """True for the default scene keys with friction (``friction-...``)."""
+    return key.startswith("friction-")
+
+
+def frictionless_twin_scene(key: str) -> str:
+    """The frictionless scene key at the same geometry as the friction scene key ``key``."""
+    return key.replace("friction-", "frictionless-", 1)
+
+
+def frictionless_twin_config(label: str) -> str:
+    """The frictionless configuration a friction configuration's cost is compared with: the same
+    label without its friction coupling (``"exudyn tuned lagged"`` -> ``"exudyn tuned"``)."""
+    for coupling in COUPLINGS:
+        if label.endswith(" " + coupling):
+            return label[:-len(coupling) - 1]
+    return label
 
 
 def best(rows: pd.DataFrame, error: str, level: float) -> pd.Series | None:
@@ -117,8 +108,9 @@ def kinematics_detail(ex: pd.Series | None, mj: pd.Series | None) -> str:
     def both(key: str) -> tuple[str, str]:
         return number(value(ex, key), ".3g"), number(value(mj, key), ".3g")
 
-    walls, ratios, torques = (both("wall_per_simulated_s"), both("speed_ratio_error"),
-                              both("torque_in_error_steady"))
+    walls = both("wall_per_simulated_s")
+    ratios = both("speed_ratio_error")
+    torques = both("torque_in_error_steady")
     return (f"wall per simulated second Exudyn {walls[0]} s, MuJoCo {walls[1]} s; speed-ratio "
             f"error {ratios[0]} vs {ratios[1]}; drive-torque error after rev. 1 {torques[0]} vs "
             f"{torques[1]}")
@@ -227,7 +219,7 @@ def paper_targets(paper: Mapping[str, Any]) -> list[dict[str, Any]]:
 
 
 def startup_target(startup: Mapping[str, Any]) -> dict[str, Any]:
-    """The import cost of ``cardan run`` (:func:`cardan_exudyn.studies.bench.startup.import_cost`:
+    """The import cost of ``cardan run`` (:func:`benchmarks.startup.import_cost`:
     its ``import_ms``, the imports up to the engine dispatch, scene build included) against its
     limit."""
     measured = float(startup["import_ms"])
@@ -248,12 +240,13 @@ def evaluate_targets(rows: pd.DataFrame, paper: Mapping[str, Any] | None,
     Parameters
     ----------
     rows : pandas.DataFrame
-        The work-precision rows (:func:`cardan_exudyn.studies.bench.ladders.work_precision`).
+        The work-precision rows (:func:`cardan_exudyn.studies.bench.ladders.work_precision`) of
+        the default scenes, keyed as :data:`cardan_exudyn.studies.bench.configs.SCENES`.
     paper : dict or None
-        The paper scenes' timing (:func:`paper_scenes_timing`), None when not run.
+        The paper scenes' timing (:func:`benchmarks.targets.paper.paper_scenes_timing`), None
+        when not run.
     startup : dict or None
-        The import cost (:func:`cardan_exudyn.studies.bench.startup.import_cost`), None when not
-        measured.
+        The import cost (:func:`benchmarks.startup.import_cost`), None when not measured.
 
     Returns
     -------
@@ -276,79 +269,3 @@ def evaluate_targets(rows: pd.DataFrame, paper: Mapping[str, Any] | None,
     if startup:
         out.append(startup_target(startup))
     return out
-
-
-def paper_scenes(parameters: str = "literal") -> list[Scene]:
-    """The paper's eleven scenes with friction (Table 2 and the speed study), summary only."""
-    return [replace(paper_scene(c["shaft_angle_deg"], c["speed_rpm"], parameters=parameters),
-                    **{"record.timeseries": False}) for c in paper_cases()]
-
-
-def timing_part(config: str, walls: list[float], results: list[Result], exact: list[float],
-                scenes: list[Scene]) -> dict[str, Any]:
-    """One engine's entry of :func:`paper_scenes_timing`; ``steps_per_revolution`` per scene
-    from each run's step (None where a run has none)."""
-    errors = [abs(r.summary.mean_efficiency - e) if r.success else float("nan")
-              for r, e in zip(results, exact, strict=True)]
-    finite = [e for e in errors if np.isfinite(e)]
-    steps = [round(2.0 * math.pi / s.drive.max_speed() / r.summary.dt) if r.summary.dt else None
-             for r, s in zip(results, scenes, strict=True)]
-    return {"config": config, "wall_s": float(np.median(walls)), "walls_s": walls,
-            "max_error": max(finite) if finite else float("nan"), "errors": errors,
-            "failed": sum(not r.success for r in results), "repeats": len(walls),
-            "scenes": [s.name for s in scenes], "steps_per_revolution": steps}
-
-
-def paper_exudyn_scene(scene: Scene, steps: int | str, coupling: str) -> Scene:
-    """``scene`` as :func:`paper_scenes_timing` runs it with Exudyn: ``steps`` per revolution, or
-    (``"auto"``) no step and ``numerics.accuracy`` = :data:`EFFICIENCY_TARGET`; ``coupling``."""
-    if steps == "auto":
-        return replace(scene, **{"numerics.dt": None, "numerics.accuracy": EFFICIENCY_TARGET,
-                                 "friction.coupling": coupling})
-    return replace(scene, **{"numerics.dt": 2.0 * math.pi / scene.drive.max_speed() / steps,
-                             "friction.coupling": coupling})
-
-
-def paper_scenes_timing(repeats: int = 3, exudyn_steps: int | str = PAPER_EXUDYN_STEPS,
-                        exudyn_options: ExudynOptions = EXUDYN_TUNED,
-                        reference_options: ReferenceOptions = PAPER_REFERENCE_OPTIONS,
-                        progress: Progress | None = None,
-                        exudyn_coupling: str = PAPER_EXUDYN_COUPLING) -> dict[str, Any]:
-    """Wall time of the eleven scenes, one after the other in this process, per engine.
-
-    Exudyn runs at ``exudyn_steps`` per revolution (``"auto"``: the step it plans for
-    ``numerics.accuracy`` = :data:`EFFICIENCY_TARGET`, from a pilot run when ``exudyn_options``
-    has no error estimate) with ``exudyn_options`` and the friction coupling ``exudyn_coupling``;
-    the reference with ``reference_options``. Errors are against the reference at its default
-    (tight) settings.
-
-    Returns
-    -------
-    dict
-        Per engine (``exudyn``, ``reference``): ``config``, ``wall_s`` (median of the rounds)
-        and ``walls_s`` [s], ``errors`` and ``max_error`` (mean efficiency) [-], ``failed``,
-        ``repeats``, ``scenes``.
-    """
-    say = progress or quiet
-    scenes = paper_scenes()
-    exact = [yardstick(s).summary.mean_efficiency for s in scenes]
-
-    # the scenes are built before the clock starts: the rounds time the engines' runs only
-    ex_scenes = [paper_exudyn_scene(s, exudyn_steps, exudyn_coupling) for s in scenes]
-    runners = {"exudyn": lambda: [engines.run(s, "exudyn", exudyn_options) for s in ex_scenes],
-               "reference": lambda: [engines.run(s, "reference", reference_options) for s in scenes]}
-    walls: dict[str, list[float]] = {k: [] for k in runners}
-    last: dict[str, list[Result]] = {}
-    for round_ in range(repeats):
-        for engine, runner in runners.items():
-            start = time.perf_counter()
-            last[engine] = runner()
-            walls[engine].append(time.perf_counter() - start)
-            say(f"paper scenes round {round_ + 1}/{repeats} {engine}: {walls[engine][-1]:.2f} s")
-    steps = (f"its own step for accuracy {EFFICIENCY_TARGET:g}" if exudyn_steps == "auto"
-             else f"{exudyn_steps} steps/rev")
-    configs = {"exudyn": f"tuned, {exudyn_coupling} coupling, {steps}",
-               "reference": f"samples {reference_options.samples_per_revolution}/rev, quadrature "
-                            f"rtol {reference_options.quadrature_rtol:g}"}
-    return {engine: timing_part(configs[engine], walls[engine], results, exact, scenes)
-            for engine, results in last.items()}

@@ -4,7 +4,7 @@ angle, the order of the energy loss in the step and its dependence on the spectr
 plain sentences for what did not run through.
 
 Measurements only: the tolerances these figures are held to, each with its reason, are the
-tests of ``tests/test_longrun.py``.
+tests of ``tests/benchmarks/test_longrun.py``.
 """
 
 from __future__ import annotations
@@ -15,10 +15,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn.model.options import ExudynOptions
-from cardan_exudyn.report.format import number
-from cardan_exudyn.studies.stress.longrun_measures import damping_coefficient, first_last, linear_trend, window_size
-from cardan_exudyn.studies.stress.longrun_plan import (
+from benchmarks.longrun.measures import damping_coefficient, first_last, linear_trend, window_size
+from benchmarks.longrun.plan import (
     DEFAULT_RHO,
     ENGINE,
     RHO_LADDER_STEPS,
@@ -27,7 +25,9 @@ from cardan_exudyn.studies.stress.longrun_plan import (
     LongRunPlan,
     settings,
 )
-from reference.results.summary import Status
+from cardan_exudyn.model.options import ExudynOptions
+from cardan_exudyn.report.format import number
+from reference.results.schema import Status
 
 DRIFT_MEASURES = ("position_violation_m", "angle_violation_rad", "velocity_violation_m_s",
                   "angular_velocity_violation_rad_s", "orthogonality_error", "ep_norm_error",
