@@ -117,7 +117,8 @@ def as_angle_history(scene: Scene) -> Scene:
 def audit_items(base: Scene, folder: str, clock: Clock = time.perf_counter) -> list[AuditItem]:
     """The audited items on the summary-only scene ``base``, timed by ``clock``; ``folder`` takes
     the solution file."""
-    tuned, everything = EXUDYN_TUNED, dc_replace(EXUDYN_TUNED, sensors="all")
+    tuned = EXUDYN_TUNED
+    everything = dc_replace(EXUDYN_TUNED, sensors="all")
 
     def full(scene: Scene, options: ExudynOptions) -> Callable[[], float]:
         return lambda: run_wall(scene, options, clock)
@@ -204,7 +205,8 @@ def fast_module_row(steps: int, revolutions: float, repeats: int) -> dict[str, A
     """The range-checks item: the regular against the fast module, two child processes each."""
     item = "range checks (regular module)"
     try:
-        regular, fast = [], []
+        regular = []
+        fast = []
         for _ in range(2):
             regular.append(fast_module_time(AUDIT_SCENE, steps, revolutions, repeats, False))
             fast.append(fast_module_time(AUDIT_SCENE, steps, revolutions, repeats, True))

@@ -143,7 +143,8 @@ def import_cost(repeats: int = 5, *, bytecode_cache: bool = True, python: str | 
         env = _environment(os.path.join(folder, "pycache") if bytecode_cache else None)
         if bytecode_cache:
             _one_run(python, env, folder, timeout)  # fills the cache; not counted
-        runs, floor = [], []
+        runs = []
+        floor = []
         for _ in range(repeats):  # interleaved, so that both see the same load of the machine
             runs.append(_one_run(python, env, folder, timeout))
             floor.append(sum(_one_run(python, env, folder, timeout, BASELINE_CODE)[0].values()) / 1000)

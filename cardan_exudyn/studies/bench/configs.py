@@ -151,6 +151,7 @@ class Config:
     sets_step: bool = True
 
     def __post_init__(self) -> None:
+        """Store ``changes`` as a sorted tuple of pairs (hashable)."""
         object.__setattr__(self, "changes", frozen_changes(self.changes))
 
     @property
@@ -191,6 +192,13 @@ def exudyn_settings(friction: bool, quick: bool) -> list[Setting]:
     the scene's default: ``default`` and ``tuned`` the converged one, ``tuned extrapolated`` the
     one-solve scheme, ``tuned lagged`` the paper's. Without friction: the velocity projection,
     and the projection with Richardson extrapolation of two runs (``numerics.richardson``).
+
+    Parameters
+    ----------
+    friction : bool
+        The scene has friction.
+    quick : bool
+        Leave out the other node types.
     """
     converged = {"friction.coupling": "converged"} if friction else {}
     out: list[Setting] = [("exudyn default", EXUDYN_DEFAULT, converged),
@@ -209,8 +217,16 @@ def exudyn_settings(friction: bool, quick: bool) -> list[Setting]:
 
 
 def exudyn_configs(friction: bool, quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """Every Exudyn setting on the ladder (quick: :data:`QUICK_FULL_LADDER` on all of it, the
-    others on its first two steps)."""
+    """Every Exudyn setting on the ladder.
+
+    Parameters
+    ----------
+    friction, quick : bool
+        As :func:`exudyn_settings`; ``quick`` also runs only :data:`QUICK_FULL_LADDER` on the whole
+        ladder, the others on its first two steps.
+    ladder : dict
+        Engine -> steps per revolution [-] (:data:`FULL_LADDER` or :data:`QUICK_LADDER`).
+    """
     out = []
     for label, options, changes in exudyn_settings(friction, quick):
         steps = ladder["exudyn"]
@@ -221,7 +237,17 @@ def exudyn_configs(friction: bool, quick: bool, ladder: dict[str, tuple[int, ...
 
 
 def mujoco_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """MuJoCo, RK4, constraint time constants 10 and 20 (recommended) steps on the ladder."""
+    """MuJoCo, RK4, constraint time constants of 10 and (not ``quick``) 20 steps, the
+    recommended one, on the ladder's MuJoCo steps (``ladder["mujoco"]`` per revolution); none without
+    the optional extra.
+
+    Parameters
+    ----------
+    quick : bool
+        The time constant of 10 steps only.
+    ladder : dict
+        Engine -> steps per revolution [-].
+    """
     out = []
     for tc in ((10.0,) if quick else (10.0, 20.0)):
         try:
@@ -234,7 +260,16 @@ def mujoco_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Conf
 
 
 def reference_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """The reference engine at quadrature tolerances 1e-9, 1e-6, 1e-4 and its table samples."""
+    """The reference engine at quadrature tolerances 1e-9, 1e-6, 1e-4 (``quick``: 1e-6) and
+    the ladder's table samples per revolution (``ladder["reference"]``).
+
+    Parameters
+    ----------
+    quick : bool
+        One tolerance.
+    ladder : dict
+        Engine -> table samples per revolution [-].
+    """
     return [Config("reference", f"reference rtol {rtol:g}", n,
                    ReferenceOptions(samples_per_revolution=n, quadrature_rtol=rtol), sets_step=False)
             for rtol in ((1e-6,) if quick else (1e-9, 1e-6, 1e-4)) for n in ladder["reference"]]
@@ -247,6 +282,15 @@ def configurations(scene: Scene, quick: bool = False,
 
     MuJoCo runs frictionless scenes without mounting errors only: it has no friction
     proportional to the reactions, and its joints are the ideal joint's.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene benchmarked.
+    quick : bool
+        The short ladders (:data:`QUICK_LADDER`) and fewer settings.
+    engines : iterable of str
+        The engines to configure (of :data:`ENGINE_NAMES`).
     """
     engines = set(engines)
     ladder = QUICK_LADDER if quick else FULL_LADDER

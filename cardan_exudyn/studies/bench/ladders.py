@@ -74,6 +74,15 @@ def yardstick(scene: Scene) -> Yardstick:
 def run_errors(scene: Scene, result: Result, yard: Yardstick) -> dict[str, float]:
     """Error measures of one run against the reference (NaN when the run has no table/means).
 
+    Parameters
+    ----------
+    scene : Scene
+        The scene the run was made of.
+    result : Result
+        The run, with its time table.
+    yard : Yardstick
+        The reference's answer for ``scene`` (:func:`yardstick`).
+
     Returns
     -------
     dict
@@ -87,7 +96,7 @@ def run_errors(scene: Scene, result: Result, yard: Yardstick) -> dict[str, float
     out = dict.fromkeys(ERROR_KEYS, float("nan"))
     if not result.success or result.table is None:
         return out
-    out.update(table_errors(scene, result.table, yard))
+    out.update(_table_errors(scene, result.table, yard))
     summary = result.summary
     exact = yard.summary
     if scene.has_friction:
@@ -97,8 +106,10 @@ def run_errors(scene: Scene, result: Result, yard: Yardstick) -> dict[str, float
     return out
 
 
-def table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[str, float]:
-    """The speed-ratio and drive-torque errors of a run's time table (see :func:`run_errors`)."""
+def _table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[str, float]:
+    """The speed-ratio and drive-torque errors of a run's time ``table`` of ``scene``
+    against the reference's ``yard`` (the first three keys of :func:`run_errors`).
+    """
     t = table["t"].to_numpy()
     theta = table["theta_in"].to_numpy()
     ratio = table["omega_out"].to_numpy() / table["omega_in"].to_numpy()
@@ -141,7 +152,17 @@ class Job:
 
 
 def bench_jobs(scenes: Mapping[str, Scene], quick: bool, engines: Iterable[str]) -> list[Job]:
-    """Every configuration of every scene (key -> scene), with the scene's yardstick."""
+    """Every configuration of every scene, with the scene's yardstick.
+
+    Parameters
+    ----------
+    scenes : mapping of str to Scene
+        Key -> scene; the key is the rows' ``scene``.
+    quick : bool
+        The short ladders.
+    engines : iterable of str
+        The engines to run.
+    """
     jobs = []
     for key, base in scenes.items():
         yard = yardstick(base)
@@ -151,7 +172,21 @@ def bench_jobs(scenes: Mapping[str, Scene], quick: bool, engines: Iterable[str])
 
 
 def timed_run(config: Config, scene: Scene) -> tuple[Result | None, str, float]:
-    """The result (None when the run raised), the error it raised and the wall time [s]."""
+    """One run of a configuration, timed.
+
+    Parameters
+    ----------
+    config : Config
+        The configuration.
+    scene : Scene
+        Its scene (``config.scene(base)``).
+
+    Returns
+    -------
+    (Result or None, str, float)
+        The result (None when the run raised), the error it raised (empty when none) and the wall
+        time [s].
+    """
     start = time.perf_counter()
     result = None
     error = ""
@@ -162,8 +197,10 @@ def timed_run(config: Config, scene: Scene) -> tuple[Result | None, str, float]:
     return result, error, time.perf_counter() - start
 
 
-def first_record(job: Job, result: Result | None, error: str) -> dict[str, Any]:
-    """The row of ``job`` from its first run: configuration, status, errors, cost counters."""
+def _first_record(job: Job, result: Result | None, error: str) -> dict[str, Any]:
+    """The row of ``job`` from its first run (``result``, None with the ``error`` it raised):
+    configuration, status, errors, cost counters, simulated time [s].
+    """
     record = {"scene": job.key, **job.config.describe()}
     # the coupling that ran (the scene's own where the configuration does not set one)
     record["coupling"] = job.scene.friction.coupling if job.scene.has_friction else None
@@ -178,7 +215,7 @@ def first_record(job: Job, result: Result | None, error: str) -> dict[str, Any]:
     return record
 
 
-def finished_row(job: Job) -> dict[str, Any]:
+def _finished_row(job: Job) -> dict[str, Any]:
     """The record of ``job`` with its median wall time [s] and per simulated second [-]."""
     wall = float(np.median(job.walls)) if job.walls else float("nan")
     return {**job.record, "wall_s": wall, "wall_per_simulated_s": wall / job.record["simulated_s"],
@@ -218,8 +255,8 @@ def work_precision(scenes: Mapping[str, Scene], quick: bool, repeats: int,
             if result is not None and result.success:
                 job.walls.append(wall)
             if job.record is None:
-                job.record = first_record(job, result, error)
+                job.record = _first_record(job, result, error)
             say(f"[{round_ * len(jobs) + i + 1}/{len(jobs) * repeats} "
                 f"{time.perf_counter() - start:6.1f} s] {job.key:20s} {job.config.label:28s} "
                 f"n={job.config.steps:<5d} {wall:7.3f} s {job.record['status']}")
-    return pd.DataFrame([finished_row(job) for job in jobs])
+    return pd.DataFrame([_finished_row(job) for job in jobs])

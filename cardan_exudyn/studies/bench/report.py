@@ -34,8 +34,15 @@ MARKERS = {"exudyn": "o", "mujoco": "s", "reference": "^"}
 
 
 def header(env: Mapping[str, Any], title: str = "cardan bench") -> str:
-    """The ``#`` lines that open a results file: ``title`` and date, commit, CPU, Python and
-    packages of the environment ``env`` (:func:`cardan_exudyn.report.environment.environment`)."""
+    """The ``#`` lines that open a results file.
+
+    Parameters
+    ----------
+    env : mapping
+        :func:`cardan_exudyn.report.environment.environment`'s date, commit, CPU, Python, packages.
+    title : str
+        The first line's title.
+    """
     lines = [f"# {title}, {env['date']}", f"# commit {env['commit']}",
              f"# cpu {env['cpu']} ({env['cpu_count']} logical), {env['platform']}",
              f"# python {env['python']}, " + ", ".join(f"{k} {v}" for k, v in env["packages"].items())]
@@ -43,8 +50,17 @@ def header(env: Mapping[str, Any], title: str = "cardan bench") -> str:
 
 
 def table(frame: pd.DataFrame, columns: Sequence[str], formats: Mapping[str, str] | None = None) -> str:
-    """``frame`` as a markdown table: float columns to three significant digits unless
-    ``formats`` gives their format."""
+    """A markdown table.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The rows.
+    columns : sequence of str
+        The columns shown.
+    formats : mapping, optional
+        Column -> format spec; float columns default to three significant digits.
+    """
     floats = {c: ".3g" for c in columns if c in frame and frame[c].dtype.kind == "f"}
     return markdown_table(frame, columns, {**floats, **(formats or {})})
 
@@ -67,8 +83,17 @@ def bench_command(settings: Mapping[str, Any]) -> str:
 
 
 def intro(result: BenchResult, title: str = "cardan bench", command: str | None = None) -> str:
-    """Title, environment, how to read the numbers, and the ``command`` that ran them (none:
-    not said)."""
+    """Title, environment and how to read the numbers.
+
+    Parameters
+    ----------
+    result : BenchResult
+        The bench.
+    title : str
+        The heading.
+    command : str, optional
+        The command line that ran the bench (none: not said).
+    """
     env = result.environment
     return (f"# {title}{' (quick)' if result.settings.get('quick') else ''}\n"
             f"{env['date']}, commit `{env['commit']}`, {env['cpu']} ({env['cpu_count']} logical "
@@ -154,7 +179,20 @@ def work_precision_figure(rows: pd.DataFrame, panels: Mapping[str, tuple[str, fl
 
 
 def write_bench(result: BenchResult, out: str | os.PathLike) -> Path:
-    """Write the results folder ``out`` (replaced as a whole, atomically); returns its path."""
+    """Write the results folder of a bench (replaced as a whole, atomically).
+
+    Parameters
+    ----------
+    result : BenchResult
+        The bench.
+    out : path
+        The folder: ``bench.csv``, ``bench.json``, ``report.md``, ``work_precision.png``.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
     from cardan_exudyn.report.plots import close  # import cost, as above
 
     panels = {key: (accuracy_measure(scene), scene.numerics.accuracy)

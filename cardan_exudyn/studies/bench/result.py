@@ -119,7 +119,16 @@ def at_accuracy(result: BenchResult) -> list[dict[str, Any]]:
 
 
 def check_inputs(engines: Iterable[str], repeats: int | None, quick: bool) -> tuple[list[str], int]:
-    """The engines and repeats of a bench run (default repeats filled in: 3, quick 1).
+    """The engines and repeats of a bench run (default repeats filled in).
+
+    Parameters
+    ----------
+    engines : iterable of str
+        Of :data:`~cardan_exudyn.studies.bench.configs.ENGINE_NAMES`.
+    repeats : int or None
+        Timed runs per configuration (None: 3, quick 1).
+    quick : bool
+        The quick bench.
 
     Raises
     ------

@@ -34,8 +34,25 @@ __all__ = ["METHOD", "BOUND_TOL", "corner_scan", "refine", "at_bounds", "envelop
 
 def corner_scan(model: CaseModel, space: Space, combinations: list[dict[str, str]],
                 cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Every corner of ``space`` under every combination: ``u``, ``choices`` and the mean
-    efficiency of each case (NaN where the run failed)."""
+    """Every corner of ``space`` under every combination of discrete choices.
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    space : Space
+        The open numbers and their map to the unit box.
+    combinations : list of dict
+        The discrete choices to combine with each corner.
+    cases : list of dict
+        The paper cases.
+
+    Returns
+    -------
+    list of dict
+        Per point: ``u`` (unit box), ``choices`` and ``eta``, the mean efficiency of each case
+        [-] (NaN where the run failed).
+    """
     points = []
     for choices in combinations:
         for u in space.corners():
@@ -47,13 +64,32 @@ def corner_scan(model: CaseModel, space: Space, combinations: list[dict[str, str
 
 def refine(model: CaseModel, space: Space, case: Mapping[str, Any], point: Mapping[str, Any],
            sign: float) -> tuple[float, np.ndarray]:
-    """Bounded local optimisation of ``sign * eta`` of ``case`` from a corner ``point``; the
-    extreme efficiency [-] and its ``u``."""
+    """Bounded local optimisation of ``sign * eta`` of ``case`` from a corner.
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    space : Space
+        The open numbers and their map to the unit box.
+    case : mapping
+        The paper case.
+    point : mapping
+        The corner (:func:`corner_scan`'s ``u`` and ``choices``).
+    sign : float
+        1 for the lowest efficiency, -1 for the highest.
+
+    Returns
+    -------
+    (float, ndarray)
+        The extreme efficiency [-] and its ``u``.
+    """
     from scipy.optimize import minimize  # import cost: this module is behind a CLI command
 
     choices = point["choices"]
 
     def objective(u: np.ndarray) -> float:
+        """``sign * eta`` at ``u``; a locked run is worse than any efficiency."""
         eta = model.efficiency(case, {**choices, **space.values(u)})
         return sign * eta if np.isfinite(eta) else 10.0  # a locked run: worse than any efficiency
 
@@ -69,8 +105,28 @@ def refine(model: CaseModel, space: Space, case: Mapping[str, Any], point: Mappi
 
 def at_bounds(model: CaseModel, space: Space, case: Mapping[str, Any], u: np.ndarray,
               choices: Mapping[str, str]) -> list[dict[str, Any]]:
-    """The parameters at a bound of the box at ``u``: name, bound, value [m] and the slope of
-    the efficiency [1/m] moving outwards (extrapolated from a step 1e-3 of the range inwards)."""
+    """The parameters at a bound of the box at ``u``.
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    space : Space
+        The open numbers and their map to the unit box.
+    case : mapping
+        The paper case.
+    u : ndarray
+        The point in the unit box.
+    choices : mapping
+        The discrete choices there.
+
+    Returns
+    -------
+    list of dict
+        Per parameter at a bound: ``name``, ``bound`` (lower, upper), ``value`` [m] and the slope
+        of the efficiency moving outwards ``slope_outwards`` [1/m] (extrapolated from a step 1e-3
+        of the range inwards).
+    """
     base = model.efficiency(case, {**choices, **space.values(u)})
     out = []
     for i, name in enumerate(space.names):
@@ -129,7 +185,28 @@ def envelope_study(engine: str = "reference", progress: Callable[[str], None] | 
 
 def case_envelope(model: CaseModel, space: Space, points: list[dict[str, Any]], k: int,
                   case: Mapping[str, Any]) -> dict[str, Any]:
-    """One case's envelope from the corner scan ``points`` (case index ``k``), refined."""
+    """One case's envelope from the corner scan, refined.
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    space : Space
+        The open numbers and their map to the unit box.
+    points : list of dict
+        :func:`corner_scan`'s points.
+    k : int
+        The case's index in the points' ``eta``.
+    case : mapping
+        The paper case.
+
+    Returns
+    -------
+    dict
+        ``case``, ``paper``, ``lowest`` and ``highest`` [-] with where they are (``lowest_at``,
+        ``highest_at``), ``reachable``, ``closest`` [-] and, outside the envelope, ``limiting``
+        (:func:`at_bounds`).
+    """
     row: dict[str, Any] = {"case": case_key(case), "paper": case["paper_mean_efficiency"]}
     where = {}
     for key, sign in (("lowest", 1.0), ("highest", -1.0)):

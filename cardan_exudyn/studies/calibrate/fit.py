@@ -33,7 +33,17 @@ XTOL = 1e-8
 
 def residuals(model: CaseModel, cases: Sequence[Mapping[str, Any]], values: Mapping[str, Any]) -> np.ndarray:
     """Model minus paper mean efficiency [-] per case; a failed (self-locking) case counts as
-    efficiency 0: a large, finite residual."""
+    efficiency 0: a large, finite residual.
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    cases : sequence of mapping
+        The paper cases.
+    values : mapping
+        Parameter values (numbers and choices).
+    """
     etas = [model.efficiency(c, values) for c in cases]
     return np.asarray([(e if math.isfinite(e) else 0.0) - c["paper_mean_efficiency"]
                        for e, c in zip(etas, cases, strict=True)])
@@ -44,6 +54,21 @@ def fit(model: CaseModel, space: Space, combinations: Sequence[Mapping[str, Any]
         progress: Callable[[str], None] | None = None) -> list[dict[str, Any]]:
     """Bounded least-squares fit of ``space``'s numbers to ``cases``, once per combination of
     discrete choices, from ``start`` (unit box).
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    space : Space
+        The open numbers and their map to the unit box.
+    combinations : sequence of mapping
+        The discrete choices, one fit each.
+    start : sequence of float
+        The start in the unit box.
+    cases : sequence of mapping
+        The paper cases fitted to.
+    progress : callable, optional
+        Called with a line of text per combination.
 
     Returns
     -------
@@ -58,6 +83,7 @@ def fit(model: CaseModel, space: Space, combinations: Sequence[Mapping[str, Any]
         count = 0
 
         def fun(u: np.ndarray, choices: Mapping[str, Any] = choices) -> np.ndarray:
+            """The residuals at ``u`` (unit box) under the combination's ``choices``, counted."""
             nonlocal count
             count += 1
             return residuals(model, cases, {**choices, **space.values(u)})
@@ -81,8 +107,23 @@ def choices_label(choices: Mapping[str, Any]) -> str:
 
 
 def case_rows(model: CaseModel, values: Mapping[str, Any], fit_keys: Sequence[str]) -> list[dict[str, Any]]:
-    """Every paper case under ``values``: paper and model mean efficiency [-], their difference,
-    whether it was used in the fit (:func:`in_fit`), status and reason."""
+    """Every paper case under ``values``.
+
+    Parameters
+    ----------
+    model : CaseModel
+        The cases' mean efficiencies under parameter values (cached).
+    values : mapping
+        Parameter values (numbers and choices).
+    fit_keys : sequence of str
+        The cases fitted to (:func:`reference.paper.paper.case_key`).
+
+    Returns
+    -------
+    list of dict
+        ``case``, ``used_in_fit`` (:func:`reference.paper.paper.in_fit`), ``paper`` and ``model``
+        mean efficiency [-], ``difference`` [-], ``status``, ``reason``.
+    """
     rows = []
     for case in paper_cases():
         eta, status, reason = model.run_case(case, values)

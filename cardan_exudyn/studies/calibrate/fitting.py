@@ -29,6 +29,9 @@ from reference.paper.paper import (
 from reference.scene.scene import replace
 from reference.scene.validation import SceneError
 
+__all__ = ["FIT_ENGINES", "FIT_ACCURACY", "MATCHED_BOUNDS", "cases_named", "case_scene", "CaseModel",
+           "Space", "box_space", "choice_combinations", "set_space"]
+
 FIT_ENGINES = ("reference", "exudyn")
 """Engines a fit may use: the reference (default: independent, no step, about 0.03 s a run) or
 Exudyn (``numerics.accuracy`` 1e-4, about a second a run)."""
@@ -55,8 +58,16 @@ def cases_named(keys: Sequence[str]) -> list[dict[str, Any]]:
 
 def case_scene(case: Mapping[str, Any], values: Mapping[str, Any]):
     """The scene of ``case`` under parameter ``values`` (applied to the literal reading, as
-    :func:`reference.paper.scenes.paper_scene` does), one input revolution (the motion at constant speed
-    is periodic in one), no time series; the mean-input load solved on that scene."""
+    :func:`reference.paper.paper.paper_scene` does), one input revolution (the motion at constant speed
+    is periodic in one), no time series; the mean-input load solved on that scene.
+
+    Parameters
+    ----------
+    case : mapping
+        A paper case (``shaft_angle_deg``, ``speed_rpm``).
+    values : mapping
+        Parameter values (numbers and choices).
+    """
     plain = {k: v for k, v in values.items() if k != "torque_reading"}
     scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=plain)
     # the accuracy sets Exudyn's step; the reference engine only compares its estimate with it
@@ -84,6 +95,7 @@ class CaseModel:
     every: int = 200
 
     def __post_init__(self) -> None:
+        """Check the engine; start the counters and the cache."""
         if not isinstance(self.engine, str) or self.engine not in FIT_ENGINES:
             raise ValueError(f"`engine` must be one of {list(FIT_ENGINES)}, got {self.engine!r:.80}")
         self.runs = 0
@@ -91,17 +103,36 @@ class CaseModel:
         self.start = time.perf_counter()
 
     def run_case(self, case: Mapping[str, Any], values: Mapping[str, Any]) -> tuple[float, str, str]:
-        """Mean efficiency [-] (NaN when the run failed), status and reason of ``case``."""
+        """Mean efficiency [-] (NaN when the run failed), status and reason of ``case``.
+
+        Parameters
+        ----------
+        case : mapping
+            A paper case (``shaft_angle_deg``, ``speed_rpm``).
+        values : mapping
+            Parameter values (numbers and choices).
+        """
         key = (case["shaft_angle_deg"], case["speed_rpm"], tuple(sorted(values.items())))
         if key not in self.cache:
             self.cache[key] = self._run(case, values)
         return self.cache[key]
 
     def efficiency(self, case: Mapping[str, Any], values: Mapping[str, Any]) -> float:
-        """Mean efficiency [-] of ``case`` under ``values``; NaN when the run failed."""
+        """Mean efficiency [-] of ``case`` under ``values``; NaN when the run failed.
+
+        Parameters
+        ----------
+        case : mapping
+            A paper case (``shaft_angle_deg``, ``speed_rpm``).
+        values : mapping
+            Parameter values (numbers and choices).
+        """
         return self.run_case(case, values)[0]
 
     def _run(self, case: Mapping[str, Any], values: Mapping[str, Any]) -> tuple[float, str, str]:
+        """One run of ``case`` under ``values``, counted; a scene whose mean-input load cannot
+        be found is a self-locking joint.
+        """
         self.runs += 1
         if self.progress and self.runs % self.every == 0:
             self.progress(f"{self.runs} runs, {time.perf_counter() - self.start:.0f} s")

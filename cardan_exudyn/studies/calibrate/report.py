@@ -23,8 +23,19 @@ ENVELOPE_FORMATS = {"paper": ".3f", "lowest": ".4f", "highest": ".4f", "closest"
 
 
 def write_result(out: str | Path, name: str, result: Mapping[str, Any], text: str) -> Path:
-    """The folder ``out`` (replaced atomically): the ``result`` as JSON in ``name`` and the report
-    ``text`` in ``report.md``."""
+    """The ``--out`` folder (replaced atomically).
+
+    Parameters
+    ----------
+    out : path
+        The folder.
+    name : str
+        The file of the ``result`` as JSON (``calibrate.json`` or ``envelope.json``).
+    result : mapping
+        The fit's or the envelope's result.
+    text : str
+        The report, written to ``report.md``.
+    """
     with atomic_directory(out) as tmp:
         (tmp / name).write_text(dumps(result))
         (tmp / "report.md").write_text(text)

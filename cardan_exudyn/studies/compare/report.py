@@ -52,7 +52,15 @@ def engines_table(comparison: Comparison) -> str:
 
 
 def difference_section(d: EngineDifference, skip_revolutions: float) -> str:
-    """The mean-value differences and the per-column statistics of one engine against the base."""
+    """The mean-value differences and the per-column statistics of one engine against the base.
+
+    Parameters
+    ----------
+    d : EngineDifference
+        The engine's differences (:class:`cardan_exudyn.comparison.EngineDifference`).
+    skip_revolutions : float
+        Revolutions left out of the steady statistics [-].
+    """
     means = [{"mean value": key, "difference": value} for key, value in d.means.items()]
     columns = []
     for column, v in d.overall.iterrows():
@@ -82,7 +90,21 @@ def overlay_groups() -> dict[str, list[tuple[str, Callable[[Any], Any]]]]:
 
 
 def overlay_plots(comparison: Comparison, folder: Path) -> list[str]:
-    """Overlay plots of the engines against the input angle into ``folder``; the file names."""
+    """Overlay plots of the engines against the input angle, one file per group of
+    :func:`overlay_groups`.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison; engines without a time table are left out.
+    folder : Path
+        An existing folder.
+
+    Returns
+    -------
+    list of str
+        The file names (``overlay_<group>.png``).
+    """
     tables = {name: r.table for name, r in comparison.results.items() if r.table is not None}
     names = []
     for group, panels in overlay_groups().items():
@@ -94,7 +116,19 @@ def overlay_plots(comparison: Comparison, folder: Path) -> list[str]:
 
 def overlay_figure(title: str, tables: dict[str, Any],
                    panels: list[tuple[str, Callable[[Any], Any]]], path: Path) -> None:
-    """One figure, one panel per ``(label, values)``, one line per engine (the base solid)."""
+    """One figure, one panel per ``(label, values)``, one line per engine (the base solid).
+
+    Parameters
+    ----------
+    title : str
+        The figure's title (the scene's name).
+    tables : dict
+        Engine -> time table, the base first.
+    panels : list of (str, callable)
+        Label and the values of a table to draw, against the input angle [deg].
+    path : Path
+        The image file.
+    """
     # import cost: matplotlib only when a report is written (report.plots selects the Agg backend
     # before any figure exists)
     import matplotlib.pyplot as plt
@@ -119,9 +153,22 @@ def overlay_figure(title: str, tables: dict[str, Any],
 
 
 def write_report(comparison: Comparison, out: str | Path) -> Path:
-    """Report folder: ``comparison.json``, ``report.md``, ``<engine>.csv`` tables, overlay plots.
+    """The report folder: ``comparison.json``, ``report.md``, ``<engine>.csv`` tables,
+    overlay plots.
 
     Written into a temporary folder renamed into place, so a failure leaves nothing half-written.
+
+    Parameters
+    ----------
+    comparison : Comparison
+        The comparison.
+    out : path
+        The folder (replaced as a whole).
+
+    Returns
+    -------
+    Path
+        ``out``.
     """
     with atomic_directory(out) as folder:
         (folder / "comparison.json").write_text(dumps(comparison.to_dict()))

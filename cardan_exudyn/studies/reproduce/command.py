@@ -33,10 +33,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
               restart: bool = False, retry_failed: bool = False,
               progress: bool | None = None) -> Reproduction:
-    """The whole of ``cardan reproduce`` without its printing: the runs
-    (:func:`cardan_exudyn.studies.reproduce.compute.run_cases`, arguments as there), then the
-    report folder ``out`` (:func:`cardan_exudyn.studies.reproduce.report.write_reproduction`).
-    The report covers the runs that ended ``ok`` and lists the others."""
+    """The whole of ``cardan reproduce`` without its printing: the runs, then the report folder.
+
+    Parameters
+    ----------
+    out : path
+        The report folder (replaced atomically; the sweep is kept in ``out/runs``).
+    quick, workers, restart, retry_failed, progress
+        As :func:`cardan_exudyn.studies.reproduce.compute.run_cases`.
+
+    Returns
+    -------
+    Reproduction
+        The runs and their records; the report (:func:`~cardan_exudyn.studies.reproduce.report.
+        write_reproduction`) covers the runs that ended ``ok`` and lists the others.
+
+    Raises
+    ------
+    SweepError
+        As :func:`~cardan_exudyn.studies.reproduce.compute.run_cases`.
+    """
     # import cost: the runs load the engines, the report pandas and matplotlib; `cardan` imports
     # this module to register the command
     from cardan_exudyn.studies.reproduce.compute import run_cases

@@ -33,14 +33,10 @@ import numpy as np
 from cardan_exudyn import engines
 from cardan_exudyn.io import atomic_write, dumps
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
-from reference.paper.cases import paper_cases
-from reference.paper.parameter_sets import DEFAULT_PARAMETER_SET, PARAMETER_SETS
-from reference.paper.scenes import paper_scene
-from reference.results.result import Result
-from reference.results.summary import Status
+from reference.paper.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
+from reference.results.schema import Result, Status
 from reference.scene.joint import PAIR_NAMES
-from reference.scene.mapping import replace, scene_to_dict
-from reference.scene.scene import Scene
+from reference.scene.scene import Scene, replace, scene_to_dict
 
 __all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_OVERRIDES",
            "PaperRun", "Reproduction", "run_numbers", "paper_case_outputs", "selected_cases",
@@ -76,7 +72,7 @@ def run_numbers(result: Result) -> dict[str, Any]:
     t = result.table
     energy = t["energy_kinetic"] + t["energy_potential"]
     work = {c: float(np.trapezoid(t[c], t["t"])) for c in ("power_in", "power_out", "power_loss")}
-    friction = s.friction
+    friction = s.extras["friction"]
     speed = s.mean_speed_in
     out.update({
         "engine": s.engine,
@@ -94,8 +90,8 @@ def run_numbers(result: Result) -> dict[str, Any]:
         "loss_work_J": s.loss_work,
         "energy_balance_residual_J": work["power_in"] - work["power_out"] - work["power_loss"]
         - float(energy.iloc[-1] - energy.iloc[0]),
-        "loop_gain_estimate": friction.loop_gain_estimate,
-        "friction_evaluations_per_step": friction.mean_iterations_per_step,
+        "loop_gain_estimate": friction["loop_gain_estimate"],
+        "friction_evaluations_per_step": friction["mean_iterations_per_step"],
         "steps": s.steps,
         "wall_time_s": s.wall_time_s,
     })
@@ -191,8 +187,23 @@ def _overrides(scene: Scene, base_leaves: dict[str, Any]) -> dict[str, Any]:
 
 def sweep_spec(runs: list[PaperRun], quick: bool = False,
                files: str | os.PathLike | None = None) -> SweepSpec:
-    """The explicit-case sweep of the runs (engine ``exudyn``, case function
-    :func:`paper_case_outputs`, writing into ``files`` when given)."""
+    """The explicit-case sweep of the runs.
+
+    Parameters
+    ----------
+    runs : list of PaperRun
+        The runs (:func:`paper_runs`), one case each.
+    quick : bool
+        ``--quick``'s overrides (:data:`QUICK_OVERRIDES`) on every case.
+    files : path, optional
+        The folder the case function :func:`paper_case_outputs` writes each run's files into
+        (none: it writes nothing).
+
+    Returns
+    -------
+    SweepSpec
+        Engine ``exudyn``, base scene :func:`base_scene`, case function :data:`CASE_FUNCTION`.
+    """
     return SweepSpec(scene=base_scene(), engine="exudyn",
                      fixed=dict(QUICK_OVERRIDES) if quick else {},
                      cases=tuple({"id": r.id, **r.overrides} for r in runs), function=CASE_FUNCTION,

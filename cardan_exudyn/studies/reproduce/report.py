@@ -20,7 +20,6 @@ from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.reproduce.compute import RUNS_DIR, Reproduction
-from reference.scene.joint import PAIR_NAMES
 from reference.paper.paper import (
     DEFAULT_PARAMETER_SET,
     LEVER_DIMENSIONS,
@@ -188,10 +187,12 @@ def start_up_effect(history: Mapping[str, Any]) -> float | None:
     theta = np.asarray(history["theta_in"], dtype=float)
     if theta[-1] < 4 * np.pi - 1e-9:
         return None
-    t, power_in = np.asarray(history["t"], float), np.asarray(history["power_in"], float)
+    t = np.asarray(history["t"], float)
+    power_in = np.asarray(history["power_in"], float)
     loss = sum(np.asarray(history[f"power_loss_{p}"], float) for p in PAIR_NAMES)
 
     def efficiency(rows: np.ndarray) -> float:
+        """The mean efficiency [-] of the ``rows`` selected: one minus lost over input work."""
         return 1.0 - np.trapezoid(loss[rows], t[rows]) / np.trapezoid(power_in[rows], t[rows])
 
     return efficiency(theta <= 2 * np.pi + 1e-9) - efficiency(theta >= theta[-1] - 2 * np.pi - 1e-9)
@@ -199,7 +200,22 @@ def start_up_effect(history: Mapping[str, Any]) -> float | None:
 
 def draw_figures(folder: Path, rows: pd.DataFrame,
                  histories: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, str]]:
-    """Save every figure of the report into ``folder``; returns (file name, caption) in order."""
+    """Save every figure of the report into ``folder``.
+
+    Parameters
+    ----------
+    folder : Path
+        An existing folder.
+    rows : pandas.DataFrame
+        One :func:`case_row` per run.
+    histories : mapping
+        Parameter set -> label -> time history (as :func:`write_report`).
+
+    Returns
+    -------
+    list of (str, str)
+        File name and caption of each figure, in the report's order.
+    """
     ok = rows[rows.status == Status.OK]
     figures = _mean_figures(folder, ok)
     for parameters in PARAMETER_SETS:
@@ -268,7 +284,19 @@ def _curves(histories: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndar
 
 def report_text(rows: pd.DataFrame, register: pd.DataFrame, figures: Sequence[tuple[str, str]], *,
                 quick: bool, wall: float, reused: int, runs_dir: str) -> str:
-    """The markdown of ``report.md`` (arguments as for :func:`write_report`)."""
+    """The markdown of ``report.md``.
+
+    Parameters
+    ----------
+    rows : pandas.DataFrame
+        One :func:`case_row` per run.
+    register : pandas.DataFrame
+        The assumption register.
+    figures : sequence of (str, str)
+        :func:`draw_figures`' file names and captions.
+    quick, wall, reused, runs_dir
+        As :func:`write_report`.
+    """
     ok = rows[rows.status == Status.OK]
     md = (_head(rows, quick, wall, reused, runs_dir) + _parameter_sets() + _results(rows, ok)
           + _envelope() + _losses_and_checks(ok) + _plots(figures) + _appendix(register))
@@ -288,6 +316,9 @@ def _table(frame: pd.DataFrame | Sequence[Mapping[str, Any]], columns: Sequence[
 
 
 def _head(rows: pd.DataFrame, quick: bool, wall: float, reused: int, runs_dir: str) -> list[str]:
+    """The report's head: title, how it was generated, the parameter sets, how every number
+    was computed, the definitions.
+    """
     earlier = (f" ({reused} of the {len(rows)} runs from the records of an earlier invocation in "
                f"`{runs_dir}/`)" if reused else "")
     ok = rows[rows.status == Status.OK]
@@ -333,7 +364,8 @@ def parameter_rows(parameters: str) -> list[dict[str, Any]]:
     (:data:`reference.paper.parameter_sets.LEVER_DIMENSIONS`), which its reason then names."""
     out = []
     for row in parameter_table(parameters):
-        plausible, inside = row["plausible"], row["plausible_value"]
+        plausible = row["plausible"]
+        inside = row["plausible_value"]
         if row["name"] in LEVER_DIMENSIONS:
             dimension, factor = LEVER_DIMENSIONS[row["name"]]
             row = {**row, "reason": f"{row['reason']} (as {'2 x ' if factor != 1 else ''}"
@@ -386,6 +418,9 @@ def error_summary(rows: pd.DataFrame) -> list[dict[str, Any]]:
 
 
 def _results(rows: pd.DataFrame, ok: pd.DataFrame) -> list[str]:
+    """The mean efficiency of every set against the paper, the errors of the fitted and the
+    held-out cases, and the cases without a result.
+    """
     md = ["\n## Mean efficiency against the paper\n"]
     for parameters in PARAMETER_SETS:
         sel = ok[ok.parameters == parameters]
@@ -403,6 +438,7 @@ def _results(rows: pd.DataFrame, ok: pd.DataFrame) -> list[str]:
 
 
 def _envelope() -> list[str]:
+    """The envelope of each paper number over the plausible box, when it is stored."""
     rows = envelope()
     md = ["\n## What plausible physics can reach: the envelope\n"]
     if not rows:

@@ -45,9 +45,24 @@ def exudyn_measures(s: Summary) -> dict[str, Any]:
 
 
 def exact_ratio(scene: Scene, t: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """The exact ``omega_out / omega_in`` [-] of ``scene`` at the instants ``t`` [s] and input
-    angles ``theta`` [rad]: Hooke's closed form for the ideal joint, the reference engine's RCCC
-    kinematics with mounting errors (where Hooke's law does not hold)."""
+    """The exact ``omega_out / omega_in`` of ``scene`` at some instants: Hooke's closed form
+    for the ideal joint, the reference engine's RCCC kinematics with mounting errors (where Hooke's
+    law does not hold).
+
+    Parameters
+    ----------
+    scene : Scene
+        The cell's scene (a prescribed input motion).
+    t : ndarray, shape (n,)
+        Instants [s].
+    theta : ndarray, shape (n,)
+        Input angles at ``t`` [rad].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The ratio [-].
+    """
     if not scene.joint.errors.any:
         return speed_ratio(theta, scene.joint.geometry.shaft_angle)
     exact = columns_at(scene, input_motion(scene, REFERENCE_OPTIONS), t)
@@ -55,18 +70,45 @@ def exact_ratio(scene: Scene, t: np.ndarray, theta: np.ndarray) -> np.ndarray:
 
 
 def ratio_error(table: pd.DataFrame, scene: Scene) -> float | None:
-    """Largest error of ``omega_out / omega_in`` of a run's ``table`` of ``scene`` against the
-    exact ratio (:func:`exact_ratio`); None if not finite."""
+    """Largest error of ``omega_out / omega_in`` of a run against the exact ratio
+    (:func:`exact_ratio`).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The run's time table (``t``, ``theta_in``, ``omega_in``, ``omega_out``).
+    scene : Scene
+        The scene it was made of.
+
+    Returns
+    -------
+    float or None
+        The error [-]; None when it is not finite.
+    """
     ratio = table["omega_out"].to_numpy() / table["omega_in"].to_numpy()
     err = np.abs(ratio - exact_ratio(scene, table["t"].to_numpy(), table["theta_in"].to_numpy()))
     return float(np.max(err)) if np.all(np.isfinite(err)) else None
 
 
 def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
-    """Run the reference and Exudyn with ``node_type`` nodes (at ``h`` and, when it is ok with
-    friction, ``h / 2``) on one cell's ``scene`` and return the raw measurements (flat scalars):
-    the reference's and Exudyn's statuses, efficiencies [-], loop gains [-], Exudyn's cost and
-    constraint violations [m], [rad], the speed-ratio error and its promise [-]."""
+    """Run the reference and Exudyn (at ``h`` and, when it is ok with friction, ``h / 2``)
+    on one cell's scene.
+
+    Parameters
+    ----------
+    scene : Scene
+        The cell's scene (:meth:`~cardan_exudyn.studies.stress.panels.Panel.overrides` on the base).
+    node_type : str
+        Exudyn's node type of the spider and the output.
+
+    Returns
+    -------
+    dict
+        Flat scalars: the reference's and Exudyn's statuses, reasons, mean efficiencies [-] and
+        friction loop gains [-]; Exudyn's steps, Newton iterations, wall time [s] and constraint
+        violations [m], [rad]; ``ratio_error`` and its promise ``ratio_promise`` [-]; with friction
+        the efficiency at ``h / 2`` and its status.
+    """
     out = reference_measures(scene)
     result = run(scene, ENGINE, node_type=node_type)
     out.update(exudyn_measures(result.summary))
@@ -83,8 +125,17 @@ def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
 
 
 def cell(scene: Scene, engine: str, node_type: str) -> dict[str, Any]:
-    """Sweep case function: one map cell of ``scene`` run by ``engine`` (Exudyn, the one the map
-    tests) with ``node_type`` nodes (a ``function_args`` value); :func:`measure_cell`'s record."""
+    """Sweep case function: one map cell (:func:`measure_cell`'s record).
+
+    Parameters
+    ----------
+    scene : Scene
+        The cell's scene.
+    engine : str
+        The sweep's engine: Exudyn, the one the map tests.
+    node_type : str
+        Exudyn's node type (a ``function_args`` value).
+    """
     if engine != ENGINE:
         raise ValueError(f"stress cells compare {ENGINE} with the {REFERENCE}; engine {engine!r}")
     return measure_cell(scene, node_type)

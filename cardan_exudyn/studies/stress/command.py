@@ -59,7 +59,15 @@ def _say(text: str) -> None:
 
 
 def summary_lines(counts: dict[str, Any], out: str | os.PathLike) -> list[str]:
-    """What ``cardan stress`` prints when it is done: the map's classes and where the report is."""
+    """What ``cardan stress`` prints when it is done.
+
+    Parameters
+    ----------
+    counts : dict
+        :meth:`~cardan_exudyn.studies.stress.map.StressMap.counts`.
+    out : path
+        The report folder.
+    """
     return ["map: " + ", ".join(f"{v} {k}" for k, v in counts["classes"].items())
             + f"; {counts['disagreements']} of {counts['cells']} cells disagree with the reference",
             f"report: {out}/report.md"]

@@ -66,8 +66,16 @@ class StressMap:
 
 
 def sweep_specs(quick: bool = False, scene: Scene | None = None) -> dict[str, SweepSpec]:
-    """One explicit-case sweep spec per node type (the map's panels grouped by node type) on the
-    base scene of ``scene`` (:func:`~cardan_exudyn.studies.stress.panels.base_scene`)."""
+    """One explicit-case sweep spec per node type (the map's panels grouped by node type).
+
+    Parameters
+    ----------
+    quick : bool
+        The coarse map.
+    scene : Scene, optional
+        The joint (default :data:`~cardan_exudyn.studies.stress.panels.BASE_SCENE`); the base scene
+        is :func:`~cardan_exudyn.studies.stress.panels.base_scene` of it.
+    """
     groups: dict[str, list[dict[str, Any]]] = {}
     for panel in panels(quick):
         for angle in panel.angles:
@@ -81,7 +89,15 @@ def sweep_specs(quick: bool = False, scene: Scene | None = None) -> dict[str, Sw
 
 
 def classified_cells(chosen: list[Panel], records: dict[str, dict[str, Any]]) -> pd.DataFrame:
-    """One row per cell of the panels: its settings, measurements and classification."""
+    """One row per cell of the panels: its settings, measurements and classification.
+
+    Parameters
+    ----------
+    chosen : list of Panel
+        The panels.
+    records : dict
+        Cell id (:func:`~cardan_exudyn.studies.stress.panels.cell_id`) -> sweep record.
+    """
     rows = []
     for panel in chosen:
         for angle in panel.angles:

@@ -54,7 +54,16 @@ class Panel:
     steps: int = DEFAULT_STEPS
 
     def cell(self, angle: float, x: float) -> dict[str, Any]:
-        """The cell's settings: shaft angle [deg], friction, rpm, steps per revolution."""
+        """The settings of one cell: shaft angle [deg], friction coefficient, rpm, steps per
+        revolution.
+
+        Parameters
+        ----------
+        angle : float
+            Shaft angle [deg], the row.
+        x : float
+            The panel's quantity (friction coefficient [-], rpm or steps per revolution), the column.
+        """
         values = {"angle_deg": angle, "friction": self.friction, "rpm": self.rpm,
                   "steps": self.steps}
         values[self.x] = x
@@ -62,7 +71,16 @@ class Panel:
         return values
 
     def overrides(self, angle: float, x: float) -> dict[str, Any]:
-        """Scene overrides (dotted paths) of one cell."""
+        """Scene overrides (dotted paths) of one cell: shaft angle, a constant-speed drive, the
+        step, the coupling, every pair's friction coefficient.
+
+        Parameters
+        ----------
+        angle : float
+            Shaft angle [deg], the row.
+        x : float
+            The panel's quantity (friction coefficient [-], rpm or steps per revolution), the column.
+        """
         c = self.cell(angle, x)
         speed = c["rpm"] * RPM
         out: dict[str, Any] = {
@@ -128,5 +146,15 @@ def base_scene(scene: Scene | None = None) -> Scene:
 
 
 def cell_id(panel: Panel, angle: float, x: float) -> str:
-    """The cell's case id in the sweeps, e.g. ``friction/10deg/friction=0.2``."""
+    """The cell's case id in the sweeps, e.g. ``friction/10deg/friction=0.2``.
+
+    Parameters
+    ----------
+    panel : Panel
+        The cell's panel.
+    angle : float
+        Shaft angle [deg], the row.
+    x : float
+        The panel's quantity (friction coefficient [-], rpm or steps per revolution), the column.
+    """
     return f"{panel.key}/{angle:g}deg/{panel.x}={x:g}"

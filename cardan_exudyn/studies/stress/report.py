@@ -35,15 +35,38 @@ def problems(stress: StressMap) -> list[str]:
 
 
 def summary(stress: StressMap, wall_s: float) -> dict[str, Any]:
-    """The content of ``stress.json`` (without the environment): the map's wall time [s], the
-    problems, the counts of :meth:`StressMap.counts`, the scene, ``quick`` and the sweeps."""
+    """The content of ``stress.json`` (without the environment).
+
+    Parameters
+    ----------
+    stress : StressMap
+        The map.
+    wall_s : float
+        Its wall time [s].
+
+    Returns
+    -------
+    dict
+        ``wall_s`` (``{"map": seconds}``), ``problems``, and ``map``: the counts of
+        :meth:`StressMap.counts`, the scene, ``quick`` and the sweeps.
+    """
     return {"wall_s": {"map": wall_s}, "problems": problems(stress),
             "map": {**stress.counts(), "scene": stress.scene, "quick": stress.quick,
                     "sweeps": stress.sweeps}}
 
 
 def write_stress(stress: StressMap, out: str | os.PathLike, wall_s: float) -> Path:
-    """The report folder ``out`` (replaced atomically), with the sweeps of ``out/runs`` moved in."""
+    """The report folder (replaced atomically), with the sweeps of ``out/runs`` moved in.
+
+    Parameters
+    ----------
+    stress : StressMap
+        The map.
+    out : path
+        The folder: ``report.md``, ``map_cells.csv``, ``stability_map.png``, ``stress.json``.
+    wall_s : float
+        The map's wall time [s].
+    """
     out = Path(out)
     env = environment()
     found = problems(stress)
@@ -76,14 +99,25 @@ def class_mark(r: pd.Series) -> str:
 
 def error_mark(r: pd.Series) -> str:
     """Efficiency error against the reference (promise in brackets), else :func:`class_mark`."""
-    err, promise = as_float(r["efficiency_error"]), as_float(r["efficiency_promise"])
+    err = as_float(r["efficiency_error"])
+    promise = as_float(r["efficiency_promise"])
     if not math.isfinite(err):
         return class_mark(r)
     return f"{err:.1e}" + (f" ({promise:.0e})" if math.isfinite(promise) else "")
 
 
 def panel_table(cells: pd.DataFrame, panel: Panel, mark: Callable[[pd.Series], str] = class_mark) -> str:
-    """Markdown grid of one panel, one ``mark(row)`` per cell (default: :func:`class_mark`)."""
+    """Markdown grid of one panel, one mark per cell.
+
+    Parameters
+    ----------
+    cells : pandas.DataFrame
+        The map's cells.
+    panel : Panel
+        The panel shown.
+    mark : callable
+        Row -> text of its cell (default :func:`class_mark`).
+    """
     sel = cells[cells["panel"] == panel.key]
     columns = ["angle", *(f"{x:g}" for x in panel.x_values)]
     rows = []

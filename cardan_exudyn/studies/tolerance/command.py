@@ -153,7 +153,15 @@ def monte_carlo_handler(args: argparse.Namespace) -> int:
 
 
 def monte_carlo_line(summary: Mapping[str, Any], out: str) -> str:
-    """Statuses, the ideal joint's efficiency and the 5/50/95 percentiles, in one line."""
+    """Statuses, the ideal joint's efficiency and the 5/50/95 percentiles, in one line.
+
+    Parameters
+    ----------
+    summary : mapping
+        The study's summary (:func:`monte_carlo`).
+    out : str
+        The output folder.
+    """
     m = summary["mean_efficiency"]
     ideal = (number(summary["ideal_mean_efficiency"], ".6f") if summary["ideal_status"] == Status.OK
              else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}")
@@ -167,10 +175,21 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
                 out: str | Path, method: str = "lhs", workers: int | None = None,
                 scheduler: Any = None, restart: bool = False,
                 progress: bool | None = None) -> dict[str, Any]:
-    """The whole of ``cardan tolerance montecarlo`` without its printing: the samples
-    (:func:`~cardan_exudyn.studies.tolerance.montecarlo.run_monte_carlo`, arguments as there;
-    the sweep in ``out/cases``) and the study folder ``out/study``
-    (:func:`~cardan_exudyn.studies.tolerance.report.write_monte_carlo`); the study's summary."""
+    """The whole of ``cardan tolerance montecarlo`` without its printing: the samples as a
+    sweep in ``out/cases``, then the study folder ``out/study``.
+
+    Parameters
+    ----------
+    scene, engine, samples, seed, distributions, method, workers, scheduler, restart, progress
+        As :func:`~cardan_exudyn.studies.tolerance.montecarlo.run_monte_carlo`.
+    out : path
+        The output folder.
+
+    Returns
+    -------
+    dict
+        The study's summary (:attr:`~cardan_exudyn.studies.tolerance.montecarlo.MonteCarlo.summary`).
+    """
     # import cost: pandas, scipy and matplotlib for this study only
     from cardan_exudyn.studies.tolerance.montecarlo import run_monte_carlo
     from cardan_exudyn.studies.tolerance.report import write_monte_carlo
@@ -183,10 +202,23 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
 
 def paper_report(out: str | Path, engines: tuple[str, ...] | list[str] = ("reference", "exudyn"),
                  progress: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
-    """The whole of ``cardan tolerance paper`` without its printing: the study
-    (:func:`~cardan_exudyn.studies.tolerance.paper_case.paper_study`) and its folder ``out``
-    (:func:`~cardan_exudyn.studies.tolerance.report.write_paper_case`); what ``paper_case.json``
-    holds."""
+    """The whole of ``cardan tolerance paper`` without its printing: the study, then its folder.
+
+    Parameters
+    ----------
+    out : path
+        The folder (replaced atomically).
+    engines : sequence of str
+        Keys of :data:`cardan_exudyn.engines.ENGINES`.
+    progress : callable, optional
+        Called with each row as it is computed.
+
+    Returns
+    -------
+    dict
+        What ``paper_case.json`` holds
+        (:func:`~cardan_exudyn.studies.tolerance.report.write_paper_case`).
+    """
     from cardan_exudyn.studies.tolerance.paper_case import paper_study  # import cost, as above
     from cardan_exudyn.studies.tolerance.report import write_paper_case
 

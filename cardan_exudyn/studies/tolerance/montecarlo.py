@@ -56,8 +56,16 @@ def correlation_ratio(x: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
 
     A first-order sensitivity index: 0 when ``y`` does not depend on ``x`` alone (up to the
     sampling noise of about ``bins / n``), 1 when it is a function of ``x``.
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (n,)
+        The input and the output samples.
+    bins : int
+        Quantile bins of ``x``; NaN with fewer than ``2 bins`` samples or a constant ``y``.
     """
-    x, y = np.asarray(x, float), np.asarray(y, float)
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
     if y.size < 2 * bins or np.var(y) == 0.0:
         return float("nan")
     edges = np.quantile(x, np.linspace(0.0, 1.0, bins + 1))
@@ -69,6 +77,15 @@ def correlation_ratio(x: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
 
 def sensitivities(table, parameters: Sequence[str], output: str = "mean_efficiency"):
     """Per parameter: Spearman rho with the value and with its magnitude, correlation ratio [-].
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The samples that ran ok: one column per parameter and ``output``.
+    parameters : sequence of str
+        The drawn parameters (scene paths).
+    output : str
+        The column whose sensitivity is measured.
 
     Returns
     -------
@@ -90,8 +107,21 @@ def sensitivities(table, parameters: Sequence[str], output: str = "mean_efficien
 
 
 def efficiency_statistics(eta: np.ndarray, eta0: float) -> dict[str, dict[str, float]]:
-    """``mean_efficiency``: mean, std, min, max and percentiles of ``eta`` [-]; ``change``: the
-    percentiles of ``eta - eta0`` [-] (empty without samples, or without ``eta0``)."""
+    """The distribution of the mean efficiency.
+
+    Parameters
+    ----------
+    eta : ndarray, shape (n,)
+        The samples' mean efficiencies [-].
+    eta0 : float
+        The ideal joint's [-] (NaN: no change reported).
+
+    Returns
+    -------
+    dict
+        ``mean_efficiency``: mean, std, min, max and percentiles of ``eta`` [-]; ``change``: the
+        percentiles of ``eta - eta0`` [-] (empty without samples, or without ``eta0``).
+    """
     if not eta.size:
         return {"mean_efficiency": {}, "change": {}}
     m = {"mean": float(eta.mean()), "std": float(eta.std(ddof=1)) if eta.size > 1 else 0.0,

@@ -193,6 +193,13 @@ def paper_study(engines: Sequence[str] = ("reference", "exudyn"),
     """``cardan tolerance paper``'s numbers: :func:`paper_case` over every parameter set, law and
     coupling, :func:`sign_envelope` per parameter set and coupling, :func:`law_verdicts`.
 
+    Parameters
+    ----------
+    engines : sequence of str
+        Keys of :data:`cardan_exudyn.engines.ENGINES`.
+    progress : callable, optional
+        Called with each row of :func:`paper_case` as it is computed.
+
     Returns
     -------
     dict

@@ -34,8 +34,16 @@ SENSITIVITY_FORMATS = {"Spearman rho": "+.3f", "rho with magnitude": "+.3f", "co
 
 
 def write_monte_carlo(study: MonteCarlo, folder: str | Path) -> Path:
-    """The study folder ``folder`` (replaced atomically): ``samples.csv``, ``sensitivity.csv``,
-    ``tolerance.json``, the plots of :func:`monte_carlo_plots` and ``report.md``."""
+    """The study folder (replaced atomically): ``samples.csv``, ``sensitivity.csv``,
+    ``tolerance.json``, the plots of :func:`monte_carlo_plots` and ``report.md``.
+
+    Parameters
+    ----------
+    study : MonteCarlo
+        The study (:func:`~cardan_exudyn.studies.tolerance.montecarlo.run_monte_carlo`).
+    folder : path
+        The folder.
+    """
     summary = study.summary
     with atomic_directory(Path(folder)) as tmp:
         study.table.to_csv(tmp / "samples.csv", index=False)
@@ -48,10 +56,20 @@ def write_monte_carlo(study: MonteCarlo, folder: str | Path) -> Path:
 
 
 def monte_carlo_plots(folder: Path, table, params: Sequence[str], eta0: float) -> None:
-    """``efficiency_histogram.png`` (the mean efficiency of the samples ``table`` that ran ok,
-    with the ideal joint's ``eta0`` [-] and the 5/50/95 percentiles) and
-    ``efficiency_vs_errors.png`` (its scatter against each error of ``params``) into ``folder``;
-    nothing without a sample."""
+    """``efficiency_histogram.png`` (with the ideal joint and the 5/50/95 percentiles) and
+    ``efficiency_vs_errors.png`` (the efficiency against each error); nothing without a sample.
+
+    Parameters
+    ----------
+    folder : Path
+        An existing folder.
+    table : pandas.DataFrame
+        The samples that ran ok.
+    params : sequence of str
+        The drawn errors (scene paths).
+    eta0 : float
+        The ideal joint's mean efficiency [-].
+    """
     # import cost: matplotlib only when a study is written
     from cardan_exudyn.report.plots import plt, save
 
@@ -71,6 +89,9 @@ def monte_carlo_plots(folder: Path, table, params: Sequence[str], eta0: float) -
 
 
 def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: float) -> None:
+    """The mean efficiency ``eta`` of the samples against each error of ``params``, the
+    ideal joint's ``eta0`` dashed, into ``path``.
+    """
     from cardan_exudyn.report.plots import plt, save  # import cost, as above
 
     cols = min(3, len(params))
@@ -87,7 +108,15 @@ def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: fl
 
 
 def monte_carlo_markdown(summary: Mapping[str, Any], sens) -> str:
-    """``report.md`` of the Monte Carlo study: the draws, the percentiles, the sensitivities."""
+    """``report.md`` of the Monte Carlo study: the draws, the percentiles, the sensitivities.
+
+    Parameters
+    ----------
+    summary : mapping
+        The study's summary.
+    sens : pandas.DataFrame
+        Its sensitivities (empty: none shown).
+    """
     ideal = (f"{number(summary['ideal_mean_efficiency'], '.6f')}." if summary["ideal_status"] == Status.OK
              else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}.")
     parts = [f"# Monte Carlo tolerance study: {summary['scene']} ({summary['engine']})\n\n"
@@ -108,8 +137,16 @@ def monte_carlo_markdown(summary: Mapping[str, Any], sens) -> str:
 
 
 def percentile_table(m: Mapping[str, float], change: Mapping[str, float]) -> str:
-    """Percentiles of the mean efficiency ``m`` and of its ``change`` from the ideal joint, mean
-    and std, as a markdown table (keys ``p<q>`` of :data:`LEVELS`, ``mean``, ``std``)."""
+    """Percentiles of the mean efficiency and of its change from the ideal joint, mean and
+    std, as a markdown table.
+
+    Parameters
+    ----------
+    m : mapping
+        ``p<q>`` for each of :data:`LEVELS`, ``mean``, ``std`` [-].
+    change : mapping
+        ``p<q>`` of the change [-] (a missing one: empty).
+    """
     rows = [{"statistic": f"p{q}", "mean efficiency": m[f"p{q}"], "change from ideal": change.get(f"p{q}")}
             for q in LEVELS]
     rows.append({"statistic": "mean / std", "change from ideal": "",
@@ -119,8 +156,15 @@ def percentile_table(m: Mapping[str, float], change: Mapping[str, float]) -> str
 
 
 def verdict_line(v: Mapping[str, Any], paper: float) -> str:
-    """One sentence: which law/coupling of a parameter set and engine matches the paper's change
-    ``paper`` [-] (``v``: one of :func:`~cardan_exudyn.studies.tolerance.paper_case.law_verdicts`)."""
+    """One sentence: which law/coupling of a parameter set and engine matches the paper's change.
+
+    Parameters
+    ----------
+    v : mapping
+        One of :func:`~cardan_exudyn.studies.tolerance.paper_case.law_verdicts`.
+    paper : float
+        The paper's relative change [-].
+    """
     if v["closest"] is None:
         return f"{v['parameters']}, {v['engine']}: no combination ran ok"
     said = "matches" if v["matches"] else f"is the closest, but outside a factor {MATCH_FACTOR:g} of"
@@ -130,8 +174,15 @@ def verdict_line(v: Mapping[str, Any], paper: float) -> str:
 
 
 def write_paper_case(study: Mapping[str, Any], out: str | Path) -> dict[str, Any]:
-    """The paper case's folder ``out`` (replaced atomically) from
-    :func:`~cardan_exudyn.studies.tolerance.paper_case.paper_study`'s ``study``.
+    """The paper case's folder (replaced atomically): ``paper_case.csv``,
+    ``paper_case.json``, ``paper_case_breakdown.png``, ``report.md``.
+
+    Parameters
+    ----------
+    study : mapping
+        :func:`~cardan_exudyn.studies.tolerance.paper_case.paper_study`.
+    out : path
+        The folder.
 
     Returns
     -------
@@ -152,8 +203,16 @@ def write_paper_case(study: Mapping[str, Any], out: str | Path) -> dict[str, Any
 
 
 def breakdown_plot(path: Path, rows) -> None:
-    """Stacked bars of each pair's loss change per (parameters, law, coupling, engine) of the
-    paper case's ``rows`` that ran ok, into ``path``; nothing when none did."""
+    """Stacked bars of each pair's loss change per (parameters, law, coupling, engine) that ran
+    ok; nothing when none did.
+
+    Parameters
+    ----------
+    path : Path
+        The image file.
+    rows : pandas.DataFrame
+        :func:`~cardan_exudyn.studies.tolerance.paper_case.paper_case`'s rows.
+    """
     # import cost: matplotlib only when a report is written
     from cardan_exudyn.report.plots import plt, save
 
@@ -181,7 +240,15 @@ def breakdown_plot(path: Path, rows) -> None:
 
 def law_table(v: Mapping[str, Any], paper: float) -> str:
     """One parameter set and engine: the table of relative changes (coupling x law) and the
-    verdict sentence."""
+    verdict sentence.
+
+    Parameters
+    ----------
+    v : mapping
+        One of :func:`~cardan_exudyn.studies.tolerance.paper_case.law_verdicts`.
+    paper : float
+        The paper's relative change [-].
+    """
     rows = [{"coupling": c, **{law: v["cells"].get(f"{law}/{c}", "-") for law in LAWS}}
             for c in COUPLINGS]
     table = markdown_table(rows, ["coupling", *LAWS], {law: "+.3%" for law in LAWS})

@@ -14,6 +14,10 @@ import numpy as np
 
 from reference.scene.joint import PAIR_KIND
 
+__all__ = ["WINDOW", "pair_violations", "rotation_health", "revolution_index", "per_revolution_max",
+           "at_revolutions", "whole_revolutions", "linear_trend", "first_last", "window_size",
+           "algorithmic_damping", "damping_coefficient", "energy_measures"]
+
 # First/last window of revolutions compared (fewer in short runs: a quarter of the run).
 WINDOW = 100
 
@@ -30,7 +34,8 @@ def pair_violations(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> dict[s
     """
     out: dict[str, np.ndarray] = {}
     for name, k in pair_kinematics.items():
-        za, zb = k["frame_a"][:, :, 2], k["frame_b"][:, :, 2]
+        za = k["frame_a"][:, :, 2]
+        zb = k["frame_b"][:, :, 2]
         d = k["pb"] - k["pa"]
         v = k["vb"] - k["va"]
         w = k["omega_b"] - k["omega_a"]
@@ -55,7 +60,9 @@ def rotation_health(kinds: Mapping[str, str], states: dict[str, dict[str, np.nda
     angles (NaN where the node type has none); ``kinds`` names each body's node type."""
     ortho = np.zeros(n)
     nan = np.full(n, np.nan)
-    ep, rotvec, angles = nan.copy(), nan.copy(), nan.copy()
+    ep = nan.copy()
+    rotvec = nan.copy()
+    angles = nan.copy()
     for name, s in states.items():
         a = s["A"][:n]
         err = np.abs(np.einsum("nji,njk->nik", a, a) - np.eye(3)).max(axis=(1, 2))
@@ -107,9 +114,11 @@ def whole_revolutions(theta: np.ndarray) -> int:
 
 def linear_trend(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
     """Least-squares line ``y = a + b x``: slope, its standard error, residual scatter."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
     keep = np.isfinite(y)
-    x, y = x[keep], y[keep]
+    x = x[keep]
+    y = y[keep]
     if x.size < 3:
         return {"slope": float("nan"), "slope_stderr": float("nan"), "scatter": float("nan")}
     xm = x - x.mean()
@@ -123,7 +132,8 @@ def linear_trend(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
 def first_last(y: np.ndarray, window: int) -> dict[str, float]:
     """Means of the first and last ``window`` values, their difference and its standard error."""
     y = np.asarray(y, float)
-    a, b = y[:window], y[-window:]
+    a = y[:window]
+    b = y[-window:]
     se = math.sqrt(np.var(a, ddof=1) / a.size + np.var(b, ddof=1) / b.size) if window > 1 else float("nan")
     return {"first_mean": float(np.mean(a)), "last_mean": float(np.mean(b)),
             "last_minus_first": float(np.mean(b) - np.mean(a)), "difference_stderr": se,

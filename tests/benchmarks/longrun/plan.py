@@ -15,8 +15,14 @@ from cardan_exudyn.model.stepsize import choose_step
 from reference.paper.paper import named_scene
 from reference.scene.scene import Scene, replace
 
+__all__ = ["ENGINE", "REFERENCE", "DRIFT_SCENE", "DRIFT_STEPS_PER_REVOLUTION", "ENERGY_SPEED_RPM",
+           "RHO_LADDER_STEPS", "DEFAULT_RHO", "STARTUP_REVOLUTIONS", "DISSIPATION_MODEL",
+           "RHO_MODEL", "LongRunPlan", "FULL", "QUICK", "drift_scene", "energy_scene",
+           "automatic_steps", "energy_plan", "case_label", "model_loss", "settings"]
+
 #: The engine whose long runs are measured, and the one measuring it (no time steps to drift).
-ENGINE, REFERENCE = "exudyn", "reference"
+ENGINE = "exudyn"
+REFERENCE = "reference"
 DRIFT_SCENE = "paper-literal-10deg-2000rpm"
 # The step of the drift runs, the same for every node type: the automatic step of Rxyz nodes at 10
 # deg for a speed-ratio error of 1e-5, given, so that the figures of docs/benchmarks.md stay

@@ -33,6 +33,9 @@ from cardan_exudyn.io import to_jsonable
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 
+__all__ = ["NODE_COLOURS", "figure_constraints", "figure_efficiency", "figure_energy", "write_long",
+           "MEASURE_LABELS", "TESTS", "drift_section", "energy_section", "markdown"]
+
 NODE_COLOURS = {"Rxyz": "C0", "EP": "C1", "RotVecLG": "C2"}
 
 
@@ -227,7 +230,8 @@ def _efficiency_rows(drift: dict[str, Any], types: list[str]) -> list[dict[str, 
 
 def drift_section(s: dict[str, Any]) -> list[str]:
     """(a) The drift runs: settings and one column of figures per node type."""
-    st, drift = s["settings"], s["drift"]
+    st = s["settings"]
+    drift = s["drift"]
     types = list(drift)
     rows = [{"per revolution": "status", **{t: str(drift[t]["status"]) for t in types}},
             {"per revolution": "wall time [s]",
@@ -271,7 +275,8 @@ def _fit_line(angle: str, fit: dict[str, Any]) -> str:
 
 def energy_section(s: dict[str, Any]) -> list[str]:
     """(b) The free-spinning runs: one row per case, the fits per shaft angle."""
-    st, en = s["settings"], s["energy"]
+    st = s["settings"]
+    en = s["energy"]
     rows = [{**c, "status": str(c["status"]), "completed_revolutions": str(c.get("completed_revolutions", 0)),
              "model_loss": _model_loss_of(c)} for c in en["cases"]]
     columns = ["case", "status", "steps_per_revolution", "completed_revolutions", "relative_drift",
@@ -295,7 +300,8 @@ def markdown(result: LongRuns) -> str:
     """A report section: settings, the measured drift and energy figures, what the tests check,
     and what did not run through."""
     s = result.summary
-    st, walls = s["settings"], s["wall_time_s"]
+    st = s["settings"]
+    walls = s["wall_time_s"]
     out = ["## Long runs", "",
            f"{st['variant'].capitalize()} variant: wall time {walls['total']:.0f} s "
            f"(drift {walls['drift']:.0f} s, energy {walls['energy']:.0f} s). Generalized-alpha, index 3, "

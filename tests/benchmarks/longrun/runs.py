@@ -76,6 +76,9 @@ from reference.engine.solve import ReferenceOptions
 from reference.results.schema import Status, cumulative
 from reference.scene.scene import Scene, replace
 
+__all__ = ["simulate", "drift_rows", "drift_run", "energy_case_exudyn", "energy_case_reference",
+           "LongRuns", "run_drift", "energy_cases", "run_energy", "long_runs"]
+
 Say = Callable[[str], None]
 #: An energy case: label, function, its arguments but the label, engine, spectral radius, steps.
 EnergyCase = tuple[str, Callable[..., Any], tuple, str, float, "int | None"]
@@ -128,7 +131,8 @@ def drift_rows(model: ExudynModel, cols: dict[str, np.ndarray], node_type: str,
                dt: float) -> pd.DataFrame:
     """One row per revolution: constraint violations, rotation coordinates, input angle and time
     grid, work, efficiency."""
-    t, theta = cols["t"], cols["theta_in"]
+    t = cols["t"]
+    theta = cols["theta_in"]
     n = len(t)
     revs = whole_revolutions(theta)
     index = revolution_index(theta, revs)
@@ -267,15 +271,16 @@ class LongRuns:
 
 def run_drift(plan: LongRunPlan, say: Say) -> tuple[pd.DataFrame, list[dict[str, Any]]]:
     """(a) The drift runs with friction, one per node type: per-revolution rows and run infos."""
-    frames, runs = [], []
+    frames = []
+    runs = []
     for node_type in plan.node_types:
         say(f"drift: {node_type} nodes, {plan.drift_revolutions} revolutions of {DRIFT_SCENE} with friction")
         try:
             rows, info = drift_run(node_type, plan.drift_revolutions)
         except Exception as exc:  # the study goes on past a broken run, whose record says why
-            rows, info = pd.DataFrame(), {"node_type": node_type, "status": "error",
-                                          "reason": f"{type(exc).__name__}: {exc}",
-                                          "wall_time_s": float("nan")}
+            rows = pd.DataFrame()
+            info = {"node_type": node_type, "status": "error",
+                    "reason": f"{type(exc).__name__}: {exc}", "wall_time_s": float("nan")}
         frames.append(rows)
         runs.append(info)
         gc.collect()  # the run's model (a reference cycle with its friction) holds ~1 GB
@@ -304,7 +309,8 @@ def energy_cases(plan: LongRunPlan, angle: float) -> list[EnergyCase]:
 
 def run_energy(plan: LongRunPlan, say: Say) -> tuple[pd.DataFrame, list[dict[str, Any]]]:
     """(b) The free-spinning runs: relative energy per revolution and one info per case."""
-    infos, frames = [], []
+    infos = []
+    frames = []
     for angle in plan.energy_angles:
         for label, call, args, engine_name, rho, steps in energy_cases(plan, angle):
             revolutions = args[1]

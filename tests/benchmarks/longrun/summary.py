@@ -29,6 +29,10 @@ from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.report.format import number
 from reference.results.schema import Status
 
+__all__ = ["DRIFT_MEASURES", "NEWTON_TOLERANCE", "ROTVEC_FAILURE", "measure_figures",
+           "efficiency_figures", "drift_summary", "step_ladder", "rho_ladder", "fit_dissipation",
+           "findings", "summarise"]
+
 DRIFT_MEASURES = ("position_violation_m", "angle_violation_rad", "velocity_violation_m_s",
                   "angular_velocity_violation_rad_s", "orthogonality_error", "ep_norm_error",
                   "rotvec_norm_max", "input_angle_error_rad", "time_grid_error_s",
@@ -52,7 +56,8 @@ def measure_figures(rows: pd.DataFrame, steady: pd.DataFrame, window: int) -> di
         if not np.isfinite(y).any():
             continue
         magnitude = np.abs(steady[key].to_numpy(dtype=float))
-        first, last = float(np.nanmax(magnitude[:window])), float(np.nanmax(magnitude[-window:]))
+        first = float(np.nanmax(magnitude[:window]))
+        last = float(np.nanmax(magnitude[-window:]))
         trend = linear_trend(steady["revolution"].to_numpy(), steady[key].to_numpy(dtype=float))
         out[key] = {
             "max_abs": float(np.nanmax(np.abs(y))),

@@ -68,7 +68,8 @@ def accuracy(scene: Scene, result: Result) -> dict[str, float]:
         summary's constraint violations. NaN when the run has no mean values (it diverged or
         did not finish).
     """
-    table, summary = result.table, result.summary
+    table = result.table
+    summary = result.summary
     if summary.mean_torque_in is None:
         return dict.fromkeys(ACCURACY_KEYS, float("nan"))
     beta = scene.joint.geometry.shaft_angle
