@@ -27,9 +27,8 @@ def test_skip_audit_measures_each_item_side_by_side():
     # whose effect is far above timing noise at this size: with / without measured 1.21 to 1.64
     # (median 1.37) over 40 such audits on 2 loaded cores, while items of no effect ranged 0.95 to
     # 1.16 (5-95 %); in wall time (the default clock) they ranged 0.46 to 2.0 there. The Python
-    # drive function, 1.66 when the angle history was a CubicSpline call (15 us), measures 1.10 to
-    # 1.14 (medians) since histories evaluate in plain floats (reference.scene.histories, about 1 us):
-    # within the noise.
+    # drive function measures 1.10 to 1.14 (medians; histories evaluate in plain floats, about
+    # 1 us, reference.scene.histories): within the noise.
     row = audit[audit["item"] == "solution file"].iloc[0]
     assert row["with_over_without"] > 1.1
 

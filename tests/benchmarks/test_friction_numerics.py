@@ -15,9 +15,8 @@ from reference.paper.paper import named_scene
 def test_sign_band_does_not_change_the_0deg_result():
     """At 0 deg no spider pair moves: every band, the exact sign included, gives the same mean
     efficiency up to the friction fixed-point tolerance (1e-6 relative; measured: identical).
-    The ideal joint's cylindrical pairs get no axial friction (they cannot slide); before, the
-    exact sign of their solver-noise slide speeds switched the full axial force and the run
-    stopped as self-locking."""
+    The ideal joint's cylindrical pairs get no axial friction (they cannot slide), so the exact
+    sign of their solver-noise slide speeds switches nothing."""
     rows = sign_band_study(["paper-0deg"], [0.0, 1e-6, 1e-3, 1e-1])
     etas = [r["mean_efficiency"] for r in rows]
     assert all(r["status"] == "ok" for r in rows)
@@ -26,12 +25,11 @@ def test_sign_band_does_not_change_the_0deg_result():
 
 
 def test_converged_coupling_beats_lagged_at_every_step():
-    """`python tests/benchmarks coupling --quick`: at 100, 200, 400 steps per revolution the converged
-    scheme's error of mean efficiency is below the lagged scheme's (measured 1.0e-3, 3.7e-4,
-    3.4e-4 against 6.8e-3, 3.4e-3, 1.5e-3), and the lagged one falls at first order. (The
-    converged one fell by 7.8 over the ladder while the table's trapezoid was first order across
-    friction's sign jumps; integrated across them, what is left at 200-800 steps is the dip of
-    this 1 mm/s ramp, which the steps only partly resolve: 3.6e-4 at 800, 6.8e-7 at 1600.)"""
+    """`python tests/benchmarks coupling --quick`: at 100, 200, 400 steps per revolution the
+    converged scheme's error of mean efficiency is below the lagged scheme's (measured 1.0e-3,
+    3.7e-4, 3.4e-4 against 6.8e-3, 3.4e-3, 1.5e-3), and the lagged one falls at first order. (What
+    is left of the converged one's at 200-800 steps is the dip of this 1 mm/s ramp, which the
+    steps only partly resolve: 3.6e-4 at 800, 6.8e-7 at 1600.)"""
     rows = coupling_study(COUPLING_QUICK["names"], COUPLING_QUICK["ladder"])
     err = {(r["coupling"], r["steps_per_revolution"]): abs(r["error"]) for r in rows}
     for n in COUPLING_QUICK["ladder"]:

@@ -153,8 +153,8 @@ def runs(request) -> LongRuns:
 
 
 def completing(result: LongRuns) -> dict[str, dict[str, Any]]:
-    """The drift runs, every one expected to run through (RotVecLG failed at revolution 268 until
-    the input's angle coordinate was wrapped, see :func:`test_full_variant_runs_rotvec_through`)."""
+    """The drift runs, every one expected to run through (RotVecLG too: the input's angle
+    coordinate is kept within pi, see :func:`test_full_variant_runs_rotvec_through`)."""
     return result.summary["drift"]
 
 
@@ -356,9 +356,9 @@ def test_write_long_and_markdown(runs, tmp_path):
 
 @pytest.mark.slow
 def test_rotvec_runs_past_revolution_268_without_friction():
-    """RotVecLG, frictionless, 300 revolutions at the drift step: it failed at revolution 268
-    (267.99) while the input's angle coordinate was the unbounded input angle, whose rounding
-    wander (1.3e-9 rad by then) the spider's rotation vector cannot follow at the identity; with
+    """RotVecLG, frictionless, 300 revolutions at the drift step: past revolution 268, where an
+    unbounded input angle coordinate's rounding wander (1.3e-9 rad by then) exceeds what the
+    spider's rotation vector can follow at the identity (docs/benchmarks.md, *Long runs*); with
     the coordinate kept within pi the misalignment there is its own wander (measured 7.6e-15 rad
     per revolution, 2.3e-12 after 300)."""
     scene = replace(named_scene(f"{DRIFT_SCENE}-frictionless"), revolutions=300.0,
@@ -373,10 +373,9 @@ def test_rotvec_runs_past_revolution_268_without_friction():
 
 @pytest.mark.slow
 def test_full_variant_runs_rotvec_through():
-    """RotVecLG runs all 2000 revolutions with friction (it failed at revolution 268 before the
-    input's angle coordinate was wrapped); its largest misalignment, at the identity steps, is
-    still the input angle's rounding wander, now 1e-11 rad instead of 1.3e-9 at revolution 268.
-    rho 0.99 still fails within 50 revolutions."""
+    """RotVecLG runs all 2000 revolutions with friction (the input's angle coordinate kept within
+    pi); its largest misalignment, at the identity steps, is the input angle's rounding wander,
+    1e-11 rad. rho 0.99 fails within 50 revolutions."""
     result = run_variant(FULL)
     s = result.summary
     assert set(s["drift"]) == {"Rxyz", "EP", "RotVecLG"}
