@@ -239,7 +239,7 @@ def _effects_and_bound(with_error: tuple, ideal: tuple) -> tuple[float, float, f
 
     An effect is the difference of two runs, so its error is at most the sum of both runs' errors;
     each engine's error is bounded by 3x its own a-posteriori ``efficiency_error_estimate``
-    (Exudyn's true error within 3x its estimate in every friction cell of ``cardan accuracy``,
+    (Exudyn's true error within 3x its estimate in every friction cell of the accuracy grid,
     docs/accuracy.md; the reference's estimate is its quadrature error, below 1e-9 here).
     """
     (ref, exu), (ref0, exu0) = with_error, ideal

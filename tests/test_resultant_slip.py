@@ -160,7 +160,7 @@ def test_energy_balance_closes_under_the_resultant_law(rig_runs):
 
 def test_exudyn_agrees_with_reference_under_the_resultant_law(rig_runs):
     """Mean efficiency within 3x Exudyn's own error estimate (its true error is within 3x its
-    estimate in every friction cell of ``cardan accuracy``, docs/accuracy.md; the reference's
+    estimate in every friction cell of the accuracy grid, docs/accuracy.md; the reference's
     quadrature error is below 1e-9): measured 0.9366463 against 0.9366278 (1.8e-5; estimate
     3.3e-4). Sliding work per pair within 1 % (measured equal to 3 digits)."""
     _, ref, exu = rig_runs
