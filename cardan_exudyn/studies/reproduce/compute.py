@@ -40,7 +40,7 @@ from reference.scene.scene import Scene, replace, scene_to_dict
 
 __all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_OVERRIDES",
            "PaperRun", "Reproduction", "run_numbers", "paper_case_outputs", "selected_cases",
-           "base_scene", "paper_runs", "sweep_spec", "run_cases"]
+           "base_scene", "paper_runs", "sweep_spec", "run_cases", "energy_balance_residual"]
 
 RUNS_DIR = "runs"
 """The sweep's folder inside the report folder."""
@@ -69,9 +69,6 @@ def run_numbers(result: Result) -> dict[str, Any]:
     out: dict[str, Any] = {"status": s.status, "reason": s.reason}
     if not result.success:
         return out
-    t = result.table
-    energy = t["energy_kinetic"] + t["energy_potential"]
-    work = {c: float(np.trapezoid(t[c], t["t"])) for c in ("power_in", "power_out", "power_loss")}
     friction = s.extras["friction"]
     speed = s.mean_speed_in
     out.update({
@@ -88,8 +85,7 @@ def run_numbers(result: Result) -> dict[str, Any]:
         "mean_torque_in": s.mean_torque_in,
         "input_work_J": s.input_work,
         "loss_work_J": s.loss_work,
-        "energy_balance_residual_J": work["power_in"] - work["power_out"] - work["power_loss"]
-        - float(energy.iloc[-1] - energy.iloc[0]),
+        "energy_balance_residual_J": energy_balance_residual(result.table),
         "loop_gain_estimate": friction["loop_gain_estimate"],
         "friction_evaluations_per_step": friction["mean_iterations_per_step"],
         "steps": s.steps,
@@ -98,6 +94,14 @@ def run_numbers(result: Result) -> dict[str, Any]:
     for pair in PAIR_NAMES:
         out[f"loss_share_{pair}"] = s.pair_loss_work[pair] / s.input_work
     return out
+
+
+def energy_balance_residual(table) -> float:
+    """Input minus output minus friction loss work minus the change of mechanical energy over a
+    run's time ``table`` [J], each work trapezoidal: zero up to the integration error."""
+    energy = table["energy_kinetic"] + table["energy_potential"]
+    work = {c: float(np.trapezoid(table[c], table["t"])) for c in ("power_in", "power_out", "power_loss")}
+    return work["power_in"] - work["power_out"] - work["power_loss"] - float(energy.iloc[-1] - energy.iloc[0])
 
 
 def paper_case_outputs(scene: Scene, engine: str, files: str | None = None) -> dict[str, Any]:
