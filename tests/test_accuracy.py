@@ -25,9 +25,9 @@ from cardan_exudyn.model.stepsize import (
     reversing_parts,
     richardson,
 )
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 from reference.results.schema import Status
-from reference.scene.scene import replace
+from reference.scene import replace
 from reference.scene.validation import SceneError
 
 ONE_REVOLUTION = {"revolutions": 1.0, "record.timeseries": False}

@@ -30,9 +30,9 @@ from cardan_exudyn.studies.bench.configs import (
 from cardan_exudyn.studies.bench.ladders import run_errors, yardstick
 from cardan_exudyn.studies.bench.report import bench_command
 from cardan_exudyn.studies.bench.result import BenchResult, at_accuracy, cheapest, check_inputs
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 from reference.results.schema import Result, Status, Summary
-from reference.scene.scene import replace
+from reference.scene import replace
 
 
 def tuned_errors(scene, steps) -> list[dict]:

@@ -17,7 +17,7 @@ import pytest
 
 from cardan_exudyn.scene_options import DEFAULT_SCENE
 from cardan_exudyn.studies import COMMANDS
-from reference.paper.paper import named_scene
+from reference.paper import named_scene, paper_data
 
 HEAVY = ("pandas", "matplotlib", "scipy", "dask", "distributed", "mujoco", "exudyn", "tqdm")
 """Third-party packages a run loads only when it needs them (tables, plots, the engines)."""

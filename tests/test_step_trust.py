@@ -17,9 +17,9 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.model import solve
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.stepsize import MAX_STEPS_PER_REVOLUTION, revolution_period
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 from reference.results.schema import Result, Status, Summary
-from reference.scene.scene import replace
+from reference.scene import replace
 from reference.scene.validation import SceneError
 
 PAIRS = ("input_spider", "spider_output", "frame_input", "output_frame")

@@ -21,7 +21,7 @@ from cardan_exudyn.studies.stress.cell import measure_cell
 from cardan_exudyn.studies.stress.classify import classify, efficiency_promise
 from cardan_exudyn.studies.stress.map import CELL_FUNCTION, sweep_specs
 from cardan_exudyn.studies.stress.panels import BASE_SCENE, Panel, base_scene
-from reference.paper.paper import named_scene, paper_errors
+from reference.paper import named_scene, paper_errors
 from reference.physics.kinematics import speed_ratio
 from reference.scene.mapping import replace
 

@@ -29,9 +29,10 @@ from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, SCENES, Progress, quiet, simulated_time
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 from reference.results.schema import Status
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["AUDIT_SCENE", "Tweak", "Clock", "AuditItem", "run_wall", "solve_only", "audit_items",
            "skip_audit"]

@@ -27,9 +27,10 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 from reference.results.schema import Status
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["COUPLING_DEFAULT", "COUPLING_QUICK", "BAND_DEFAULT", "BAND_QUICK", "efficiency_row",
            "step", "coupling_study", "ladder_rows", "sign_band_study", "run_study", "markdown",

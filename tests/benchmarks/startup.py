@@ -3,8 +3,8 @@
 :func:`import_cost` runs, in fresh interpreters under ``python -X importtime``, what ``cardan
 run`` does before it hands the scene to an engine: import :mod:`cardan_exudyn.cli`, parse the
 command line (:func:`cardan_exudyn.cli.parse_args`), then build the default scene
-(:func:`cardan_exudyn.scene_options.scene_from_args`, which for the paper's ``physical`` set runs the
-reference engine twice to find the output load). A marker written to stderr between the parse and
+(:func:`cardan_exudyn.arguments.scene_from_args`; the paper's ``physical`` set reads its output
+load from the data file). A marker written to stderr between the parse and
 the scene splits the imports into those made before the scene is built (the target's figure) and
 those made while it is built. The cost of a phase is the sum of the cumulative times of its
 top-level imports (those ``-X importtime`` prints at indent 0, ``site`` included: the
@@ -122,8 +122,8 @@ def import_cost(repeats: int = 5, *, bytecode_cache: bool = True, python: str | 
         start-up, CLI module, parse), the figure :data:`IMPORT_TARGET_MS` is for; ``runs_ms``:
         each run's [ms]; ``top``: its 10 most expensive top-level imports, ``[module, median
         cumulative ms]``, most expensive first; ``scene_build_ms``: median of the imports made
-        while the default scene is built (the reference engine the ``physical`` set's load
-        needs) [ms], ``scene_top`` its 5 most expensive; ``through_scene_ms``: median of both
+        while the default scene is built [ms] (none when the default scene needs no module
+        the parse has not loaded), ``scene_top`` its 5 most expensive; ``through_scene_ms``: median of both
         phases' totals [ms]; ``baseline_ms``: median total [ms] of :data:`BASELINE_CODE`
         (start-up and numpy alone, run between the others: what no change to this project can
         remove, and a gauge of the machine's load); ``target_ms``; ``repeats``;

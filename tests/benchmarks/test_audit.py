@@ -12,8 +12,8 @@ import pytest
 from benchmarks.audit import skip_audit, solution_file, solve_only
 from cardan_exudyn import engines
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED
-from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.paper import named_scene
+from reference.scene import replace
 
 
 def test_skip_audit_measures_each_item_side_by_side():

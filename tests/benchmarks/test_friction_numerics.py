@@ -9,7 +9,7 @@ import pytest
 
 from benchmarks.cli import main
 from benchmarks.friction_numerics import COUPLING_QUICK, coupling_study, sign_band_study
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 
 
 def test_sign_band_does_not_change_the_0deg_result():

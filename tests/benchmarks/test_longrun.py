@@ -51,8 +51,8 @@ from cardan_exudyn import ExudynOptions
 from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.model.options import NODE_TYPES
 from cardan_exudyn.model.stepsize import MIN_STEPS_PER_REVOLUTION, efficiency_error
-from reference.paper.paper import named_scene
-from reference.scene.scene import replace
+from reference.paper import named_scene
+from reference.scene import replace
 
 
 class Tolerance(NamedTuple):

@@ -19,10 +19,11 @@ from typing import Any
 
 from cardan_exudyn import engines
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
-from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import named_scene, paper_errors
+from reference.engine import ReferenceOptions
+from reference.paper import named_scene, paper_errors
 from reference.results.schema import Result
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["SCENES", "MOUNTING_ERROR_SCENES", "ENGINE_NAMES", "EXUDYN_DEFAULT", "EXUDYN_TUNED",
            "FULL_LADDER", "QUICK_LADDER", "QUICK_FULL_LADDER", "BenchError", "Progress", "quiet",

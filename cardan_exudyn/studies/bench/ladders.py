@@ -38,7 +38,8 @@ from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Result, Summary
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["ERROR_KEYS", "Yardstick", "yardstick", "run_errors", "cost_counters", "Job",
            "bench_jobs", "timed_run", "work_precision"]

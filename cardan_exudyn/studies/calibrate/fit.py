@@ -20,7 +20,8 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, cases_named, set_space
-from reference.paper.paper import case_key, in_fit, paper_cases, parameter_set
+from reference.paper import case_key, paper_cases, parameter_set
+from reference.paper.cases import in_fit
 
 __all__ = ["FIT_SETS", "XTOL", "residuals", "fit", "choices_label", "case_rows", "fit_statistics",
            "calibrate"]
@@ -116,12 +117,12 @@ def case_rows(model: CaseModel, values: Mapping[str, Any], fit_keys: Sequence[st
     values : mapping
         Parameter values (numbers and choices).
     fit_keys : sequence of str
-        The cases fitted to (:func:`reference.paper.paper.case_key`).
+        The cases fitted to (:func:`reference.paper.cases.case_key`).
 
     Returns
     -------
     list of dict
-        ``case``, ``used_in_fit`` (:func:`reference.paper.paper.in_fit`), ``paper`` and ``model``
+        ``case``, ``used_in_fit`` (:func:`reference.paper.cases.in_fit`), ``paper`` and ``model``
         mean efficiency [-], ``difference`` [-], ``status``, ``reason``.
     """
     rows = []

@@ -18,15 +18,8 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import run
-from reference.paper.paper import (
-    apply_parameters,
-    case_key,
-    paper_cases,
-    paper_scene,
-    parameter_set,
-    plausible_box,
-)
-from reference.scene.scene import replace
+from reference.paper import apply_parameters, case_key, paper_cases, paper_scene, parameter_set, plausible_box
+from reference.scene import replace
 from reference.scene.validation import SceneError
 
 __all__ = ["FIT_ENGINES", "FIT_ACCURACY", "MATCHED_BOUNDS", "cases_named", "case_scene", "CaseModel",
@@ -58,7 +51,7 @@ def cases_named(keys: Sequence[str]) -> list[dict[str, Any]]:
 
 def case_scene(case: Mapping[str, Any], values: Mapping[str, Any]):
     """The scene of ``case`` under parameter ``values`` (applied to the literal reading, as
-    :func:`reference.paper.paper.paper_scene` does), one input revolution (the motion at constant speed
+    :func:`reference.paper.scenes.paper_scene` does), one input revolution (the motion at constant speed
     is periodic in one), no time series; the mean-input load solved on that scene.
 
     Parameters

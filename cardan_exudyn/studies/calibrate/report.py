@@ -11,7 +11,7 @@ from typing import Any
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.calibrate.fit import choices_label
-from reference.paper.paper import parameter_set
+from reference.paper import parameter_set
 
 __all__ = ["CASE_COLUMNS", "CASE_FORMATS", "ENVELOPE_COLUMNS", "ENVELOPE_FORMATS", "fit_text",
            "envelope_text", "write_result"]

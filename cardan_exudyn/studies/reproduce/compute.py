@@ -1,8 +1,8 @@
 """The runs of ``cardan reproduce``: the paper's eleven cases under each parameter set of
-:data:`reference.paper.paper.PARAMETER_SETS`, as one sweep of :mod:`cardan_exudyn.sweep`.
+:data:`reference.paper.parameter_sets.PARAMETER_SETS`, as one sweep of :mod:`cardan_exudyn.sweep`.
 
 The sweep's base scene is ``paper_scene(10 deg, 2000 rpm)`` of the ``physical`` set; each case's
-overrides are the leaves in which its own scene (:func:`reference.paper.paper.paper_scene`, any
+overrides are the leaves in which its own scene (:func:`reference.paper.scenes.paper_scene`, any
 parameter set) differs from the base, and :func:`paper_runs` checks that the runner rebuilds
 exactly that scene. Case ids read like ``matched-table2-35deg-2000rpm``. The sweep lives in
 ``OUT/runs/``: a rerun runs only the cases without a record, a case that fails is recorded with its
@@ -33,10 +33,11 @@ import numpy as np
 from cardan_exudyn import engines
 from cardan_exudyn.io import atomic_write, dumps
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
-from reference.paper.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
+from reference.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
 from reference.results.schema import Result, Status
+from reference.scene import replace, scene_to_dict
 from reference.scene.joint import PAIR_NAMES
-from reference.scene.scene import Scene, replace, scene_to_dict
+from reference.scene.scene import Scene
 
 __all__ = ["RUNS_DIR", "FILES_DIR", "CASE_FUNCTION", "HISTORY_COLUMNS", "QUICK_OVERRIDES",
            "PaperRun", "Reproduction", "run_numbers", "paper_case_outputs", "selected_cases",

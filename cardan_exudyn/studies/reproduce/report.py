@@ -20,14 +20,18 @@ from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.reproduce.compute import RUNS_DIR, Reproduction
-from reference.paper.paper import (
+from reference.paper import (
     DEFAULT_PARAMETER_SET,
-    LEVER_DIMENSIONS,
     PARAMETER_SETS,
+    assumption_register,
+    envelope,
     parameter_set,
     parameter_table,
+    stated_values,
 )
-from reference.results.summary import Status
+from reference.paper.cases import in_fit
+from reference.paper.parameter_sets import LEVER_DIMENSIONS
+from reference.results.schema import Status
 from reference.scene.joint import PAIR_NAMES
 
 __all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_reproduction", "write_report",

@@ -15,10 +15,13 @@ from cardan_exudyn.engines import run
 from cardan_exudyn.model.stepsize import error_coefficient
 from cardan_exudyn.studies.stress.classify import RATIO_FLOOR, SAFETY
 from cardan_exudyn.studies.stress.panels import ENGINE, REFERENCE
-from reference.engine.solve import ReferenceOptions, columns_at, input_motion
+from reference.engine import ReferenceOptions
+from reference.engine.motion import input_motion
+from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Summary
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["REFERENCE_OPTIONS", "reference_measures", "exudyn_measures", "exact_ratio",
            "ratio_error", "measure_cell", "cell"]

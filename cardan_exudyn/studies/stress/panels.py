@@ -11,9 +11,10 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
+from reference.scene import replace
 from reference.scene.joint import PAIR_NAMES
-from reference.scene.scene import Scene, replace
+from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM
 
 __all__ = ["ENGINE", "REFERENCE", "BASE_SCENE", "REVOLUTIONS", "DEFAULT_STEPS", "DEFAULT_RPM",

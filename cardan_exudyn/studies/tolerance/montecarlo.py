@@ -21,10 +21,11 @@ import numpy as np
 
 from cardan_exudyn.engines import run
 from cardan_exudyn.sweep import run_sweep
-from reference.paper.paper import value
+from reference.paper import value
 from reference.results.schema import Status
+from reference.scene import replace
 from reference.scene.joint import ERROR_NAMES
-from reference.scene.scene import Scene, replace
+from reference.scene.scene import Scene
 
 __all__ = ["LEVELS", "default_distributions", "correlation_ratio", "sensitivities",
            "efficiency_statistics", "MonteCarlo", "run_monte_carlo"]

@@ -19,10 +19,10 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import run
-from reference.paper.paper import PARAMETER_SETS, paper_errors, rig_scene, value
+from reference.paper import PARAMETER_SETS, paper_errors, rig_scene, value
 from reference.results.schema import Status, Summary
+from reference.scene import FRICTION_LAWS, replace
 from reference.scene.joint import PAIR_NAMES
-from reference.scene.scene import FRICTION_LAWS, replace
 
 __all__ = ["CYLINDRICAL", "COUPLINGS", "LAWS", "MATCH_FACTOR", "case_numbers", "paper_row",
            "paper_case", "law_verdicts", "sign_envelope", "paper_study"]
@@ -59,7 +59,7 @@ def paper_row(parameters: str, coupling: str, engine: str, law: str = "paper") -
     Parameters
     ----------
     parameters : str
-        A parameter set of :func:`reference.paper.paper.rig_scene`.
+        A parameter set of :func:`reference.paper.scenes.rig_scene`.
     coupling : str
         One of :data:`COUPLINGS`.
     engine : str
@@ -97,7 +97,7 @@ def paper_case(engines: Sequence[str] = ("reference", "exudyn"),
     ----------
     engines, parameter_sets, couplings, laws : sequence of str
         Keys of :data:`cardan_exudyn.engines.ENGINES`, parameter sets of
-        :func:`reference.paper.paper.rig_scene`, ``friction.coupling`` and ``friction.law`` values.
+        :func:`reference.paper.scenes.rig_scene`, ``friction.coupling`` and ``friction.law`` values.
     progress : callable, optional
         Called with each row as it is computed.
 
@@ -161,7 +161,7 @@ def sign_envelope(parameters: str = "matched", coupling: str = "converged",
     Parameters
     ----------
     parameters : str
-        A parameter set of :func:`reference.paper.paper.rig_scene`.
+        A parameter set of :func:`reference.paper.scenes.rig_scene`.
     coupling : str
         The scene's ``friction.coupling``.
     engine : str

@@ -18,8 +18,9 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn.engines import run
-from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
+from reference.paper import named_scene
+from reference.scene import replace
+from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM
 
 __all__ = ["ANGLES_DEG", "SPEEDS_RPM", "FRICTIONS", "ERRORS", "DRIVES", "REFERENCE_TIGHT",

@@ -40,10 +40,11 @@ from cardan_exudyn.studies.bench.configs import Progress, quiet
 from cardan_exudyn.studies.tolerance.command import monte_carlo
 from cardan_exudyn.studies.tolerance.montecarlo import default_distributions
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
-from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import named_scene, rig_scene
+from reference.engine import ReferenceOptions
+from reference.paper import named_scene, rig_scene
 from reference.results.schema import Status
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["SIZES", "QUICK_SIZES", "TORQUE_DRIVE", "DASK_SAMPLES", "QUICK",
            "FULL", "SEED", "study_scene", "tolerance_scenes", "cost_by_batch_size", "paper_batch",

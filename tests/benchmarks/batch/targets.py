@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 from cardan_exudyn.report.format import number
-from reference.engine.solve import ReferenceOptions
+from reference.engine import ReferenceOptions
 from reference.results.schema import Status
 
 __all__ = ["MONTE_CARLO_TARGET_S", "PAPER_BATCH_TARGET_S", "TORQUE_TARGET_S", "MONTE_CARLO_SAMPLES",

@@ -12,8 +12,9 @@ from typing import Any
 from benchmarks.longrun.measures import damping_coefficient
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from cardan_exudyn.model.stepsize import choose_step
-from reference.paper.paper import named_scene
-from reference.scene.scene import Scene, replace
+from reference.paper import named_scene
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["ENGINE", "REFERENCE", "DRIFT_SCENE", "DRIFT_STEPS_PER_REVOLUTION", "ENERGY_SPEED_RPM",
            "RHO_LADDER_STEPS", "DEFAULT_RHO", "STARTUP_REVOLUTIONS", "DISSIPATION_MODEL",

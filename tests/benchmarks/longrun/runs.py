@@ -72,9 +72,10 @@ from cardan_exudyn.model.build import ExudynModel
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.postprocess import body_states, mechanical_energy, postprocess, stored
 from cardan_exudyn.model.solve import solve
-from reference.engine.solve import ReferenceOptions
+from reference.engine import ReferenceOptions
 from reference.results.schema import Status, cumulative
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["simulate", "drift_rows", "drift_run", "energy_case_exudyn", "energy_case_reference",
            "LongRuns", "run_drift", "energy_cases", "run_energy", "long_runs"]

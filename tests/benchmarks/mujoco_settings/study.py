@@ -25,11 +25,11 @@ from cardan_exudyn.mujoco.options import (
     MujocoOptions,
 )
 from reference.engine.dynamics import inverse_dynamics
-from reference.paper.paper import named_scene
+from reference.paper import named_scene
 from reference.physics.kinematics import speed_ratio
 from reference.results.schema import Result
+from reference.scene import replace as replace_scene
 from reference.scene.scene import Scene
-from reference.scene.scene import replace as replace_scene
 
 __all__ = ["MUJOCO_DEFAULT_TIMESTEP", "MUJOCO_DEFAULTS", "STUDY_SCENES", "STUDY_TIMESTEPS",
            "accuracy", "study_cases", "step_cases", "knob_cases", "low_speed_cases", "settings_study",

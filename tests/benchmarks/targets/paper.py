@@ -15,10 +15,11 @@ from cardan_exudyn import engines
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, Progress, quiet
 from cardan_exudyn.studies.bench.ladders import yardstick
-from reference.engine.solve import ReferenceOptions
-from reference.paper.paper import paper_cases, paper_scene
+from reference.engine import ReferenceOptions
+from reference.paper import paper_cases, paper_scene
 from reference.results.schema import Result
-from reference.scene.scene import Scene, replace
+from reference.scene import replace
+from reference.scene.scene import Scene
 
 __all__ = ["PAPER_EXUDYN_STEPS", "PAPER_EXUDYN_COUPLING", "PAPER_REFERENCE_OPTIONS", "paper_scenes",
            "timing_part", "paper_exudyn_scene", "paper_scenes_timing"]

@@ -18,7 +18,7 @@ from benchmarks.targets.paper import PAPER_EXUDYN_COUPLING, PAPER_EXUDYN_STEPS, 
 from benchmarks.targets.targets import evaluate_targets, frictionless_twin_scene, is_friction_scene
 from cardan_exudyn.studies.bench.configs import ENGINE_NAMES, SCENES, BenchError, Progress, fixed_scenes
 from cardan_exudyn.studies.bench.result import BenchResult, run_bench
-from reference.scene.scene import COUPLINGS
+from reference.scene import COUPLINGS
 
 __all__ = ["TargetsResult", "scene_keys", "check_paper", "run_targets"]
 
@@ -117,7 +117,7 @@ def run_targets(quick: bool = False, repeats: int | None = None, scenes: Iterabl
         Exudyn's steps per revolution in the paper scenes' timing (``"auto"``: each scene's own
         step for the target accuracy).
     paper_coupling : str
-        Exudyn's friction coupling there (one of :data:`reference.scene.scene.COUPLINGS`).
+        Exudyn's friction coupling there (one of :data:`reference.scene.settings.COUPLINGS`).
 
     Raises
     ------

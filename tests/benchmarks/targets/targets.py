@@ -18,7 +18,7 @@ from cardan_exudyn.report.format import number
 from cardan_exudyn.studies.bench.configs import SCENES
 from cardan_exudyn.studies.bench.result import cheapest
 from reference.results.schema import Status
-from reference.scene.scene import COUPLINGS
+from reference.scene import COUPLINGS
 
 __all__ = ["SPEED_RATIO_TARGET", "EFFICIENCY_TARGET", "FRICTION_COST_TARGET", "KINEMATICS_TARGET",
            "PAPER_EXUDYN_TARGET_S", "PAPER_REFERENCE_TARGET_S", "STARTUP_TARGET_MS", "TARGETS",
