@@ -30,13 +30,15 @@ from cardan_exudyn.comparison import compare
 from cardan_exudyn.engines import EngineUnavailable, get_engine, run
 from cardan_exudyn.outputs import OutputError, write_result
 from cardan_exudyn.sweep import Distribution, SweepError, run_sweep, spec_from_mapping
-from reference.engine.solve import ReferenceOptions
-from reference.paper import named_scene
-from reference.results.schema import OptionsError, Result, Status, Summary
-from reference.scene import replace, scene_from_dict
+from reference.engine.options import ReferenceOptions
+from reference.paper.scenes import named_scene
+from reference.results.result import Result
+from reference.results.summary import OptionsError, Status, Summary
 from reference.scene.files import load_scene
 from reference.scene.joint import Body
-from reference.scene.scene import Load, Scene
+from reference.scene.load import Load
+from reference.scene.mapping import replace, scene_from_dict
+from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
 from rigdata.readers import read

@@ -25,9 +25,9 @@ from cardan_exudyn.model.stepsize import (
     reversing_parts,
     richardson,
 )
-from reference.paper import named_scene
-from reference.results.schema import Status
-from reference.scene import replace
+from reference.paper.scenes import named_scene
+from reference.results.summary import Status
+from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
 ONE_REVOLUTION = {"revolutions": 1.0, "record.timeseries": False}
@@ -128,8 +128,7 @@ def test_companion_is_two_to_three_times_the_step():
     scene = replace(named_scene("paper-literal-10deg"), **ONE_REVOLUTION,
                     **{"friction.coupling": "converged"})
     s = run(scene).summary
-    info = s.extras["accuracy"]
-    assert 2.0 - 1e-9 <= info["companion_dt"] / s.dt <= 3.0 + 1e-9
+    assert 2.0 - 1e-9 <= s.accuracy.companion.dt / s.dt <= 3.0 + 1e-9
     true = abs(s.mean_efficiency - run(scene, "reference", **REFERENCE_TIGHT).summary.mean_efficiency)
     assert s.accuracy_met is True and true <= scene.numerics.accuracy
     assert true / 3.0 <= s.efficiency_error_estimate <= 3.0 * true
@@ -152,7 +151,7 @@ def test_frictionless_run_reports_zero_error_without_a_companion():
     result = run(replace(named_scene("paper-literal-10deg-frictionless"), **ONE_REVOLUTION))
     assert result.summary.efficiency_error_estimate == 0.0
     assert result.summary.accuracy_met is True
-    assert "companion_dt" not in result.summary.extras["accuracy"]
+    assert result.summary.accuracy.companion is None
 
 
 def test_reference_reports_its_quadrature_estimate():
@@ -216,9 +215,9 @@ def test_without_error_estimate_one_run_and_no_estimate():
     full = run(scene, "exudyn")
     alone = run(scene, "exudyn", error_estimate=False)
     assert alone.summary.mean_efficiency == full.summary.mean_efficiency
-    assert alone.summary.efficiency_error_estimate is None and "accuracy" not in alone.summary.extras
+    assert alone.summary.efficiency_error_estimate is None and alone.summary.accuracy is None
     assert full.summary.efficiency_error_estimate is not None
-    assert full.summary.extras["accuracy"]["companion_dt"] == 4e-4  # the companion the other skips
+    assert full.summary.accuracy.companion.dt == 4e-4  # the companion the other skips
 
 
 @pytest.mark.parametrize("coupling", ["converged", "extrapolated"])

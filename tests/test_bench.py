@@ -31,7 +31,8 @@ from cardan_exudyn.studies.bench.ladders import run_errors, yardstick
 from cardan_exudyn.studies.bench.report import bench_command
 from cardan_exudyn.studies.bench.result import BenchResult, at_accuracy, cheapest, check_inputs
 from reference.paper import named_scene
-from reference.results.schema import Result, Status, Summary
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
 from reference.scene import replace
 
 

@@ -11,8 +11,8 @@ import pytest
 
 from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
-from cardan_exudyn.studies.calibrate.fit import calibrate, case_rows, fit, fit_statistics, residuals
 from cardan_exudyn.studies.calibrate.envelope import envelope_study
+from cardan_exudyn.studies.calibrate.fit import calibrate, case_rows, fit, fit_statistics, residuals
 from cardan_exudyn.studies.calibrate.fitting import CaseModel, Space, cases_named, set_space
 from reference.paper.cases import envelope, paper_cases
 from reference.paper.parameter_sets import parameter_set, parameter_table, plausible_box, set_values

@@ -14,11 +14,11 @@ import pytest
 
 from cardan_exudyn import run
 from cardan_exudyn.model.build import build_model
-from reference.paper import named_scene
+from reference.paper.scenes import named_scene
 from reference.physics.bands import characteristic_speeds, sign_bands
 from reference.physics.friction import friction_from_columns, pair_friction, regularised_sign
-from reference.scene import replace
 from reference.scene.joint import PAIR_KIND, PAIR_NAMES, Pair
+from reference.scene.mapping import replace
 
 
 def _scene(coupling: str, **changes):

@@ -1,4 +1,4 @@
-"""A lean start: ``cardan run`` and ``cardan --help`` import only what they use.
+"""A lean start: ``cardan run`` and ``cardan --help`` import only what they use (issue 19).
 
 Each check runs in a fresh interpreter, so that what this test session has imported already
 (pandas, scipy, Exudyn, ...) cannot hide an import. The timing itself is a benchmark figure
@@ -17,7 +17,8 @@ import pytest
 
 from cardan_exudyn.scene_options import DEFAULT_SCENE
 from cardan_exudyn.studies import COMMANDS
-from reference.paper import named_scene, paper_data
+from reference.paper.data import paper_data
+from reference.paper.scenes import named_scene
 
 HEAVY = ("pandas", "matplotlib", "scipy", "dask", "distributed", "mujoco", "exudyn", "tqdm")
 """Third-party packages a run loads only when it needs them (tables, plots, the engines)."""

@@ -37,8 +37,9 @@ from cardan_exudyn.testing.assertions import check_flow
 from reference.engine.options import ReferenceOptions
 from reference.paper.scenes import named_scene
 from reference.results.power_flow import PowerFlow, classify_works, sign_changes
-from reference.results.schema import SCHEMA_VERSION, Result, Status, Summary
-from reference.scene import replace
+from reference.results.result import Result
+from reference.results.summary import SCHEMA_VERSION, Status, Summary
+from reference.scene.mapping import replace
 from reference.scene.validation import DEG, RPM
 
 MIRROR = np.diag([1.0, 1.0, -1.0])

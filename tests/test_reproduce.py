@@ -14,8 +14,8 @@ from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run as engine_run
 from cardan_exudyn.report import plots
 from cardan_exudyn.studies.reproduce import compute as rep
-from cardan_exudyn.studies.reproduce.command import reproduce
 from cardan_exudyn.studies.reproduce import report as report
+from cardan_exudyn.studies.reproduce.command import reproduce
 from cardan_exudyn.sweep import CASES_FILE, make_plan, read_records
 from reference.paper.parameter_sets import PARAMETER_SETS, parameter_set
 from reference.paper.scenes import paper_scene

@@ -2,7 +2,7 @@
 estimate, a loop gain measured by the pilot wherever the friction feeds back, the limits on steps
 kept after every factor, the failure hints and the cost of the whole call.
 
-Each case was found by a review of ``cardan_exudyn/model/solve.py`` and failed before its fix
+Each case was found by a review of the automatic step (``cardan_exudyn/model/accuracy.py``) and failed before its fix
 (the measured numbers are in the docstrings)."""
 
 from __future__ import annotations
@@ -14,12 +14,13 @@ import pytest
 from benchmarks.accuracy.grid import cell_scene
 
 from cardan_exudyn.engines import run
-from cardan_exudyn.model import solve
+from cardan_exudyn.model import accuracy
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.stepsize import MAX_STEPS_PER_REVOLUTION, revolution_period
-from reference.paper import named_scene
-from reference.results.schema import Result, Status, Summary
-from reference.scene import replace
+from reference.paper.scenes import named_scene
+from reference.results.result import Result
+from reference.results.summary import Status, Summary
+from reference.scene.mapping import replace
 from reference.scene.validation import SceneError
 
 PAIRS = ("input_spider", "spider_output", "frame_input", "output_frame")
@@ -53,7 +54,7 @@ def test_a_failed_companion_at_a_given_step_claims_nothing():
     main.summary.mean_efficiency, main.summary.dt = 0.7, 1e-4
     coarse = Result(None, Summary(Status.SELF_LOCKING, engine="exudyn"))
     coarse.summary.dt = 2e-4
-    solve._report_accuracy(main, coarse, scene, ExudynOptions())
+    accuracy.publish(main, *accuracy.assess(main, coarse, scene, ExudynOptions()))
     assert main.summary.accuracy_met is None and main.summary.efficiency_error_estimate is None
     assert any("no error estimate" in w and "self_locking" in w for w in main.summary.warnings)
 
@@ -64,8 +65,8 @@ def test_the_pilot_measures_the_loop_gain_at_small_angles():
     applied, and the planned run read the efficiency 1.56e-4 off at accuracy 1e-4."""
     scene = with_friction(replace(named_scene("paper-literal-10deg"),
                                   **{"record.timeseries": False, "numerics.accuracy": 1e-4}), 0.52)
-    pilot, *_ = solve._pilot_plan(scene, ExudynOptions())
-    assert pilot.summary.extras["friction"]["gain_probes"] >= 8
+    pilot = accuracy.pilot_plan(scene, ExudynOptions()).pilot
+    assert pilot.summary.friction.gain_probes >= 8
     assert pilot.summary.max_friction_loop_gain > 0.5
     summary = run(scene, "exudyn", ExudynOptions(error_estimate=False)).summary
     truth = run(scene, "reference").summary.mean_efficiency
@@ -88,9 +89,9 @@ def test_the_gain_factor_keeps_the_step_limit(monkeypatch):
         s.wall_time_s, s.steps = 1.0, 1
         return Result(None, s)
 
-    monkeypatch.setattr(solve, "run_once", fake_run_once)
+    monkeypatch.setattr(accuracy, "run_once", fake_run_once)
     with pytest.raises(SceneError, match="steps per input revolution"):
-        solve.run(scene, ExudynOptions(error_estimate=False))
+        accuracy.run(scene, ExudynOptions(error_estimate=False))
     assert len(seen) == 1  # the pilot only
     assert revolution_period(scene) / seen[0] < MAX_STEPS_PER_REVOLUTION
 
@@ -114,7 +115,7 @@ def test_the_planned_run_reports_the_cost_of_the_whole_call():
     start = time.perf_counter()
     summary = run(scene, "exudyn", ExudynOptions(error_estimate=False)).summary
     elapsed = time.perf_counter() - start
-    pilot = summary.extras["accuracy"]["pilot"]["wall_time_s"]
+    pilot = summary.accuracy.pilot.wall_time_s
     assert math.isfinite(pilot) and pilot > 0.0
     # before: the main run's time alone, elapsed minus the pilot (which is at least 10 % of it)
     assert summary.wall_time_s + 0.5 * pilot >= elapsed >= summary.wall_time_s

@@ -11,9 +11,9 @@ from cardan_exudyn.studies.tolerance.command import monte_carlo
 from cardan_exudyn.studies.tolerance.montecarlo import correlation_ratio, sensitivities
 from cardan_exudyn.studies.tolerance.paper_case import MATCH_FACTOR, law_verdicts, paper_case
 from cardan_exudyn.studies.tolerance.report import verdict_line
-from reference.paper import named_scene
 from reference.paper.parameter_sets import RENAMED_SETS
-from reference.scene import replace
+from reference.paper.scenes import named_scene
+from reference.scene.mapping import replace
 
 # the set fitted to the paper's numbers (formerly "calibrated"), whose measurements these tests hold
 MATCHED = RENAMED_SETS["calibrated"]

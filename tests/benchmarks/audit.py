@@ -30,7 +30,7 @@ from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.solve import solve
 from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, SCENES, Progress, quiet, simulated_time
 from reference.paper import named_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene import replace
 from reference.scene.scene import Scene
 

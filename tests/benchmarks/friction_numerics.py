@@ -28,7 +28,7 @@ from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
 from reference.paper import named_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene import replace
 from reference.scene.scene import Scene
 
@@ -76,8 +76,8 @@ def efficiency_row(scene: Scene) -> dict[str, Any]:
     out = {"status": s.status.value, "reason": s.reason, "wall_time_s": wall, "steps": s.steps,
            "newton_iterations": s.newton_iterations, "mean_efficiency": _value(s.mean_efficiency),
            "mean_instantaneous_efficiency": _value(s.mean_instantaneous_efficiency)}
-    if "friction" in s.extras:
-        out["friction_evaluations_per_step"] = s.extras["friction"]["mean_iterations_per_step"]
+    if s.friction is not None:
+        out["friction_evaluations_per_step"] = s.friction.mean_iterations_per_step
     return out
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from benchmarks.batch.measure import torque_drive
 from benchmarks.batch.targets import TORQUE_TARGET_S, batch_targets
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 
 def test_batch_bench_reports_the_torque_drive_target():

@@ -29,15 +29,14 @@ def test_parse_importtime_sums_top_level_entries_per_phase():
 
 
 def test_import_cost_measures_cardan_run():
-    """One measured run: the phases, their largest imports and the numpy floor are reported; the
-    scene phase adds to the import phase (the default scene's stored load needs no engine, so it
-    may add nothing)."""
+    """One measured run: the phases, their largest imports and the numpy floor are reported."""
     cost = import_cost(1)
     assert cost["import_ms"] == cost["runs_ms"][0] > 0
     assert "cardan_exudyn.cli" in [name for name, _ in cost["top"]]
-    assert "reference.engine.solve" not in [name for name, _ in cost["scene_top"]]
-    assert cost["through_scene_ms"] == pytest.approx(cost["import_ms"] + cost["scene_build_ms"])
-    assert 0 < cost["baseline_ms"]
+    # a named scene is data: building it imports no engine
+    assert not [name for name, _ in cost["scene_top"] if name.startswith("reference.engine")]
+    assert cost["baseline_ms"] > 0
+    assert cost["through_scene_ms"] >= cost["import_ms"]  # equal when the scene imports nothing
     assert cost["target_ms"] == 150.0 and cost["repeats"] == 1
 
 

@@ -21,7 +21,7 @@ from cardan_exudyn import engines
 from cardan_exudyn.model.options import NODE_TYPES, ExudynOptions
 from reference.engine import ReferenceOptions
 from reference.paper import named_scene, paper_errors
-from reference.results.schema import Result
+from reference.results.result import Result
 from reference.scene import replace
 from reference.scene.scene import Scene
 

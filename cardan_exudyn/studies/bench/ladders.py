@@ -37,7 +37,8 @@ from reference.engine.motion import InputMotion, input_motion
 from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
-from reference.results.schema import Result, Summary
+from reference.results.result import Result
+from reference.results.summary import Summary
 from reference.scene import replace
 from reference.scene.scene import Scene
 
@@ -132,11 +133,11 @@ def _table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[st
 def cost_counters(summary: Summary) -> dict[str, Any]:
     """The engine's own cost counters, flattened: steps, Newton iterations, Jacobians, friction
     evaluations per step (Exudyn with friction), quadrature panels (reference)."""
-    friction = summary.extras.get("friction") or {}
+    friction = summary.friction
     quadrature = summary.extras.get("quadrature")
     return {"steps": summary.steps, "newton_iterations": summary.newton_iterations,
             "jacobian_evaluations": summary.jacobian_evaluations,
-            "friction_evaluations_per_step": friction.get("mean_iterations_per_step"),
+            "friction_evaluations_per_step": friction.mean_iterations_per_step if friction else None,
             "quadrature_panels": quadrature.get("panels") if isinstance(quadrature, dict) else None}
 
 

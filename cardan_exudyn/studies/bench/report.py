@@ -14,7 +14,7 @@ import pandas as pd
 from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table
 from cardan_exudyn.studies.bench.result import BenchResult, accuracy_measure, at_accuracy
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 __all__ = ["ROW_COLUMNS", "MEASURE_LABELS", "header", "table", "bench_command", "intro",
            "accuracy_section", "rows_section", "report_markdown", "work_precision_figure",

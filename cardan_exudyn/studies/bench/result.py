@@ -15,7 +15,7 @@ import pandas as pd
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.studies.bench.configs import ENGINE_NAMES, BenchError, Progress, fixed_scenes
 from cardan_exudyn.studies.bench.ladders import work_precision
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.scene import Scene
 
 __all__ = ["BenchResult", "accuracy_measure", "cheapest", "at_accuracy", "check_inputs", "run_bench"]

@@ -34,7 +34,8 @@ from cardan_exudyn import engines
 from cardan_exudyn.io import atomic_write, dumps
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
 from reference.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
-from reference.results.schema import Result, Status
+from reference.results.result import Result
+from reference.results.summary import Status
 from reference.scene import replace, scene_to_dict
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.scene import Scene
@@ -70,7 +71,7 @@ def run_numbers(result: Result) -> dict[str, Any]:
     out: dict[str, Any] = {"status": s.status, "reason": s.reason}
     if not result.success:
         return out
-    friction = s.extras["friction"]
+    friction = s.friction
     speed = s.mean_speed_in
     out.update({
         "engine": s.engine,
@@ -87,8 +88,8 @@ def run_numbers(result: Result) -> dict[str, Any]:
         "input_work_J": s.input_work,
         "loss_work_J": s.loss_work,
         "energy_balance_residual_J": energy_balance_residual(result.table),
-        "loop_gain_estimate": friction["loop_gain_estimate"],
-        "friction_evaluations_per_step": friction["mean_iterations_per_step"],
+        "loop_gain_estimate": friction.loop_gain_estimate,
+        "friction_evaluations_per_step": friction.mean_iterations_per_step,
         "steps": s.steps,
         "wall_time_s": s.wall_time_s,
     })

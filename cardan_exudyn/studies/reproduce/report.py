@@ -31,7 +31,7 @@ from reference.paper import (
 )
 from reference.paper.cases import in_fit
 from reference.paper.parameter_sets import LEVER_DIMENSIONS
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES
 
 __all__ = ["RUN_NUMBERS", "START_UP_STEPS", "fit_case_keys", "case_row", "write_reproduction", "write_report",

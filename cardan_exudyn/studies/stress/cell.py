@@ -19,7 +19,7 @@ from reference.engine import ReferenceOptions
 from reference.engine.motion import input_motion
 from reference.engine.table import columns_at
 from reference.physics.kinematics import speed_ratio
-from reference.results.schema import Summary
+from reference.results.summary import Summary
 from reference.scene import replace
 from reference.scene.scene import Scene
 

@@ -31,7 +31,7 @@ import math
 from typing import Any
 
 from cardan_exudyn.report.format import number
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 __all__ = ["SAFETY", "RATIO_FLOOR", "EFFICIENCY_FLOOR", "CONSTRAINT_LIMIT", "ORDER", "CLASSES",
            "EXUDYN_FAILURES", "MEASURED", "as_float", "efficiency_promise", "broken_promises",

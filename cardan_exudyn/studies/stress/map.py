@@ -19,7 +19,7 @@ import pandas as pd
 from cardan_exudyn.studies.stress.classify import classify, measured
 from cardan_exudyn.studies.stress.panels import BASE_SCENE, ENGINE, Panel, base_scene, cell_id, panels
 from cardan_exudyn.sweep import CASES_FILE, SweepSpec, read_records, run_sweep
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.scene import Scene
 
 __all__ = ["CELL_FUNCTION", "StressMap", "sweep_specs", "classified_cells", "run_map"]

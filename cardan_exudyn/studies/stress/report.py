@@ -19,7 +19,7 @@ from cardan_exudyn.report.format import markdown_table
 from cardan_exudyn.studies.stress.classify import CLASSES, as_float
 from cardan_exudyn.studies.stress.map import StressMap
 from cardan_exudyn.studies.stress.panels import DEFAULT_RPM, DEFAULT_STEPS, PANEL_FRICTION, X_LABELS, Panel
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 __all__ = ["SYMBOLS", "TESTS", "problems", "summary", "write_stress", "class_mark", "error_mark",
            "panel_table", "map_markdown", "plot_map"]

@@ -27,7 +27,7 @@ from cardan_exudyn.engines import ENGINES
 from cardan_exudyn.io import dumps
 from cardan_exudyn.report.format import number
 from cardan_exudyn.sweep import Distribution, SweepError
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.scene import Scene
 
 __all__ = ["register", "handler", "MONTE_CARLO_ONLY", "PAPER_ONLY", "error_distribution",

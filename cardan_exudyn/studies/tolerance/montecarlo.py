@@ -22,7 +22,7 @@ import numpy as np
 from cardan_exudyn.engines import run
 from cardan_exudyn.sweep import run_sweep
 from reference.paper import value
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene import replace
 from reference.scene.joint import ERROR_NAMES
 from reference.scene.scene import Scene

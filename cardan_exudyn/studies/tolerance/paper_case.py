@@ -20,7 +20,7 @@ import numpy as np
 
 from cardan_exudyn.engines import run
 from reference.paper import PARAMETER_SETS, paper_errors, rig_scene, value
-from reference.results.schema import Status, Summary
+from reference.results.summary import Status, Summary
 from reference.scene import FRICTION_LAWS, replace
 from reference.scene.joint import PAIR_NAMES
 

@@ -16,7 +16,7 @@ from cardan_exudyn.io import atomic_directory, dumps
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.tolerance.montecarlo import LEVELS, MonteCarlo
 from cardan_exudyn.studies.tolerance.paper_case import COUPLINGS, LAWS, MATCH_FACTOR
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene.joint import PAIR_NAMES
 
 __all__ = ["write_monte_carlo", "monte_carlo_plots", "monte_carlo_markdown", "percentile_table",

@@ -19,6 +19,7 @@ import numpy as np
 
 from cardan_exudyn.engines import run
 from reference.paper import named_scene
+from reference.results.accuracy import RunAccuracy
 from reference.scene import replace
 from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM
@@ -97,18 +98,18 @@ def run_cell(cell: dict[str, Any], accuracy: float) -> dict[str, Any]:
     row["status"] = f"{ex.status}/{ref.status}"
     if not (ex.success and ref.success) or ex.mean_efficiency is None or ref.mean_efficiency is None:
         return row
-    info = ex.extras.get("accuracy", {})
+    info = ex.accuracy or RunAccuracy()
     true = abs(ex.mean_efficiency - ref.mean_efficiency)
     estimate = ex.efficiency_error_estimate
-    pilot = info.get("pilot", {})
-    overhead = (info.get("companion_wall_time_s") or 0.0) + (
-        0.0 if pilot.get("is_companion", True) else pilot.get("wall_time_s") or 0.0)
-    row.update(steps_per_revolution=info.get("steps_per_revolution"), mean_efficiency=ex.mean_efficiency,
+    pilot = info.pilot
+    overhead = ((info.companion.wall_time_s if info.companion else None) or 0.0) + (
+        0.0 if pilot is None or pilot.is_companion else pilot.wall_time_s or 0.0)
+    row.update(steps_per_revolution=info.steps_per_revolution, mean_efficiency=ex.mean_efficiency,
                true_error=true, estimate=estimate, met=ex.accuracy_met, within_target=true <= accuracy,
                ratio=true / estimate if estimate else (0.0 if true == 0 else math.inf),
                cost_ratio=ex.wall_time_s / max(ex.wall_time_s - overhead, 1e-12),
-               order=info.get("order"), loss_fraction=info.get("loss_fraction"),
-               model=info.get("model"), richardson=info.get("richardson"))
+               order=info.order, loss_fraction=info.loss_fraction,
+               model=info.model, richardson=info.richardson)
     return row
 
 

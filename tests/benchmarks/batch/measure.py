@@ -42,7 +42,7 @@ from cardan_exudyn.studies.tolerance.montecarlo import default_distributions
 from cardan_exudyn.sweep import BATCH_SIZE, Distribution, RandomSpec, run_sweep
 from reference.engine import ReferenceOptions
 from reference.paper import named_scene, rig_scene
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene import replace
 from reference.scene.scene import Scene
 

@@ -8,7 +8,7 @@ from typing import Any
 
 from cardan_exudyn.report.format import number
 from reference.engine import ReferenceOptions
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 __all__ = ["MONTE_CARLO_TARGET_S", "PAPER_BATCH_TARGET_S", "TORQUE_TARGET_S", "MONTE_CARLO_SAMPLES",
            "AGREEMENT", "batch_targets"]

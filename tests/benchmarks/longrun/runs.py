@@ -73,7 +73,8 @@ from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.model.postprocess import body_states, mechanical_energy, postprocess, stored
 from cardan_exudyn.model.solve import solve
 from reference.engine import ReferenceOptions
-from reference.results.schema import Status, cumulative
+from reference.results.means import cumulative
+from reference.results.summary import Status
 from reference.scene import replace
 from reference.scene.scene import Scene
 
@@ -109,7 +110,7 @@ def simulate(scene: Scene, options: ExudynOptions,
                "dt_choice": solved.dt_reason, "newton_iterations": int(solved.solver.it.newtonStepsCount),
                "solve_wall_time_s": solved.wall_time_s, "wall_time_s": time.perf_counter() - wall_start}
     if model.friction is not None:
-        summary["friction"] = model.friction.summary()
+        summary["friction"] = model.friction.diagnostics().to_dict()
     return summary, model, cols
 
 

@@ -27,7 +27,7 @@ from benchmarks.longrun.plan import (
 )
 from cardan_exudyn.model.options import ExudynOptions
 from cardan_exudyn.report.format import number
-from reference.results.schema import Status
+from reference.results.summary import Status
 
 __all__ = ["DRIFT_MEASURES", "NEWTON_TOLERANCE", "ROTVEC_FAILURE", "measure_figures",
            "efficiency_figures", "drift_summary", "step_ladder", "rho_ladder", "fit_dissipation",

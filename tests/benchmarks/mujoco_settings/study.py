@@ -27,7 +27,7 @@ from cardan_exudyn.mujoco.options import (
 from reference.engine.dynamics import inverse_dynamics
 from reference.paper import named_scene
 from reference.physics.kinematics import speed_ratio
-from reference.results.schema import Result
+from reference.results.result import Result
 from reference.scene import replace as replace_scene
 from reference.scene.scene import Scene
 

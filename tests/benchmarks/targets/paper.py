@@ -17,7 +17,7 @@ from cardan_exudyn.studies.bench.configs import EXUDYN_TUNED, Progress, quiet
 from cardan_exudyn.studies.bench.ladders import yardstick
 from reference.engine import ReferenceOptions
 from reference.paper import paper_cases, paper_scene
-from reference.results.schema import Result
+from reference.results.result import Result
 from reference.scene import replace
 from reference.scene.scene import Scene
 

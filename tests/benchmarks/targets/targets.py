@@ -17,7 +17,7 @@ from benchmarks.startup import IMPORT_TARGET_MS
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies.bench.configs import SCENES
 from cardan_exudyn.studies.bench.result import cheapest
-from reference.results.schema import Status
+from reference.results.summary import Status
 from reference.scene import COUPLINGS
 
 __all__ = ["SPEED_RATIO_TARGET", "EFFICIENCY_TARGET", "FRICTION_COST_TARGET", "KINEMATICS_TARGET",
