@@ -15,7 +15,8 @@ from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 from reference.scene.validation import DEG, RPM, SceneError
 
-__all__ = ["DEFAULT_SCENE", "SCENE_OPTIONS", "add_scene_options", "scene_from_args", "override_name"]
+__all__ = ["DEFAULT_SCENE", "SCENE_OPTIONS", "LEAVE_OUT", "add_scene_options", "scene_from_args",
+           "override_name"]
 
 DEFAULT_SCENE = "paper-10deg-2000rpm"
 """The scene of ``cardan run`` without ``--name`` or ``--scene``: the paper's joint with friction
@@ -39,25 +40,28 @@ _VALUE_OPTIONS = (("coupling", "friction.coupling", "coupling", ""),
 _TOKENS = {"angle": re.compile(r"^\d+(?:\.\d+)?deg$"), "rpm": re.compile(r"^\d+(?:\.\d+)?rpm$")}
 
 
-def _add_source_options(p: argparse.ArgumentParser) -> None:
-    """``--scene FILE`` or ``--name NAME``."""
+def _add_source_options(p: argparse.ArgumentParser, default: str) -> None:
+    """``--scene FILE`` or ``--name NAME`` (``default``: what the command takes without one)."""
     src = p.add_mutually_exclusive_group()
     src.add_argument("--scene", metavar="FILE", help="scene TOML file")
     src.add_argument("--name", metavar="NAME",
                      help=f"named scene, e.g. paper-35deg, paper-literal-10deg-500rpm, rig-errors (parameter "
-                          f"sets physical, literal, matched; default {DEFAULT_SCENE}, physical set)")
+                          f"sets physical, literal, matched; default {default})")
 
 
-def _add_friction_options(p: argparse.ArgumentParser) -> None:
-    """The friction coefficients, coupling, law and sign band."""
-    p.add_argument("--friction-spider", metavar="F", type=number("-", non_negative=True),
-                   help="friction coefficient of the two spider pairs (the paper's f1)")
-    p.add_argument("--friction-frame", metavar="F", type=number("-", non_negative=True),
-                   help="friction coefficient of the two frame pairs (the paper's f2)")
-    p.add_argument("--coupling", choices=("extrapolated", "converged", "lagged"),
-                   help="friction coupling: one Newton solve per step on extrapolated law inputs "
-                        "(default), iterated to the fixed point per step, or lagged one step "
-                        "(the paper's)")
+def _add_friction_options(p: argparse.ArgumentParser, offered: set[str]) -> None:
+    """The friction coefficients and coupling (those of ``offered``), law and sign band."""
+    if "friction_spider" in offered:
+        p.add_argument("--friction-spider", metavar="F", type=number("-", non_negative=True),
+                       help="friction coefficient of the two spider pairs (the paper's f1)")
+    if "friction_frame" in offered:
+        p.add_argument("--friction-frame", metavar="F", type=number("-", non_negative=True),
+                       help="friction coefficient of the two frame pairs (the paper's f2)")
+    if "coupling" in offered:
+        p.add_argument("--coupling", choices=("extrapolated", "converged", "lagged"),
+                       help="friction coupling: one Newton solve per step on extrapolated law inputs "
+                            "(default), iterated to the fixed point per step, or lagged one step "
+                            "(the paper's)")
     p.add_argument("--friction-law", choices=("paper", "resultant"),
                    help="friction of a pair that rotates and slides: the paper's eqs. (3), (5), "
                         "a full Coulomb load in each direction (default), or one Coulomb force "
@@ -71,24 +75,62 @@ def _add_friction_options(p: argparse.ArgumentParser) -> None:
                            "0: exact sign)")
 
 
-def add_scene_options(p: argparse.ArgumentParser) -> None:
-    """Add the scene options (destinations :data:`SCENE_OPTIONS`) to a command's parser."""
-    _add_source_options(p)
-    p.add_argument("--angle", metavar="DEG", type=number("deg"), help="shaft angle [deg]")
-    p.add_argument("--rpm", metavar="RPM", type=number("rpm"),
-                   help="constant input speed [rpm] (makes the drive a constant-speed drive)")
-    p.add_argument("--load-torque", metavar="NM", type=number("N m"),
-                   help="resisting torque on the output shaft [N m]")
-    _add_friction_options(p)
+LEAVE_OUT = ("angle", "rpm", "load_torque", "friction_spider", "friction_frame", "coupling", "dt",
+             "accuracy", "revolutions")
+"""Destinations of :data:`SCENE_OPTIONS` a command may set itself (:func:`add_scene_options`)."""
+
+
+def add_scene_options(p: argparse.ArgumentParser, *, default: str | None = None,
+                      leave_out: tuple[str, ...] = ()) -> None:
+    """Add the scene options (destinations :data:`SCENE_OPTIONS`) to a command's parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The command's parser.
+    default : str, optional
+        What ``--name`` says the command takes without a scene (default: :data:`DEFAULT_SCENE`,
+        physical set, as ``cardan run``).
+    leave_out : tuple of str
+        Destinations of :data:`LEAVE_OUT` the command sets itself: not offered (argparse refuses
+        them), None in the parsed arguments, so that :func:`scene_from_args` works.
+
+    Raises
+    ------
+    ValueError
+        ``leave_out`` names an option no command may set itself.
+    """
+    if not set(leave_out) <= set(LEAVE_OUT):
+        raise ValueError(f"`leave_out` must name options of {list(LEAVE_OUT)}, got {leave_out!r}")
+    offered = set(SCENE_OPTIONS) - set(leave_out)
+    p.set_defaults(**{dest: None for dest in leave_out})
+    _add_source_options(p, default or f"{DEFAULT_SCENE}, physical set")
+    if "angle" in offered:
+        p.add_argument("--angle", metavar="DEG", type=number("deg"), help="shaft angle [deg]")
+    if "rpm" in offered:
+        p.add_argument("--rpm", metavar="RPM", type=number("rpm"),
+                       help="constant input speed [rpm] (makes the drive a constant-speed drive)")
+    if "load_torque" in offered:
+        p.add_argument("--load-torque", metavar="NM", type=number("N m"),
+                       help="resisting torque on the output shaft [N m]")
+    _add_friction_options(p, offered)
     p.add_argument("--no-gravity", action="store_true", help="switch gravity off")
-    p.add_argument("--dt", metavar="S", type=number("s", positive=True),
-                   help="time step [s] (default: chosen from the scene to meet --accuracy)")
-    p.add_argument("--accuracy", metavar="E", type=number("-", positive=True),
-                   help="target absolute error of the mean efficiency (and relative error of "
-                        "omega_out/omega_in; default 1e-3): the step is chosen to meet it, and a "
-                        "run whose estimated error exceeds it says so (exit 5)")
-    p.add_argument("--revolutions", metavar="N", type=number("-", positive=True),
-                   help="input revolutions to simulate")
+    _add_numerics_options(p, offered)
+
+
+def _add_numerics_options(p: argparse.ArgumentParser, offered: set[str]) -> None:
+    """The step, the accuracy and the revolutions (those of ``offered``)."""
+    if "dt" in offered:
+        p.add_argument("--dt", metavar="S", type=number("s", positive=True),
+                       help="time step [s] (default: chosen from the scene to meet --accuracy)")
+    if "accuracy" in offered:
+        p.add_argument("--accuracy", metavar="E", type=number("-", positive=True),
+                       help="target absolute error of the mean efficiency (and relative error of "
+                            "omega_out/omega_in; default 1e-3): the step is chosen to meet it, and a "
+                            "run whose estimated error exceeds it says so (exit 5)")
+    if "revolutions" in offered:
+        p.add_argument("--revolutions", metavar="N", type=number("-", positive=True),
+                       help="input revolutions to simulate")
 
 
 def scene_from_args(args: argparse.Namespace) -> Scene:

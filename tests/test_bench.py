@@ -280,7 +280,7 @@ def test_a_command_leaves_out_the_scene_options_it_sets_itself():
     scene builds as without them; only options a command can set itself can be left out."""
     import argparse
 
-    from cardan_exudyn.arguments import add_scene_options, scene_from_args
+    from cardan_exudyn.scene_options import add_scene_options, scene_from_args
 
     p = argparse.ArgumentParser()
     add_scene_options(p, leave_out=("dt", "coupling"))

@@ -35,7 +35,7 @@ import cardan_exudyn
 from cardan_exudyn.cli import build_parser, main
 from cardan_exudyn.model.accuracy import MODEL_FLOOR
 from cardan_exudyn.scene_options import scene_from_args
-from cardan_exudyn.studies.calibrate.compute import case_rows, fit_statistics
+from cardan_exudyn.studies.calibrate.fit import case_rows, fit_statistics
 from cardan_exudyn.studies.calibrate.fitting import CaseModel
 from cardan_exudyn.testing import make_scene
 from reference.paper.cases import envelope, paper_cases

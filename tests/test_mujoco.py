@@ -20,15 +20,11 @@ import pytest
 
 pytest.importorskip("mujoco")
 
+from benchmarks.mujoco_settings.study import MUJOCO_DEFAULTS, accuracy  # noqa: E402
+
 from cardan_exudyn import engines
-from cardan_exudyn.mujoco import engine as mujoco_engine  # noqa: E402 (after the optional-import skip)
 from cardan_exudyn.mujoco import MujocoOptions, choose_timestep, speed_ratio_error_model  # noqa: E402
-from cardan_exudyn.studies.mujoco_settings.compute import (  # noqa: E402
-    MUJOCO_DEFAULTS,
-    accuracy,
-    settings_study,
-    study_cases,
-)
+from cardan_exudyn.mujoco import engine as mujoco_engine  # noqa: E402 (after the optional-import skip)
 from reference.engine.dynamics import inverse_dynamics  # noqa: E402
 from reference.paper.scenes import named_scene  # noqa: E402
 from reference.results.columns import table_columns  # noqa: E402
@@ -214,11 +210,3 @@ def test_invalid_settings_are_rejected(kwargs, match):
     """Bad settings raise OptionsError (a ValueError) naming the argument."""
     with pytest.raises(OptionsError, match=match):
         MujocoOptions(**kwargs)
-
-
-def test_settings_study_table():
-    """The study returns one row per scene and case with every error measure."""
-    cases = study_cases((DT,))[:3]
-    table = settings_study(scenes=("paper-literal-10deg-frictionless",), cases=cases, repeats=1)
-    assert list(table["case"]) == [label for label, _ in cases]
-    assert {"speed_ratio_error", "torque_in_error", "bearing_drift_m", "wall_time_s"} <= set(table)

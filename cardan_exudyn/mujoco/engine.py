@@ -8,7 +8,7 @@ first use, so a missing MuJoCo makes only this engine unavailable.
 The engine in four steps: the time step (:mod:`~cardan_exudyn.mujoco.timestep`), the MJCF model
 (:mod:`~cardan_exudyn.mujoco.mjcf`), the time loop (:mod:`~cardan_exudyn.mujoco.simulate`) and
 the result columns (:mod:`~cardan_exudyn.mujoco.table`). Defaults: the settings study of
-:mod:`cardan_exudyn.studies.mujoco_settings.compute`, ``docs/mujoco.md``.
+``docs/mujoco.md`` (``python tests/benchmarks mujoco-settings``).
 
 References
 ----------

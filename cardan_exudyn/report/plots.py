@@ -12,7 +12,7 @@ import numpy as np  # noqa: E402
 from reference.results.summary import Status  # noqa: E402
 
 __all__ = ["CLASS_COLOURS", "speed_ratio", "data_limits", "efficiency_against_input_angle", "pair_losses",
-           "efficiency_against_paper", "save", "work_precision", "close", "stability_map"]
+           "efficiency_against_paper", "save", "close", "stability_map"]
 
 
 def _axes(ax):
@@ -225,58 +225,6 @@ def save(fig, path, dpi: int = 130) -> None:
     """
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
-
-
-def work_precision(rows, speed_ratio_level: float, efficiency_level: float):
-    """Error against wall time per simulated second, log-log, one column per bench scene.
-
-    Top row: the scene's accuracy measure (speed-ratio error without friction, mean-efficiency
-    error with friction) with the target level dashed; bottom row: drive-torque error after the
-    first revolution. One line per configuration, points along its step-size ladder.
-
-    Parameters
-    ----------
-    rows : DataFrame
-        The benchmark's rows (``scene``, ``status``, ``config``, ``engine``,
-        ``steps_per_revolution``, ``wall_per_simulated_s`` and the error columns).
-    speed_ratio_level : float
-        Target level of the speed-ratio error [-].
-    efficiency_level : float
-        Target level of the mean-efficiency error [-].
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-    """
-    scenes = list(dict.fromkeys(rows["scene"]))
-    fig, axes = plt.subplots(2, len(scenes), figsize=(4.6 * len(scenes), 7.5), squeeze=False,
-                             constrained_layout=True)
-    markers = {"exudyn": "o", "mujoco": "s", "reference": "^"}
-    for j, scene in enumerate(scenes):
-        sel = rows[(rows["scene"] == scene) & (rows["status"] == Status.OK)]
-        friction = scene.startswith("friction-")
-        top = "mean_efficiency_error" if friction else "speed_ratio_error"
-        level = efficiency_level if friction else speed_ratio_level
-        for i, (key, label) in enumerate(((top, "mean-efficiency error" if friction
-                                            else "max speed-ratio error"),
-                                           ("torque_in_error_steady",
-                                            "drive-torque error after rev. 1 (rel.)"))):
-            ax = axes[i][j]
-            for config, part in sel.groupby("config", sort=False):
-                part = part.sort_values("steps_per_revolution")
-                y = part[key].astype(float).clip(lower=1e-16)
-                if not y.notna().any():
-                    continue
-                ax.loglog(part["wall_per_simulated_s"], y, marker=markers.get(part["engine"].iloc[0], "o"),
-                          ms=4, lw=1, label=config)
-            if i == 0:
-                ax.axhline(level, color="k", ls="--", lw=0.8)
-                ax.set_title(scene)
-            ax.set_xlabel("wall time per simulated second [s]")
-            ax.set_ylabel(label)
-            ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=6)
-    return fig
 
 
 def close(fig) -> None:

@@ -37,7 +37,7 @@ BATCH_SIZE = 1000
 """Most cases in one batch: it bounds a batch's memory, which grows linearly with the batch (a
 scene that records its time table holds 721 x 72 floats, 0.4 MB), while the cost per case stops
 falling well before it. Measured (per-sample cost against batch size, peak memory per 1000
-scenes): docs/bench.md#the-batched-reference-engine."""
+scenes): docs/benchmarks.md#the-batched-reference-engine."""
 BATCHES_PER_WORKER = 4
 """Batches are cut so that each worker gets at least this many (smaller batches when the sweep is
 small): the last batch to finish does not leave the other workers idle for long, records land and

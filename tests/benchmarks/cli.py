@@ -10,7 +10,7 @@ import sys
 
 from benchmarks import BENCHMARKS
 from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_INTERRUPTED, BadInput
-from cardan_exudyn.io import OutputError
+from cardan_exudyn.outputs import OutputError
 from reference.results.summary import OptionsError
 from reference.scene.validation import SceneError
 

@@ -26,17 +26,10 @@ import argparse
 import sys
 from typing import Any
 
-from cardan_exudyn.arguments import (
-    EXIT_OK,
-    SCENE_OPTIONS,
-    BadInput,
-    add_scene_options,
-    count,
-    out_folder,
-    scene_from_args,
-)
-from cardan_exudyn.io import dumps
+from cardan_exudyn.arguments import EXIT_OK, BadInput, count, out_folder
+from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.report.format import number
+from cardan_exudyn.scene_options import SCENE_OPTIONS, add_scene_options, scene_from_args
 
 __all__ = ["register", "handler", "names", "given_scene_options", "scenes_from_args", "summary_lines"]
 

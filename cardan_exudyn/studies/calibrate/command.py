@@ -9,7 +9,7 @@ import argparse
 import sys
 
 from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, out_folder
-from cardan_exudyn.io import dumps
+from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.studies.calibrate.envelope import envelope_study
 from cardan_exudyn.studies.calibrate.fit import FIT_SETS, calibrate
 from cardan_exudyn.studies.calibrate.fitting import FIT_ENGINES

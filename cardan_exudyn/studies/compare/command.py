@@ -5,16 +5,9 @@ from __future__ import annotations
 
 import argparse
 
-from cardan_exudyn.arguments import (
-    EXIT_FAILED,
-    EXIT_OK,
-    BadInput,
-    add_scene_options,
-    number,
-    out_folder,
-    scene_from_args,
-)
-from cardan_exudyn.io import dumps
+from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, number, out_folder
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.scene_options import add_scene_options, scene_from_args
 
 __all__ = ["register", "handler", "engine_names"]
 

@@ -31,7 +31,8 @@ from typing import Any
 import numpy as np
 
 from cardan_exudyn import engines
-from cardan_exudyn.io import atomic_write, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_write
 from cardan_exudyn.sweep import CASES_FILE, SweepError, SweepSpec, flatten_paths, read_records, run_sweep
 from reference.paper import DEFAULT_PARAMETER_SET, PARAMETER_SETS, paper_cases, paper_scene
 from reference.results.result import Result

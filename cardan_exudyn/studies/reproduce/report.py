@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.reproduce.compute import RUNS_DIR, Reproduction

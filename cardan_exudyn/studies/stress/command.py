@@ -14,15 +14,8 @@ import sys
 import time
 from typing import Any
 
-from cardan_exudyn.arguments import (
-    EXIT_FAILED,
-    EXIT_OK,
-    BadInput,
-    add_scene_options,
-    count,
-    out_folder,
-    scene_from_args,
-)
+from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, BadInput, count, out_folder
+from cardan_exudyn.scene_options import add_scene_options, scene_from_args
 from cardan_exudyn.studies.stress.panels import BASE_SCENE
 
 __all__ = ["register", "handler", "SET_BY_CELL", "summary_lines"]
@@ -77,7 +70,8 @@ def handler(args: argparse.Namespace) -> int:
     """Run ``cardan stress``; exit 3 when a map cell raised in the harness."""
     # Imported here, not at the top: `cardan` imports this module to register the command, and the
     # map loads pandas, Exudyn and matplotlib (about 2 s) that no other command should wait for.
-    from cardan_exudyn.io import check_output_folder, dumps
+    from cardan_exudyn.jsonable import dumps
+    from cardan_exudyn.outputs import check_output_folder
     from cardan_exudyn.studies.stress.map import run_map
     from cardan_exudyn.studies.stress.report import problems, summary, write_stress
     from cardan_exudyn.sweep import SweepError

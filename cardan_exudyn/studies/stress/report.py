@@ -12,7 +12,8 @@ from typing import Any
 
 import pandas as pd
 
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.environment import environment
 from cardan_exudyn.report.format import markdown_table

@@ -14,18 +14,16 @@ from cardan_exudyn.arguments import (
     COUNT_LIMITS,
     EXIT_FAILED,
     EXIT_OK,
-    SCENE_OPTIONS,
     BadInput,
-    add_scene_options,
     count,
     out_folder,
     path_value,
     refuse_options,
-    scene_from_args,
 )
 from cardan_exudyn.engines import ENGINES
-from cardan_exudyn.io import dumps
+from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.report.format import number
+from cardan_exudyn.scene_options import SCENE_OPTIONS, add_scene_options, scene_from_args
 from cardan_exudyn.sweep import Distribution, SweepError
 from reference.results.summary import Status
 from reference.scene.scene import Scene

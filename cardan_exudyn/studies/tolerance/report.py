@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table, number
 from cardan_exudyn.studies.tolerance.montecarlo import LEVELS, MonteCarlo
 from cardan_exudyn.studies.tolerance.paper_case import COUPLINGS, LAWS, MATCH_FACTOR

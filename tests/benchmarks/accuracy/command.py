@@ -13,7 +13,8 @@ from typing import Any
 from benchmarks.accuracy.grid import CELL_TIMEOUT_S, grid_cells, run_cell_limited
 from benchmarks.accuracy.verdict import fit_constants, honesty
 from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, count, number, out_folder
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
 
 __all__ = ["COLUMNS", "register", "handler"]

@@ -7,7 +7,7 @@ import argparse
 import sys
 
 from cardan_exudyn.arguments import EXIT_OK, count, out_folder
-from cardan_exudyn.io import dumps
+from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.studies.bench.command import show_progress
 from cardan_exudyn.studies.bench.configs import quiet
 

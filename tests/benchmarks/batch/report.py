@@ -8,7 +8,8 @@ from typing import Any
 
 import pandas as pd
 
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
 from cardan_exudyn.studies.bench.report import header
 

@@ -7,7 +7,8 @@ import argparse
 import sys
 
 from cardan_exudyn.arguments import EXIT_FAILED, EXIT_OK, out_folder
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.environment import environment
 
 __all__ = ["register", "handler"]

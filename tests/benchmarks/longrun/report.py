@@ -29,7 +29,7 @@ from benchmarks.longrun.plan import (
 )
 from benchmarks.longrun.runs import LongRuns
 from benchmarks.longrun.summary import rho_ladder, step_ladder
-from cardan_exudyn.io import to_jsonable
+from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.report import plots
 from cardan_exudyn.report.format import markdown_table, number
 

@@ -7,7 +7,7 @@ import argparse
 import sys
 
 from cardan_exudyn.arguments import EXIT_OK, BadInput, count, out_folder
-from cardan_exudyn.io import atomic_directory
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import markdown_table
 
 __all__ = ["PRINTED", "PRINTED_FORMATS", "register", "handler"]

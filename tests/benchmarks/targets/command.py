@@ -9,7 +9,7 @@ import argparse
 import sys
 
 from cardan_exudyn.arguments import EXIT_OK, BadInput, count, out_folder
-from cardan_exudyn.io import dumps
+from cardan_exudyn.jsonable import dumps
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies.bench.command import names, show_progress
 

@@ -20,7 +20,8 @@ from benchmarks.targets.targets import (
     friction_ladders,
     is_friction_scene,
 )
-from cardan_exudyn.io import atomic_directory, dumps
+from cardan_exudyn.jsonable import dumps
+from cardan_exudyn.outputs import atomic_directory
 from cardan_exudyn.report.format import number
 from cardan_exudyn.studies.bench.report import header, intro, rows_section, table, work_precision_figure
 
