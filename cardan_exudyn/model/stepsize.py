@@ -123,8 +123,8 @@ def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
 
 EFFICIENCY_FIRST_ORDER = 0.6
 """``C1`` [1/rad] of the mean-efficiency model's first-order term ``C1 h r`` (``r`` the loss
-fraction), the ``lagged`` coupling's (:func:`convergence_order`); ``cardan accuracy --fit``
-refits it."""
+fraction), the ``lagged`` coupling's (:func:`convergence_order`); ``python tests/benchmarks
+accuracy --fit`` refits it."""
 EFFICIENCY_FIRST_ORDER_ERRORS = 3.5
 """``C1`` with mounting errors: their sliding reverses too, and its sign changes cost far more
 than its small loss."""
