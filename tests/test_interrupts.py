@@ -152,7 +152,7 @@ def test_run_interrupted_keeps_previous_output(tmp_path, signum, seed):
     assert main(["run", "--name", "paper-literal-10deg", "--engine", "reference", "--revolutions", "1",
                  "--out", str(out)]) == 0
     before = snapshot(out)
-    proc = start(["run", "--name", "paper-literal-35deg", "--revolutions", "5", "--out", str(out)], tmp_path)
+    proc = start(["run", "--name", "paper-literal-35deg", "--revolutions", "20", "--out", str(out)], tmp_path)
     wait_for(lambda: (tmp_path / ".out.lock").exists(), proc)  # the command has started
     stderr, took = interrupt(proc, signum, delay(seed, 0.0, 1.5))
     assert_stopped(proc, signum, stderr, took)
@@ -166,7 +166,7 @@ def test_compare_interrupted_keeps_previous_output(tmp_path, signum):
     out.mkdir()
     (out / "report.md").write_text("previous\n")
     proc = start(["compare", "--name", "paper-literal-35deg", "--engines", "reference,exudyn",
-                  "--revolutions", "3",
+                  "--revolutions", "10",
                   "--out", str(out)], tmp_path)
     wait_for(lambda: (tmp_path / ".cmp.lock").exists(), proc)
     stderr, took = interrupt(proc, signum, delay(signum, 0.0, 1.5))
