@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -23,14 +24,29 @@ __all__ = ["sign_breakpoints"]
 
 def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
                      per_revolution: int = SCAN_PER_REVOLUTION) -> np.ndarray:
-    """Instants in (t_a, t_b) where a friction sign ramp starts or ends [s].
+    """Instants where a friction sign ramp starts or ends.
 
-    Each relative surface (or sliding) speed is sampled on a grid, every crossing of its ramp
-    edges ``+-band`` (:func:`reference.engine.slots.slot_bands`; of 0 for the exact sign) is
-    bracketed (:mod:`reference.engine.crossings`: sign changes, and grazing crossings between two
-    samples) and refined to rounding.
+    Each ramp speed (:func:`reference.engine.slots.ramp_speeds`) is sampled on a grid, every
+    crossing of its ramp edges ``+-band`` (of 0 for the exact sign) is bracketed
+    (:mod:`reference.engine.crossings`: sign changes, and grazing crossings between two samples)
+    and refined to rounding.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene on the run's clock.
+    motion : InputMotion
+        The input's motion (:func:`reference.engine.motion.input_motion`).
+    t_a, t_b : float
+        The span searched [s].
+    per_revolution : int
+        Grid samples per input revolution (at least 64 in all).
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The distinct instants in ``(t_a, t_b)`` [s], ascending.
     """
-
     slots = friction_slots(scene)
     if not slots or t_b <= t_a:
         return np.zeros(0)
@@ -45,21 +61,34 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
     n = max(64, int(per_revolution * abs(theta_b - theta_a) / (2.0 * math.pi)))
     grid = np.linspace(t_a, t_b, n + 1)
     values = speeds(grid)
-    bands = ramp_bands(scene, slots)
+    brackets = _brackets(grid, values, ramp_bands(scene, slots), speeds)
+    if not brackets:
+        return np.zeros(0)
+    return distinct_instants(_refine(brackets, speeds), t_b - t_a)
+
+
+def _brackets(grid: np.ndarray, values: np.ndarray, bands: np.ndarray,
+              speeds: Callable[[np.ndarray], np.ndarray]) -> list[tuple]:
+    """Brackets of every crossing of ``+-bands`` (K,) by the sampled ``values`` (m, K) on
+    ``grid`` (m,) [s]: sign changes, and grazing crossings checked at their vertices by
+    ``speeds`` (instants to speeds (., K))."""
     brackets = []
     grazing = []
-    for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge below
+    for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge later
         brackets += sign_change_brackets(grid, values, levels)
         grazing += [(levels, c) for c in grazing_candidates(grid, values, levels)]
     if grazing:  # every vertex in one evaluation
         at = speeds(np.array([c[0] for _, c in grazing]))
         for row, (levels, c) in enumerate(grazing):
             brackets += grazing_brackets(grid, values, levels, [c], at[row, c[2]:c[2] + 1])
-    if not brackets:
-        return np.zeros(0)
+    return brackets
+
+
+def _refine(brackets: list[tuple], speeds: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """Each bracket's crossing [s] to rounding: Illinois regula falsi on all brackets at once."""
     a, b, f_a, f_b, j, level = (np.array(v) for v in zip(*brackets, strict=True))
     rows = np.arange(a.size)
-    for _ in range(100):  # Illinois regula falsi on all brackets at once
+    for _ in range(100):
         c = b - f_b * (b - a) / (f_b - f_a)
         f_c = speeds(c)[rows, j] - level
         same = np.sign(f_c) == np.sign(f_b)
@@ -69,4 +98,4 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
         f_b = f_c
         if np.all((np.abs(b - a) <= 1e-15) | (f_b == 0.0)):
             break
-    return distinct_instants(b, t_b - t_a)
+    return b

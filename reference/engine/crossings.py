@@ -29,8 +29,22 @@ crossing, e.g. the two spider pairs, converge to instants a few ulp apart)."""
 
 
 def sign_change_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray) -> list[tuple]:
-    """Cells of ``grid`` (m,) where a column of ``values`` (m, K) crosses its level ``levels`` (K,):
-    ``(t_a, t_b, f_a, f_b, column, level)`` with ``f = value - level``."""
+    """Cells of the grid where a column of ``values`` crosses its level.
+
+    Parameters
+    ----------
+    grid : ndarray, shape (m,)
+        Sample instants [s].
+    values : ndarray, shape (m, K)
+        Sampled speeds [m/s].
+    levels : ndarray, shape (K,)
+        Each column's level [m/s].
+
+    Returns
+    -------
+    list of tuple
+        ``(t_a, t_b, f_a, f_b, column, level)`` per crossing, ``f = value - level``.
+    """
     g = values - levels
     cell, col = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)
     return [(grid[i], grid[i + 1], g[i, j], g[i + 1, j], j, levels[j])
@@ -39,9 +53,23 @@ def sign_change_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarra
 
 def grazing_candidates(grid: np.ndarray, values: np.ndarray,
                        levels: np.ndarray) -> list[tuple[float, int, int]]:
-    """Interior samples where a column of ``values`` (m, K) has a sampled extremum on one side of
-    its level (K,), and the parabola through it and its neighbours crosses the level:
-    ``(t_vertex, sample, column)``."""
+    """Interior samples where a column has a sampled extremum on one side of its level and the
+    parabola through it and its neighbours crosses the level.
+
+    Parameters
+    ----------
+    grid : ndarray, shape (m,)
+        Equispaced sample instants [s].
+    values : ndarray, shape (m, K)
+        Sampled speeds [m/s].
+    levels : ndarray, shape (K,)
+        Each column's level [m/s].
+
+    Returns
+    -------
+    list of (float, int, int)
+        ``(t_vertex, sample, column)``: the parabola's vertex [s], the extremum's row, its column.
+    """
     g = values - levels
     if g.shape[0] < 3:
         return []
@@ -68,8 +96,23 @@ def grazing_candidates(grid: np.ndarray, values: np.ndarray,
 
 def grazing_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray,
                      candidates: list[tuple[float, int, int]], at_vertex: np.ndarray) -> list[tuple]:
-    """The two brackets of each candidate (:func:`grazing_candidates`) whose ``at_vertex`` value
-    (the column's speed at ``t_vertex``) is across the level; the others are dropped."""
+    """The two brackets of each grazing candidate whose speed at the vertex is across the level.
+
+    Parameters
+    ----------
+    grid, values, levels
+        As for :func:`grazing_candidates`.
+    candidates : list of (float, int, int)
+        From :func:`grazing_candidates`.
+    at_vertex : ndarray, shape (len(candidates),)
+        Each candidate column's speed at its ``t_vertex`` [m/s].
+
+    Returns
+    -------
+    list of tuple
+        Brackets as :func:`sign_change_brackets`'s, two per candidate across its level; the
+        other candidates are dropped.
+    """
     out = []
     for (t_v, k, col), v in zip(candidates, at_vertex, strict=True):
         f_v = v - levels[col]
@@ -84,7 +127,20 @@ def grazing_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray,
 
 
 def distinct_instants(instants: np.ndarray, span: float) -> np.ndarray:
-    """Sorted ``instants`` [s] with those within ``MERGE * span`` of the one before dropped."""
+    """Sorted instants, near duplicates merged.
+
+    Parameters
+    ----------
+    instants : ndarray, shape (n,)
+        Refined crossings [s].
+    span : float
+        The scanned span [s]; an instant within ``MERGE * span`` of the one before is dropped.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The distinct instants [s], ascending.
+    """
     t = np.unique(instants)
     if t.size < 2:
         return t

@@ -20,16 +20,32 @@ __all__ = ["FixedPoint", "friction_law_values", "loop_gain", "reduced_law_values
            "power_bound", "POWER_SQUARINGS"]
 
 POWER_SQUARINGS = 6
-"""Squarings of :func:`power_bound`: the bound of ``||G^64||^(1/64)``, within 12 % of the spectral
-radius on rig samples at an eighth of the eigenvalues' cost.
+"""Squarings of :func:`power_bound`: the bound of ``||G^64||^(1/64)``.
 Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
 def friction_law_values(x: np.ndarray, index: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
                         k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:meth:`FrictionLaw.__call__` with its coefficients given: ``index`` (K, 4) the columns of
-    ``x`` holding each slot's fx, fy, mx, my; ``k_force`` [m or -] and ``k_moment`` [-, 1/m]
-    the law's factors of ``|F|`` and ``|M|``, shape (K,) or one row per sample (n, K)."""
+    """:meth:`reference.engine.slots.FrictionLaw.__call__` with its coefficients given.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n, 18)
+        Reactions and the drive unknown.
+    index : ndarray of int, shape (K, 4)
+        The columns of ``x`` holding each slot's fx, fy, mx, my.
+    signs : ndarray, shape (n, K)
+        Each slot's friction factor in [-1, 1].
+    k_force, k_moment : ndarray, shape (K,) or (n, K)
+        The law's factors of ``|F|`` [m or -] and ``|M|`` [- or 1/m].
+
+    Returns
+    -------
+    values : ndarray, shape (n, K)
+        Friction values [N m or N].
+    jacobian : ndarray, shape (n, K, 18)
+        ``dG/dx``.
+    """
     values, slopes = reduced_law_values(x[:, index], signs, k_force, k_moment)
     jacobian = np.zeros(x.shape[:1] + index.shape[:1] + x.shape[1:])
     jacobian[:, np.arange(index.shape[0])[:, None], index] = slopes
@@ -38,10 +54,23 @@ def friction_law_values(x: np.ndarray, index: np.ndarray, signs: np.ndarray, k_f
 
 def reduced_law_values(c: np.ndarray, signs: np.ndarray, k_force: np.ndarray,
                        k_moment: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The law of eqs. (3) and (5) on the components it reads: ``c`` (n, K, 4) each slot's fx,
-    fy, mx, my. Returns the values (n, K) and their derivatives with respect to ``c`` (n, K, 4)
-    (the zero subgradient where a norm is exactly zero); :func:`friction_law_values` scatters
-    them into ``dG/dx``."""
+    """The law of eqs. (3) and (5) on the components it reads.
+
+    Parameters
+    ----------
+    c : ndarray, shape (n, K, 4)
+        Each slot's fx, fy [N], mx, my [N m].
+    signs, k_force, k_moment
+        As for :func:`friction_law_values`.
+
+    Returns
+    -------
+    values : ndarray, shape (n, K)
+        Friction values [N m or N].
+    slopes : ndarray, shape (n, K, 4)
+        Their derivatives with respect to ``c`` (the zero subgradient where a norm is exactly
+        zero); :func:`friction_law_values` scatters them into ``dG/dx``.
+    """
     force = np.hypot(c[..., 0], c[..., 1])
     moment = np.hypot(c[..., 2], c[..., 3])
     per_force = -signs * k_force
@@ -90,11 +119,24 @@ class FixedPoint:
 
 
 def power_bound(g: np.ndarray, norm: np.ndarray) -> np.ndarray:
-    """Upper bounds of the spectral radii of the matrices ``g`` (n, K, K), from their infinity
-    norms ``norm`` (n,) (positive): ``rho(G) = rho(G^m)^(1/m) <= ||G^m||^(1/m)`` (Gelfand), with
-    ``m = 2^POWER_SQUARINGS`` by squaring ``G / ||G||`` (whose powers cannot overflow). The
-    bound falls towards ``rho`` as ``m`` grows; where it stays at or above a threshold the caller
-    computes the eigenvalues."""
+    """Upper bounds of spectral radii: ``rho(G) = rho(G^m)^(1/m) <= ||G^m||^(1/m)`` (Gelfand),
+    with ``m = 2^POWER_SQUARINGS`` by squaring ``G / ||G||`` (whose powers cannot overflow).
+
+    The bound falls towards ``rho`` as ``m`` grows; where it stays at or above a threshold the
+    caller computes the eigenvalues.
+
+    Parameters
+    ----------
+    g : ndarray, shape (n, K, K)
+        The matrices.
+    norm : ndarray, shape (n,)
+        Their infinity norms (positive).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The bounds, at most ``norm``.
+    """
     p = g / norm[:, None, None]
     for _ in range(POWER_SQUARINGS):
         p = p @ p
@@ -131,26 +173,34 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
         return FixedPoint(x0, np.zeros((n, 0)), np.ones(n, bool), np.zeros(n), 0)
     # the law reads 4 components per slot: Newton on those, (n, K, 4) and (n, K, 4, K), not on x
     index = law.index
-    c0 = x0[:, index]
     s_c = s[:, index, :]
+    phi, converged, iterations = _newton(law, x0[:, index], s_c, signs, tolerance, max_iterations)
+    x = x0 - np.einsum("nik,nk->ni", s, phi)
+    _, g_c = law.reduced(x[:, index], signs)
+    gain = loop_gain(g_c, s_c, exact_gain)
+    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
+    return FixedPoint(x, phi, converged, gain, iterations)
+
+
+def _newton(law: Any, c0: np.ndarray, s_c: np.ndarray, signs: np.ndarray, tolerance: float,
+            max_iterations: int) -> tuple[np.ndarray, np.ndarray, int]:
+    """Newton on ``phi = G(c0 - S_c phi)`` per sample from ``G(c0)``, the unconverged samples'
+    data compacted as samples converge (arguments as :func:`solve_friction`'s, ``c0`` (n, K, 4)
+    and ``s_c`` (n, K, 4, K) restricted to the components the law reads). Returns ``phi``
+    (n, K), ``converged`` (n,) and the iterations of the slowest sample."""
+    n = c0.shape[0]
     phi, _ = law.reduced(c0, signs)
-    scale = np.max(np.abs(phi), -1)
     converged = np.zeros(n, bool)
     active = np.arange(n)
-    # the unconverged samples' data, compacted as samples converge
     c_a = c0
     s_a = s_c
     signs_a = signs
     phi_a = phi.copy()
-    scale_a = scale.copy()
+    scale_a = np.max(np.abs(phi), -1)
     iterations = 0
-    eye = np.eye(k)
-    for iterations in range(1, max_iterations + 1):  # noqa: B007 (reported below)
-        shift = (s_a.reshape(s_a.shape[0], 4 * k, k) @ phi_a[..., None]).reshape(c_a.shape)
-        g, g_c = law.reduced(c_a - shift, signs_a)
-        jac = eye + (g_c[:, :, None, :] @ s_a)[:, :, 0, :]  # I + d(G(x0 - S phi))/dphi
-        with np.errstate(all="ignore"):
-            step = np.linalg.solve(jac, (phi_a - g)[..., None])[..., 0]
+    eye = np.eye(s_c.shape[-1])
+    for iterations in range(1, max_iterations + 1):  # noqa: B007 (returned)
+        step = _newton_step(law, c_a, s_a, signs_a, phi_a, eye)
         phi_a -= step
         scale_a = np.maximum(scale_a, np.max(np.abs(phi_a), -1))
         done = np.max(np.abs(step), -1) <= tolerance * np.maximum(scale_a, np.finfo(float).tiny)
@@ -168,11 +218,19 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
             signs_a = signs_a[keep]
             phi_a = phi_a[keep]
             scale_a = scale_a[keep]
-    x = x0 - np.einsum("nik,nk->ni", s, phi)
-    _, g_c = law.reduced(x[:, index], signs)
-    gain = loop_gain(g_c, s_c, exact_gain)
-    gain[~converged] = np.inf  # no solution found: the friction loop has no finite value
-    return FixedPoint(x, phi, converged, gain, iterations)
+    return phi, converged, iterations
+
+
+def _newton_step(law: Any, c: np.ndarray, s_c: np.ndarray, signs: np.ndarray, phi: np.ndarray,
+                 eye: np.ndarray) -> np.ndarray:
+    """Newton's update of ``phi`` (n, K) for ``phi = G(c - S_c phi)``: ``J^-1 (phi - G)`` with
+    ``J = I + d(G(c - S_c phi))/dphi``."""
+    k = eye.shape[0]
+    shift = (s_c.reshape(s_c.shape[0], 4 * k, k) @ phi[..., None]).reshape(c.shape)
+    g, g_c = law.reduced(c - shift, signs)
+    jac = eye + (g_c[:, :, None, :] @ s_c)[:, :, 0, :]
+    with np.errstate(all="ignore"):
+        return np.linalg.solve(jac, (phi - g)[..., None])[..., 0]
 
 
 def loop_gain(g_c: np.ndarray, s_c: np.ndarray, exact_gain: float = 0.5) -> np.ndarray:

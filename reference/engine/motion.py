@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -25,7 +26,13 @@ __all__ = ["InputMotion", "SelfLocking", "input_motion"]
 
 
 class SelfLocking(Exception):
-    """Friction has no finite consistent value at some instant (raised inside the integrator)."""
+    """Friction has no finite consistent value at some instant (raised inside the integrator).
+
+    Parameters
+    ----------
+    t, theta : float
+        The instant [s] and input angle [rad].
+    """
 
     def __init__(self, t: float, theta: float) -> None:
         super().__init__(t, theta)
@@ -94,15 +101,26 @@ def _angle_motion(scene: Scene, drive: AngleDrive) -> InputMotion:
 
 
 def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) -> InputMotion:
-    from scipy.integrate import solve_ivp  # scipy.integrate takes ~0.5 s to import
+    budget = EvaluationBudget(scene)
+    rhs = _torque_rhs(scene, drive, budget)
+    try:
+        sol = _integrate(scene, drive, options, rhs)
+    except SelfLocking as exc:
+        return _stopped(drive, budget, exc.t, Status.SELF_LOCKING,
+                        f"friction self-locks at t = {exc.t:.6g} s, input angle "
+                        f"{math.degrees(exc.theta):.6g} deg: no consistent friction")
+    except Stalled as exc:
+        return _stopped(drive, budget, exc.t, Status.INCOMPLETE, exc.reason)
+    return _integrated(scene, drive, sol, budget.count)
 
+
+def _torque_rhs(scene: Scene, drive: TorqueDrive,
+                budget: EvaluationBudget) -> Callable[[float, np.ndarray], np.ndarray]:
+    """The ODE ``(t, [theta, theta_t]) -> [theta_t, theta_tt]``, each call counted on ``budget``;
+    raises :class:`SelfLocking` where friction has no consistent value."""
     from reference.engine.forward import right_hand_side  # scipy.linalg: imported with scipy.integrate
 
-    target = 2.0 * math.pi * scene.revolutions
-    w0 = drive.initial_speed
-    t_max = drive.time_allowed(target)  # the span every engine allows
-    budget = EvaluationBudget(scene)
-    acceleration = right_hand_side(scene, drive.torque)  # microseconds a call (reference.engine.forward)
+    acceleration = right_hand_side(scene, drive.torque)
 
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         theta = float(y[0])
@@ -113,29 +131,41 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
             raise SelfLocking(t, theta)
         return np.array([theta_t, theta_tt])
 
-    def reached(t: float, y: np.ndarray) -> float:  # turned `target` either way, as Exudyn's stop
+    return rhs
+
+
+def _integrate(scene: Scene, drive: TorqueDrive, options: ReferenceOptions,
+               rhs: Callable[[float, np.ndarray], np.ndarray]) -> Any:
+    """``solve_ivp``'s solution from rest at angle 0, stopped where the input has turned the
+    scene's revolutions either way (as Exudyn's stop) or at the time every engine allows."""
+    from scipy.integrate import solve_ivp  # scipy.integrate takes ~0.5 s to import
+
+    target = 2.0 * math.pi * scene.revolutions
+    w0 = drive.initial_speed
+
+    def reached(t: float, y: np.ndarray) -> float:
         return abs(y[0]) - target
 
     reached.terminal = True
-    try:
-        a0 = float(rhs(0.0, np.array([0.0, w0]))[1])
-        sol = solve_ivp(rhs, (0.0, t_max), [0.0, w0], method="DOP853", dense_output=True,
-                        events=reached, rtol=options.ode_rtol,
-                        atol=[options.ode_atol, speed_tolerance(options.ode_atol, w0, a0, target)])
-    except SelfLocking as exc:
-        return InputMotion(0.0, exc.t, lambda t: (np.nan, np.nan, None), drive.torque,
-                           status=Status.SELF_LOCKING,
-                           reason=(f"friction self-locks at t = {exc.t:.6g} s, input angle "
-                                   f"{math.degrees(exc.theta):.6g} deg: no consistent friction"),
-                           ode_evaluations=budget.count, tabulated=False)
-    except Stalled as exc:
-        return InputMotion(0.0, exc.t, lambda t: (np.nan, np.nan, None), drive.torque,
-                           status=Status.INCOMPLETE, reason=exc.reason,
-                           ode_evaluations=budget.count, tabulated=False)
+    a0 = float(rhs(0.0, np.array([0.0, w0]))[1])
+    return solve_ivp(rhs, (0.0, drive.time_allowed(target)), [0.0, w0], method="DOP853",
+                     dense_output=True, events=reached, rtol=options.ode_rtol,
+                     atol=[options.ode_atol, speed_tolerance(options.ode_atol, w0, a0, target)])
+
+
+def _stopped(drive: TorqueDrive, budget: EvaluationBudget, t_end: float, status: Status,
+             reason: str) -> InputMotion:
+    """A motion stopped inside the integrator at ``t_end`` [s]: nothing to tabulate."""
+    return InputMotion(0.0, t_end, lambda t: (np.nan, np.nan, None), drive.torque, status=status,
+                       reason=reason, ode_evaluations=budget.count, tabulated=False)
+
+
+def _integrated(scene: Scene, drive: TorqueDrive, sol: Any, evaluations: int) -> InputMotion:
+    """The motion from ``solve_ivp``'s solution ``sol``: its dense output up to the stop."""
     if not sol.success:
         return InputMotion(0.0, float(sol.t[-1]), sol.sol, drive.torque,
                            status=Status.INTEGRATION_FAILURE, reason=sol.message,
-                           ode_evaluations=budget.count, tabulated=bool(sol.t[-1] > 0.0))
+                           ode_evaluations=evaluations, tabulated=bool(sol.t[-1] > 0.0))
     t_end = float(sol.t_events[0][0]) if sol.t_events[0].size else float(sol.t[-1])
     dense = sol.sol
 
@@ -143,7 +173,7 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
         y = dense(np.asarray(t, float))
         return y[0], y[1], None
 
-    motion = InputMotion(0.0, t_end, state, drive.torque, ode_evaluations=budget.count)
+    motion = InputMotion(0.0, t_end, state, drive.torque, ode_evaluations=evaluations)
     if not sol.t_events[0].size:
         motion.status = Status.INCOMPLETE
         motion.reason = (f"torque drive turned {abs(sol.y[0, -1]) / (2 * math.pi):.3g} of "

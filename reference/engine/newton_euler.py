@@ -37,7 +37,18 @@ COMPONENTS = {"revolute": ("fx", "fy", "fz", "mx", "my"), "cylindrical": ("fx", 
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product over the last axis (``numpy.cross`` without its per-call overhead)."""
+    """Cross product over the last axis (``numpy.cross`` without its per-call overhead).
+
+    Parameters
+    ----------
+    a, b : ndarray, shape (..., 3)
+        Vectors, broadcast against each other.
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+        ``a x b``.
+    """
     a, b = np.broadcast_arrays(a, b)
     return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
                      a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
@@ -73,9 +84,25 @@ def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
 
 def mass_kinematics(mass: float | np.ndarray, com: np.ndarray, inertia: np.ndarray,
                     motion: BodyMotion) -> dict[str, np.ndarray]:
-    """:func:`body_kinematics` from the canonical mass properties (:meth:`Body.canonical`):
-    ``mass`` [kg], ``com`` (3,) [m] and ``inertia`` (3, 3) [kg m^2], or one per sample, shapes
-    (...,), (..., 3), (..., 3, 3) (many scenes in one pass, :mod:`reference.engine.batch.solve`)."""
+    """:func:`body_kinematics` from the canonical mass properties (:meth:`Body.canonical`).
+
+    Parameters
+    ----------
+    mass : float or ndarray, shape (...,)
+        Mass [kg].
+    com : ndarray, shape (3,) or (..., 3)
+        Centre of mass in the canonical body frame [m].
+    inertia : ndarray, shape (3, 3) or (..., 3, 3)
+        Inertia about the centre of mass, canonical body axes [kg m^2]; one per sample for many
+        scenes in one pass (:mod:`reference.engine.batch.model`).
+    motion : reference.physics.rccc.motion.BodyMotion
+        Pose and motion of the body.
+
+    Returns
+    -------
+    dict
+        As :func:`body_kinematics`.
+    """
     rot = motion.rotation
     c = rot @ com if np.ndim(com) == 1 else np.einsum("...ij,...j->...i", rot, com)
     w_c = cross(motion.omega, c)
@@ -86,10 +113,26 @@ def mass_kinematics(mass: float | np.ndarray, com: np.ndarray, inertia: np.ndarr
 
 def required_wrench(body: Body, motion: BodyMotion,
                     gravity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Force [N] and moment about O [N m] the pairs, drive and load must apply to a body.
+    """Force and moment about O the pairs, drive and load must apply to a body.
 
     Newton-Euler with gravity moved to the left: ``F = m (a_c - g)``,
     ``M_O = r_c x F + J alpha + omega x J omega`` (J about the centre of mass, global axes).
+
+    Parameters
+    ----------
+    body : Body
+        Mass properties.
+    motion : reference.physics.rccc.motion.BodyMotion
+        Pose and motion of the body.
+    gravity : ndarray, shape (3,) or (..., 3)
+        Gravitational acceleration [m/s^2].
+
+    Returns
+    -------
+    force : ndarray, shape (..., 3)
+        [N].
+    moment : ndarray, shape (..., 3)
+        About O [N m].
     """
     k = body_kinematics(body, motion)
     force = k["mass"] * (k["a"] - gravity)
@@ -100,7 +143,20 @@ def required_wrench(body: Body, motion: BodyMotion,
 
 def mechanical_energy(scene: Scene,
                       motions: dict[str, BodyMotion]) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy of the three bodies [J] (potential zero at O)."""
+    """Kinetic and potential energy of the three bodies.
+
+    Parameters
+    ----------
+    scene : Scene
+        Mass properties and gravity.
+    motions : dict of str to BodyMotion
+        Each body's motion (:attr:`reference.physics.joint_motion.JointMotion.bodies`).
+
+    Returns
+    -------
+    kinetic, potential : ndarray, shape (...)
+        [J]; the potential is zero at O.
+    """
     gravity = np.asarray(scene.gravity)
     kinetic = 0.0
     potential = 0.0
@@ -114,11 +170,23 @@ def mechanical_energy(scene: Scene,
 
 
 def wrench_columns(motion: JointMotion, components: list[tuple[str, str]]) -> np.ndarray:
-    """Body wrenches of unit pair loads, rows as :func:`reaction_system`, shape (..., 18, m).
+    """Body wrenches of unit pair loads.
 
     Each component ``(pair, "fx" | "fy" | "fz" | "mx" | "my" | "mz")`` is a unit force along
     (at the pair origin) or moment about that axis of the pair frame, acting on body b; body a
     receives the opposite. All components are built in one vectorised pass.
+
+    Parameters
+    ----------
+    motion : JointMotion
+        Pair frames and origins, per sample.
+    components : list of (pair, component)
+        The m unit loads.
+
+    Returns
+    -------
+    ndarray, shape (..., 18, m)
+        Rows as :func:`reaction_system`'s [N, N m per unit load].
     """
     shape = motion.bodies["input"].omega.shape[:-1]
     if not components:
@@ -142,8 +210,15 @@ def reaction_system(scene: Scene, motion: JointMotion,
                     load_torque: float | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Newton-Euler equations of the three bodies as ``matrix @ unknowns = rhs``.
 
-    ``load_torque`` [N m] (scalar or one per sample) is the output load at these samples; None
-    takes the scene's constant load (a load history needs it given: the motion has no time).
+    Parameters
+    ----------
+    scene : Scene
+        Bodies and gravity (and the constant load).
+    motion : JointMotion
+        The joint's motion, per sample.
+    load_torque : float or ndarray, shape (...), or None
+        The output load at these samples [N m]; None: the scene's constant load (a history
+        needs it given: the motion has no time).
 
     Returns
     -------

@@ -1,20 +1,12 @@
 """One revolution of a periodic time table, repeated.
 
-At a constant input speed and a constant load the joint's state is a function of the input angle
-modulo one revolution (closed-form or loop kinematics, inverse dynamics, friction): every column
-of the time table repeats with the period ``T = 2 pi / |omega|`` except the time and the two shaft
-angles, which advance by ``T`` and one turn. When the table's rows fall on the same input angles in
-every revolution (a whole number of rows per period, as :func:`reference.engine.table.table_times` gives
-for whole revolutions), the rows of the first period are evaluated and the others are copies: the
-same values to rounding (the trigonometric functions of ``theta`` and ``theta + 2 pi k`` differ
-in the last bits only), at ``1 / revolutions`` of the cost.
-
-Only summary-only runs (``record.timeseries = false``) use it, where the table serves the verdict
-and the means: in a recorded table a copied row's angle is its own ``theta + 2 pi k`` rounded, not
-the angle its state was computed at, which a user recomputing the state from the row (the power
-balance at 85 deg, ``tests/test_reference_dynamics.py``) would see at 1e-8 of the power.
+At a constant input speed and load every column repeats with the period ``T = 2 pi / |omega|``
+except ``t`` and the two shaft angles, which advance by ``T`` and one turn. When the rows fall on
+the same input angles in every revolution, the first period is evaluated and the others are copies
+(the same values to rounding, at ``1 / revolutions`` of the cost). Summary-only runs use it: in a
+recorded table a copied row's angle is ``theta + 2 pi k`` rounded, not the angle its state was
+computed at.
 """
-
 from __future__ import annotations
 
 import math
@@ -29,9 +21,21 @@ the period; every other column repeats."""
 
 
 def period_rows(t: np.ndarray, speed: float) -> int | None:
-    """Rows of the uniform table ``t`` [s] in one period of the input speed ``speed`` [rad/s]:
-    None unless the rows repeat on the same angles (a whole number of steps per period, at least
-    one period after the first)."""
+    """Rows of a uniform time table in one period of the input speed.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Equispaced instants [s].
+    speed : float
+        Constant input speed [rad/s].
+
+    Returns
+    -------
+    int or None
+        Rows per period; None unless the rows repeat on the same angles (a whole number of steps
+        per period, at least one period after the first).
+    """
     if t.size < 3 or speed == 0.0:
         return None
     period = 2.0 * math.pi / abs(speed)
@@ -43,9 +47,22 @@ def period_rows(t: np.ndarray, speed: float) -> int | None:
 
 
 def repeat_period(first: dict[str, np.ndarray], t: np.ndarray, speed: float) -> dict[str, np.ndarray]:
-    """The whole table at ``t`` [s] from ``first``, the columns at ``t[:rows]`` (one period, see
-    :func:`period_rows`); ``t`` is taken as given, the shaft angles advance by ``2 pi`` per period
-    in the direction of ``speed`` [rad/s]."""
+    """The whole table from its first period.
+
+    Parameters
+    ----------
+    first : dict of str to ndarray, shape (rows,)
+        The columns at ``t[:rows]`` (one period, :func:`period_rows`).
+    t : ndarray, shape (n,)
+        The whole table's instants [s], taken as given.
+    speed : float
+        Input speed [rad/s]; the shaft angles advance by ``2 pi`` per period in its direction.
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        Every column of ``first`` over the whole table.
+    """
     rows = next(iter(first.values())).shape[0]
     k = np.arange(t.size)
     turns, index = np.divmod(k, rows)

@@ -43,10 +43,22 @@ def friction_slots(scene: Scene) -> list[tuple[str, str]]:
 
 
 def friction_matrix(motion: JointMotion, slots: list[tuple[str, str]]) -> np.ndarray:
-    """Body wrenches of unit friction values, rows as :func:`reaction_system`, shape (..., 18, K).
+    """Body wrenches of unit friction values.
 
     A friction torque acts on body b about the pair axis, an axial force along it at the pair
     origin; body a receives the opposite.
+
+    Parameters
+    ----------
+    motion : JointMotion
+        Pair frames and origins, per sample.
+    slots : list of (pair, "torque" | "force")
+        From :func:`friction_slots`.
+
+    Returns
+    -------
+    ndarray, shape (..., 18, K)
+        Rows as :func:`reference.engine.newton_euler.reaction_system`'s [N, N m per unit value].
     """
     return wrench_columns(motion, [(pair, "mz" if kind == "torque" else "fz") for pair, kind in slots])
 
@@ -100,15 +112,43 @@ class FrictionLaw:
         return friction_law_values(x, self.index, signs, self.k_force, self.k_moment)
 
     def reduced(self, c: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reduced_law_values` of the slots' reaction components ``c`` = ``x[:, index]``."""
+        """:func:`reduced_law_values` on the components the law reads.
+
+        Parameters
+        ----------
+        c : ndarray, shape (n, K, 4)
+            ``x[:, index]``: each slot's fx, fy [N], mx, my [N m].
+        signs : ndarray, shape (n, K)
+            As for :meth:`__call__`.
+
+        Returns
+        -------
+        values : ndarray, shape (n, K)
+            Friction values [N m or N].
+        slopes : ndarray, shape (n, K, 4)
+            Their derivatives with respect to ``c``.
+        """
         return reduced_law_values(c, signs, self.k_force, self.k_moment)
 
 
 def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
                 slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-    """Relative surface speed (rotation: ``omega_rel d / 2``) or sliding speed of each slot [m/s].
+    """The speeds whose sign the friction law takes: relative surface speed (rotation,
+    ``omega_rel d / 2``) or sliding speed of each slot.
 
-    These are the speeds whose sign the friction law takes, shape (..., K).
+    Parameters
+    ----------
+    scene : Scene
+        Journal diameters [m].
+    slots : list of (pair, "torque" | "force")
+        From :func:`friction_slots`.
+    omega_rel, slide_rel : dict of str to ndarray, shape (...)
+        Per pair the relative angular speed [rad/s] and sliding speed [m/s].
+
+    Returns
+    -------
+    ndarray, shape (..., K)
+        Speeds [m/s].
     """
     out = []
     for pair, kind in slots:
@@ -120,11 +160,25 @@ def slot_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str,
 
 
 def slot_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = None) -> np.ndarray:
-    """Width of each slot's sign ramp [m/s] (``bands``, or :func:`reference.physics.bands.sign_bands`),
-    shape (K,).
+    """Width of each slot's sign ramp.
 
     Under the resultant-slip law (``scene.friction.law``) both slots of a pair share the ramp of
     its resultant slip speed.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its friction law (and bands, when ``bands`` is None).
+    slots : list of (pair, "torque" | "force")
+        From :func:`friction_slots`.
+    bands : dict or None
+        Per pair :class:`reference.physics.bands.PairBands`; None:
+        :func:`reference.physics.bands.sign_bands` of the scene.
+
+    Returns
+    -------
+    ndarray, shape (K,)
+        Widths [m/s].
     """
     bands = sign_bands(scene) if bands is None else bands
     if scene.friction.law == "resultant":
@@ -134,8 +188,20 @@ def slot_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = 
 
 
 def slip_speeds(slots: list[tuple[str, str]], speeds: np.ndarray) -> np.ndarray:
-    """Per slot, the resultant slip speed of its pair [m/s]: the hypotenuse of the pair's slot
-    speeds (:func:`slot_speeds`, shape (..., K)), shape (..., K)."""
+    """Per slot, the resultant slip speed of its pair: the hypotenuse of the pair's slot speeds.
+
+    Parameters
+    ----------
+    slots : list of (pair, "torque" | "force")
+        From :func:`friction_slots`.
+    speeds : ndarray, shape (..., K)
+        :func:`slot_speeds` [m/s].
+
+    Returns
+    -------
+    ndarray, shape (..., K)
+        Slip speeds [m/s].
+    """
     out = np.empty_like(speeds)
     for pair in dict.fromkeys(pair for pair, _ in slots):
         mine = [j for j, (p, _) in enumerate(slots) if p == pair]
@@ -145,12 +211,27 @@ def slip_speeds(slots: list[tuple[str, str]], speeds: np.ndarray) -> np.ndarray:
 
 def slot_signs(scene: Scene, slots: list[tuple[str, str]], speeds: np.ndarray,
                bands: np.ndarray) -> np.ndarray:
-    """The factor of each slot's Coulomb magnitude, in [-1, 1], shape (..., K).
+    """The factor of each slot's Coulomb magnitude.
 
-    ``speeds`` from :func:`slot_speeds`, ``bands`` from :func:`slot_bands`. The paper's law: the
-    regularised sign of each slot's speed (:func:`reference.physics.friction.regularised_sign`). The
-    resultant-slip law: the slot's component of its pair's regularised unit slip vector
-    ``v / max(|v|, band)`` (:mod:`reference.physics.friction`).
+    The paper's law: the regularised sign of each slot's speed
+    (:func:`reference.physics.friction.regularised_sign`). The resultant-slip law: the slot's
+    component of its pair's regularised unit slip vector ``v / max(|v|, band)``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its friction law.
+    slots : list of (pair, "torque" | "force")
+        From :func:`friction_slots`.
+    speeds : ndarray, shape (..., K)
+        :func:`slot_speeds` [m/s].
+    bands : ndarray, shape (K,) or (..., K)
+        :func:`slot_bands` [m/s].
+
+    Returns
+    -------
+    ndarray, shape (..., K)
+        Factors in [-1, 1].
     """
     if scene.friction.law != "resultant":
         return regularised_sign(speeds, bands)
@@ -161,10 +242,22 @@ def slot_signs(scene: Scene, slots: list[tuple[str, str]], speeds: np.ndarray,
 
 def ramp_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str, np.ndarray],
                 slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-    """Speeds [m/s] whose crossings of ``+-`` :func:`ramp_bands` are the kinks of the friction
-    factors (:func:`slot_signs`), shape (..., K'): the slot speeds (:func:`slot_speeds`), and under
-    the resultant-slip law also the pairs' slip speeds (the slot speeds' zero crossings stay: with
-    a zero band the factor jumps there when the pair does not slide)."""
+    """Speeds whose crossings of ``+-`` :func:`ramp_bands` are the kinks of the friction factors.
+
+    The slot speeds, and under the resultant-slip law also the pairs' slip speeds (the slot
+    speeds' zero crossings stay: with a zero band the factor jumps there when the pair does not
+    slide).
+
+    Parameters
+    ----------
+    scene, slots, omega_rel, slide_rel
+        As for :func:`slot_speeds`.
+
+    Returns
+    -------
+    ndarray, shape (..., K')
+        Speeds [m/s]; K' = K, or 2 K under the resultant-slip law.
+    """
     speeds = slot_speeds(scene, slots, omega_rel, slide_rel)
     if scene.friction.law != "resultant":
         return speeds
@@ -172,6 +265,17 @@ def ramp_speeds(scene: Scene, slots: list[tuple[str, str]], omega_rel: dict[str,
 
 
 def ramp_bands(scene: Scene, slots: list[tuple[str, str]], bands: dict | None = None) -> np.ndarray:
-    """Ramp widths [m/s] of :func:`ramp_speeds`, shape (K',) (``bands`` as for :func:`slot_bands`)."""
+    """Ramp widths of :func:`ramp_speeds`.
+
+    Parameters
+    ----------
+    scene, slots, bands
+        As for :func:`slot_bands`.
+
+    Returns
+    -------
+    ndarray, shape (K',)
+        Widths [m/s].
+    """
     bands = slot_bands(scene, slots, bands)
     return np.concatenate([bands, bands]) if scene.friction.law == "resultant" else bands

@@ -1,13 +1,11 @@
 """The reference engine: any scene in, the shared result schema out, without time stepping error.
 
-Prescribed input motion (constant speed, angle history) is pure inverse dynamics: every sample
-is solved on its own (:func:`reference.engine.dynamics.dynamics_columns`), friction included, so the
-time table has no discretisation error at all; a torque drive's motion is integrated
-(:mod:`reference.engine.motion`). The mean values that matter (input, output and lost work, hence
-the mean efficiency) come from the works' quadrature (:mod:`reference.engine.work`); the
-time-averaged instantaneous efficiency is taken from the table (:mod:`reference.engine.table`) like
-every engine does (it has poles where the input power crosses zero, so it has no exact value to
-converge to).
+A prescribed input motion is pure inverse dynamics, every sample solved on its own
+(:mod:`reference.engine.dynamics`); a torque drive's motion is integrated
+(:mod:`reference.engine.motion`). The works, hence the mean efficiency, come from quadrature
+(:mod:`reference.engine.work`); the time-averaged instantaneous efficiency from the table
+(:mod:`reference.engine.table`), as in every engine (it has poles where the input power crosses
+zero, so no exact value to converge to).
 """
 
 from __future__ import annotations
@@ -102,12 +100,25 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
     return result_table(columns, scene.record.every, EXTRA_COLUMNS) if scene.record.timeseries else None
 
 
-
 def means_from_works(scene: Scene, works: dict, columns: dict[str, np.ndarray],
                      options: ReferenceOptions, summary: Summary) -> None:
-    """The means over whole revolutions from :func:`work_quadrature`'s ``works`` (consumed)."""
+    """The means over whole revolutions from the works, into the summary.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (its skipped revolutions, accuracy and drive kind).
+    works : dict
+        :func:`work_quadrature`'s output; consumed.
+    columns : dict of str to ndarray, shape (n,)
+        The time table's columns (the window and the time-averaged efficiency).
+    options : ReferenceOptions
+        The ODE's ``rtol`` enters a torque drive's error estimate.
+    summary : Summary
+        Filled in place; failed with status ``self_locking`` when friction locks at a node.
+    """
     if works.pop("self_locking_nodes", False):
-        # as when it locks at a sample: no means (they were NaN or meaningless)
+        # as when it locks at a sample: no means (they would be NaN or meaningless)
         summary.fail(Status.SELF_LOCKING,
                      "friction self-locks between the table's samples (at quadrature nodes)")
         return

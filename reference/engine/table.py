@@ -53,11 +53,25 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray,
 
 
 def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`columns_at` on the table's instants ``t`` (n,) [s], the same arguments.
+    """:func:`columns_at` on the table's instants.
 
     Summary only (no table recorded): a periodic motion's first period, repeated
     (:mod:`reference.engine.periodic`); a recorded table is evaluated row by row, so that each
     row's angle is the one its state was computed at.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene on the run's clock.
+    motion : InputMotion
+        The input's motion.
+    t : ndarray, shape (n,)
+        The table's instants [s] (:func:`table_times`).
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        As :func:`columns_at`.
     """
     rows = period_rows(t, scene.drive.speed) if motion.periodic and not scene.record.timeseries else None
     if rows is None:
@@ -105,7 +119,19 @@ def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) ->
 
 def table_verdict(t: np.ndarray, columns: dict[str, np.ndarray], summary: Summary,
                   origin: float = 0.0) -> None:
-    """Step, sample count, self-locking samples, loop gain of the table at ``t`` [s] into ``summary``."""
+    """The table's step, sample count, self-locking samples and loop gain into the summary.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        The table's instants [s].
+    columns : dict of str to ndarray, shape (n,)
+        Its columns (``self_locking``, ``friction_loop_gain``, ``theta_in`` are read).
+    summary : Summary
+        Filled in place; failed with status ``self_locking`` when a sample locks.
+    origin : float
+        Added to the times reported [s] (:func:`reference.scene.histories.run_clock`).
+    """
     locked = columns["self_locking"]
     summary.dt = float(t[1] - t[0])
     summary.steps = int(t.size - 1)

@@ -1,11 +1,8 @@
 """What a torque drive's integration needs besides the dynamics: its speed tolerance and its budget.
 
-The reference engine integrates a torque-driven scene's input angle and speed
-(:func:`reference.engine.motion.input_motion`). Two things make that integration well posed for a drive
-that starts (almost) at rest: a tolerance on the speed relative to the speeds the run reaches
-(:func:`speed_tolerance`), and a bound on its cost (:class:`EvaluationBudget`), so that a drive
-that cannot turn its joint ends as an incomplete run with a reason instead of integrating for
-the whole time allowed.
+A tolerance on the speed relative to the speeds the run reaches (:func:`speed_tolerance`), and a
+bound on the integration's cost (:class:`EvaluationBudget`): a drive that cannot turn its joint
+ends as an incomplete run with a reason, not after the whole time allowed.
 """
 
 from __future__ import annotations
@@ -20,34 +17,56 @@ __all__ = ["ODE_EVALUATIONS_PER_REVOLUTION", "ODE_EVALUATIONS_PER_KNOT", "Evalua
 
 ODE_EVALUATIONS_PER_REVOLUTION = 20_000
 """Right-hand-side evaluations a torque drive's integration may spend per requested revolution
-(at least one revolution's worth), plus :data:`ODE_EVALUATIONS_PER_KNOT`; a run that turns
-needs 3000-6000 per revolution (tolerances 1e-8 to 1e-13, reversals included). Why a budget: a
-drive that cannot overcome its load and friction from (near) rest creeps inside the friction's
-sign ramps (where the steps shrink to the ramps' time scale) or rocks about an equilibrium, and
-would do so for the whole time allowed (four times the requested angle over the initial speed:
-290 days for one revolution from 1e-6 rad/s)."""
+(at least one revolution's worth), plus :data:`ODE_EVALUATIONS_PER_KNOT`. Why: a drive that
+cannot overcome its load and friction from (near) rest creeps inside the friction's sign ramps
+or rocks about an equilibrium for the whole time allowed; a run that turns stays far below.
+Measured: docs/engines.md#constants-of-the-reference-engine."""
 ODE_EVALUATIONS_PER_KNOT = 1_000
-"""More evaluations per load-history sample the integration has passed: each is a kink of the
-acceleration, which costs the integrator 130-320 evaluations (tolerances 1e-8 to 1e-13)."""
+"""More evaluations per load-history sample the integration has passed (each is a kink of the
+acceleration). Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
 def speed_tolerance(atol: float, initial_speed: float, initial_acceleration: float,
                     angle: float) -> float:
-    """Absolute tolerance [rad/s] on a torque drive's speed.
+    """Absolute tolerance on a torque drive's speed.
 
-    ``atol`` relative to the initial speed [rad/s], but at least the speed error that, held for
-    the time the initial acceleration [rad/s^2] takes to turn ``angle`` [rad] (the run's target)
-    from rest, ``sqrt(2 angle / |initial_acceleration|)``, moves the angle by ``atol`` [rad]. Why:
-    a drive that starts (almost) at rest reaches speeds set by its acceleration, not by its
-    initial speed; a tolerance relative to the initial speed alone vanishes with it (1e-23 rad/s
-    from 1e-12 rad/s, which costs 360,000 evaluations in the first microsecond; a subnormal one
-    from 1e-300 rad/s, on which ``solve_ivp``'s first step fails).
+    ``atol`` relative to the initial speed, but at least the speed error that, held for the time
+    the initial acceleration takes to turn ``angle`` from rest, ``sqrt(2 angle /
+    |initial_acceleration|)``, moves the angle by ``atol``. Why: a drive that starts (almost) at
+    rest reaches speeds set by its acceleration, not by its initial speed, and a tolerance
+    relative to the initial speed alone vanishes with it.
+    Measured: docs/engines.md#constants-of-the-reference-engine.
+
+    Parameters
+    ----------
+    atol : float
+        Absolute tolerance of the angle [rad], relative tolerance of the speed [-].
+    initial_speed : float
+        Input speed at the start [rad/s].
+    initial_acceleration : float
+        Input acceleration at the start [rad/s^2].
+    angle : float
+        The angle the run is to turn [rad] (positive).
+
+    Returns
+    -------
+    float
+        The tolerance [rad/s].
     """
     return max(atol * abs(initial_speed), atol * math.sqrt(abs(initial_acceleration) / (2.0 * angle)))
 
 
 class Stalled(Exception):
     """A torque drive's integration spent its evaluation budget (raised inside the integrator).
+
+    Parameters
+    ----------
+    scene : Scene
+        The torque-driven scene (its revolutions and drive go into the reason).
+    t, theta, theta_t : float
+        The evaluation refused: time [s], input angle [rad], speed [rad/s].
+    evaluations : int
+        Evaluations spent.
 
     Attributes
     ----------
@@ -90,8 +109,18 @@ class EvaluationBudget:
         self._knots = scene.load.knots.tolist()
 
     def spend(self, t: float, theta: float, theta_t: float) -> None:
-        """Count one evaluation at time ``t`` [s], input angle ``theta`` [rad] and speed
-        ``theta_t`` [rad/s]; raise :class:`Stalled` instead when the budget is spent."""
+        """Count one evaluation.
+
+        Parameters
+        ----------
+        t, theta, theta_t : float
+            Time [s], input angle [rad] and speed [rad/s] of the evaluation.
+
+        Raises
+        ------
+        Stalled
+            The budget is spent (the evaluation is not counted).
+        """
         if self.count >= self._base and (
                 self.count >= self._base + ODE_EVALUATIONS_PER_KNOT * bisect.bisect_right(self._knots, t)):
             raise Stalled(self.scene, t, theta, theta_t, self.count)

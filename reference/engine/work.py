@@ -39,8 +39,25 @@ __all__ = ["WORK_KEYS", "time_at_angle", "window_times", "work_means", "work_qua
 
 
 def time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> float:
-    """Illinois regula falsi as in :func:`sign_breakpoints`: scipy.optimize would cost every
-    command that builds a ``mean_input`` scene (``cardan run``) ~0.3 s of imports."""
+    """The instant at which the input passes an angle, by Illinois regula falsi.
+
+    (Not ``scipy.optimize``: its import would cost every command that builds a ``mean_input``
+    scene about 0.3 s.)
+
+    Parameters
+    ----------
+    motion : InputMotion
+        The input's motion.
+    theta : float
+        The angle [rad].
+    lo, hi : float
+        A bracket of the instant [s].
+
+    Returns
+    -------
+    float
+        The instant [s], to rounding; the nearer end when the bracket holds no sign change.
+    """
     a = lo
     b = hi
     f_a = motion.angle(a) - theta
@@ -65,8 +82,23 @@ WORK_KEYS = ("power_in", "power_out", "power_loss", "self_locking",
 
 def window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
                   theta_0: float, theta_1: float) -> tuple[float, float]:
-    """Instants [s] at which the input passes ``theta_0`` and ``theta_1`` [rad], each solved
-    between the table rows that bracket it."""
+    """The instants at which the input passes the window's ends.
+
+    Parameters
+    ----------
+    motion : InputMotion
+        The input's motion.
+    theta, t : ndarray, shape (n,)
+        The time table's input angles [rad] and instants [s]; each end is solved between the
+        rows that bracket it.
+    theta_0, theta_1 : float
+        The window's first and last input angle [rad].
+
+    Returns
+    -------
+    t_0, t_1 : float
+        The instants [s].
+    """
     sign = 1.0 if theta[-1] >= theta[0] else -1.0
 
     def bracket(angle: float) -> tuple[float, float]:
@@ -97,8 +129,22 @@ def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.
 
 
 def work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
-    """Summary keys from the works [J] over the window (the means derived from them are
-    :func:`reference.results.means.mean_values`')."""
+    """Summary keys from the works over the window.
+
+    Parameters
+    ----------
+    work : dict of str to float
+        The integrals of :data:`WORK_KEYS` [J].
+    ends : dict of str to ndarray, shape (2,)
+        ``energy_kinetic`` and ``energy_potential`` [J] at the window's ends.
+
+    Returns
+    -------
+    dict
+        ``input_work``, ``output_work``, ``loss_work``, ``loss_work_<pair>``,
+        ``loss_work_<pair>_sliding`` and ``energy_balance_residual`` [J]; the means derived from
+        them are :func:`reference.results.means.mean_values`'.
+    """
     out = {"input_work": work["power_in"], "output_work": work["power_out"],
            "loss_work": work["power_loss"]}
     for pair in PAIR_NAMES:
