@@ -1,20 +1,13 @@
 """Dynamics of the Cardan joint with the paper's friction: reactions, friction and the drive unknown.
 
-Newton-Euler (:mod:`reference.engine.newton_euler`) gives ``K x = r - W phi`` with ``phi`` the
-friction values (:mod:`reference.engine.slots`: a torque per pair with friction, an axial force
-per cylindrical pair with friction), and friction depends on the reactions, ``phi = G(x)``. Linear
-in ``x``, so ``x = x0 - S phi`` with ``x0 = K^-1 r`` and ``S = K^-1 W``, and the fixed point reduces
-to at most seven unknowns, ``phi = G(x0 - S phi)``. It is solved by Newton's method with the
-analytic Jacobian of ``G``, every sample at once (:mod:`reference.engine.fixed_point`). A sample
-whose fixed point does not converge, or converges to a point where the loop gain (spectral
-radius of ``dG/dphi``) is 1 or more, is *self-locking*: friction grows faster than the reactions
-that cause it, the Coulomb problem has no unique finite solution.
-
-Pair origins and frames come with the joint motion: in the ideal joint the origins are fixed in
-space (``frame_input`` at ``-input_bearing e_x``, the spider pairs at O, ``output_frame`` at
-``output_bearing a2``) and no pair slides, so the regularised sign of the zero sliding speed is 0
-and the axial friction of eq. (5) vanishes. With mounting errors the cylindrical pairs slide and
-their axial friction does work (``power_loss_<pair>_sliding``).
+Newton-Euler (:mod:`reference.engine.newton_euler`) gives ``K x = r - W phi``, ``phi`` the friction
+values (:mod:`reference.engine.slots`), and the law gives ``phi = G(x)``. Linear in ``x``:
+``x = x0 - S phi`` with ``x0 = K^-1 r`` and ``S = K^-1 W``, so the fixed point has at most seven
+unknowns, ``phi = G(x0 - S phi)`` (:mod:`reference.engine.fixed_point`). A sample without a
+converged fixed point, or with a loop gain (spectral radius of ``dG/dphi``) of 1 or more, is
+*self-locking*: the Coulomb problem has no unique finite solution. In the ideal joint no pair
+slides and the axial friction of eq. (5) vanishes; with mounting errors it does work
+(``power_loss_<pair>_sliding``).
 
 References
 ----------
@@ -22,8 +15,9 @@ Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan jo
 experimental validation": Section 3, eqs. (3), (5) (friction from the reactions) and eq. (18)
 (instantaneous efficiency).
 """
-
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 
@@ -52,6 +46,19 @@ from reference.scene.scene import Scene
 __all__ = ["dynamics_columns", "inverse_dynamics", "solution_columns", "solve_dynamics"]
 
 
+class _System(NamedTuple):
+    """Newton-Euler at n samples, the friction's unit wrenches and the pairs' relative speeds."""
+
+    matrix: np.ndarray
+    """(n, 18, 18)."""
+    rhs: np.ndarray
+    """(n, 18)."""
+    wrenches: np.ndarray
+    """(n, 18, K)."""
+    omega_rel: dict[str, np.ndarray]
+    slide_rel: dict[str, np.ndarray]
+
+
 def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                    theta_tt: np.ndarray | None = None,
                    torque_in: float | np.ndarray | None = None,
@@ -60,12 +67,24 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                    bands: np.ndarray | None = None) -> tuple[JointMotion, FixedPoint]:
     """Reactions, friction and the drive unknown for every sample.
 
-    Exactly one of ``theta_tt`` (inverse dynamics: the drive torque is the unknown) and
-    ``torque_in`` (forward dynamics: the input acceleration is the unknown) is given.
-    ``method`` chooses the kinematics (:func:`reference.physics.joint_motion.joint_motion`);
-    ``load_torque`` [N m] the output load per sample (None: the scene's constant load);
-    ``bands`` the sign ramps' widths (None: :func:`slot_bands`, looked up by the scene, whose
-    hash a caller solving one sample at a time may save by passing them).
+    Parameters
+    ----------
+    scene : Scene
+        Joint, gravity, friction (and the constant load).
+    theta, theta_t : ndarray, shape (n,)
+        Input angle [rad] and speed [rad/s].
+    theta_tt : ndarray, shape (n,), or None
+        Input acceleration [rad/s^2]: inverse dynamics, the drive torque is the unknown.
+    torque_in : float or ndarray, shape (n,), or None
+        Drive torque [N m]: forward dynamics, the input acceleration is the unknown. Exactly one
+        of ``theta_tt`` and ``torque_in`` is given.
+    method : str
+        The kinematics (:func:`reference.physics.joint_motion.joint_motion`).
+    load_torque : float or ndarray, shape (n,), or None
+        The output load per sample [N m]; None: the scene's constant load.
+    bands : ndarray, shape (K,), or None
+        The sign ramps' widths [m/s]; None: :func:`slot_bands` (a caller solving one sample at
+        a time saves the scene's hash by passing them).
 
     Returns
     -------
@@ -76,44 +95,55 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
     """
     if (theta_tt is None) == (torque_in is None):
         raise ValueError("give exactly one of `theta_tt` (inverse) and `torque_in` (forward)")
-    joint = scene.joint
     theta = np.atleast_1d(np.asarray(theta, float))
     theta_t = np.atleast_1d(np.asarray(theta_t, float))
-    n = theta.size
     if theta_tt is not None:
-        motion = joint_motion(joint, theta, theta_t, np.broadcast_to(theta_tt, theta.shape), method)
+        motion = joint_motion(scene.joint, theta, theta_t, np.broadcast_to(theta_tt, theta.shape), method)
         matrix, rhs = reaction_system(scene, motion, load_torque)
-        omega_rel = motion.omega_rel
-        slide_rel = motion.slide_rel
-        wrenches = friction_matrix(motion, friction_slots(scene))
-    else:  # one batch at accelerations 0 and 1: the right-hand side is affine in theta_tt
-        pair = joint_motion(joint, np.tile(theta, 2), np.tile(theta_t, 2), np.repeat([0.0, 1.0], n),
-                            method)
-        load = None if load_torque is None else np.tile(np.broadcast_to(load_torque, theta.shape), 2)
-        matrix, rhs = reaction_system(scene, pair, load)
-        matrix = matrix[:n]
-        rhs_one = rhs[n:]
-        rhs = rhs[:n]
-        matrix[..., :, -1] = -(rhs_one - rhs)  # the acceleration's share moves to the left
-        rhs[..., DRIVE_ROW] -= torque_in
-        # velocity-level quantities and the pair geometry do not depend on the acceleration
-        omega_rel = {p: v[:n] for p, v in pair.omega_rel.items()}
-        slide_rel = {p: v[:n] for p, v in pair.slide_rel.items()}
-        wrenches = friction_matrix(pair, friction_slots(scene))[:n]
+        system = _System(matrix, rhs, friction_matrix(motion, friction_slots(scene)), motion.omega_rel,
+                         motion.slide_rel)
+    else:
+        system = _forward_system(scene, theta, theta_t, torque_in, method, load_torque)
+    fixed = _fixed_point(scene, system, bands, theta.size)
+    if torque_in is not None:
+        motion = joint_motion(scene.joint, theta, theta_t, fixed.x[..., -1], method)
+    return motion, fixed
+
+
+def _forward_system(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
+                    torque_in: float | np.ndarray, method: str,
+                    load_torque: float | np.ndarray | None) -> _System:
+    """The system with the input acceleration as the last unknown (:func:`solve_dynamics`'
+    arguments): one batch at accelerations 0 and 1, the right-hand side being affine in it."""
+    n = theta.size
+    pair = joint_motion(scene.joint, np.tile(theta, 2), np.tile(theta_t, 2), np.repeat([0.0, 1.0], n),
+                        method)
+    load = None if load_torque is None else np.tile(np.broadcast_to(load_torque, theta.shape), 2)
+    matrix, rhs = reaction_system(scene, pair, load)
+    matrix = matrix[:n]
+    rhs_one = rhs[n:]
+    rhs = rhs[:n]
+    matrix[..., :, -1] = -(rhs_one - rhs)  # the acceleration's share moves to the left
+    rhs[..., DRIVE_ROW] -= torque_in
+    # velocity-level quantities and the pair geometry do not depend on the acceleration
+    return _System(matrix, rhs, friction_matrix(pair, friction_slots(scene))[:n],
+                   {p: v[:n] for p, v in pair.omega_rel.items()},
+                   {p: v[:n] for p, v in pair.slide_rel.items()})
+
+
+def _fixed_point(scene: Scene, system: _System, bands: np.ndarray | None, n: int) -> FixedPoint:
+    """The friction fixed point of the ``n`` samples of ``system`` (``bands`` as for
+    :func:`solve_dynamics`)."""
     slots = friction_slots(scene)
-    both = np.linalg.solve(matrix, np.concatenate([rhs[..., None], wrenches], -1))
+    both = np.linalg.solve(system.matrix, np.concatenate([system.rhs[..., None], system.wrenches], -1))
     if bands is None:
         bands = slot_bands(scene, slots)
-    signs = (slot_signs(scene, slots, slot_speeds(scene, slots, omega_rel, slide_rel), bands)
-             if slots else np.zeros(theta.shape + (0,)))
+    signs = (slot_signs(scene, slots, slot_speeds(scene, slots, system.omega_rel, system.slide_rel), bands)
+             if slots else np.zeros((n, 0)))
     law = FrictionLaw(scene, slots)
     if scene.friction.coupling == "uncoupled":  # evaluated on the frictionless reactions only
-        fixed = FixedPoint(both[..., 0], law(both[..., 0], signs)[0], np.ones(n, bool), np.zeros(n), 0)
-    else:
-        fixed = solve_friction(law, both[..., 0], both[..., 1:], signs)
-    if torque_in is not None:
-        motion = joint_motion(joint, theta, theta_t, fixed.x[..., -1], method)
-    return motion, fixed
+        return FixedPoint(both[..., 0], law(both[..., 0], signs)[0], np.ones(n, bool), np.zeros(n), 0)
+    return solve_friction(law, both[..., 0], both[..., 1:], signs)
 
 
 def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
@@ -124,8 +154,13 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                      ) -> tuple[dict[str, np.ndarray], FixedPoint]:
     """Result-schema columns (without ``t``) for the given motion, with friction.
 
-    Inverse dynamics when ``theta_tt`` is given, forward dynamics when ``torque_in`` is (see
-    :func:`solve_dynamics`). Samples that self-lock carry NaN reactions, friction and powers.
+    Samples that self-lock carry NaN reactions, friction and powers.
+
+    Parameters
+    ----------
+    scene, theta, theta_t, theta_tt, torque_in, method, load_torque
+        As for :func:`solve_dynamics`: inverse dynamics when ``theta_tt`` is given, forward
+        dynamics when ``torque_in`` is.
 
     Returns
     -------
@@ -155,9 +190,30 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
                      inputs: tuple[np.ndarray, np.ndarray, np.ndarray], drive: np.ndarray,
                      load: float | np.ndarray,
                      energy: tuple[np.ndarray, np.ndarray]) -> dict[str, np.ndarray]:
-    """:func:`dynamics_columns`' columns from the solution: ``inputs`` the input angle [rad],
-    speed [rad/s] and acceleration [rad/s^2], ``drive`` the drive torque [N m], ``load`` the
-    output load [N m], ``energy`` the kinetic and potential energy [J], all per sample (n,)."""
+    """:func:`dynamics_columns`' columns from the solution.
+
+    Parameters
+    ----------
+    motion : JointMotion
+        The joint's motion at the n samples.
+    fixed : FixedPoint
+        The solved reactions and friction (NaN where a sample self-locks).
+    slots : list of (pair, "torque" | "force")
+        :func:`reference.engine.slots.friction_slots`.
+    inputs : tuple of three ndarray, shape (n,)
+        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
+    drive : ndarray, shape (n,)
+        Drive torque [N m].
+    load : float or ndarray, shape (n,)
+        Output load [N m].
+    energy : tuple of two ndarray, shape (n,)
+        Kinetic and potential energy [J].
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        As :func:`dynamics_columns`.
+    """
     (theta, theta_t, accel) = inputs
     locked = fixed.self_locking
     x = np.where(locked[:, None], np.nan, fixed.x)
@@ -172,22 +228,9 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
     applied = {(pair, kind): phi[:, j] for j, (pair, kind) in enumerate(slots)}
     loss_total = zero.copy()
     for pair in PAIR_NAMES:
-        torque = applied.get((pair, "torque"), zero)
-        force = applied.get((pair, "force"), zero)
-        omega_rel = motion.omega_rel[pair] + zero
-        slide_rel = motion.slide_rel[pair] + zero
-        rotation = pair_power_loss(torque, zero, omega_rel, zero)
-        sliding = pair_power_loss(zero, force, zero, slide_rel)
-        loss_total = loss_total + rotation + sliding
-        cols[f"power_loss_{pair}"] = rotation + sliding
-        cols[f"power_loss_{pair}_rotation"] = rotation
-        cols[f"power_loss_{pair}_sliding"] = sliding
-        cols.update({f"{pair}_{suffix}": zero for suffix in PAIR_SUFFIXES})
-        cols[f"{pair}_friction_torque"] = torque + zero
-        cols[f"{pair}_friction_force"] = force + zero
-        cols[f"{pair}_omega_rel"] = omega_rel
-        cols[f"{pair}_slide_rel"] = slide_rel
-        cols[f"{pair}_slide"] = motion.slide[pair] + zero
+        own = _pair_columns(motion, pair, applied, zero)
+        loss_total = loss_total + own[f"power_loss_{pair}_rotation"] + own[f"power_loss_{pair}_sliding"]
+        cols.update(own)
     for j, (pair, component) in enumerate(unknowns()[:-1]):
         cols[f"{pair}_{component}"] = x[:, j]
     cols["power_loss"] = loss_total
@@ -195,6 +238,27 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
     cols["input_acceleration"] = accel
     cols["friction_loop_gain"] = fixed.loop_gain
     cols["self_locking"] = locked
+    return cols
+
+
+def _pair_columns(motion: JointMotion, pair: str, applied: dict[tuple[str, str], np.ndarray],
+                  zero: np.ndarray) -> dict[str, np.ndarray]:
+    """One pair's friction, speeds, slide and losses (its reactions zero, filled by the caller),
+    from the ``applied`` friction values per ``(pair, kind)``; ``zero`` (n,)."""
+    torque = applied.get((pair, "torque"), zero)
+    force = applied.get((pair, "force"), zero)
+    omega_rel = motion.omega_rel[pair] + zero
+    slide_rel = motion.slide_rel[pair] + zero
+    rotation = pair_power_loss(torque, zero, omega_rel, zero)
+    sliding = pair_power_loss(zero, force, zero, slide_rel)
+    cols = {f"power_loss_{pair}": rotation + sliding, f"power_loss_{pair}_rotation": rotation,
+            f"power_loss_{pair}_sliding": sliding}
+    cols.update({f"{pair}_{suffix}": zero for suffix in PAIR_SUFFIXES})
+    cols[f"{pair}_friction_torque"] = torque + zero
+    cols[f"{pair}_friction_force"] = force + zero
+    cols[f"{pair}_omega_rel"] = omega_rel
+    cols[f"{pair}_slide_rel"] = slide_rel
+    cols[f"{pair}_slide"] = motion.slide[pair] + zero
     return cols
 
 
