@@ -15,6 +15,7 @@ Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan jo
 experimental validation": Section 3, eqs. (3), (5) (friction from the reactions) and eq. (18)
 (instantaneous efficiency).
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple

@@ -174,7 +174,9 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
     # the law reads 4 components per slot: Newton on those, (n, K, 4) and (n, K, 4, K), not on x
     index = law.index
     s_c = s[:, index, :]
-    phi, converged, iterations = _newton(law, x0[:, index], s_c, signs, tolerance, max_iterations)
+    c0 = x0[:, index]
+    phi, _ = law.reduced(c0, signs)  # the friction of the frictionless reactions
+    converged, iterations = _newton(law, c0, s_c, signs, phi, tolerance, max_iterations)
     x = x0 - np.einsum("nik,nk->ni", s, phi)
     _, g_c = law.reduced(x[:, index], signs)
     gain = loop_gain(g_c, s_c, exact_gain)
@@ -182,14 +184,14 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
     return FixedPoint(x, phi, converged, gain, iterations)
 
 
-def _newton(law: Any, c0: np.ndarray, s_c: np.ndarray, signs: np.ndarray, tolerance: float,
-            max_iterations: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """Newton on ``phi = G(c0 - S_c phi)`` per sample from ``G(c0)``, the unconverged samples'
-    data compacted as samples converge (arguments as :func:`solve_friction`'s, ``c0`` (n, K, 4)
-    and ``s_c`` (n, K, 4, K) restricted to the components the law reads). Returns ``phi``
-    (n, K), ``converged`` (n,) and the iterations of the slowest sample."""
-    n = c0.shape[0]
-    phi, _ = law.reduced(c0, signs)
+def _newton(law: Any, c0: np.ndarray, s_c: np.ndarray, signs: np.ndarray, phi: np.ndarray,
+            tolerance: float, max_iterations: int) -> tuple[np.ndarray, int]:
+    """Newton on ``phi = G(c0 - S_c phi)`` per sample, the unconverged samples' data compacted as
+    samples converge (arguments as :func:`solve_friction`'s, ``c0`` (n, K, 4) and ``s_c``
+    (n, K, 4, K) restricted to the components the law reads). ``phi`` (n, K), the first iterate,
+    is overwritten with the solution. Returns ``converged`` (n,) and the iterations of the
+    slowest sample."""
+    n = phi.shape[0]
     converged = np.zeros(n, bool)
     active = np.arange(n)
     c_a = c0
@@ -218,7 +220,7 @@ def _newton(law: Any, c0: np.ndarray, s_c: np.ndarray, signs: np.ndarray, tolera
             signs_a = signs_a[keep]
             phi_a = phi_a[keep]
             scale_a = scale_a[keep]
-    return phi, converged, iterations
+    return converged, iterations
 
 
 def _newton_step(law: Any, c: np.ndarray, s_c: np.ndarray, signs: np.ndarray, phi: np.ndarray,

@@ -1,37 +1,20 @@
-"""Forward dynamics of a torque-driven scene at one state in microseconds.
+"""Forward dynamics of a torque-driven scene at one state, from precomputed Fourier series.
 
-A torque drive is integrated in time (:func:`reference.engine.motion.input_motion`); every call of the
-integrator's right-hand side needs the input acceleration at one state ``(t, theta, theta_t)``.
-Solving the Newton-Euler system for that one sample (:func:`reference.engine.dynamics.solve_dynamics`,
-kept here as :func:`direct_acceleration`) costs milliseconds of Python overhead on tiny arrays.
-This module takes the same equations apart instead:
+With one degree of freedom the Newton-Euler system of forward dynamics is
 
-- in forward dynamics the system ``K(theta) x = R0(theta) + theta_t^2 R2(theta) + T_load U(theta)
-  - T_in e - W(theta) phi`` has a matrix (the acceleration's column included) and friction
-  wrenches ``W`` that depend on the input angle only, and a right-hand side that is linear in
-  ``theta_t^2``, the load torque ``T_load`` and the drive torque ``T_in`` (one degree of freedom:
-  every velocity is ``theta_t`` times a function of the angle, every acceleration ``theta_tt``
-  times one plus ``theta_t^2`` times another); the slot speeds whose signs the friction law takes
-  are ``theta_t`` times functions of the angle;
-- so ``K^-1 R0``, ``K^-1 R2``, ``K^-1 U``, ``K^-1 e``, ``K^-1 W`` and the unit slot speeds,
-  restricted to the rows the friction law and the acceleration need, are computed once, in one
-  vectorised pass over an equispaced grid of one input revolution (they are periodic in the
-  angle: the geometry is constant), and represented by their Fourier series, truncated where the
-  harmonics fall below rounding (the grid is doubled until they do);
-- a call evaluates the series (one product gives the frictionless solution at this speed and
-  load, and the friction's response), and solves the friction fixed point ``phi = G(x0 - S phi)``
-  (eqs. (3), (5)) by Newton's method on at most seven values, LAPACK's ``dgesv`` called directly,
-  started from the previous call's solution (the integrator's calls are close) and stopped where
-  its quadratic convergence puts the next update below :func:`reference.engine.fixed_point.solve_friction`'s
-  tolerance; where the loop gain comes near 1 the sample is solved again exactly as
-  ``solve_friction`` does, so the self-locking verdict is the direct solve's.
+    K(theta) x = R0(theta) + theta_t^2 R2(theta) + T_load U(theta) - T_in e - W(theta) phi,
 
-The parts are taken at a large speed, acceleration and load (:data:`PART_SCALE`), so their
-differences keep all digits; the direct solve takes the acceleration's column as the difference
-of two right-hand sides at accelerations 0 and 1 and loses about three digits to gravity and the
-centrifugal terms (measured: docs/engines.md#constants-of-the-reference-engine). Where the grid
-cannot be built (the loop with mounting errors does not close at some angle) or no grid of
-:data:`GRID_SIZES` resolves the series, :func:`right_hand_side` falls back to the direct solve.
+its matrix (the acceleration's column included) and friction wrenches ``W`` depending on the
+input angle only, and the slot speeds are ``theta_t`` times functions of the angle. So
+``K^-1 R0``, ``K^-1 R2``, ``K^-1 U``, ``K^-1 e``, ``K^-1 W`` and the unit slot speeds, restricted
+to the rows the friction law and the acceleration need, are computed once on a grid of one
+revolution and held as Fourier series (:mod:`reference.engine.series`). A call evaluates the
+series and solves ``phi = G(x0 - S phi)`` (eqs. (3), (5)) by Newton's method
+(:mod:`reference.engine.friction_newton`), warm-started from the previous call; near
+self-locking it solves again as :func:`reference.engine.fixed_point.solve_friction` does, so the
+verdict is the direct solve's. Where no series can be built, :func:`right_hand_side` falls back
+to the direct solve (:func:`direct_acceleration`).
+Measured: docs/engines.md#constants-of-the-reference-engine.
 
 References
 ----------
@@ -68,8 +51,10 @@ __all__ = ["GRID_SIZES", "METHODS", "PART_SCALE", "ForwardDynamics", "ForwardSta
 GRID_SIZES = (64, 128, 256, 512, 1024, 2048)
 """Grid points per revolution tried in turn until the series is resolved."""
 PART_SCALE = 1024.0
-"""Speed [rad/s], acceleration [rad/s^2] and load [N m] at which the system's parts are taken
-(a power of two: the divisions are exact)."""
+"""Speed [rad/s], acceleration [rad/s^2] and load [N m] at which the system's parts are taken:
+large, so that their differences from the state at rest keep all digits (gravity and the
+centrifugal terms would cost the direct solve's difference of accelerations 0 and 1 about three),
+and a power of two, so that the divisions are exact."""
 
 Acceleration = Callable[[float, float, float], tuple[float, bool]]
 """``(t [s], theta [rad], theta_t [rad/s]) -> (theta_tt [rad/s^2], self_locking)``."""
@@ -77,6 +62,15 @@ Acceleration = Callable[[float, float, float], tuple[float, bool]]
 
 def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[str, np.ndarray]:
     """The angle-only parts of the forward-dynamics system on ``n`` angles ``2 pi j / n``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The torque-driven scene.
+    slots : list of (pair, "torque" | "force")
+        :func:`reference.engine.slots.friction_slots` (K of them).
+    n : int
+        Grid points per revolution.
 
     Returns
     -------
@@ -150,7 +144,6 @@ class ForwardState:
         return not (self.converged and self.loop_gain < 1.0)
 
 
-
 class ForwardDynamics:
     """The input acceleration of a torque-driven scene at one state, from precomputed series.
 
@@ -167,6 +160,17 @@ class ForwardDynamics:
     active : ndarray of int
         The friction slots that can rub (a slot whose speed is zero at every angle, the axial
         friction of the ideal joint, has none).
+
+    Parameters
+    ----------
+    scene : Scene
+        The torque-driven scene.
+    series : TrigSeries
+        The fit of :func:`_layout`'s parts, side by side.
+    active : ndarray of int
+        See Attributes.
+    parts : int
+        How many parts ``series`` holds (2, or 3 with a load history).
     """
 
     def __init__(self, scene: Scene, series: TrigSeries, active: np.ndarray, parts: int) -> None:
@@ -203,8 +207,21 @@ class ForwardDynamics:
 
     @classmethod
     def of_scene(cls, scene: Scene, torque_in: float) -> ForwardDynamics | None:
-        """Fit the series for ``scene`` under the drive torque ``torque_in`` [N m]; None where
-        the loop does not close at some angle or no grid of :data:`GRID_SIZES` resolves them."""
+        """Fit the series for a scene.
+
+        Parameters
+        ----------
+        scene : Scene
+            The torque-driven scene.
+        torque_in : float
+            Drive torque [N m].
+
+        Returns
+        -------
+        ForwardDynamics or None
+            None where the loop does not close at some angle or no grid of :data:`GRID_SIZES`
+            resolves the series.
+        """
         slots = friction_slots(scene)
         index = FrictionLaw(scene, slots).index
         for n in GRID_SIZES:
@@ -248,8 +265,19 @@ class ForwardDynamics:
         return float(last[k] - last[:k] @ phi), phi, converged, gain, iterations
 
     def solve(self, theta: float, theta_t: float, load: float | None = None) -> ForwardState:
-        """The forward dynamics at input angle ``theta`` [rad] and speed ``theta_t`` [rad/s] under
-        the output load ``load`` [N m] (None: the scene's constant load; needed for a history)."""
+        """The forward dynamics at one state.
+
+        Parameters
+        ----------
+        theta, theta_t : float
+            Input angle [rad] and speed [rad/s].
+        load : float or None
+            Output load [N m]; None: the scene's constant load (a history needs it given).
+
+        Returns
+        -------
+        ForwardState
+        """
         if self._history is not None and load is None:
             raise ValueError("the scene's load is a torque history: pass `load` [N m]")
         accel, phi, converged, gain, iterations = self._friction(theta, theta_t, load)
@@ -300,8 +328,25 @@ def _layout(scene: Scene, torque_in: float, f: dict[str, np.ndarray], rows: np.n
 
 def direct_acceleration(scene: Scene, torque_in: float, t: float, theta: float, theta_t: float,
                         bands: np.ndarray | None = None) -> tuple[float, bool]:
-    """``(theta_tt [rad/s^2], self_locking)`` from :func:`reference.engine.dynamics.solve_dynamics` on
-    one sample (the reference engine's right-hand side before the series; milliseconds)."""
+    """The input acceleration at one state by :func:`reference.engine.dynamics.solve_dynamics`.
+
+    Parameters
+    ----------
+    scene : Scene
+        The torque-driven scene.
+    torque_in : float
+        Drive torque [N m].
+    t, theta, theta_t : float
+        Time [s] (the load history's), input angle [rad] and speed [rad/s].
+    bands : ndarray, shape (K,), or None
+        The slots' ramp widths [m/s] (:func:`reference.engine.slots.slot_bands`); None: looked up.
+
+    Returns
+    -------
+    theta_tt : float
+        [rad/s^2].
+    self_locking : bool
+    """
     _, fixed = solve_dynamics(scene, np.array([theta]), np.array([theta_t]), torque_in=torque_in,
                               load_torque=scene.load.at(np.array([t])), bands=bands)
     return float(fixed.x[0, -1]), bool(fixed.self_locking[0])
@@ -311,10 +356,23 @@ METHODS = ("auto", "series", "direct")
 
 
 def right_hand_side(scene: Scene, torque_in: float, method: str = "auto") -> Acceleration:
-    """The input acceleration as a function ``(t, theta, theta_t) -> (theta_tt, self_locking)``.
+    """The input acceleration as a function of the state.
 
-    ``method``: ``"series"`` (:class:`ForwardDynamics`; ValueError where it cannot be built),
-    ``"direct"`` (:func:`direct_acceleration`) or ``"auto"`` (the series, else the direct solve).
+    Parameters
+    ----------
+    scene : Scene
+        The torque-driven scene.
+    torque_in : float
+        Drive torque [N m].
+    method : str
+        ``"series"`` (:class:`ForwardDynamics`; ValueError where it cannot be built),
+        ``"direct"`` (:func:`direct_acceleration`) or ``"auto"`` (the series, else the direct
+        solve).
+
+    Returns
+    -------
+    callable
+        ``(t [s], theta [rad], theta_t [rad/s]) -> (theta_tt [rad/s^2], self_locking)``.
     """
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")

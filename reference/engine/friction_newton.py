@@ -1,9 +1,8 @@
 """The friction fixed point of one sample by Newton's method, LAPACK called directly.
 
 The forward dynamics' right-hand side (:mod:`reference.engine.forward`) solves
-``phi = G(x0 - S phi)`` (eqs. (3), (5)) for at most seven friction values per call, microseconds
-a call: the same rule as :func:`reference.engine.fixed_point.solve_friction`, without its
-batched arrays.
+``phi = G(x0 - S phi)`` (eqs. (3), (5)) for at most seven friction values per call: the same rule
+as :func:`reference.engine.fixed_point.solve_friction`, without its batched arrays.
 """
 
 from __future__ import annotations
@@ -23,10 +22,10 @@ NEWTON_TOLERANCE = 1e-13
 fraction of the largest friction value."""
 NEWTON_ITERATIONS = 50
 WARM_START_GAIN = 0.9
-"""Newton starts from the previous call's friction (the integrator's calls are close: two or three
-iterations instead of five); where the loop gain it finds is at least this, the sample is solved
-again from :func:`reference.engine.fixed_point.solve_friction`'s start, so that a verdict near self-locking
-is the same as the direct solve's."""
+"""Newton starts from the previous call's friction (the integrator's calls are close); where the
+loop gain it finds is at least this, the sample is solved again from
+:func:`reference.engine.fixed_point.solve_friction`'s start, so that a verdict near self-locking is
+the same as the direct solve's."""
 
 
 _TINY = np.finfo(float).tiny  # n + tiny is n for every normal n, and keeps 0 / 0 away
@@ -79,14 +78,18 @@ def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
 
     Returns
     -------
-    phi, converged, loop_gain, iterations
+    phi : ndarray, shape (K,)
+        Friction values [N m or N].
+    converged : bool
+    loop_gain : float
+        As :func:`reference.engine.fixed_point.loop_gain`'s; infinite when not converged.
+    iterations : int
     """
     k = sxa.shape[1] - 1
     ops = _OPERATORS[k]
     strict = start is None or not coupled
     if strict:
-        c0 = sxa[:, k]
-        phi = ops.slots @ (ks * np.sqrt(ops.norms @ (c0 * c0)))
+        phi = _frictionless(sxa, ks, ops)
         if not coupled:
             return phi, True, 0.0, 0
     else:
@@ -96,12 +99,7 @@ def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
     before = 0.0
     p = np.ones(k + 1)
     for iterations in range(1, NEWTON_ITERATIONS + 1):
-        # G is homogeneous in the pair components: G = W c with W the unit components times
-        # their factors, so Newton's iterate is (I + W sx)^-1 W c0 (one product gives both)
-        p[:k] = -phi
-        both = _products(sxa @ p, ks, sxa, ops)
-        gm = both[:, :k]
-        _, _, phi, info = dgesv(gm + ops.eye, both[:, k])
+        phi, gm, info = _iterate(phi, p, sxa, ks, ops)
         last = values
         values = phi.tolist()
         size = max(abs(a - b) for a, b in zip(values, last, strict=True))
@@ -111,13 +109,38 @@ def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
         scale = max(scale, top)
         if size <= NEWTON_TOLERANCE * scale:
             if strict:
-                p[:k] = -phi
-                gm = _products(sxa @ p, ks, sxa, ops)[:, :k]
+                gm = _products_at(phi, p, sxa, ks, ops)[:, :k]
             return phi, True, _gain(gm, 0.5 if strict else WARM_START_GAIN), iterations
         if not strict and size ** 3 <= 0.01 * NEWTON_TOLERANCE * scale * before ** 2:
             return phi, True, _gain(gm, WARM_START_GAIN), iterations
         before = size
     return phi, False, math.inf, iterations
+
+
+def _frictionless(sxa: np.ndarray, ks: np.ndarray, ops: _Operators) -> np.ndarray:
+    """The friction (K,) of the frictionless reactions (:func:`friction_newton`'s arguments)."""
+    c0 = sxa[:, -1]
+    return ops.slots @ (ks * np.sqrt(ops.norms @ (c0 * c0)))
+
+
+def _products_at(phi: np.ndarray, p: np.ndarray, sxa: np.ndarray, ks: np.ndarray,
+                 ops: _Operators) -> np.ndarray:
+    """:func:`_products` at the friction ``phi`` (K,); ``p`` (K + 1,) is a buffer ending in 1."""
+    p[:phi.size] = -phi
+    return _products(sxa @ p, ks, sxa, ops)
+
+
+def _iterate(phi: np.ndarray, p: np.ndarray, sxa: np.ndarray, ks: np.ndarray,
+             ops: _Operators) -> tuple[np.ndarray, np.ndarray, int]:
+    """Newton's next iterate from ``phi`` (K,) (``p`` as for :func:`_products_at`): G is
+    homogeneous in the pair components, ``G = W c`` with ``W`` the unit components times their
+    factors, so the iterate is ``(I + W sx)^-1 W c0`` (one product gives both). Returns the
+    iterate, the loop's Jacobian ``-dG/dphi`` at ``phi`` (K, K) and LAPACK's ``info``."""
+    k = phi.size
+    both = _products_at(phi, p, sxa, ks, ops)
+    gm = both[:, :k]
+    _, _, phi, info = dgesv(gm + ops.eye, both[:, k])
+    return phi, gm, info
 
 
 @dataclass(frozen=True)

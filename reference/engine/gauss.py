@@ -23,9 +23,22 @@ __all__ = ["GROSS_SCALE", "DENSE_WIDTH", "DENSE_NODES", "MAX_OPEN_PANELS", "ROUN
 
 
 def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.ndarray]:
-    """Panels ``(a, b)`` covering consecutive segments ``edges``, none wider than ``max_width``:
-    each segment cut into equal parts, ``np.linspace``'s cuts (vectorised: a history's samples
-    may make 10^5 segments)."""
+    """Panels covering the segments between consecutive edges, none wider than ``max_width``:
+    each segment cut into equal parts at ``np.linspace``'s cuts (vectorised: a history's samples
+    may make 10^5 segments).
+
+    Parameters
+    ----------
+    edges : ndarray, shape (E,)
+        Ascending edges [s]; repeated ones make no panel.
+    max_width : float
+        Widest panel [s].
+
+    Returns
+    -------
+    lo, hi : ndarray, shape (P,)
+        The panels' ends [s].
+    """
     edges = np.asarray(edges, float)
     keep = edges[1:] > edges[:-1]
     a = edges[:-1][keep]
@@ -42,29 +55,27 @@ def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.
 
 
 GROSS_SCALE = 1e-3
+"""Least scale of an integral, as a fraction of the integral of its absolute value."""
 DENSE_WIDTH = 0.125
 DENSE_NODES = 3
 """History knots alone making panels mostly below ``DENSE_WIDTH`` of the initial width: at most
-``DENSE_NODES`` Gauss nodes each (smooth between knots, error O(h^7); 9 evaluations per knot, not 24)."""
+``DENSE_NODES`` Gauss nodes each (smooth between knots, error O(h^7))."""
 MAX_OPEN_PANELS = 20_000
 ROUNDING_FLOOR = 64 * np.finfo(float).eps
 """A panel whose whole and halves agree to this fraction of the integral's scale is closed
 whatever its width (about 1.4e-14): a difference at the integral's rounding level is the rounding
-of the integrand itself (a friction ramp a few hundred ulp of time wide, where the speed's last
-digits decide the friction), which halving does not reduce; under the width-proportional rule
-alone such a panel splits every round, both halves too, until :data:`MAX_OPEN_PANELS`."""
+of the integrand itself (e.g. a friction ramp a few hundred ulp of time wide), which halving does
+not reduce."""
 
 
 LOAD_LEVELS = 7
 """Load values per Gauss node at which :class:`HistoryRule` evaluates the integrand (odd: the
-middle one is the panel's mid-range load, where a flat history is evaluated exactly). Measured
-on load histories of 20,000 samples a revolution (20 % sine, 1 % noise): 7 levels meet the
-tolerance on panels an eighth of a revolution wide; with 5, under the paper's friction, the
-panels are split down to their samples (37 times the evaluations)."""
+middle one is the panel's mid-range load, where a flat history is evaluated exactly).
+Measured: docs/engines.md#constants-of-the-reference-engine."""
 HISTORY_SAMPLES_PER_PANEL = 48
 """Load-history samples per panel of the initial width above which the reference engine takes
-:class:`HistoryRule` rather than the samples as panel edges, the cheaper from there on
-(measured crossover: 46-69 samples a panel at 8 Gauss nodes)."""
+:class:`HistoryRule` rather than the samples as panel edges, the cheaper from there on.
+Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
 class GaussRule:
@@ -75,6 +86,13 @@ class GaussRule:
     the panels a refinement splits them into (their halves), with each one's parent;
     ``evaluations`` counts the integrand's instants so far, ``cut_panels`` the panels split
     otherwise than in halves.
+
+    Parameters
+    ----------
+    integrand : callable
+        Times (m,) [s] to values (m, k).
+    nodes : int
+        Gauss nodes per panel.
     """
 
     def __init__(self, integrand: Callable[[np.ndarray], np.ndarray], nodes: int) -> None:
@@ -99,8 +117,22 @@ class GaussRule:
 
     def children(self, lo: np.ndarray, hi: np.ndarray,
                  over: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The halves of the panels ``[lo, hi]``: all left halves, then all right ones, and the
-        index of each one's panel (``over``, the panels whose own bound failed, is not needed)."""
+        """The panels a refinement splits ``[lo, hi]`` into: their halves.
+
+        Parameters
+        ----------
+        lo, hi : ndarray, shape (P,)
+            The panels [s].
+        over : ndarray of bool, shape (P,)
+            The panels whose own bound failed (not needed here).
+
+        Returns
+        -------
+        lo, hi : ndarray, shape (2 P,)
+            All left halves, then all right ones [s].
+        parent : ndarray of int, shape (2 P,)
+            Each one's panel.
+        """
         mid = 0.5 * (lo + hi)
         parent = np.arange(lo.size)
         return np.concatenate([lo, mid]), np.concatenate([mid, hi]), np.concatenate([parent, parent])
@@ -158,7 +190,7 @@ class HistoryRule(GaussRule):
     through zero, the samples become panel edges, as for a sparse history).
 
     Why: with every sample a panel edge, a history costs 9 evaluations of the dynamics per
-    sample (400 times a constant load's run at 20,000 samples a revolution).
+    sample.
 
     Parameters
     ----------
@@ -222,8 +254,19 @@ class HistoryRule(GaussRule):
 
     def children(self, lo: np.ndarray, hi: np.ndarray,
                  over: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Halves (as :meth:`GaussRule.children`), and for the panels ``over`` their bound with
-        at most :attr:`cut_samples` samples inside, their pieces between the samples instead."""
+        """:meth:`GaussRule.children`, except that a panel ``over`` its bound with at most
+        :attr:`cut_samples` samples inside is cut at its samples rather than halved.
+
+        Parameters
+        ----------
+        lo, hi, over
+            As for :meth:`GaussRule.children`.
+
+        Returns
+        -------
+        lo, hi, parent : ndarray, shape (Q,)
+            The new panels [s] and each one's panel.
+        """
         count = self._count(lo, hi)
         cut = over & (count > 0) & (count <= self.cut_samples)
         c_lo, c_hi, parent = super().children(lo, hi, over)
@@ -306,19 +349,33 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
     Every open panel is integrated with the ``nodes``-point Gauss-Legendre rule as a whole and
     as two halves; it is closed when the two agree within ``rtol * |I[scale_key]| * width /
     total width``, or within ``ROUNDING_FLOOR * |I[scale_key]|``, in every component (the halves'
-    value is kept; their difference goes into the error estimate), otherwise it is split and its
-    halves are the next round's panels, whose whole-panel values are already known. All open
-    panels of a round are evaluated in one call; the integrand maps times (m,) to values (m, k).
-    The scale is at least ``GROSS_SCALE`` times the integral of ``|I[scale_key]|`` and at least
-    ``scale_floor`` (so that an integral that cancels or vanishes, e.g. the input work of a joint
-    with no load and no loss, does not ask for rounding-level accuracy), and at most
-    ``MAX_OPEN_PANELS`` panels stay open.
+    value is kept; their difference goes into the error estimate), otherwise its halves are the
+    next round's panels, whose whole-panel values are already known. All open panels of a round
+    are evaluated in one call. The scale is at least ``GROSS_SCALE`` times the integral of
+    ``|I[scale_key]|`` and at least ``scale_floor`` (so that an integral that cancels or
+    vanishes, e.g. the input work of a joint with no load and no loss, does not ask for
+    rounding-level accuracy), and at most ``MAX_OPEN_PANELS`` panels stay open.
 
-    With ``history`` (sample times [s] and values of a piecewise-linear load ``L(t)``), the
-    integrand is ``f(t, L)``, mapping times and loads (m,) to values (m, k), and the panels are
-    integrated and split by :class:`HistoryRule` (its evaluations do not grow with the samples
-    where ``f`` is smooth in the load); the rule's own error bounds of the parts are added to
-    the difference of whole and parts, in the closing test and in the error estimate.
+    Parameters
+    ----------
+    integrand : callable
+        Times (m,) [s] to values (m, k); with ``history``, times and loads (m,) to values (m, k).
+    a, b : ndarray, shape (P,)
+        The initial panels [s].
+    nodes : int
+        Gauss nodes per panel.
+    rtol : float
+        Tolerance relative to the scale, shared out by width.
+    scale_key : int
+        The component that sets the scale.
+    max_rounds : int
+        Rounds of halving at most.
+    scale_floor : float
+        Least scale, in the units of component ``scale_key``'s integral.
+    history : (ndarray, ndarray) or None
+        Sample times [s] and values of a piecewise-linear load ``L(t)``: the panels are
+        integrated and split by :class:`HistoryRule`, whose own error bounds are added to the
+        difference of whole and parts, in the closing test and in the error estimate.
 
     Returns
     -------
@@ -334,13 +391,24 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
     gross = float(np.sum(np.abs(whole[:, scale_key])))
     scale = max(abs(float(np.sum(whole[:, scale_key]))), GROSS_SCALE * gross, scale_floor,
                 np.finfo(float).tiny)
-    result = np.zeros(whole.shape[1])
-    error = np.zeros(whole.shape[1])
-    closed = 0
 
     def allowed(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         return scale * np.maximum(rtol * (hi - lo) / total_width, ROUNDING_FLOOR)
 
+    result, error, closed, rounds = _rounds(rule, a, b, whole, whole_bound, allowed, max_rounds)
+    return result, {"evaluations": rule.evaluations, "rounds": rounds, "panels": closed,
+                    "cut_panels": rule.cut_panels, "error_estimate": error.tolist()}
+
+
+def _rounds(rule: GaussRule, a: np.ndarray, b: np.ndarray, whole: np.ndarray, whole_bound: np.ndarray,
+            allowed: Callable[[np.ndarray, np.ndarray], np.ndarray],
+            max_rounds: int) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """:func:`adaptive_gauss`' rounds of halving from the panels ``[a, b]`` and their ``whole``
+    values and bounds (P, k), ``allowed(lo, hi)`` each panel's tolerance (P,). Returns the
+    integral and error estimate (k,), the panels closed and the rounds made."""
+    result = np.zeros(whole.shape[1])
+    error = np.zeros(whole.shape[1])
+    closed = 0
     for rounds in range(1, max_rounds + 1):
         lo, hi, parent = rule.children(a, b, np.any(whole_bound > allowed(a, b)[:, None], -1))
         parts, bound = rule(lo, hi)
@@ -349,15 +417,15 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
         np.add.at(both, parent, parts)  # two halves: left + right, as written out
         np.add.at(bounds, parent, bound)
         diff = np.abs(both - whole) + bounds
-        # a non-finite panel (NaN from a locked or failed sample) cannot converge: close it and
-        # let the NaN reach the result instead of splitting it every round (2^rounds panels)
+        # a non-finite panel (NaN from a locked or failed sample) cannot converge: closed, so
+        # that the NaN reaches the result rather than the panel splitting every round
         done = (np.all(diff <= allowed(a, b)[:, None], -1) | (rounds == max_rounds)
                 | (lo.size > MAX_OPEN_PANELS) | ~np.all(np.isfinite(both), -1))
         result += both[done].sum(0)
         error += diff[done].sum(0)
         closed += int(np.count_nonzero(done))
         # nothing open, or a NaN (locked sample) already decides the integral: refining the
-        # steep panels next to a locked arc would only cost (19 s at 47 deg, 2000 rpm)
+        # steep panels next to a locked arc would only cost time
         if np.all(done) or not np.all(np.isfinite(result)):
             break
         keep = ~done[parent]
@@ -365,16 +433,35 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
         b = hi[keep]
         whole = parts[keep]
         whole_bound = bound[keep]
-    return result, {"evaluations": rule.evaluations, "rounds": rounds, "panels": closed,
-                    "cut_panels": rule.cut_panels, "error_estimate": error.tolist()}
+    return result, error, closed, rounds
 
 
 def quadrature_summary(info: dict, nodes: int, rtol: float, sign_breakpoints: int, knots: int,
                        revolutions_integrated: int, weighted_load_samples: int = 0) -> dict:
-    """``summary.extras["quadrature"]``: how the works were integrated (``info`` from
-    :func:`adaptive_gauss`; its error estimates of the input and lost work [J], components 0 and 2
-    of the reference engine's ``WORK_KEYS``). ``knots`` are the history samples that are panel
-    edges, ``weighted_load_samples`` those that enter through :class:`HistoryRule`'s weights."""
+    """``summary.extras["quadrature"]``: how the works were integrated.
+
+    Parameters
+    ----------
+    info : dict
+        :func:`adaptive_gauss`' info; its error estimates of components 0 and 2 (the input and
+        lost work [J] of :data:`reference.engine.work.WORK_KEYS`) are reported.
+    nodes : int
+        Gauss nodes per panel.
+    rtol : float
+        The quadrature's tolerance.
+    sign_breakpoints : int
+        Friction ramp edges found.
+    knots : int
+        History samples that are panel edges.
+    revolutions_integrated : int
+        Whole revolutions integrated (one when a periodic motion's is multiplied).
+    weighted_load_samples : int
+        History samples that enter through :class:`HistoryRule`'s weights.
+
+    Returns
+    -------
+    dict
+    """
     return {"method": "adaptive Gauss-Legendre panels", "nodes_per_panel": nodes, "rtol": rtol,
             "sign_breakpoints": sign_breakpoints, "knots": knots,
             "weighted_load_samples": weighted_load_samples,

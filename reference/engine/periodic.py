@@ -7,6 +7,7 @@ the same input angles in every revolution, the first period is evaluated and the
 recorded table a copied row's angle is ``theta + 2 pi k`` rounded, not the angle its state was
 computed at.
 """
+
 from __future__ import annotations
 
 import math
