@@ -1,18 +1,12 @@
 """Many constant-speed scenes as one model: per-sample parameters, one vectorised evaluation.
 
-:class:`SceneStack` holds what may differ between the scenes of a batch (:mod:`reference.engine.batch.solve`):
-drive speed, load torque, gravity, the bodies' mass properties, the joint's geometry and mounting
-errors, the friction coefficients, journal diameters and sign-ramp widths. What the scenes share
-(:func:`reference.engine.batch.solve.batch_key`: the friction slots, law and coupling, ideal joint or not)
-decides the code path. :meth:`SceneStack.columns` takes, per sample, the index of its scene and
-its instant, gathers each sample's parameters and evaluates all samples of all scenes in one pass
-with the functions of :mod:`reference.physics.kinematics`, :mod:`reference.physics.rccc`,
-:mod:`reference.physics.loop_closure` and :mod:`reference.engine.dynamics`: each sample's values are those of
-``reference.engine.table.columns_at`` for its own scene, to rounding.
-
-A sample whose loop does not close (or whose branches meet) cannot be evaluated: its scene is
-added to :attr:`SceneStack.failed` (the caller runs it on its own, which reports the error) and
-the sample is evaluated at input angle 0 instead, so that the other scenes go on.
+:class:`SceneStack` holds what may differ between the scenes of a batch (speed, load, gravity,
+mass properties, geometry and mounting errors, friction coefficients, journal diameters, ramp
+widths); what they share (:func:`reference.engine.batch.solve.batch_key`) decides the code path.
+:meth:`SceneStack.columns` evaluates samples of many scenes in one pass, each sample's values
+those of :func:`reference.engine.table.columns_at` for its own scene, to rounding. A sample whose
+loop does not close puts its scene in :attr:`SceneStack.failed` (the caller runs it on its own)
+and is evaluated at input angle 0, so that the other scenes go on.
 """
 
 from __future__ import annotations
@@ -47,6 +41,8 @@ from reference.physics.joint_motion import JointMotion, ideal_pair_origins, loop
 from reference.physics.loop_closure import solve_wrapped
 from reference.scene.joint import BODY_NAMES, PAIR_NAMES
 from reference.scene.scene import Scene
+
+__all__ = ["CHUNK_SAMPLES", "HOOKE", "SceneStack", "StackedLaw", "StackedLoop"]
 
 HOOKE = -1.0
 """Root of the loop's input-output equation on the ``"hooke"`` branch (the one every engine uses)."""
@@ -93,13 +89,26 @@ class StackedLaw:
         return friction_law_values(x, self.index, packed[..., 0], packed[..., 1], packed[..., 2])
 
     def reduced(self, c: np.ndarray, packed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reference.engine.fixed_point.reduced_law_values` of ``c`` = ``x[:, index]`` (n, K, 4)."""
+        """:func:`reference.engine.fixed_point.reduced_law_values` with per-sample coefficients.
+
+        Parameters
+        ----------
+        c : ndarray, shape (n, K, 4)
+            ``x[:, index]``: each slot's fx, fy [N], mx, my [N m].
+        packed : ndarray, shape (n, K, 3)
+            Each slot's friction factor, ``k_force`` and ``k_moment``.
+
+        Returns
+        -------
+        values : ndarray, shape (n, K)
+        slopes : ndarray, shape (n, K, 4)
+        """
         return reduced_law_values(c, packed[..., 0], packed[..., 1], packed[..., 2])
 
 
 def _slot_coefficients(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray:
     """Per slot: journal diameter [m], the law's factors of ``|F|`` and ``|M|``; shape (K, 3)."""
-    out = []  # moment levers resolved
+    out = []
     pairs = dict(scene.joint.friction_pairs())
     for pair, kind in slots:
         data = pairs[pair]
@@ -220,7 +229,19 @@ class SceneStack:
 
     def motion(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray,
                theta_tt: np.ndarray) -> JointMotion:
-        """:func:`reference.physics.joint_motion.joint_motion` of each sample's scene (shape (n,) each)."""
+        """:func:`reference.physics.joint_motion.joint_motion` of each sample's scene.
+
+        Parameters
+        ----------
+        idx : ndarray of int, shape (n,)
+            Each sample's scene.
+        theta, theta_t, theta_tt : ndarray, shape (n,)
+            Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
+
+        Returns
+        -------
+        JointMotion
+        """
         if self.ideal:
             beta = self.beta[idx]
             simple = kinematics.body_motions(theta, theta_t, theta_tt, beta)
@@ -297,14 +318,39 @@ class SceneStack:
 
     def slot_speeds(self, idx: np.ndarray, omega_rel: dict[str, np.ndarray],
                     slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-        """:func:`reference.engine.slots.slot_speeds` per sample [m/s], shape (n, K)."""
+        """:func:`reference.engine.slots.slot_speeds` with each sample's journal diameters.
+
+        Parameters
+        ----------
+        idx : ndarray of int, shape (n,)
+            Each sample's scene.
+        omega_rel, slide_rel : dict of str to ndarray, shape (n,)
+            Per pair the relative angular [rad/s] and sliding [m/s] speeds.
+
+        Returns
+        -------
+        ndarray, shape (n, K)
+            Speeds [m/s].
+        """
         out = [0.5 * self.diameter[idx, j] * omega_rel[pair] if kind == "torque"
                else slide_rel[pair] for j, (pair, kind) in enumerate(self.slots)]
         return np.stack(out, -1) if out else np.zeros(idx.shape + (0,))
 
     def ramp_speeds(self, idx: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """:func:`reference.engine.slots.ramp_speeds` at instants ``t`` [s] of scenes ``idx`` (n, K'),
-        :data:`CHUNK_SAMPLES` at a time."""
+        """:func:`reference.engine.slots.ramp_speeds`, :data:`CHUNK_SAMPLES` at a time.
+
+        Parameters
+        ----------
+        idx : ndarray of int, shape (n,)
+            Each sample's scene.
+        t : ndarray, shape (n,)
+            Instants [s].
+
+        Returns
+        -------
+        ndarray, shape (n, K')
+            Speeds [m/s].
+        """
         if idx.size <= CHUNK_SAMPLES:
             return self._ramp_speeds(idx, t)
         return np.concatenate([self._ramp_speeds(idx[k:k + CHUNK_SAMPLES], t[k:k + CHUNK_SAMPLES])
@@ -334,10 +380,23 @@ class SceneStack:
         return solve_friction(law, both[..., 0], both[..., 1:], packed, exact_gain=exact_gain)
 
     def columns(self, idx: np.ndarray, t: np.ndarray, energy: bool = True) -> dict[str, np.ndarray]:
-        """``reference.engine.table.columns_at`` of each sample's scene: scene indices ``idx`` and
-        instants ``t`` [s], shape (n,) each; evaluated :data:`CHUNK_SAMPLES` at a time.
-        ``energy`` False: the energy columns are left zero and the loop gain is exact only where it
-        decides self-locking (the work integrands need neither)."""
+        """:func:`reference.engine.table.columns_at` of each sample's scene, :data:`CHUNK_SAMPLES`
+        at a time.
+
+        Parameters
+        ----------
+        idx : ndarray of int, shape (n,)
+            Each sample's scene.
+        t : ndarray, shape (n,)
+            Instants [s].
+        energy : bool
+            False: the energy columns are left zero and the loop gain is exact only where it
+            decides self-locking (the work integrands need neither).
+
+        Returns
+        -------
+        dict of str to ndarray, shape (n,)
+        """
         idx = np.asarray(idx, int)
         t = np.asarray(t, float)
         if idx.size <= CHUNK_SAMPLES:

@@ -28,6 +28,9 @@ from reference.engine.motion import InputMotion
 from reference.engine.options import ReferenceOptions
 from reference.engine.work import WORK_KEYS, window_times, work_means
 from reference.results.means import whole_revolution_window
+from reference.scene.scene import Scene
+
+__all__ = ["adaptive_gauss", "sign_breakpoints", "work_quadratures"]
 
 
 def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) -> list[tuple]:
@@ -53,8 +56,23 @@ def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) ->
 
 def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
                      t_b: np.ndarray) -> list[np.ndarray]:
-    """:func:`reference.engine.breakpoints.sign_breakpoints` of the scenes ``members`` of ``stack`` in their
-    windows ``(t_a, t_b)`` [s]; one sorted array of instants [s] per member."""
+    """:func:`reference.engine.breakpoints.sign_breakpoints` of many scenes of a stack, the brackets
+    of all refined together.
+
+    Parameters
+    ----------
+    stack : SceneStack
+        The scenes.
+    members : sequence of int
+        The scenes searched (indices into ``stack.scenes``).
+    t_a, t_b : ndarray, shape (len(members),)
+        Each member's window [s].
+
+    Returns
+    -------
+    list of ndarray
+        Per member the sorted instants [s].
+    """
     empty = [np.zeros(0) for _ in members]
     if not stack.slots:
         return empty
@@ -105,18 +123,61 @@ def _gauss(integrand: Callable, rules: dict, nodes: np.ndarray, owner: np.ndarra
 def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.ndarray,
                    nodes: np.ndarray, rtol: float, scale_floor: np.ndarray,
                    max_rounds: int = 40) -> tuple[np.ndarray, list[dict]]:
-    """:func:`reference.engine.gauss.adaptive_gauss` for many scenes: panels ``[a, b]`` of scene
-    ``owner`` (0 .. S - 1), ``nodes`` and ``scale_floor`` per scene (S,); ``integrand`` maps
-    scene indices and times (m,) to values (m, k). Returns the integrals (S, k) and per scene
-    the info dict of the single version."""
+    """:func:`reference.engine.gauss.adaptive_gauss` for many scenes, each with its own rule,
+    scale and closing rule, all open panels of a round in one integrand call.
+
+    Parameters
+    ----------
+    integrand : callable
+        Scene indices and times (m,) [s] to values (m, k).
+    owner : ndarray of int, shape (P,)
+        Each panel's scene, 0 .. S - 1.
+    a, b : ndarray, shape (P,)
+        The initial panels [s].
+    nodes : ndarray of int, shape (S,)
+        Gauss nodes per panel, per scene.
+    rtol : float
+        Tolerance relative to each scene's scale.
+    scale_floor : ndarray, shape (S,)
+        Least scale per scene.
+    max_rounds : int
+        Rounds of halving at most.
+
+    Returns
+    -------
+    integrals : ndarray, shape (S, k)
+    infos : list of dict
+        Per scene the info of :func:`reference.engine.gauss.adaptive_gauss` (without
+        ``cut_panels``).
+    """
     count = nodes.size
     rules = {int(n): np.polynomial.legendre.leggauss(int(n)) for n in np.unique(nodes)}
-    whole = _gauss(integrand, rules, nodes, owner, a, b)
-    evaluations = np.bincount(owner, nodes[owner], count)
+    evaluations = np.zeros(count)
+
+    def evaluate(owner: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        evaluations[:] += np.bincount(owner, nodes[owner], count)
+        return _gauss(integrand, rules, nodes, owner, lo, hi)
+
+    whole = evaluate(owner, a, b)
     total_width = np.bincount(owner, b - a, count)
     gross = np.bincount(owner, np.abs(whole[:, 0]), count)
     scale = np.maximum.reduce([np.abs(np.bincount(owner, whole[:, 0], count)), GROSS_SCALE * gross,
                                scale_floor, np.full(count, np.finfo(float).tiny)])
+
+    def allowed(owner: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        return rtol * scale[owner] * (hi - lo) / total_width[owner]
+
+    result, error, closed, rounds = _rounds(evaluate, allowed, owner, a, b, whole, count, max_rounds)
+    return result, [{"evaluations": int(evaluations[s]), "rounds": int(rounds[s]), "panels": int(closed[s]),
+                     "error_estimate": error[s].tolist()} for s in range(count)]
+
+
+def _rounds(evaluate: Callable, allowed: Callable, owner: np.ndarray, a: np.ndarray, b: np.ndarray,
+            whole: np.ndarray, count: int, max_rounds: int) -> tuple[np.ndarray, ...]:
+    """:func:`adaptive_gauss`' rounds of halving from the panels ``[a, b]`` of scenes ``owner``
+    and their ``whole`` values (P, k); ``evaluate(owner, lo, hi)`` integrates panels,
+    ``allowed(owner, lo, hi)`` gives their tolerances. Returns per scene (``count`` of them) the
+    integrals and error estimates (S, k), the panels closed and the rounds made (S,)."""
     result = np.zeros((count, whole.shape[1]))
     error = np.zeros((count, whole.shape[1]))
     closed = np.zeros(count, int)
@@ -124,16 +185,13 @@ def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.
     for r in range(1, max_rounds + 1):
         rounds[np.unique(owner)] = r
         mid = 0.5 * (a + b)
-        both = _gauss(integrand, rules, nodes, np.concatenate([owner, owner]), np.concatenate([a, mid]),
-                      np.concatenate([mid, b]))
-        evaluations += 2 * np.bincount(owner, nodes[owner], count)
+        both = evaluate(np.concatenate([owner, owner]), np.concatenate([a, mid]), np.concatenate([mid, b]))
         left = both[:a.size]
         right = both[a.size:]
         diff = np.abs(left + right - whole)
-        allowed = rtol * scale[owner] * (b - a) / total_width[owner]
         open_ = np.bincount(owner, minlength=count)[owner]
-        done = (np.all(diff <= allowed[:, None], -1) | (r == max_rounds) | (2 * open_ > MAX_OPEN_PANELS)
-                | ~np.all(np.isfinite(left + right), -1))
+        done = (np.all(diff <= allowed(owner, a, b)[:, None], -1) | (r == max_rounds)
+                | (2 * open_ > MAX_OPEN_PANELS) | ~np.all(np.isfinite(left + right), -1))
         np.add.at(result, owner[done], (left + right)[done])
         np.add.at(error, owner[done], diff[done])
         closed += np.bincount(owner[done], minlength=count)
@@ -144,11 +202,11 @@ def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.
         b = np.concatenate([mid[keep], b[keep]])
         owner = np.concatenate([owner[keep], owner[keep]])
         whole = np.concatenate([left[keep], right[keep]])
-    return result, [{"evaluations": int(evaluations[s]), "rounds": int(rounds[s]), "panels": int(closed[s]),
-                     "error_estimate": error[s].tolist()} for s in range(count)]
+    return result, error, closed, rounds
 
 
-def _window(scene, motion: InputMotion, table: dict[str, np.ndarray]) -> tuple[float, float, int] | None:
+def _window(scene: Scene, motion: InputMotion,
+            table: dict[str, np.ndarray]) -> tuple[float, float, int] | None:
     """Start and end of the window [s] and the whole revolutions in it (None: none)."""
     theta = table["theta_in"]
     t = table["t"]
@@ -161,8 +219,27 @@ def _window(scene, motion: InputMotion, table: dict[str, np.ndarray]) -> tuple[f
 
 def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequence[InputMotion],
                      tables: Sequence[dict[str, np.ndarray]], options: ReferenceOptions) -> list[dict]:
-    """:func:`reference.engine.work.work_quadrature` of the scenes ``members`` of ``stack`` (constant
-    speed and load: one revolution integrated, times the revolutions), one dict per member."""
+    """:func:`reference.engine.work.work_quadrature` of many scenes of a stack (constant speed and
+    load: one revolution integrated, times the revolutions).
+
+    Parameters
+    ----------
+    stack : SceneStack
+        The scenes.
+    members : sequence of int
+        The scenes to integrate (indices into ``stack.scenes``).
+    motions : sequence of InputMotion
+        Their motions.
+    tables : sequence of dict of str to ndarray
+        Their time tables' ``t`` [s] and ``theta_in`` [rad].
+    options : ReferenceOptions
+        Panels per revolution, nodes per panel and the quadrature's tolerance.
+
+    Returns
+    -------
+    list of dict
+        One per member, as :func:`reference.engine.work.work_quadrature`'s.
+    """
     windows = [_window(stack.scenes[m], mo, tab) for m, mo, tab in zip(members, motions, tables, strict=True)]
     live = [i for i, w in enumerate(windows) if w is not None]
     out: list[dict] = [{} for _ in members]
@@ -170,18 +247,10 @@ def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequenc
         return out
     ids = np.array([members[i] for i in live], int)
     t_a, t_b, n = (np.array([windows[i][k] for i in live]) for k in range(3))
-    period = (t_b - t_a) / n
-    t_end = t_a + period
+    t_end = t_a + (t_b - t_a) / n
     kinks = sign_breakpoints(stack, ids, t_a, t_end)
-    width = period / options.panels_per_revolution
-    owner = []
-    lo = []
-    hi = []
-    nodes = np.empty(ids.size, int)
-    for s in range(ids.size):
-        a, b = initial_panels(np.unique(np.concatenate([[t_a[s], t_end[s]], kinks[s]])), width[s])
-        nodes[s] = options.gauss_nodes  # no history knots at constant speed and load: never dense
-        owner.append(np.full(a.size, s)), lo.append(a), hi.append(b)
+    owner, lo, hi = _panels(t_a, t_end, kinks, (t_b - t_a) / n / options.panels_per_revolution)
+    nodes = np.full(ids.size, options.gauss_nodes)  # no history knots at constant speed and load
     ends = stack.columns(np.repeat(ids, 2), np.column_stack([t_a, t_b]).ravel())
     energy = np.abs(ends["energy_kinetic"]).reshape(-1, 2).max(1) + np.abs(ends["energy_potential"]).reshape(
         -1, 2).max(1)
@@ -191,13 +260,27 @@ def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequenc
         return np.stack([np.asarray(cols[k], float) for k in WORK_KEYS], -1)
 
     with np.errstate(invalid="ignore"):
-        values, infos = adaptive_gauss(integrand, np.concatenate(owner), np.concatenate(lo),
-                                       np.concatenate(hi), nodes, options.quadrature_rtol,
+        values, infos = adaptive_gauss(integrand, owner, lo, hi, nodes, options.quadrature_rtol,
                                        GROSS_SCALE * energy)
     for s, i in enumerate(live):
         pair_ends = {k: ends[k][2 * s:2 * s + 2] for k in ("energy_kinetic", "energy_potential")}
         out[i] = _works(n[s] * values[s], pair_ends, infos[s], int(nodes[s]), kinks[s].size, options)
     return out
+
+
+def _panels(t_a: np.ndarray, t_end: np.ndarray, kinks: list[np.ndarray],
+            width: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every scene's initial panels over ``[t_a, t_end]`` (S,) [s], broken at its ``kinks`` [s],
+    at most ``width`` (S,) [s] wide: each panel's scene, and the panels' ends (P,)."""
+    owner = []
+    lo = []
+    hi = []
+    for s in range(t_a.size):
+        a, b = initial_panels(np.unique(np.concatenate([[t_a[s], t_end[s]], kinks[s]])), width[s])
+        owner.append(np.full(a.size, s))
+        lo.append(a)
+        hi.append(b)
+    return np.concatenate(owner), np.concatenate(lo), np.concatenate(hi)
 
 
 def _works(values: np.ndarray, ends: dict[str, np.ndarray], info: dict, nodes: int, kinks: int,

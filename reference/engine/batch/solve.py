@@ -1,25 +1,16 @@
 """Many scenes through the reference engine at once.
 
-CONTRACT (kept by every implementation; the sweep runner and the tolerance study build on it):
+Contract (the sweep runner and the tolerance study build on it):
 
-- :func:`batch_key(scene)` is a hashable key; scenes with equal keys can share one vectorised
-  pass (same drive kind, same set of active friction pairs, same friction law and options that
-  change the code path). ``None``: the scene must run on its own (torque drive, angle history...).
-- :func:`run_batch(scenes, options)` returns one :class:`reference.results.result.Result` per scene, in
-  order, each equal to ``reference.engine.solve.run(scene, options)`` (to rounding, or to the
-  quadrature tolerance where the adaptivity differs). A scene that locks, fails or does not close
-  its loop gets its own failed Result and does not spoil the others. Invalid scenes raise
-  before anything runs (the error names the scene's index).
-
-How: constant-speed scenes with a constant load share a key when they share the friction slots
-(:func:`reference.engine.slots.friction_slots`), the friction law and coupling and whether the
-joint is ideal (closed-form kinematics) or has mounting errors (the dual-number loop). Their
-time tables, sign breakpoints and work quadratures are evaluated together, in chunks of at most
-:data:`BATCH_SCENES` scenes (:mod:`reference.engine.batch.model`, :mod:`reference.engine.batch.quadrature`);
-each scene's summary is then filled by the engine's own functions. A scene whose loop does not
-close somewhere (its sign bands cannot be computed, or a sample of the pass does not close) is run
-on its own by :func:`reference.engine.solve.run`, which reports the error as it always does. Every other
-drive runs on its own. ``summary.wall_time_s`` of a batched scene is its share of its chunk's time.
+- :func:`batch_key` is a hashable key; scenes with equal keys share one vectorised pass
+  (constant speed and load, the same friction slots, law and coupling, ideal joint or not).
+  None: the scene runs on its own.
+- :func:`run_batch` returns one :class:`reference.results.result.Result` per scene, in order, each
+  equal to :func:`reference.engine.solve.run`'s (to rounding, or to the quadrature tolerance where
+  the adaptivity differs). A scene that locks, fails or does not close its loop gets its own
+  failed Result (from :func:`reference.engine.solve.run`) and does not spoil the others; invalid
+  scenes raise before anything runs, naming the scene's index. ``summary.wall_time_s`` of a
+  batched scene is its share of its chunk's time.
 """
 
 from __future__ import annotations
@@ -51,7 +42,7 @@ BATCH_SCENES = 32
 gain little time. Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
-def batch_key(scene) -> Hashable | None:
+def batch_key(scene: Scene) -> Hashable | None:
     """Scenes with the same key may run in one pass; None: on its own."""
     require_scene(scene)
     if not isinstance(scene.drive, SpeedDrive) or not scene.load.constant:
@@ -61,7 +52,20 @@ def batch_key(scene) -> Hashable | None:
 
 
 def run_batch(scenes: Sequence, options: ReferenceOptions | None = None) -> list[Result]:
-    """One :class:`Result` per scene, in order (see the module's contract)."""
+    """Run many scenes, sharing vectorised passes where their :func:`batch_key` agrees.
+
+    Parameters
+    ----------
+    scenes : sequence of Scene
+        Any scenes.
+    options : ReferenceOptions or None
+        Resolution, the same for all; None: the defaults.
+
+    Returns
+    -------
+    list of Result
+        One per scene, in order (see the module's contract).
+    """
     scenes = list(scenes)
     options = check_scenes(scenes, options)
     groups: dict[Hashable, list[int]] = {}
@@ -81,13 +85,25 @@ def run_batch(scenes: Sequence, options: ReferenceOptions | None = None) -> list
 
 
 def check_scenes(scenes: Sequence, options: ReferenceOptions | None = None) -> ReferenceOptions:
-    """Refuse, before anything runs, what :func:`run_batch` would refuse: a non-scene, options
-    that are not :class:`ReferenceOptions`, a scene whose table or integration exceeds the step
-    limit (each message names the scene's index in ``scenes``). Returns the options in effect.
+    """Refuse, before anything runs, what :func:`run_batch` would refuse.
+
+    Parameters
+    ----------
+    scenes : sequence
+        What should be scenes.
+    options : ReferenceOptions or None
+        What should be options (None: the defaults).
+
+    Returns
+    -------
+    ReferenceOptions
+        The options in effect.
 
     Raises
     ------
     TypeError, OptionsError, SceneError
+        A non-scene, options that are not :class:`ReferenceOptions`, a scene whose table or
+        integration exceeds the step limit (each message names the scene's index).
     """
     for i, scene in enumerate(scenes):
         require_scene(scene, f"scenes[{i}]")
