@@ -5,7 +5,7 @@ except ``t`` and the two shaft angles, which advance by ``T`` and one turn. When
 the same input angles in every revolution, the first period is evaluated and the others are copies
 (the same values to rounding, at ``1 / revolutions`` of the cost). Summary-only runs use it: in a
 recorded table a copied row's angle is ``theta + 2 pi k`` rounded, not the angle its state was
-computed at.
+computed at. Measured: docs/engines.md#constants-of-the-reference-engine.
 """
 
 from __future__ import annotations
