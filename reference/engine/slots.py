@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.engine.fixed_point import friction_law_values, reduced_law_values
+from reference.engine.law_values import friction_law_values, reduced_law_values
 from reference.engine.newton_euler import unknowns, wrench_columns
 from reference.physics.bands import sign_bands
 from reference.physics.friction import friction_magnitudes, regularised_sign

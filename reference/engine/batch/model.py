@@ -16,7 +16,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from reference.engine.dynamics import solution_columns
-from reference.engine.fixed_point import FixedPoint, friction_law_values, reduced_law_values, solve_friction
+from reference.engine.fixed_point import FixedPoint, solve_friction
+from reference.engine.law_values import friction_law_values, reduced_law_values
 from reference.engine.newton_euler import DRIVE_ROW, cross, mass_kinematics, unknowns, wrench_columns
 from reference.engine.slots import (
     friction_matrix,
@@ -89,7 +90,7 @@ class StackedLaw:
         return friction_law_values(x, self.index, packed[..., 0], packed[..., 1], packed[..., 2])
 
     def reduced(self, c: np.ndarray, packed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reference.engine.fixed_point.reduced_law_values` with per-sample coefficients.
+        """:func:`reference.engine.law_values.reduced_law_values` with per-sample coefficients.
 
         Parameters
         ----------
