@@ -17,6 +17,7 @@ from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from cardan_exudyn.interrupts import deferred_signals
 from reference.results.result import Result
 from reference.results.summary import OptionsError
 from reference.scene.scene import Scene
@@ -88,7 +89,10 @@ def _entry(name: str) -> Engine:
 def _import(name: str, module: str) -> Any:
     """Import an engine's ``module``; a missing dependency makes engine ``name`` unavailable."""
     try:
-        return importlib.import_module(module)
+        # a Ctrl-C inside a compiled module's initialisation comes back as an ImportError
+        # (Exudyn: "initialization failed"); held back, it arrives after the import as itself
+        with deferred_signals():
+            return importlib.import_module(module)
     except ImportError as exc:
         raise EngineUnavailable(f"engine {name!r} is not available: {exc}") from None
 

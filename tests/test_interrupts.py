@@ -5,6 +5,7 @@ signal, and the same command resumes with the missing cases only."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import random
@@ -18,6 +19,7 @@ import pytest
 from processes import CLI, start, wait_for
 
 from cardan_exudyn.cli import main
+from cardan_exudyn import engines
 from cardan_exudyn.engines import run
 from cardan_exudyn.interrupts import Terminated, deferred_signals, terminate_raises, watch_signals
 from cardan_exudyn.sweep import read_records, run_sweep
@@ -125,6 +127,27 @@ def test_deferred_signals_wait_for_the_block():
             time.sleep(0.05)
             done.append(True)
     assert done == [True]
+
+
+INIT_FAILS_ON_CTRL_C = """
+import os, signal, time
+try:
+    os.kill(os.getpid(), signal.SIGINT)
+    time.sleep(0.2)
+except KeyboardInterrupt:
+    raise ImportError("initialization failed") from None
+"""
+
+
+def test_ctrl_c_while_an_engine_imports_is_an_interruption(tmp_path, monkeypatch):
+    """SIGINT while an engine's module is imported (a compiled module that turns it into an
+    ImportError, as Exudyn's does) raises KeyboardInterrupt, not "engine not available"."""
+    (tmp_path / "engine_init_on_ctrl_c.py").write_text(INIT_FAILS_ON_CTRL_C)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    fake = dataclasses.replace(engines.ENGINES["mujoco"], module="engine_init_on_ctrl_c")
+    monkeypatch.setitem(engines.ENGINES, "mujoco", fake)
+    with pytest.raises(KeyboardInterrupt):
+        engines.get_engine("mujoco")
 
 
 def test_ctrl_c_inside_exudyn_is_an_interruption_not_a_failure():
