@@ -1,17 +1,8 @@
-"""A synthetic rig: the model's joint measured by a model of the paper's transducers.
+"""A synthetic rig: the reference engine's joint measured by a model of the paper's transducers.
 
-The truth is the reference engine (numpy, no time steps) running the rig case (15 deg,
-f = 0.42, physical parameter set by default) driven by a motor whose speed ripples with the
-input angle (so every revolution repeats and the kinetic energy returns each revolution: the
-true efficiency over any whole revolutions is the engine's mean efficiency) and loaded by a
-constant brake torque chosen for a mean input torque of 0.2 N m. The transducer model adds
-what a real acquisition adds: each torque's first-order output filter (lag), accuracy-class
-offset and zero drift (drawn within their limits unless given), white noise, the card's
-quantisation and range; each speed as a cumulative pulse count at 60 pulses per revolution
-(quantised angle; the input encoder starts at an unknown yoke phase), or as a speed channel.
-
-Every file it writes says it is synthetic (metadata ``synthetic = true``, ``generator``,
-``settings`` with every setting, every drawn error and the true efficiency and phase).
+Motor speed ``w0 (1 + e1 cos th + e2 cos 2th)`` (the motion repeats each revolution, so the true
+efficiency over whole revolutions is the engine's mean efficiency), constant brake torque; torques
+get lag, offset, drift, noise, quantisation; speeds are pulse counts or rpm. Files say they are synthetic.
 """
 
 from __future__ import annotations
@@ -53,43 +44,36 @@ FORMATS = ("csv", "lvm", "tdms")
 
 @dataclass(frozen=True)
 class RigSettings:
-    """What the synthetic rig runs and how it measures.
+    """What the synthetic rig runs and how it measures; a bad setting raises TypeError/ValueError.
 
     Attributes
     ----------
     scene : str
-        Named scene of the joint (``reference.paper.scenes.named_scene``); its drive and load are
-        replaced by the motor and brake below.
+        Named scene of the joint; its drive and load are replaced by motor and brake.
     shaft_angle_deg : float or None
-        The joint's shaft angle [deg]; None: the scene's (15 for the rig).
+        Shaft angle [deg]; None: the scene's.
     speed : float
-        Mean input speed [rad/s] (paper: 6).
+        Mean input speed [rad/s].
     ripple : tuple of float
-        Motor speed ripple: relative amplitudes at 1x and 2x the input angle [-].
+        Relative motor speed ripple at 1x and 2x the input angle [-].
     input_torque : float
-        Target mean input torque [N m] (paper: 0.2); the brake torque is set from it.
+        Target mean input torque [N m]; sets the brake torque.
     revolutions : float
         Input revolutions recorded [-].
     rate : float
         Sampling rate [Hz].
     phase : float
-        True input yoke angle when the input pulse count starts [rad] (unknown to the reader).
+        True input yoke angle when the pulse count starts [rad].
     noise : float
-        Torque noise, standard deviation [N m].
+        Torque noise standard deviation [N m].
     lag : float
         Time constant of each torque output's first-order filter [s].
     offsets, drifts : tuple of float or None
-        Accuracy-class offsets and zero drifts over the record (input, output) [N m]; None
-        draws them uniformly within the transducer's limits (``seed``).
+        Offsets and zero drifts (input, output) [N m]; None: drawn within the transducer's limits.
     speed_channel : {"pulses", "rpm"}
-        Pulse counts (the rig's 60 per revolution) or a speed channel in rpm.
+        Pulse counts or a speed channel in rpm.
     seed : int
-        Seed of every drawn error and of the noise.
-
-    Raises
-    ------
-    TypeError, ValueError
-        A setting of the wrong type or out of range, naming it.
+        Seed of the drawn errors and the noise.
     """
 
     scene: str = "rig"
@@ -127,8 +111,7 @@ class RigSettings:
         self._check_size()
 
     def _check_types(self) -> None:
-        """``TypeError``/``ValueError`` for a setting of the wrong type: a number that is none, a
-        scene that is no name, a seed out of range, a pair that is not two finite numbers."""
+        """TypeError/ValueError for a setting of the wrong type."""
         for name in ("speed", "input_torque", "revolutions", "rate", "phase", "noise", "lag"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -145,8 +128,7 @@ class RigSettings:
                 raise ValueError(f"`{name}` must be two finite numbers [N m]{none}, got {value!r:.80}")
 
     def _check_size(self) -> None:
-        """``ValueError`` for a record without a whole revolution after settling, or one of more
-        than :data:`MAX_SAMPLES` samples."""
+        """ValueError for less than one whole revolution after settling or over MAX_SAMPLES samples."""
         if self.revolutions < 1.6:
             raise ValueError(f"`revolutions` must be >= 1.6 (one whole revolution after settling), "
                              f"got {self.revolutions!r}")
@@ -175,16 +157,14 @@ class Truth:
     ----------
     t : ndarray, shape (n,)
         Sample times [s].
-    angle_in, angle_out : ndarray, shape (n,)
-        Shaft angles [rad].
-    speed_in, speed_out : ndarray, shape (n,)
-        Shaft speeds [rad/s].
+    angle_in, angle_out, speed_in, speed_out : ndarray, shape (n,)
+        Shaft angles [rad] and speeds [rad/s].
     torque_in, torque_out : ndarray, shape (n,)
         Drive and brake torques [N m].
     efficiency : float
-        The reference engine's mean efficiency over whole revolutions [-].
+        Reference engine's mean efficiency over whole revolutions [-].
     brake_torque : float
-        The constant brake torque [N m].
+        Constant brake torque [N m].
     """
 
     t: np.ndarray
@@ -199,23 +179,10 @@ class Truth:
 
 
 def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tuple[np.ndarray, np.ndarray]:
-    """The motion of a motor with speed ``w0 (1 + e1 cos th + e2 cos 2th)``.
+    """Times [s] and input angles [rad] of a motor with speed ``w0 (1 + e1 cos th + e2 cos 2th)``.
 
-    The speed is a function of the angle, so the motion repeats every revolution.
-
-    Parameters
-    ----------
-    settings : RigSettings
-        Mean speed ``w0``, ripple ``(e1, e2)``, revolutions, phase.
-    points_per_revolution : int
-        Knots per revolution of the returned history.
-
-    Returns
-    -------
-    t : ndarray
-        Times [s], from 0.
-    angle : ndarray
-        Input angles [rad], from the settings' phase; half a revolution more than recorded.
+    Angles start at the settings' phase and run half a revolution past the record;
+    ``points_per_revolution`` knots per revolution.
     """
     e1, e2 = settings.ripple
     total = 2 * math.pi * (settings.revolutions + 0.5)
@@ -230,11 +197,9 @@ def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tupl
 
 
 def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
-    """The constant brake torque [N m] for a mean input torque of ``target`` [N m], and the
-    reference engine's run with it.
+    """Brake torque [N m] for a mean input torque ``target`` [N m], and the engine's run with it.
 
-    Efficiency barely depends on the load level (friction is proportional to it), so one
-    correction step is enough.
+    Efficiency barely depends on load level, so one correction step suffices.
     """
     brake = target
     for _ in range(2):
@@ -246,13 +211,8 @@ def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
 
 
 def true_signals(settings: RigSettings) -> Truth:
-    """Run the reference engine on the rig driven by the motor (:func:`motor_angle`) and loaded by
-    the brake torque that gives the settings' mean input torque; sample on the rig's grid.
-
-    Raises
-    ------
-    ValueError
-        The rig's model does not run (status not ``ok``).
+    """Reference engine on the rig driven by :func:`motor_angle` and braked for the settings' input torque,
+    sampled on the rig's grid.
     """
     t_knots, angle = motor_angle(settings)
     base = named_scene(settings.scene)
@@ -274,8 +234,9 @@ def true_signals(settings: RigSettings) -> Truth:
 
 def _errors(settings: RigSettings, transducer: Transducer,
             rng: np.random.Generator) -> tuple[tuple[float, float], tuple[float, float]]:
-    """The accuracy-class offsets and zero drifts (input, output) [N m]: the settings', else drawn
-    uniformly within the transducer's limits."""
+    """Offsets and zero drifts (input, output) [N m]: the settings', else drawn within the transducer's
+    limits.
+    """
     offsets = settings.offsets if settings.offsets is not None else \
         tuple(rng.uniform(-1, 1, 2) * transducer.accuracy_limit)
     drifts = settings.drifts if settings.drifts is not None else \
@@ -285,9 +246,9 @@ def _errors(settings: RigSettings, transducer: Transducer,
 
 def _torque_volts(torque: np.ndarray, offset: float, drift: np.ndarray, settings: RigSettings,
                   transducer: Transducer, rng: np.random.Generator) -> np.ndarray:
-    """One torque as the acquisition card reads it [V]: the transducer's output filter (first
-    order, causal, bilinear), offset, drift ramp [N m] and noise, scaled by the sensitivity,
-    clipped to the card's range and quantised to its step."""
+    """One torque as the card reads it [V]: first-order lag, offset, drift, noise, sensitivity,
+    range clip, quantisation.
+    """
     if settings.lag > 0:
         b, a = signal.bilinear([1.0], [settings.lag, 1.0], fs=settings.rate)
         torque = signal.lfilter(b, a, torque, zi=signal.lfilter_zi(b, a) * torque[0])[0]
@@ -304,22 +265,19 @@ def measure(truth: Truth, settings: RigSettings,
     Parameters
     ----------
     truth : Truth
-        The true signals (:func:`true_signals`).
     settings : RigSettings
-        Noise, lag, drawn errors (``seed``), speed channel.
     transducer : Transducer, optional
-        Sensitivity, accuracy, drift and acquisition (default: :class:`Transducer`).
+        Default: :class:`Transducer`.
 
     Returns
     -------
     table : dict of str to ndarray
-        Raw columns as a file holds them: ``Time`` [s] from 0, ``Torque In/Out`` [V], and
-        ``Pulses In/Out`` [counts] or ``Speed In/Out`` [rpm].
+        Raw columns: ``Time`` [s], ``Torque In/Out`` [V], ``Pulses In/Out`` [counts] or ``Speed In/Out``
+        [rpm].
     units : dict of str to str
         Each column's unit.
     used : dict
-        Every setting, the drawn errors, the encoder start, the true phase and efficiency, the
-        brake torque and the transducer.
+        Settings, drawn errors, encoder start, true phase and efficiency, brake torque, transducer.
     """
     transducer = transducer or Transducer()
     rng = np.random.default_rng(settings.seed)
@@ -353,29 +311,27 @@ def measure(truth: Truth, settings: RigSettings,
 
 
 def metadata(used: dict) -> dict:
-    """The label every synthetic file carries: ``synthetic``, ``generator``, ``settings`` (JSON of
-    ``used``, :func:`measure`'s) and ``description``."""
+    """Label of every synthetic file: ``synthetic``, ``generator``, ``settings`` (JSON of ``used``),
+    ``description``.
+    """
     return {"synthetic": "true", "generator": GENERATOR, "settings": json.dumps(used, sort_keys=True),
             "description": "SYNTHETIC rig data: reference-engine joint + transducer model, not a measurement"}
 
 
 def record(settings: RigSettings | None = None, transducer: Transducer | None = None,
            truth: Truth | None = None) -> tuple[RigRecord, dict]:
-    """A synthetic measurement as a record in memory (no file).
+    """A synthetic measurement as an in-memory record (SI units, provenance labelled synthetic).
 
     Parameters
     ----------
     settings : RigSettings, optional
-        Default: :class:`RigSettings`.
     transducer : Transducer, optional
-        Default: :class:`~rigdata.transducer.Transducer`.
     truth : Truth, optional
-        The true signals, when already computed for ``settings`` (:func:`true_signals`).
+        True signals already computed for ``settings``.
 
     Returns
     -------
     record : RigRecord
-        In SI units, provenance labelled synthetic.
     used : dict
         As :func:`measure` returns it.
     """
@@ -402,21 +358,16 @@ def record(settings: RigSettings | None = None, transducer: Transducer | None = 
 
 def write(path, fmt: str, settings: RigSettings | None = None, transducer: Transducer | None = None,
           truth: Truth | None = None) -> dict:
-    """Write a synthetic measurement file, labelled as such (:func:`metadata`).
+    """Write a synthetic measurement file labelled as such; return ``used`` (:func:`measure`).
 
     Parameters
     ----------
     path : str or path-like
         The file (replaced atomically).
     fmt : {"csv", "lvm", "tdms"}
-        ``csv``: comma and point; ``lvm``: LabVIEW with decimal comma; ``tdms``.
+        ``lvm`` is written with decimal comma.
     settings, transducer, truth : optional
         As for :func:`record`.
-
-    Returns
-    -------
-    dict
-        The settings used, with the drawn errors and the true efficiency (:func:`measure`).
     """
     if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
         raise TypeError(f"`path` must be a str or path naming the file to write, got {path!r:.80}")
