@@ -1,19 +1,8 @@
 """Measured efficiency and its standard uncertainty.
 
-Over whole input revolutions the measured mean efficiency is output work over input work,
-``eta = W_out / W_in`` with ``W = int T omega dt`` of the conditioned signals (the rig measures
-both powers; over whole revolutions of a periodic motion the kinetic energy returns to its
-value, so this is also 1 - lost work / input work). The instantaneous one is ``P_out / P_in``.
-
-The uncertainty follows the GUM's law of propagation (first order, uncorrelated inputs): each
-transducer's accuracy-class error (a constant offset within +-class x full scale, rectangular),
-the acquisition's resolution (half a step either way, rectangular: without noise to dither it,
-rounding is a constant error, at 0.2 N m on a 16-bit card 0.8 % of the torque), its zero drift
-(a linear ramp over the record, rectangular limit), its noise (white, its level estimated from
-the data) and the timing of the window's ends (one sample interval, rectangular). Monte Carlo
-(:mod:`rigdata.montecarlo`) propagates the same distributions through the filter and the
-integrals as a check on the linearisation; at 0.2 N m the accuracy class makes the relative
-uncertainty of each torque about 30 %, where first order starts to be rough.
+``eta = W_out / W_in`` with ``W = int T omega dt`` over whole input revolutions (kinetic energy
+returns, so also 1 - lost work / input work); instantaneous ``P_out / P_in``. Uncertainty by the GUM
+(first order, uncorrelated): accuracy class, resolution, zero drift (ramp), noise, window-end timing.
 """
 
 from __future__ import annotations
@@ -40,20 +29,7 @@ SQRT12 = math.sqrt(12.0)
 
 
 def noise_level(raw: np.ndarray, filtered: np.ndarray) -> float:
-    """Standard deviation of the noise: robust (MAD) spread of ``raw - filtered``.
-
-    Parameters
-    ----------
-    raw : ndarray, shape (n,)
-        The signal as measured.
-    filtered : ndarray, shape (n,)
-        The same signal low-passed.
-
-    Returns
-    -------
-    float
-        In the signals' unit.
-    """
+    """Noise standard deviation: robust (MAD) spread of ``raw - filtered``, in the signals' unit."""
     r = np.asarray(raw) - np.asarray(filtered)
     return float(1.4826 * np.median(np.abs(r - np.median(r))))
 
@@ -69,16 +45,16 @@ class Measured:
     u : float
         Combined standard uncertainty (GUM, first order) [-].
     budget : list of dict
-        Per input quantity: ``quantity``, ``standard_uncertainty`` with ``unit``,
-        ``sensitivity`` [-/unit] and ``contribution`` [-] (sensitivity x uncertainty).
+        Per input quantity: ``quantity``, ``standard_uncertainty``, ``unit``, ``sensitivity``,
+        ``contribution`` [-].
     monte_carlo : dict
-        ``samples``, ``seed``, ``std``, ``mean``, ``interval_95`` when Monte Carlo ran, else empty.
+        ``samples``, ``seed``, ``std``, ``mean``, ``interval_95``; empty without Monte Carlo.
     summary : dict
         JSON-ready numbers: works, means, noise levels, window.
     draws : dict of str to ndarray
-        The Monte Carlo draws (:func:`rigdata.montecarlo.monte_carlo`), else empty.
+        Monte Carlo draws, else empty.
     band : callable or None
-        Computes :attr:`instantaneous` when it is first read (only Figure 10 reads it).
+        Computes :attr:`instantaneous` on first read.
     """
 
     efficiency: float
@@ -91,33 +67,20 @@ class Measured:
 
     @functools.cached_property
     def instantaneous(self) -> dict:
-        """``t`` [s], ``efficiency`` (``P_out / P_in``) [-] and its standard uncertainty ``u`` [-],
-        each of shape (n,); empty without a :attr:`band`."""
+        """``t`` [s], ``efficiency`` ``P_out / P_in`` [-] and its ``u`` [-], shape (n,); empty without
+        :attr:`band`.
+        """
         return self.band() if self.band is not None else {}
 
     def as_dict(self) -> dict:
-        """The JSON summary: ``measured_efficiency`` and its ``_u``, the summary's numbers, the
-        budget, Monte Carlo."""
+        """JSON summary: ``measured_efficiency`` and ``_u``, summary numbers, budget, Monte Carlo."""
         return {"measured_efficiency": self.efficiency, "measured_efficiency_u": self.u,
                 **self.summary, "uncertainty_budget": self.budget, "monte_carlo": self.monte_carlo}
 
 
 def filtered_noise_factor(c: Conditioned, order: int, seed: int = 0) -> float:
-    """Standard deviation of unit white noise after the conditioning low-pass [-].
-
-    Parameters
-    ----------
-    c : Conditioned
-        Its grid and cut-off are read.
-    order : int
-        Butterworth order of one pass.
-    seed : int
-        Seed of the noise drawn.
-
-    Returns
-    -------
-    float
-        The standard deviation the low-pass leaves of unit white noise [-].
+    """Standard deviation [-] unit white noise keeps after ``c``'s low-pass (Butterworth ``order``, noise
+    ``seed``).
     """
     noise = np.random.default_rng(seed).standard_normal(c.t.size)
     return float(np.std(lowpass(noise, c.cutoff, 1.0 / c.dt, order)))
@@ -125,26 +88,10 @@ def filtered_noise_factor(c: Conditioned, order: int, seed: int = 0) -> float:
 
 def instantaneous_efficiency(c: Conditioned, transducers: tuple[Transducer, Transducer], sigma: dict,
                              ramp: np.ndarray) -> dict:
-    """The instantaneous efficiency ``P_out / P_in`` and its standard uncertainty at every sample.
+    """``t`` [s], ``efficiency`` ``P_out / P_in`` [-] and its ``u`` [-] at every sample of ``c``.
 
-    Each torque's variance: accuracy class and resolution (rectangular), the zero drift up to
-    that instant (rectangular ramp) and the noise as the low-pass leaves it; speeds are exact.
-
-    Parameters
-    ----------
-    c : Conditioned
-        The conditioned signals.
-    transducers : (Transducer, Transducer)
-        Input and output transducers.
-    sigma : dict
-        Noise level of each torque (``"in"``, ``"out"``) before the low-pass [N m].
-    ramp : ndarray, shape (n,)
-        The drift's ramp, 0 at the first sample and 1 at the last [-].
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        ``t`` [s], ``efficiency`` [-], ``u`` [-].
+    Torque variance: class and resolution, drift up to the instant (``ramp`` 0..1), noise ``sigma``
+    [N m] as the low-pass leaves it; speeds exact.
     """
     order = int(c.settings.get("filter_order", 4))
     factor = filtered_noise_factor(c, order)
@@ -164,7 +111,7 @@ def instantaneous_efficiency(c: Conditioned, transducers: tuple[Transducer, Tran
 
 def transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | None
                     ) -> tuple[Transducer, Transducer]:
-    """Input and output transducers from one, a pair or None (the default :class:`Transducer`)."""
+    """Input and output transducers from one, a pair or None (default :class:`Transducer`)."""
     transducers = transducers or Transducer()
     tin, tout = transducers if isinstance(transducers, tuple) else (transducers, transducers)
     if not (isinstance(tin, Transducer) and isinstance(tout, Transducer)):
@@ -174,28 +121,9 @@ def transducer_pair(transducers: tuple[Transducer, Transducer] | Transducer | No
 
 def uncertainty_budget(c: Conditioned, transducers: tuple[Transducer, Transducer], eta: float,
                        w_in: float, sigma: dict, ramp: np.ndarray) -> list[dict]:
-    """The GUM budget of the measured efficiency: one row per input quantity.
-
-    Parameters
-    ----------
-    c : Conditioned
-        The conditioned signals and window.
-    transducers : (Transducer, Transducer)
-        Input and output transducers.
-    eta : float
-        The measured efficiency [-].
-    w_in : float
-        Input work over the window [J].
-    sigma : dict
-        Noise level of each torque (``"in"``, ``"out"``) [N m].
-    ramp : ndarray, shape (n,)
-        The drift's ramp, 0 at the first sample and 1 at the last [-].
-
-    Returns
-    -------
-    list of dict
-        ``quantity``, ``standard_uncertainty`` in ``unit``, ``sensitivity`` [-/unit] and
-        ``contribution`` [-] (|sensitivity| x uncertainty).
+    """GUM budget rows of efficiency ``eta`` [-] from input work ``w_in`` [J], noise ``sigma`` [N m] and
+    drift ``ramp``: ``quantity``, ``standard_uncertainty``, ``unit``, ``sensitivity``, ``contribution``
+    [-].
     """
     tin, tout = transducers
     t_a, t_b = c.window
@@ -230,9 +158,9 @@ def uncertainty_budget(c: Conditioned, transducers: tuple[Transducer, Transducer
 
 def _summary(c: Conditioned, transducers: tuple[Transducer, Transducer], w_in: float, w_out: float,
              sigma: dict) -> dict:
-    """The JSON-ready numbers of a measurement: window, works [J], mean speeds [rad/s] and torques
-    [N m], noise levels [N m], each torque's relative uncertainty from class and drift [-], the
-    transducers."""
+    """JSON-ready numbers: window, works [J], mean speeds [rad/s] and torques [N m], noise [N m], relative
+    uncertainties, transducers.
+    """
     tin, tout = transducers
     t_a, t_b = c.window
     weights = window_weights(c.t, t_a, t_b)
@@ -255,28 +183,9 @@ def _summary(c: Conditioned, transducers: tuple[Transducer, Transducer], w_in: f
 
 def measured_efficiency(c: Conditioned, transducers: tuple[Transducer, Transducer] | Transducer | None = None,
                         monte_carlo: int = 0, seed: int = 0) -> Measured:
-    """Measured mean efficiency over ``c``'s whole-revolution window, with its uncertainty.
+    """Measured mean efficiency over ``c``'s window with its uncertainty (``monte_carlo`` draws, 0: GUM only).
 
-    Parameters
-    ----------
-    c : Conditioned
-        The conditioned signals and window.
-    transducers : Transducer or (input, output) pair, optional
-        Default: :class:`~rigdata.transducer.Transducer` for both.
-    monte_carlo : int
-        Monte Carlo draws (0: GUM only).
-    seed : int
-        Seed of the draws.
-
-    Returns
-    -------
-    Measured
-        The instantaneous efficiency and its band are computed when first read.
-
-    Raises
-    ------
-    RigDataError
-        Input work over the window not positive.
+    RigDataError when the input work over the window is not positive.
     """
     montecarlo.check_draws(monte_carlo, seed)
     pair = transducer_pair(transducers)

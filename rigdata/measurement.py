@@ -1,5 +1,4 @@
-"""The measured efficiency of one rig record or file (``cardan rig measure``): read, conditioned
-over whole input revolutions, measured with the GUM budget and Monte Carlo."""
+"""Measured efficiency of one rig record or file (``cardan rig measure``)."""
 
 from __future__ import annotations
 
@@ -24,9 +23,7 @@ Source = RigRecord | str | os.PathLike
 
 
 def as_record(source: Source, **read_options: Any) -> RigRecord:
-    """``source`` itself when it is a record, else the record :func:`rigdata.readers.read` reads
-    from it with ``read_options`` (``format``, ``mapping``, ``units``, ``sensitivity``,
-    ``pulses_per_rev``)."""
+    """``source`` if a record, else :func:`rigdata.readers.read` of it with ``read_options``."""
     if isinstance(source, RigRecord):
         if read_options:
             raise ValueError(f"read options {sorted(read_options)} apply to a file, not to a RigRecord")
@@ -41,9 +38,8 @@ class Measurement:
     ----------
     record : RigRecord
     conditioned : Conditioned
-        The signals over the whole-revolution window and the input yoke phase.
+        Signals over the whole-revolution window and the input yoke phase.
     measured : Measured
-        Efficiency, its standard uncertainty, budget and Monte Carlo.
     """
 
     record: RigRecord
@@ -61,8 +57,9 @@ class Measurement:
         return self.measured.u
 
     def as_dict(self) -> dict[str, Any]:
-        """``cardan rig measure --json``: file, the measured efficiency and its uncertainty
-        (:meth:`Measured.as_dict`), input yoke phase [deg], whether the data are synthetic."""
+        """``cardan rig measure --json``: file, efficiency and uncertainty, input yoke phase [deg], synthetic
+        flag.
+        """
         return {"file": str(self.record.file), **self.measured.as_dict(),
                 "phase_deg": math.degrees(self.conditioned.phase),
                 "synthetic": bool(self.record.provenance.get("synthetic"))}
@@ -76,27 +73,21 @@ def measure(source: Source, shaft_angle_deg: float = 15.0, *, conditioning: Cond
     Parameters
     ----------
     source : RigRecord, str or path-like
-        A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
+        A record or a rig file (read with ``read_options``, :func:`rigdata.readers.read`).
     shaft_angle_deg : float
-        The joint's shaft angle [deg] (for the yoke phase estimate); 15 is the paper's rig.
+        Shaft angle [deg], for the yoke phase estimate.
     conditioning : Conditioning, optional
-        Filter, window and derivative settings (default: :class:`Conditioning`).
     transducers : Transducer or (input, output) pair, optional
-        Accuracy, drift and acquisition of the transducers (default: the paper's, with the
-        assumptions of :data:`rigdata.transducer.PROVENANCE`).
+        Default: the paper's (assumptions: :data:`rigdata.transducer.PROVENANCE`).
     monte_carlo : int
         Monte Carlo draws (0: GUM only).
     seed : int
         Seed of the draws.
 
-    Returns
-    -------
-    Measurement
-
     Raises
     ------
     RigDataError
-        A file or record that cannot be measured (fewer than one whole revolution, ...).
+        A file or record that cannot be measured.
     """
     if isinstance(shaft_angle_deg, bool) or not isinstance(shaft_angle_deg, (int, float, np.number)):
         raise TypeError(f"`shaft_angle_deg` must be a number [deg], got {shaft_angle_deg!r:.80}")

@@ -1,6 +1,6 @@
-"""Monte Carlo propagation of the measured efficiency's uncertainty (GUM Supplement 1): the same
-input distributions as the first-order budget of :mod:`rigdata.efficiency`, drawn and pushed
-through the filter and the window integrals, as a check on the linearisation."""
+"""Monte Carlo (GUM Supplement 1) of the measured efficiency: the first-order budget's distributions
+pushed through the filter and window integrals, a check on the linearisation.
+"""
 
 from __future__ import annotations
 
@@ -19,16 +19,7 @@ CHUNK = 200
 
 
 def check_draws(monte_carlo: object, seed: object) -> None:
-    """``ValueError`` naming the argument unless ``monte_carlo`` is an integer in [0,
-    :data:`MAX_DRAWS`] and ``seed`` one in [0, 2**63 - 1].
-
-    Parameters
-    ----------
-    monte_carlo : object
-        Number of draws, as the caller gave it.
-    seed : object
-        Seed of the draws, as the caller gave it.
-    """
+    """ValueError unless ``monte_carlo`` is an integer in [0, MAX_DRAWS] and ``seed`` in [0, 2**63 - 1]."""
     for name, value, top in (("monte_carlo", monte_carlo, MAX_DRAWS), ("seed", seed, 2**63 - 1)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value <= top:
             raise ValueError(f"`{name}` must be an integer in [0, {top}], got {value!r:.40}")
@@ -54,33 +45,11 @@ def _drawn_torques(c: Conditioned, transducers: tuple[Transducer, Transducer], s
 
 def monte_carlo(c: Conditioned, transducers: tuple[Transducer, Transducer], sigma: dict,
                 samples: int, seed: int) -> tuple[dict, dict]:
-    """The measured efficiency drawn ``samples`` times through the filter and the integrals.
+    """The measured efficiency drawn ``samples`` times through the filter and integrals.
 
-    Each draw takes, per transducer, a constant offset (accuracy class and resolution,
-    rectangular), a zero-drift ramp (rectangular limit) and white noise at the estimated level,
-    low-passed as the conditioning does; and a timing shift of each window end (one sample,
-    rectangular).
-
-    Parameters
-    ----------
-    c : Conditioned
-        The conditioned signals and window.
-    transducers : (Transducer, Transducer)
-        Input and output transducers.
-    sigma : dict
-        Noise level of each torque (``"in"``, ``"out"``) [N m].
-    samples : int
-        Number of draws, in [1, :data:`MAX_DRAWS`].
-    seed : int
-        Seed of :func:`numpy.random.default_rng`.
-
-    Returns
-    -------
-    summary : dict
-        ``samples``, ``seed``, ``mean``, ``std`` and ``interval_95`` of the efficiency [-].
-    draws : dict of str to ndarray, shape (samples,)
-        ``efficiency`` [-] and ``offset_out`` [N m] (the output torque offsets drawn, for
-        quantities correlated with them).
+    Per draw and transducer: constant offset (class, resolution), drift ramp, white noise ``sigma`` [N m]
+    low-passed; each window end shifted up to one sample. Returns ``summary`` (``samples``, ``seed``,
+    ``mean``, ``std``, ``interval_95`` [-]) and ``draws`` (``efficiency`` [-], ``offset_out`` [N m]).
     """
     rng = np.random.default_rng(seed)
     ramp = (c.t - c.t[0]) / (c.t[-1] - c.t[0])

@@ -1,10 +1,6 @@
-"""Measured against computed efficiency for one record (``cardan rig validate`` without the
-report): the measurement (:mod:`rigdata.measurement`), then each engine driven by it
-(:func:`rigdata.model.measured_scene`) and the comparison: the difference, its standard
-uncertainty (the output transducer's error enters both sides, so that part is propagated as
-correlated) and whether it is significant at k = 2 (and by the Monte Carlo interval, which at
-0.2 N m is far from symmetric). :func:`rigdata.report.write_report` puts a :class:`Validation`
-in a folder.
+"""Measured against computed efficiency for one record: the measurement, each engine driven by it,
+and the difference with its standard uncertainty (the output transducer's error enters both sides,
+propagated as correlated) and significance at k = 2 and by Monte Carlo.
 """
 
 from __future__ import annotations
@@ -44,9 +40,7 @@ CONSTANT_OUTPUT_ERRORS = ("accuracy class, output torque", "resolution (acquisit
 
 
 def as_scene(scene: Scene | str | os.PathLike) -> Scene:
-    """``scene`` itself when it is a scene; a scene TOML file (the user's own joint, a path or a
-    name ending in ``.toml``, :func:`reference.scene.files.load_scene`); else a named scene
-    (:func:`reference.paper.scenes.named_scene`). Raises ``SceneError`` naming what is wrong."""
+    """``scene`` itself, a scene TOML file, else a named scene; SceneError naming what is wrong."""
     if isinstance(scene, Scene):
         return scene
     if not isinstance(scene, (str, os.PathLike)):
@@ -58,29 +52,13 @@ def as_scene(scene: Scene | str | os.PathLike) -> Scene:
 
 
 def compare(measured: Measured, computed: Mapping[str, Any], sensitivities: Mapping[str, float]) -> dict:
-    """Difference measured - computed, its standard uncertainty and significance (k = 2).
+    """Difference measured - computed [-], its standard uncertainty and significance (k = 2).
 
-    The output transducer's constant errors (class, resolution) move the measured efficiency by
-    ``c_meas`` per N m and the computed one (through the load) by ``sensitivities["load"]``: the
-    difference sees ``c_meas - c_model`` (the drift, a ramp, is left uncorrelated: its share is
-    below 1e-3 of the variance). The yoke phase's half-turn ambiguity is a rectangular term of half
-    width |difference| / 2.
-
-    Parameters
-    ----------
-    measured : Measured
-        The measured efficiency, its budget and (optionally) its Monte Carlo draws.
-    computed : mapping
-        One engine's :func:`rigdata.model.computed_efficiency` (status ``ok``).
-    sensitivities : mapping of str to float
-        :func:`rigdata.model.model_sensitivities`.
-
-    Returns
-    -------
-    dict
-        ``engine``, ``computed_efficiency`` [-], ``difference`` [-], ``difference_u`` [-],
-        ``expanded_u`` [-] (k = 2), ``significant_k2``; with Monte Carlo draws also
-        ``difference_interval_95_mc`` [-] and ``significant_mc``.
+    The output transducer's constant errors move measured and computed (through the load) efficiency,
+    so the difference sees ``c_meas - c_model``; the drift is left uncorrelated (below 1e-3 of the
+    variance). The yoke phase's half-turn ambiguity is rectangular of half width |difference| / 2.
+    Keys: ``engine``, ``computed_efficiency``, ``difference``, ``difference_u``, ``expanded_u``,
+    ``significant_k2``; with draws ``difference_interval_95_mc``, ``significant_mc``.
     """
     eta_model = computed["mean_efficiency"]
     d = measured.efficiency - eta_model
@@ -106,20 +84,8 @@ def compare(measured: Measured, computed: Mapping[str, Any], sensitivities: Mapp
 
 
 def accuracy_needed(measured: Measured, target_u: float = 0.01) -> float:
-    """Accuracy class the torque transducers would need for a standard uncertainty of
-    ``target_u`` from the class alone (it scales linearly).
-
-    Parameters
-    ----------
-    measured : Measured
-        The measurement (its budget and transducers).
-    target_u : float
-        Standard uncertainty of the efficiency aimed at [-].
-
-    Returns
-    -------
-    float
-        Accuracy class [-, fraction of full scale]; NaN when the class contributes nothing.
+    """Accuracy class [-] the torque transducers need for efficiency uncertainty ``target_u`` [-] from the
+    class alone (NaN if it contributes nothing).
     """
     acc = [b["contribution"] for b in measured.budget if b["quantity"].startswith("accuracy class")]
     total = math.sqrt(sum(a * a for a in acc))
@@ -137,15 +103,14 @@ class Validation:
     conditioned : Conditioned
     measured : Measured
     scene : Scene
-        The scene the engines ran: the joint driven and loaded by the measurement.
+        The joint driven and loaded by the measurement.
     computed : dict of str to dict
-        Per engine, :func:`rigdata.model.computed_efficiency` of its run.
+        Per engine, :func:`rigdata.model.computed_efficiency`.
     comparisons : dict of str to dict
         Per engine that ran ``ok``, :func:`compare`.
     sensitivities : dict
-        :func:`rigdata.model.model_sensitivities` (empty when no engine ran ``ok``).
+        :func:`rigdata.model.model_sensitivities`; empty when no engine ran ``ok``.
     transducers : tuple of Transducer
-        Input and output transducers.
     """
 
     record: RigRecord
@@ -173,8 +138,9 @@ class Validation:
         return all(comp["status"] == Status.OK for comp in self.computed.values())
 
     def as_dict(self) -> dict[str, Any]:
-        """The JSON summary (``validation.json``): file, provenance, conditioning, the measured
-        efficiency with its budget, the computed ones, comparisons, sensitivities, assumptions."""
+        """JSON summary (``validation.json``): file, provenance, conditioning, measured and computed
+        efficiencies, comparisons, sensitivities, assumptions.
+        """
         rec = self.record
         cond = self.conditioned
         meas = self.measured
@@ -198,7 +164,7 @@ class Validation:
 
 
 def _ok_efficiency(computed: Mapping[str, Any] | None) -> float | None:
-    """The mean efficiency of a computed run that ended ``ok`` (None otherwise)."""
+    """Mean efficiency of a computed run that ended ``ok``, else None."""
     if computed is None or computed["status"] != Status.OK:
         return None
     return float(computed["mean_efficiency"])
@@ -209,35 +175,27 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
              transducers: Transducer | tuple[Transducer, Transducer] | None = None,
              monte_carlo: int = 2000, seed: int = 0, progress: Callable[[str], None] | None = None,
              **read_options: Any) -> Validation:
-    """Measured against computed efficiency for one record (see the module docstring).
+    """Measured against computed efficiency for one record; nothing is written (see :func:`write_report`).
 
     Parameters
     ----------
     source : RigRecord, str or path-like
-        A record, or a rig file (read with ``read_options``, see :func:`rigdata.readers.read`).
+        A record or a rig file (read with ``read_options``, :func:`rigdata.readers.read`).
     scene : Scene, str or path-like
-        Joint, shaft angle, friction and numerics of the model (its drive and load are replaced):
-        a scene, a scene TOML file or a name for :func:`reference.paper.scenes.named_scene`
-        (:func:`as_scene`).
+        Joint, shaft angle, friction and numerics (drive and load replaced): scene, TOML file or name.
     engines : tuple of str
-        Engines to drive (keys of :data:`cardan_exudyn.engines.ENGINES` that take angle drives
-        and load histories: :data:`MODEL_ENGINES`).
+        Engines taking angle drives and load histories (:data:`MODEL_ENGINES`).
     conditioning, transducers, monte_carlo, seed
         As for :func:`rigdata.measurement.measure`.
     progress : callable(str), optional
         Called with a line before each long step.
-
-    Returns
-    -------
-    Validation
-        Nothing is written; :func:`rigdata.report.write_report` writes the report folder.
 
     Raises
     ------
     RigDataError
         A file or record that cannot be measured.
     EngineUnavailable
-        An engine that is unknown or not installed.
+        An unknown or not installed engine.
     """
     say = progress or (lambda line: None)
     if isinstance(engines, (str, bytes)):
@@ -258,8 +216,9 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
 
 
 def _check_engines(engines: tuple[str, ...]) -> None:
-    """:class:`EngineUnavailable` for an engine that is unknown, not installed, or cannot take a
-    measured angle drive and load history."""
+    """:class:`EngineUnavailable` for an engine unknown, not installed, or unable to take a measured drive and
+    load.
+    """
     for engine in engines:
         if engine not in MODEL_ENGINES:
             get_engine(engine)  # unknown or not installed: its own message
@@ -269,9 +228,9 @@ def _check_engines(engines: tuple[str, ...]) -> None:
 
 def _run_models(cond: Conditioned, base: Scene, model: Scene, engines: tuple[str, ...], measured: Measured,
                 pair: tuple[Transducer, Transducer], say: Callable[[str], None]) -> tuple[dict, dict, dict]:
-    """Each engine on the measured scene ``model``: per engine its computed efficiency and, for
-    those that ran ``ok``, the comparison; and the model sensitivities (run once, with the first
-    engine that ran ``ok``; empty when none did)."""
+    """Each engine on scene ``model``: computed efficiency, comparison if ``ok``, and sensitivities (first
+    ``ok`` engine).
+    """
     computed: dict[str, dict[str, Any]] = {}
     comparisons: dict[str, dict[str, Any]] = {}
     sens = None
