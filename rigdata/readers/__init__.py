@@ -1,28 +1,8 @@
-"""Readers of measured rig files: delimited text, LabVIEW Measurement (.lvm), NI TDMS.
+"""Readers of rig files (delimited text, LabVIEW .lvm, NI TDMS): :func:`read_table` (what the file holds)
+and :func:`read` (a validated RigRecord in SI units); every file problem is one RigDataError.
 
-:func:`read_table` returns what a file holds (:class:`RawTable`: columns as floats, units and
-header as written); :func:`read` goes on to the record: it picks the time axis and the four
-transducer channels (explicit ``mapping`` or recognition by name, :func:`match_channels`),
-converts them to SI with :mod:`rigdata.conversion` and returns a validated
-:class:`~rigdata.record.RigRecord` whose ``provenance`` says where every number came from.
-
-Every problem with a file is one :class:`~rigdata.record.RigDataError` naming the file, the
-channel or column, and the problem; errors of pandas, lvm_read and npTDMS are wrapped the same
-way. The record's own validation (time increasing and uniform, no NaN) is not repeated here.
-
-Modules: ``dispatch`` (:func:`read_table`, :func:`read`), ``detect`` (bytes, format, text),
-``delimited``, ``lvm``, ``tdms`` (one per format), ``table`` (the :class:`RawTable` they return),
-``channels`` (recognition, mapping, units of columns), ``assemble`` (time axis, SI conversion,
-provenance).
-
-Assumptions
------------
-* A time column without a unit (header ``time`` or ``t``) is in seconds; the record's
-  provenance lists this under ``assumptions``. LVM X values and TDMS waveform timing are seconds
-  by the formats' definitions.
-* Pulse counts are a cumulative counter (:func:`rigdata.conversion.unwrap_counter`); a speed given as
-  a pulse frequency must say ``pulses/s``, ``Hz`` is refused as ambiguous.
-* Raw conversions default to the paper's Magtrol TMB 210: 0.1 V/(N m), 60 pulses per revolution.
+Assumed: a time column without unit is seconds; pulse counts are cumulative; a pulse frequency
+must say ``pulses/s`` (``Hz`` is ambiguous); raw conversions default to Magtrol TMB 210.
 """
 
 from __future__ import annotations

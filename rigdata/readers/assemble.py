@@ -1,8 +1,6 @@
-"""From the table to the record: the time axis, the channels in SI units, the provenance.
+"""From the table to the record: time axis, channels in SI units, provenance.
 
-Shared by every format. Time comes from the time column, else the channels' waveform timing
-(LVM ``X0``/``Delta_X``, TDMS ``wf_start_offset``/``wf_increment``), else a sample rate or
-interval in the file's header.
+Time: the time column, else the channels' waveform timing, else a header rate or interval.
 """
 
 from __future__ import annotations
@@ -110,27 +108,9 @@ def _time_from_column(raw: RawTable, chosen: Mapping[str, str], units: Mapping[s
 
 def time_axis(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str],
               n: int) -> tuple[np.ndarray, dict[str, Any], list[str]]:
-    """Sample times [s]: the time column, else the channels' sampling, else the header's rate.
+    """Sample times [s] of ``n`` samples, where they came from, and the assumptions made.
 
-    Parameters
-    ----------
-    raw : RawTable
-        The file's table.
-    chosen : mapping of str to str
-        Channel (and ``"time"``) -> column.
-    units : mapping of str to str
-        Units given by channel or column name, over the file's.
-    n : int
-        Samples of every chosen column.
-
-    Returns
-    -------
-    t : ndarray
-        Sample times [s].
-    info : dict
-        Where they came from (the record's ``provenance["time"]``).
-    assumptions : list of str
-        What was assumed (a time column without a unit is in seconds).
+    ``chosen``: channel (and ``"time"``) -> column; ``units``: by channel or column name.
     """
     if chosen.get("time") is not None:
         return _time_from_column(raw, chosen, units, n)
@@ -162,29 +142,8 @@ def _synthetic(meta: Mapping[str, str]) -> dict[str, str] | None:
 
 def to_record(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str], sensitivity: float,
               pulses_per_rev: int) -> RigRecord:
-    """The record of ``raw``'s chosen columns in SI units, with its provenance.
-
-    Parameters
-    ----------
-    raw : RawTable
-    chosen : mapping of str to str
-        Channel (and ``"time"``) -> column, from :func:`rigdata.readers.match_channels`.
-    units : mapping of str to str
-        Unit by channel or column name, over the file's own.
-    sensitivity : float
-        Torque transducer output [V/(N m)] for channels in volts.
-    pulses_per_rev : int
-        Pulses per revolution for channels in pulse counts or pulses/s.
-
-    Returns
-    -------
-    RigRecord
-        In SI units, its provenance saying where every number came from.
-
-    Raises
-    ------
-    RigDataError
-        A channel without a unit, a unit of the wrong kind, a bad time axis, absurd values.
+    """Record of ``raw``'s ``chosen`` columns in SI units with provenance; ``sensitivity`` [V/(N m)],
+    ``pulses_per_rev`` [-]. RigDataError for a missing or wrong unit, bad time axis, absurd values.
     """
     n = _lengths(raw, chosen)
     time, time_info, assumptions = time_axis(raw, chosen, units, n)

@@ -1,9 +1,5 @@
-"""Which column is which channel: recognition by name, the explicit mapping (``--map``) and the
-unit of each column and channel.
-
-Recognition reads a header's words (case, separators and camelCase do not matter): a time word,
-or one side word and one kind word; when the name has a side and no kind word, or two kinds,
-the unit decides. A mapping names columns explicitly and wins over recognition.
+"""Which column is which channel: recognition by header words, the explicit mapping (``--map``, wins)
+and each column's and channel's unit.
 """
 
 from __future__ import annotations
@@ -75,7 +71,7 @@ def is_time(words: list[str]) -> bool:
 def recognise(header: str, unit: str | None = None) -> str | None:
     """The record channel a column header names, ``"time"``, or None.
 
-    Recognised (case, separators and camelCase do not matter; a unit annotation is ignored):
+    Case, separators, camelCase and a unit annotation do not matter:
 
     * time: ``time``, ``t``, ``Time [s]``, ``time_ms``, ``X_Value``, ``Zeit``, ``elapsed``;
     * kind: torque (``torque``, ``trq``, ``tq``, ``T``, ``M``, ``moment``), speed (``speed``,
@@ -84,21 +80,8 @@ def recognise(header: str, unit: str | None = None) -> str | None:
     * side: input (``in``, ``input``, ``1``, ``drive``, ``motor``), output (``out``,
       ``output``, ``2``, ``brake``, ``load``, ``driven``).
 
-    A header needs exactly one side and one kind (``torque_in``, ``Torque In``, ``T_in``,
-    ``Trq1``, ``Brake torque``, ``omega_out``, ``n2``, ``Encoder 1``). When the name has a side
-    and no kind word, or two kinds, the unit decides (``Drive [N m]``, ``Encoder speed [rpm]``).
-
-    Parameters
-    ----------
-    header : str
-        Column header as in the file.
-    unit : str, optional
-        Unit of the column when it is not in the header.
-
-    Returns
-    -------
-    str or None
-        A key of :data:`rigdata.record.CHANNELS`, ``"time"``, or None.
+    Exactly one side and one kind (``Trq1``, ``Brake torque``, ``n2``); with a side and no or two
+    kinds, ``unit`` (or the header's) decides (``Drive [N m]``).
     """
     bare, annotated = split_header(header)
     words_list = tokens(bare)
@@ -125,20 +108,8 @@ def time_column(columns: Mapping[str, np.ndarray]) -> str | None:
 
 
 def column_unit(header: str, stated: str | None) -> str | None:
-    """Unit of a column: the header annotation, else a unit stated elsewhere (units row, LVM
-    label, TDMS property), else a unit suffix of a time column name (``time_s``).
-
-    Parameters
-    ----------
-    header : str
-        The column's header as written.
-    stated : str or None
-        A unit the file states elsewhere.
-
-    Returns
-    -------
-    str or None
-        The unit as written; None when the file states none.
+    """Unit of a column as written: header annotation, else ``stated``, else a time name's suffix
+    (``time_s``); None if none.
     """
     bare, unit = split_header(header)
     if unit is None:
@@ -152,28 +123,9 @@ def column_unit(header: str, stated: str | None) -> str | None:
 
 
 def channel_unit(raw: RawTable, column: str, channel: str, units: Mapping[str, str]) -> Unit:
-    """Unit of ``channel`` read from ``column``: given by channel or column name in ``units``,
-    else as the file states it.
+    """Unit of ``channel`` read from ``column``: from ``units`` by channel or column name, else the file's.
 
-    Parameters
-    ----------
-    raw : RawTable
-        The file's table (its stated units).
-    column : str
-        The column the channel is read from.
-    channel : str
-        The record channel (``"time"``, ``"torque_in"``, ...): the kind of unit it takes.
-    units : mapping of str to str
-        Units given by channel or column name.
-
-    Returns
-    -------
-    Unit
-
-    Raises
-    ------
-    RigDataError
-        A column without a unit, or a unit unknown, ambiguous or of another quantity.
+    RigDataError for a missing unit or one unknown, ambiguous or of another quantity.
     """
     kind = "time" if channel == "time" else channel.split("_")[0]
     given = units.get(channel, units.get(column))
@@ -236,11 +188,9 @@ def match_channels(raw: RawTable, mapping: Mapping[str, str | None] | None = Non
     Parameters
     ----------
     raw : RawTable
-        From :func:`rigdata.readers.read_table`.
     mapping : mapping of str to str or None, optional
-        Record channel (key of :data:`rigdata.record.CHANNELS`, or ``"time"``) -> column name
-        (exact, or ignoring case and blanks, or without its unit annotation). None leaves a
-        channel out that recognition would otherwise add.
+        Channel (key of :data:`rigdata.record.CHANNELS` or ``"time"``) -> column (exact, ignoring case
+        and blanks, or without unit); None leaves a channel out.
 
     Returns
     -------
@@ -250,8 +200,7 @@ def match_channels(raw: RawTable, mapping: Mapping[str, str | None] | None = Non
     Raises
     ------
     RigDataError
-        Unknown channel in ``mapping``, a mapped column missing, two columns recognised as one
-        channel, a required channel with no column.
+        Unknown channel, missing mapped column, two columns for one channel, a required channel missing.
     """
     path = Path(raw.file)
     mapping = dict(mapping or {})

@@ -1,9 +1,5 @@
-"""Delimited text of any separator and decimal mark: tab, ``;``, ``,``, ``|`` or blanks; decimal
-point or comma; a preamble of ``key: value`` lines; units in the headers or in a units row.
-
-The layout is found, not configured: the separator giving the widest block of numeric rows, a
-decimal comma when the numbers show one, the header line just above the data (a units row in
-between is recognised). The data rows are then parsed by pandas.
+"""Delimited text of any separator (tab, ``;``, ``,``, ``|``, blanks) and decimal mark, with a
+``key: value`` preamble and units in headers or a units row. The layout is found, not configured.
 """
 
 from __future__ import annotations
@@ -30,7 +26,7 @@ SEPARATORS = ("\t", ";", ",", "|", None)
 
 @dataclass(frozen=True)
 class Layout:
-    """Where a delimited file's parts are (line indices are 0-based)."""
+    """Where a delimited file's parts are (0-based line indices)."""
 
     sep: str | None          # None: runs of blanks
     decimal: str
@@ -41,19 +37,7 @@ class Layout:
 
 
 def split(line: str, sep: str | None) -> list[str]:
-    """Fields of ``line``, quotes and blanks around them removed.
-
-    Parameters
-    ----------
-    line : str
-        One line of the file.
-    sep : str or None
-        The separator; None splits at runs of blanks.
-
-    Returns
-    -------
-    list of str
-    """
+    """Fields of ``line`` split at ``sep`` (None: runs of blanks), quotes and blanks removed."""
     return line.split() if sep is None else [f.strip().strip('"').strip() for f in line.split(sep)]
 
 
@@ -63,8 +47,7 @@ def separator_name(sep: str | None) -> str:
 
 
 def _numeric_row(fields: list[str]) -> bool:
-    """Two or more fields, most of them numbers, none holding a tab or semicolon (which would
-    mean the line was split at the wrong separator)."""
+    """Two or more fields, mostly numbers, none holding a tab or semicolon (a wrong separator)."""
     return (len(fields) >= 2 and 2 * sum(map(is_number, fields)) > len(fields)
             and not any("\t" in f or ";" in f for f in fields))
 
@@ -91,21 +74,7 @@ def _units_row(fields: list[str]) -> bool:
 
 
 def header_fields(line: str, sep: str | None, width: int) -> list[str]:
-    """Fields of a header line; blank-separated names may hold single blanks.
-
-    Parameters
-    ----------
-    line : str
-        The header line.
-    sep : str or None
-        The separator (None: blanks).
-    width : int
-        Fields of the data rows.
-
-    Returns
-    -------
-    list of str
-    """
+    """Fields of header ``line`` for ``width`` data fields; blank-separated names may hold single blanks."""
     fields = split(line, sep)
     if sep is None and len(fields) != width:
         # blank-separated files may have names with single blanks, columns apart by two or more
@@ -114,8 +83,7 @@ def header_fields(line: str, sep: str | None, width: int) -> list[str]:
 
 
 def _separator(lines: list[str], path: Path) -> tuple[str | None, int, int]:
-    """The separator with the widest block of numeric rows (earliest on a tie), where the block
-    starts and its width."""
+    """Separator with the widest numeric block (earliest on a tie), its start and width."""
     best = None
     for order, sep in enumerate(SEPARATORS):
         found = _data_start(lines, sep)
@@ -128,24 +96,7 @@ def _separator(lines: list[str], path: Path) -> tuple[str | None, int, int]:
 
 
 def layout(lines: list[str], path: Path) -> Layout:
-    """Separator, decimal mark, header, units row and first data row of a delimited file.
-
-    Parameters
-    ----------
-    lines : list of str
-        The file's lines.
-    path : Path
-        Named in errors.
-
-    Returns
-    -------
-    Layout
-
-    Raises
-    ------
-    RigDataError
-        No separator that splits the data rows alike, or no header line above them.
-    """
+    """Separator, decimal mark, header, units row and first data row; RigDataError when none fits."""
     sep, first, width = _separator(lines, path)
     sample = [f for line in lines[first:first + 50] for f in split(line, sep)]
     decimal = "," if sep != "," and any(COMMA_NUMBER.match(f) for f in sample) else "."
@@ -169,19 +120,8 @@ def layout(lines: list[str], path: Path) -> Layout:
 
 
 def preamble(lines: list[str], sep: str | None) -> dict[str, str]:
-    """Key/value pairs of the lines above the header: ``key: value``, ``key = value`` (with or
-    without a leading ``#``), or two fields apart by the separator. Free text is skipped.
-
-    Parameters
-    ----------
-    lines : list of str
-        The lines above the header.
-    sep : str or None
-        The file's separator (None: blanks).
-
-    Returns
-    -------
-    dict of str to str
+    """Key/value pairs above the header: ``key: value``, ``key = value`` (``#`` optional), or two fields
+    apart by ``sep``; free text skipped.
     """
     meta = {}
     for line in lines:
@@ -222,8 +162,7 @@ def _check_widths(lines: list[str], rows: list[int], lay: Layout, path: Path, en
 
 
 def _headers(lines: list[str], lay: Layout, path: Path) -> tuple[list[str], list[str], list[str]]:
-    """Header fields as written, column names (a blank header named by its position) and the
-    units row's fields (blank without one)."""
+    """Header fields as written, column names (blank ones named by position), units row fields."""
     headers = header_fields(lines[lay.header], lay.sep, lay.width)
     names = [h or f"column {i + 1}" for i, h in enumerate(headers)]
     dup = sorted({n for n in names if names.count(n) > 1})
@@ -235,7 +174,7 @@ def _headers(lines: list[str], lay: Layout, path: Path) -> tuple[list[str], list
 
 
 def _pandas() -> Any:
-    """pandas, imported on first use: it costs about 0.5 s that LVM and TDMS files never need."""
+    """pandas, imported on first use (about 0.5 s that LVM and TDMS files never need)."""
     import pandas
 
     return pandas
@@ -272,26 +211,7 @@ def _notes(lay: Layout) -> tuple[str, ...]:
 
 
 def read_delimited(path: Path, text: str, sha: str) -> RawTable:
-    """The table of a delimited text file.
-
-    Parameters
-    ----------
-    path : Path
-        The file (for messages and the table's ``file``).
-    text : str
-        Its decoded text.
-    sha : str
-        SHA-256 of its bytes.
-
-    Returns
-    -------
-    RawTable
-
-    Raises
-    ------
-    RigDataError
-        No separator or header, rows of another width, a file cut short, cells pandas cannot parse.
-    """
+    """RawTable of delimited file ``path`` from its decoded ``text`` and ``sha`` (SHA-256)."""
     lines = text.splitlines()
     lay = layout(lines, path)
     rows = [i for i in range(lay.first, len(lines)) if lines[i].strip()]

@@ -1,5 +1,4 @@
-"""A rig file's bytes, its format (the extension or the caller's word, checked against the first
-bytes) and, for text formats, its text."""
+"""A rig file's bytes, its format (extension or the caller's word, checked against the first bytes) and text."""
 
 from __future__ import annotations
 
@@ -34,8 +33,7 @@ MAGIC = {"tdms": b"TDSm", "lvm": b"LabVIEW Measurement"}
 
 
 def _cut_in_magic(fmt: str, head: bytes) -> bool:
-    """Whether ``head``, a whole file, is a proper start of the format's :data:`MAGIC` (the file
-    was cut inside it)."""
+    """Whether ``head``, a whole file, is a proper prefix of the format's MAGIC (cut inside it)."""
     start = head.lstrip(b"\xef\xbb\xbf").strip() if fmt == "lvm" else head
     return bool(start) and len(start) < len(MAGIC[fmt]) and MAGIC[fmt].startswith(start)
 
@@ -51,26 +49,8 @@ def content_format(head: bytes) -> str | None:
 
 
 def choose_format(path: Path, format: str, head: bytes) -> str:
-    """The format to read, checked against the file's first bytes.
-
-    Parameters
-    ----------
-    path : Path
-        The file (its extension decides when ``format`` is ``"auto"``).
-    format : str
-        A key of :data:`FORMAT_ALIASES`.
-    head : bytes
-        The file's first bytes.
-
-    Returns
-    -------
-    str
-        ``"csv"``, ``"lvm"`` or ``"tdms"``.
-
-    Raises
-    ------
-    RigDataError
-        Content that contradicts the extension or the format given, or a file cut inside its tag.
+    """Format to read (``"csv"``, ``"lvm"``, ``"tdms"``) from ``format`` (``"auto"``: the extension),
+    checked against ``head``; RigDataError on contradiction or a file cut inside its tag.
     """
     suffix = path.suffix.lower()
     if suffix == ".tdms_index":
@@ -97,24 +77,7 @@ def choose_format(path: Path, format: str, head: bytes) -> str:
 
 
 def decode(data: bytes, path: Path) -> str:
-    """Text of a file: UTF-8 (BOM or not), UTF-16 with BOM, else Latin-1.
-
-    Parameters
-    ----------
-    data : bytes
-        The file's bytes.
-    path : Path
-        Named in errors.
-
-    Returns
-    -------
-    str
-
-    Raises
-    ------
-    RigDataError
-        Binary content, or unreadable UTF-16.
-    """
+    """Text of ``data``: UTF-8 (BOM or not), UTF-16 with BOM, else Latin-1; RigDataError if binary."""
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         try:
             return data.decode("utf-16")

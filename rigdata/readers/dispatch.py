@@ -1,5 +1,6 @@
-"""Reading a rig file: the format chosen and its reader run (:func:`read_table`), then the
-channels chosen and converted into a record (:func:`read`)."""
+"""Reading a rig file: format chosen and read (:func:`read_table`), then channels into a record
+(:func:`read`).
+"""
 
 from __future__ import annotations
 
@@ -28,10 +29,8 @@ def read_table(path: str | Path, format: str = "auto") -> RawTable:
     Parameters
     ----------
     path : str or Path
-        File to read.
     format : {"auto", "csv", "lvm", "tdms"}
-        ``"auto"`` goes by the extension (``.lvm``, ``.tdms``, anything else delimited text);
-        content that contradicts the extension or the given format is an error.
+        ``"auto"`` goes by the extension (else delimited text); contradicting content is an error.
 
     Returns
     -------
@@ -40,9 +39,7 @@ def read_table(path: str | Path, format: str = "auto") -> RawTable:
     Raises
     ------
     RigDataError
-        File missing, empty, binary where text is expected, of another format than stated,
-        truncated, without a header line, with rows of the wrong number of fields, or that the
-        format's library cannot parse.
+        Any problem with the file, naming it.
     """
     if not isinstance(format, str) or format not in FORMAT_ALIASES:
         raise ValueError(f"`format` must be 'auto' or one of {FORMATS}, got {format!r:.80}")
@@ -66,39 +63,31 @@ def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | Non
     Parameters
     ----------
     path : str or Path
-        Delimited text (``.csv``, ``.tsv``, ``.txt``, ``.dat``), LabVIEW Measurement (``.lvm``)
-        or NI TDMS (``.tdms``) file.
+        Delimited text (``.csv``, ``.tsv``, ``.txt``, ``.dat``), ``.lvm`` or ``.tdms``.
     format : {"auto", "csv", "lvm", "tdms"}
         See :func:`read_table`.
     mapping : mapping of str to str or None, optional
-        Record channel (or ``"time"``) -> column; channels not named are recognised by their
-        headers (:func:`recognise`). None drops a channel.
+        Channel (or ``"time"``) -> column; others recognised (:func:`recognise`); None drops one.
     units : mapping of str to str, optional
-        Unit by channel or column name; overrides or supplies the file's units (``{"speed_in":
-        "rpm"}``, ``{"time": "ms"}``).
+        Unit by channel or column name, over the file's (``{"speed_in": "rpm"}``).
     sensitivity : float
-        Torque transducer output [V/(N m)] for channels in volts; default 0.1 (paper, section 4:
-        Magtrol TMB 210, 100 mV/(N m)).
+        Torque output [V/(N m)] for volts; default 0.1 (Magtrol TMB 210).
     pulses_per_rev : int
-        Pulses per revolution for channels in pulse counts or pulses/s; default 60 (paper,
-        section 4: Magtrol TMB 210).
+        For pulse counts or pulses/s; default 60 (Magtrol TMB 210).
 
     Returns
     -------
     RigRecord
-        Time [s], torques [N m], speeds [rad/s], angles [rad]; ``provenance`` holds ``file``,
-        ``format``, ``reader`` (name, version), ``sha256``, ``header`` (the file's key/value
-        pairs), ``time`` (column or how the time axis was built), ``conversion``
-        (sensitivity, pulses per revolution), ``notes``, ``assumptions`` and, when the header
-        has a ``synthetic`` key, ``synthetic`` (``synthetic``, ``generator``, ``settings`` as
-        written).
+        Time [s], torques [N m], speeds [rad/s], angles [rad]; ``provenance``: ``file``, ``format``,
+        ``reader``, ``sha256``, ``header``, ``time``, ``conversion``, ``notes``, ``assumptions``,
+        and ``synthetic`` when the header says so.
 
     Raises
     ------
     RigDataError
-        Any problem with the file or its data, naming the file, the channel and the problem.
+        Any problem with the file or its data, naming file and channel.
     ValueError
-        Bad arguments (``format``, ``mapping`` keys, ``sensitivity``, ``pulses_per_rev``).
+        Bad arguments.
     """
     _check_read_arguments(sensitivity, pulses_per_rev, mapping, units)
     raw = read_table(path, format)
@@ -108,8 +97,7 @@ def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | Non
 
 def _check_read_arguments(sensitivity: float, pulses_per_rev: int, mapping: Mapping[str, str | None] | None,
                           units: Mapping[str, str] | None) -> None:
-    """``ValueError``/``TypeError`` naming the argument of :func:`read` that is out of range or of
-    the wrong type."""
+    """ValueError/TypeError naming an argument of :func:`read` out of range or of the wrong type."""
     if isinstance(sensitivity, bool) or not (isinstance(sensitivity, (int, float))
                                              and 1e-12 <= sensitivity <= 1e12):  # NaN fails too
         raise ValueError(f"`sensitivity` must be a number of V/(N m) in [1e-12, 1e12], "

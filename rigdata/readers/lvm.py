@@ -1,10 +1,7 @@
-"""LabVIEW Measurement files (``.lvm``), parsed by ``lvm_read.read_str``.
+"""LabVIEW Measurement files (``.lvm``), parsed by ``lvm_read.read_str``; continuing segments joined.
 
-Segments are joined when they continue one another (same channels, same ``Delta_X``, no gap);
-the X column, when there is one, is the time axis. lvm_read leaves NaN, silently, in cells it
-cannot read and accepts rows cut short: both are checked here against the text itself. A file it
-cannot parse at all (it raises a bare ``KeyError``, ``IndexError`` or ``SyntaxError``) is read
-again here for the reason: cut short inside a header, or the header line it stumbled on.
+lvm_read silently leaves NaN in unreadable cells, accepts short rows and fails on bad headers with
+bare KeyError/IndexError/SyntaxError: all are checked here against the text.
 """
 
 from __future__ import annotations
@@ -64,8 +61,7 @@ def _floats(values: list) -> list[float]:
 
 
 def _per_column(seg: dict, key: str, count: int, first: int) -> list:
-    """A segment header tag's value for each of ``count`` columns: the header row has the tag
-    under the first column, values under the Y columns."""
+    """A segment header tag's value for each of ``count`` columns (tag under the first column)."""
     values = list(seg.get(key, []))
     at = [j + first - 1 for j in range(count)]
     return [values[i] if 0 <= i < len(values) else None for i in at]
@@ -101,23 +97,7 @@ def _x_values(names: list[str], data: np.ndarray, k: int, path: Path) -> np.ndar
 
 
 def segment(seg: dict, k: int, x_columns: str, path: Path) -> Segment:
-    """Segment ``k`` (0-based) of what lvm_read returns, checked.
-
-    Parameters
-    ----------
-    seg : dict
-        lvm_read's segment.
-    k : int
-        Its index.
-    x_columns : {"One", "No"}
-        The header's ``X_Columns``.
-    path : Path
-        Named in errors.
-
-    Returns
-    -------
-    Segment
-    """
+    """Segment ``k`` (0-based) of lvm_read's output, checked (``x_columns``: header's ``X_Columns``)."""
     names, data = _segment_data(seg, k, path)
     first = 1 if x_columns == "No" else 0
     y_index = [j for j, name in enumerate(names) if name != "X_Value"]
@@ -163,20 +143,7 @@ def _check_contiguous(prev: Segment, seg: Segment, k: int, dt: float, path: Path
 
 
 def join(segments: list[Segment], path: Path) -> list[str]:
-    """Check that the segments continue one another.
-
-    Parameters
-    ----------
-    segments : list of Segment
-        In file order.
-    path : Path
-        Named in errors.
-
-    Returns
-    -------
-    list of str
-        Notes on what was joined, for the record's provenance.
-    """
+    """Check that ``segments`` continue one another; notes on what was joined, for provenance."""
     ref = segments[0]
     for k, seg in enumerate(segments):
         _check_segment(seg, k, ref, path)
@@ -186,8 +153,7 @@ def join(segments: list[Segment], path: Path) -> list[str]:
 
 
 def data_rows(lines: list[str], sep: str, width: int, path: Path, ends_clean: bool) -> list[int]:
-    """Line indices of the data rows; a row with fewer than ``width`` fields is an error (the
-    last one, or one without a line end: the file was cut short)."""
+    """Line indices of the data rows; one with fewer than ``width`` fields is an error (file cut short)."""
     rows = _data_lines(lines, sep)
     for k, i in enumerate(rows):
         n = len(lines[i].split(sep))
@@ -206,28 +172,7 @@ def data_rows(lines: list[str], sep: str, width: int, path: Path, ends_clean: bo
 
 def text_cells(lines: list[str], rows: list[int], sep: str, decimal: str,
                positions: Mapping[str, int], columns: Mapping[str, np.ndarray]) -> dict[str, TextCells]:
-    """The text behind the NaN that lvm_read leaves, silently, for cells it cannot read.
-
-    Parameters
-    ----------
-    lines : list of str
-        The file's lines.
-    rows : list of int
-        Line indices of the data rows.
-    sep : str
-        The separator.
-    decimal : {".", ","}
-        The decimal mark.
-    positions : mapping of str to int
-        Column name -> field index.
-    columns : mapping of str to ndarray
-        The columns lvm_read returned.
-
-    Returns
-    -------
-    dict of str to TextCells
-        Per column with text cells.
-    """
+    """Per column, the text behind the NaN lvm_read leaves for cells it cannot read."""
     cells = {}
     for name, j in positions.items():
         if not np.isnan(columns[name]).any():
@@ -247,9 +192,9 @@ a whole number)."""
 
 
 def _tagged_lines(text: str) -> tuple[list[str], list[str], str]:
-    """The text's lines, each line's first field (its tag, as lvm_read compares it: exactly) and
-    the column separator as lvm_read takes it: the character after ``Separator``
-    (``Separator<TAB>Tab``), tab without one."""
+    """Lines, each line's tag (first field, exact as lvm_read compares) and lvm_read's separator (tab by
+    default).
+    """
     lines = text.splitlines()
     tagged = [line.strip() for line in lines[:22] if line.startswith("Separator")]
     sep = tagged[0][9] if tagged and len(tagged[0]) > 9 else "\t"
@@ -262,13 +207,9 @@ def _header_end(tags: list[str]) -> int | None:
 
 
 def _missing_data(text: str) -> str | None:
-    """Where the text ends when a header has no data section after it (a file cut short), or
-    None when every header it starts is followed by a column-names line.
+    """Where the text ends when a header has no data section after it (cut short), else None.
 
-    Walks the lines as lvm_read does: the file header up to its ``***End_of_Header***``, then
-    segments, each a blank line, a header and an ``X_Value`` column-names line before its rows.
-    Read from the text because lvm_read reports such a file only as an internal ``KeyError``,
-    ``IndexError`` or ``SyntaxError``.
+    Walks the lines as lvm_read does, which reports such a file only as an internal exception.
     """
     lines, tags, sep = _tagged_lines(text)
     ends = f"the file ends at line {len(lines)}"
@@ -293,11 +234,7 @@ def _missing_data(text: str) -> str | None:
 
 
 def _header_problem(text: str) -> str | None:
-    """The first header line lvm_read cannot read, in words, or None when none is found: a
-    blank line inside the file header (lvm_read would start a segment there), a ``Separator``
-    tag without a value, a ``Decimal_Separator`` line that is not a tag and one value, and in a
-    segment (:func:`_segment_problem`) a missing or malformed ``X_Value`` line or a header value
-    that is not a number."""
+    """First header line lvm_read cannot read, in words, or None."""
     lines, tags, sep = _tagged_lines(text)
     end = _header_end(tags)
     end = len(lines) if end is None else end
@@ -318,8 +255,7 @@ def _header_problem(text: str) -> str | None:
 
 def _segment_problem(lines: list[str], tags: list[str], sep: str, decimal: str,
                      start: int) -> str | None:
-    """:func:`_header_problem` for the segments, from line index ``start`` on (``decimal``: the
-    file's decimal mark)."""
+    """:func:`_header_problem` for the segments from line ``start`` on."""
     segment = 0
     named = True
     for i in range(start, len(lines)):
@@ -348,8 +284,7 @@ def _segment_problem(lines: list[str], tags: list[str], sep: str, decimal: str,
 
 
 def _literal_number(text: str, whole: bool) -> bool:
-    """Whether lvm_read's ``ast.literal_eval`` reads ``text`` as a number (an int when
-    ``whole``)."""
+    """Whether lvm_read's ``ast.literal_eval`` reads ``text`` as a number (an int when ``whole``)."""
     try:
         value = ast.literal_eval(text)
     except (ValueError, TypeError, SyntaxError, MemoryError, RecursionError):
@@ -393,17 +328,7 @@ def _time(lvm: Any, segments: list[Segment], path: Path) -> np.ndarray | None:
 
 
 def read_lvm(path: Path, text: str, sha: str) -> RawTable:
-    """The table of a LabVIEW Measurement file.
-
-    Parameters
-    ----------
-    path : Path
-        The file (for messages and the table's ``file``).
-    text : str
-        Its decoded text.
-    sha : str
-        SHA-256 of its bytes.
-    """
+    """RawTable of LabVIEW Measurement file ``path`` from its decoded ``text`` and ``sha`` (SHA-256)."""
     lvm, header = _parse(text, path)
     x_columns = header.get("X_Columns", "One").strip()
     sep = SEPARATORS.get(header.get("Separator", "Tab").strip().lower(), "\t")

@@ -1,9 +1,4 @@
-"""The parsed table every reader returns: columns as floats, units and header as written.
-
-:class:`RawTable` is what a file holds before channels are chosen and converted; its
-non-numeric cells are NaN in the columns and kept as text in :class:`TextCells`, so that an
-error can quote them.
-"""
+"""The parsed table every reader returns: columns as floats, units and header as written, text cells kept."""
 
 from __future__ import annotations
 
@@ -28,14 +23,13 @@ MISSING = {"", "nan", "-nan", "+nan", "na", "n/a", "nat", "null", "none", "#n/a"
 
 @dataclass(frozen=True)
 class TextCells:
-    """Non-numeric cells of one column (their values are NaN in :attr:`RawTable.columns`).
+    """Non-numeric cells of one column (NaN in :attr:`RawTable.columns`).
 
     Attributes
     ----------
     count : int
-        How many cells of the column hold text.
     first : tuple of (int, int or None, str)
-        Sample row (0-based), file line (1-based, None when unknown) and text of the first few.
+        Sample row (0-based), file line (1-based or None) and text of the first few.
     """
 
     count: int
@@ -56,32 +50,22 @@ class RawTable:
     Attributes
     ----------
     file : str
-        Path of the file.
     format : {"csv", "lvm", "tdms"}
-        Format read.
     time : str or None
-        Name of the time column, None when the file has none (time then comes from
-        :attr:`sampling` or the header's sample rate).
+        Time column name; None: time from :attr:`sampling` or the header's rate.
     columns : dict of str to ndarray
-        Every column as floats, keyed by its name in the file (the whole header, units included,
-        for text files; ``group/channel`` for TDMS channels whose name repeats across groups).
-        Non-numeric cells are NaN and listed in :attr:`text_cells`. TDMS channels may differ in
-        length.
+        Every column as floats by its name in the file (``group/channel`` for repeated TDMS names);
+        text cells are NaN; TDMS channels may differ in length.
     units : dict of str to str or None
-        Unit of each column as the file states it (header annotation, units row, LVM
-        ``Y_Unit_Label``, TDMS ``unit_string``), None when it states none.
+        Each column's unit as the file states it.
     metadata : dict of str to str
-        Header key/value pairs: preamble ``key: value`` lines, LVM file header tags, TDMS file
-        properties.
+        Header key/value pairs.
     text_cells : dict of str to TextCells
-        Columns with non-numeric cells.
     sampling : dict of str to (float, float)
-        Start time [s] and sampling interval [s] of each channel, from LVM ``X0``/``Delta_X``
-        or TDMS ``wf_start_offset``/``wf_increment``; empty for text files.
+        Start and interval [s] per channel (LVM, TDMS waveforms); empty for text.
     reader : dict of str to str
-        Library that parsed the file: ``name`` and ``version``.
+        ``name`` and ``version`` of the parsing library.
     sha256 : str
-        Hash of the file's bytes.
     notes : tuple of str
         What the reader decided (separator, decimal mark, header line, segments joined).
     """
@@ -99,24 +83,7 @@ class RawTable:
     notes: tuple[str, ...] = ()
 
     def values(self, column: str, channel: str) -> np.ndarray:
-        """The column's values as floats.
-
-        Parameters
-        ----------
-        column : str
-            The column.
-        channel : str
-            The record channel it is read for (named in the error).
-
-        Returns
-        -------
-        ndarray, shape (n,)
-
-        Raises
-        ------
-        RigDataError
-            The column has text cells.
-        """
+        """Column ``column`` as floats; RigDataError naming ``channel`` if it has text cells."""
         cells = self.text_cells.get(column)
         if cells is not None:
             raise RigDataError(f"{cells.describe()} in column {column!r}", file=self.file, channel=channel)
@@ -133,19 +100,8 @@ def is_number(text: str) -> bool:
 
 
 def cell_value(text: str, decimal: str = ".") -> float:
-    """A text cell as a number: the cells :func:`is_number` accepts, with the decimal mark
-    replaced by a point; NaN for any other text (``float`` alone would also take ``"1_0"``).
-
-    Parameters
-    ----------
-    text : str
-        The cell.
-    decimal : {".", ","}
-        The file's decimal mark.
-
-    Returns
-    -------
-    float
+    """Text cell as a number (:func:`is_number` cells, ``decimal`` mark replaced), else NaN
+    (``float`` alone would take ``"1_0"``).
     """
     if not is_number(text):
         return math.nan
@@ -156,22 +112,7 @@ def cell_value(text: str, decimal: str = ".") -> float:
 
 
 def find_text_cells(raw: Any, numbers: np.ndarray, lines: list[int] | None) -> TextCells | None:
-    """Cells whose text is neither a number nor a missing-value mark.
-
-    Parameters
-    ----------
-    raw : array_like of object
-        The cells as read (strings, or numbers where the parser made them).
-    numbers : ndarray
-        The same cells as floats, NaN where they are not numbers.
-    lines : list of int, optional
-        File line (1-based) of every cell, when known.
-
-    Returns
-    -------
-    TextCells or None
-        The cells that are text (None when every cell is a number or empty).
-    """
+    """TextCells of ``raw`` cells that are neither numbers nor missing marks (``lines``: 1-based), else None."""
     strings = np.asarray(raw, dtype=object)
     nan = np.flatnonzero(np.isnan(numbers))
     hits = [k for k in nan if isinstance(strings[k], str) and strings[k].strip().lower() not in MISSING]

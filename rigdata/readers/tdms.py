@@ -1,8 +1,5 @@
-"""NI TDMS files, parsed by npTDMS from the bytes already read.
-
-Channels are named by their channel name, or ``group/channel`` when the name repeats across
-groups; waveform timing (``wf_start_offset``, ``wf_increment``) is kept per channel. npTDMS
-reports a cut or damaged file only in its log: the log is read while the file is.
+"""NI TDMS files, parsed by npTDMS from the bytes already read; channels named ``group/channel`` when
+names repeat; waveform timing kept. npTDMS reports a cut file only in its log, which is read.
 """
 
 from __future__ import annotations
@@ -38,8 +35,7 @@ shorter than one was cut before its first segment's metadata."""
 
 @contextlib.contextmanager
 def nptdms_warnings() -> Iterator[list[str]]:
-    """Collect npTDMS' logged warnings (it reports a cut file only there) and keep them off the
-    console while the file is read."""
+    """Collect npTDMS' logged warnings and keep them off the console while a file is read."""
     messages: list[str] = []
 
     class Keep(logging.Handler):
@@ -65,8 +61,7 @@ def nptdms_warnings() -> Iterator[list[str]]:
 
 
 def channel_values(channel: Any) -> tuple[np.ndarray, TextCells | None, str | None]:
-    """A channel's values as floats, its text cells, and the unit its type implies (timestamps:
-    seconds from the first)."""
+    """A channel's values as floats, its text cells, and its type's unit (timestamps: seconds from the first)."""
     data = channel[:]
     if np.issubdtype(data.dtype, np.datetime64):
         seconds = (data - data[0]) / np.timedelta64(1, "s") if data.size else data.astype(float)
@@ -79,8 +74,7 @@ def channel_values(channel: Any) -> tuple[np.ndarray, TextCells | None, str | No
 
 
 def _load(data: bytes, path: Path) -> tuple[Any, list[tuple], list[str]]:
-    """The TDMS file, its channels (group, channel, values, text cells, implied unit) and
-    npTDMS' warnings."""
+    """The TDMS file, its channels (group, channel, values, text cells, unit) and npTDMS' warnings."""
     if len(data) < LEAD_IN_BYTES:
         raise RigDataError(f"truncated: {len(data)} bytes, less than the {LEAD_IN_BYTES}-byte lead-in of a "
                            f"TDMS segment", file=path)
@@ -109,25 +103,8 @@ def _sampling(props: Any) -> tuple[float, float] | None:
 
 
 def read_tdms(path: Path, data: bytes, sha: str) -> RawTable:
-    """The table of an NI TDMS file.
-
-    Parameters
-    ----------
-    path : Path
-        The file (for messages and the table's ``file``).
-    data : bytes
-        Its bytes.
-    sha : str
-        SHA-256 of its bytes.
-
-    Returns
-    -------
-    RawTable
-
-    Raises
-    ------
-    RigDataError
-        A file cut short or damaged, or without channels.
+    """RawTable of TDMS file ``path`` from ``data`` and ``sha`` (SHA-256); RigDataError if cut, damaged or
+    empty.
     """
     tdms, loaded, warnings = _load(data, path)
     plain = [c.name for _, c, *_ in loaded]
