@@ -1,6 +1,6 @@
-"""Channel values to SI: the factor of a unit, raw signals (transducer volts, pulse counts and
-pulse rates) through the transducers' data, counter wraps undone, and the plausible magnitudes
-of the result."""
+"""Channel values to SI (raw volts, pulse counts and rates included), counter wraps undone, magnitudes
+checked.
+"""
 
 from __future__ import annotations
 
@@ -24,21 +24,8 @@ LIMITS = {"time": 1e11, "torque": 1e8, "speed": 1e5, "angle": 1e9}
 
 
 def check_magnitudes(time: np.ndarray, channels: dict[str, np.ndarray], file: object = None) -> None:
-    """Refuse values beyond :data:`LIMITS`: a wrong unit or scale, or a corrupt file.
-
-    Parameters
-    ----------
-    time : ndarray, shape (n,)
-        Sample times [s].
-    channels : dict of str to ndarray, shape (n,)
-        Channels in SI units, keys such as ``torque_in`` (the kind is the first word).
-    file : object, optional
-        Named in the error.
-
-    Raises
-    ------
-    RigDataError
-        Naming the channel, the sample and the limit.
+    """RigDataError naming channel, sample and limit for values beyond :data:`LIMITS` (wrong unit or corrupt
+    file).
     """
     for name, values in (("time", time), *channels.items()):
         kind = name.split("_")[0]
@@ -60,13 +47,12 @@ class Converted:
     Attributes
     ----------
     values : ndarray, shape (n,)
-        In the SI unit of the channel kind (N m, rad/s, rad, s).
     conversion : str
-        The conversion in words, for :class:`rigdata.record.ChannelSource`.
+        The conversion in words.
     quantum : float
         Resolution in SI (2 pi / pulses per revolution for counts), 0.0 when continuous.
     notes : tuple of str
-        What was done beyond the factor (counter wraps and resets undone).
+        Counter wraps and resets undone.
     """
 
     values: np.ndarray
@@ -83,27 +69,8 @@ def _factor_text(unit: Unit, si: str) -> str:
 
 def to_si(values: np.ndarray, unit: Unit, *, sensitivity: float = SENSITIVITY,
           pulses_per_rev: int = PULSES_PER_REV) -> Converted:
-    """Convert a channel to SI, raw signals included.
-
-    Parameters
-    ----------
-    values : ndarray, shape (n,)
-        In ``unit``.
-    unit : Unit
-        From :func:`parse_unit`.
-    sensitivity : float
-        Torque transducer output [V/(N m)] for ``voltage`` units; default 0.1, the paper's
-        Magtrol TMB 210 (100 mV/(N m)).
-    pulses_per_rev : int
-        Pulses per revolution for ``counts`` and ``pulse_rate`` units; default 60, the paper's
-        Magtrol TMB 210 speed output.
-
-    Returns
-    -------
-    Converted
-        Voltage -> torque [N m]; cumulative counts -> angle [rad], unwrapped
-        (:func:`unwrap_counter`), quantum 2 pi / ``pulses_per_rev``; pulse rate -> speed [rad/s];
-        other quantities -> their SI unit by the factor.
+    """Channel ``values`` in ``unit`` to SI: volts / ``sensitivity`` [V/(N m)] -> torque; counts (unwrapped)
+    and pulse rates via ``pulses_per_rev`` -> angle, speed; else the factor.
     """
     v = np.asarray(values, dtype=float) * unit.factor
     if unit.quantity == "voltage":
@@ -122,28 +89,10 @@ def to_si(values: np.ndarray, unit: Unit, *, sensitivity: float = SENSITIVITY,
 
 def unwrap_counter(counts: np.ndarray,
                    pulses_per_rev: int = PULSES_PER_REV) -> tuple[np.ndarray, tuple[str, ...]]:
-    """Undo wraps and resets of a cumulative pulse counter.
+    """Continuous ``counts`` from the first reading, and notes on each wrap or reset undone.
 
-    A pulse counter only moves one way while the shaft turns one way, so a step of more than
-    half a revolution against the direction of counting is a discontinuity. When that step is a
-    wrap of a counter of 8 to 32 bits (the jump plus the typical step is a power of two, within
-    two pulses) the power of two is added back exactly; otherwise the counter was reset and
-    the step is replaced by the median of the ten steps around it, so the angle there is known
-    to about one step.
-
-    Parameters
-    ----------
-    counts : ndarray, shape (n,)
-        Counter readings [pulses].
-    pulses_per_rev : int
-        Pulses per revolution.
-
-    Returns
-    -------
-    counts : ndarray, shape (n,)
-        Continuous counter readings [pulses], starting at the first reading.
-    notes : tuple of str
-        One line per wrap or reset undone, for the record's provenance.
+    A step over half a revolution backwards is a wrap (an 8-32 bit power of two, within two pulses,
+    added back) or else a reset (replaced by the median of the ten steps around it).
     """
     c = np.asarray(counts, dtype=float)
     if c.size < 2 or not np.all(np.isfinite(c)):

@@ -1,14 +1,6 @@
-"""Writers of rig files: delimited text, LabVIEW Measurement (.lvm), NI TDMS.
-
-Used by the synthetic rig and the tests; :mod:`rigdata.readers` reads every file written here
-back to the same numbers, units and metadata. A table is a dict of column name -> 1-D array that
-includes a time column [s]; ``units`` gives every column's unit as written into the file;
-``metadata`` (str -> str) goes into the preamble, the LVM header or the TDMS file properties.
-A synthetic file carries ``synthetic = "true"``, ``generator`` and ``settings`` (a JSON string)
-there, and the readers copy them into the record's provenance.
-
-Every writer is atomic: it writes a temporary file in the target folder, flushes it to disk and
-renames it over the target, so a failure leaves either the old file or none, never half a file.
+"""Atomic writers of rig files (delimited text, LVM, TDMS) that :mod:`rigdata.readers` reads back to
+the same numbers, units and metadata. A table is column name -> 1-D array with a time column [s];
+``metadata`` (str -> str) goes to the preamble, LVM header or TDMS file properties.
 """
 
 from __future__ import annotations
@@ -38,8 +30,9 @@ _LVM_RESERVED = {"writer_version", "reader_version", "separator", "decimal_separ
 
 def _check(table: Mapping[str, np.ndarray], units: Mapping[str, str],
            metadata: Mapping[str, str]) -> tuple[dict[str, np.ndarray], str]:
-    """Columns as float arrays of one length, every unit given, metadata one line each;
-    returns the columns and the name of the time column."""
+    """Columns as float arrays of one length, every unit given, metadata one line each; columns and time
+    column name.
+    """
     columns = {str(k): np.asarray(v, dtype=float).ravel() for k, v in table.items()}
     lengths = {k: v.size for k, v in columns.items()}
     if not columns or len(set(lengths.values())) != 1:
@@ -73,32 +66,10 @@ def _numbers(columns: Mapping[str, np.ndarray], sep: str, decimal: str) -> str:
 def write_csv(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
               metadata: Mapping[str, str], sep: str = ",", decimal: str = ".", preamble: bool = True,
               *, units_row: bool = False) -> Path:
-    """Write a delimited text file: preamble, header with units, one row per sample.
-
-    Parameters
-    ----------
-    path : path-like
-        Target file (``.csv``, ``.tsv``, ``.txt``, ``.dat``).
-    table : mapping of str to ndarray, shape (n,)
-        Columns, a time column (``time``, ``t``) among them.
-    units : mapping of str to str
-        Unit of every column, as it should appear in the file (``"N m"``, ``"rpm"``, ``"V"``).
-    metadata : mapping of str to str
-        Written as ``# key: value`` lines before the header when ``preamble`` is true.
-    sep : str
-        Column separator: ``","``, ``";"``, ``"\\t"`` or ``" "``.
-    decimal : {".", ","}
-        Decimal mark; ``","`` needs another separator.
-    preamble : bool
-        Write the metadata lines (the file then starts with the header when false, and the
-        metadata is not in the file).
-    units_row : bool
-        Units in a row of their own under the header instead of ``name [unit]`` headers.
-
-    Returns
-    -------
-    Path
-        ``path``.
+    """Write a delimited text file: ``# key: value`` preamble (if ``preamble``), header with units (or a
+    ``units_row``), one row per sample; ``sep`` any of ``,`` ``;`` tab or blank, ``decimal`` ``.`` or
+    ``,``.
+    Returns ``path``.
     """
     if decimal not in (".", ",") or sep == decimal or sep not in (",", ";", "\t", " "):
         raise ValueError(f"`sep` must be one of ',', ';', tab, space and `decimal` '.' or ',' and differ "
@@ -118,46 +89,18 @@ def write_csv(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
 
 
 def _lvm_row(key: str, values: list[str]) -> str:
-    """A segment header row: one value under each Y column and an empty field under Comment, as
-    LabVIEW writes them."""
+    """A segment header row: one value per Y column, an empty field under Comment, as LabVIEW writes."""
     return "\t".join([key, *values, ""])
 
 
 def write_lvm(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
               metadata: Mapping[str, str], decimal: str = ",", segments: int = 1,
               *, x_columns: str = "One") -> Path:
-    """Write a LabVIEW Measurement file (LVM 2.0, tab-separated), one or more segments.
+    """Write a LabVIEW Measurement file (LVM 2.0, tab-separated) in ``segments`` contiguous segments.
 
-    Layout (NI, *Specification for the LabVIEW Measurement File*): ``LabVIEW Measurement``, the
-    file header (``Writer_Version``, ``Separator``, ``Decimal_Separator``, ``X_Columns``, ``Date``,
-    ``Time``, then the metadata as further tags), ``***End_of_Header***``; per segment an empty
-    line, ``Channels``, ``Samples``, ``Date``, ``Time``, ``Y_Unit_Label``, ``X_Dimension``,
-    ``X0``, ``Delta_X``, ``***End_of_Header***``, the ``X_Value ... Comment`` line and the rows.
-
-    Parameters
-    ----------
-    path : path-like
-        Target ``.lvm`` file.
-    table : mapping of str to ndarray, shape (n,)
-        Columns, a uniform time column [s] among them (the X values).
-    units : mapping of str to str
-        Unit of every column, written as ``Y_Unit_Label``.
-    metadata : mapping of str to str
-        Extra header tags; ``Date``, ``Time``, ``Operator``, ``Description`` replace the
-        writer's own. Without ``Date`` and ``Time`` the current local time is written.
-    decimal : {",", "."}
-        Decimal mark of the numbers, stated as ``Decimal_Separator``.
-    segments : int
-        Number of segments the rows are split into, contiguous in time (X0 of each segment is
-        its first sample time).
-    x_columns : {"One", "No"}
-        ``"One"``: the X values are the first column; ``"No"``: the first field of each row is
-        left empty and readers build the time from ``X0`` and ``Delta_X``.
-
-    Returns
-    -------
-    Path
-        ``path``.
+    ``metadata`` adds header tags (``Date``/``Time`` default to now); ``decimal`` is stated as
+    ``Decimal_Separator``; ``x_columns="No"`` leaves X empty (time from ``X0``/``Delta_X``). Returns
+    ``path``.
     """
     if decimal not in (".", ",") or x_columns not in ("One", "No"):
         raise ValueError(f"`decimal` must be '.' or ',' and `x_columns` 'One' or 'No', "
@@ -187,14 +130,13 @@ def write_lvm(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: M
 
 
 def _lvm_number(x: float, decimal: str) -> str:
-    """``x`` to its last digit, with the decimal mark ``decimal``."""
+    """``x`` to its last digit with decimal mark ``decimal``."""
     return repr(float(x)).replace(".", decimal)
 
 
 def _lvm_segment(t: np.ndarray, columns: Mapping[str, np.ndarray], units: Mapping[str, str],
                  rows: np.ndarray, stamp: tuple[str, str], decimal: str, x_columns: str) -> list[str]:
-    """The lines of one LVM segment: its header (``Channels`` ... ``Delta_X``), the column line
-    and the rows ``rows`` of the columns (``stamp``: the date and time written)."""
+    """Lines of one LVM segment: header, column line and rows ``rows`` (``stamp``: date and time)."""
     names = list(columns)
     m = len(columns)
     date, clock = stamp
@@ -220,27 +162,8 @@ def _lvm_segment(t: np.ndarray, columns: Mapping[str, np.ndarray], units: Mappin
 
 def write_tdms(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
                metadata: Mapping[str, str]) -> Path:
-    """Write an NI TDMS file with npTDMS: group ``Rig``, one channel per column.
-
-    Every channel, the time column included, carries ``unit_string``, ``wf_start_offset`` (the
-    first sample time [s]), ``wf_increment`` (the sampling interval [s]) and ``wf_samples``;
-    the metadata are the file (root) properties.
-
-    Parameters
-    ----------
-    path : path-like
-        Target ``.tdms`` file (no index file is written).
-    table : mapping of str to ndarray, shape (n,)
-        Columns, a uniform time column [s] among them.
-    units : mapping of str to str
-        Unit of every column (``unit_string``).
-    metadata : mapping of str to str
-        File properties.
-
-    Returns
-    -------
-    Path
-        ``path``.
+    """Write an NI TDMS file with npTDMS: group ``Rig``, one channel per column with ``unit_string`` and
+    waveform timing; ``metadata`` as file properties; no index file. Returns ``path``.
     """
     columns, time = _check(table, units, metadata)
     t = columns[time]

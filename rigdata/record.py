@@ -1,10 +1,6 @@
 """One validated record of a rig measurement: time, the four transducer channels, provenance.
 
-Every reader (:mod:`rigdata.readers`) returns a :class:`RigRecord`, in SI units and radians:
-torques [N m], speeds [rad/s], angles [rad], time [s]. Raw signals (volts at a sensitivity,
-pulse counts at a number of pulses per revolution) are converted by the reader; the conversion
-is kept in :attr:`ChannelSource.conversion` so that nothing is done to the data that the record
-does not say.
+SI units throughout; each channel's conversion from the raw signal is kept in its :class:`ChannelSource`.
 """
 
 from __future__ import annotations
@@ -30,8 +26,7 @@ RATE_TOLERANCE = 1e-3
 
 
 class RigDataError(ValueError):
-    """Bad measured data. The message names the file, the channel (where there is one) and the
-    problem in one line; the CLI prints it and exits with status 2."""
+    """Bad measured data; the one-line message names file, channel and problem (CLI exit status 2)."""
 
     def __init__(self, problem: str, *, file: Any = None, channel: str | None = None) -> None:
         self.problem = problem
@@ -52,12 +47,11 @@ class ChannelSource:
     column : str
         Column / channel name in the file.
     unit : str
-        Unit as stated in the file or given by the user (``"V"``, ``"rpm"``, ``"counts"``, ...).
+        Unit as stated or given (``"V"``, ``"rpm"``, ``"counts"``).
     conversion : str
-        How the values were brought to SI, in words (``"V / 0.1 V/(N m)"``, ``"x 2 pi / 60"``).
+        Conversion to SI in words (``"V / 0.1 V/(N m)"``).
     quantum : float
-        Resolution of the converted values in SI (2 pi / pulses per revolution for pulse
-        counts), 0.0 when continuous.
+        Resolution in SI, 0.0 when continuous.
     """
 
     column: str
@@ -68,28 +62,18 @@ class ChannelSource:
 
 @dataclass(frozen=True)
 class RigRecord:
-    """A measurement on a uniform time grid.
+    """A measurement on a uniform time grid; RigDataError on construction when invalid.
 
     Attributes
     ----------
     time : ndarray, shape (n,)
-        Sample times [s], strictly increasing, uniform to :data:`RATE_TOLERANCE`.
+        Sample times [s], increasing, uniform to :data:`RATE_TOLERANCE`, n >= 4.
     channels : mapping of str to ndarray, shape (n,)
-        Keys from :data:`CHANNELS`; always ``torque_in``, ``torque_out`` and for each shaft
-        ``speed_*`` or ``angle_*`` (or both). Finite values in SI units.
+        Keys from :data:`CHANNELS`: both torques and per shaft ``speed_*`` and/or ``angle_*``; finite SI.
     sources : mapping of str to ChannelSource
         One per channel.
     provenance : mapping
-        ``file``, ``format``, ``reader`` (name and version), ``sha256`` of the file, the file's
-        own header keys (``header``) and, for synthetic files, ``synthetic`` (generator and
-        settings as written in the file).
-
-    Raises
-    ------
-    RigDataError
-        On construction: fewer than 4 samples, time not finite, not increasing or not uniform,
-        an unknown or missing channel, a channel of another length or with a non-finite value,
-        sources that do not match the channels.
+        ``file``, ``format``, ``reader``, ``sha256``, ``header`` and, if synthetic, ``synthetic``.
     """
 
     time: np.ndarray
@@ -128,13 +112,13 @@ class RigRecord:
 
     @property
     def file(self) -> Any:
-        """The file the record was read from (``provenance["file"]``), None if not known."""
+        """The file read (``provenance["file"]``), None if not known."""
         return self.provenance.get("file")
 
     def turned(self, shaft: str = "in") -> float:
-        """Angle turned by a shaft over the record [rad], from its angle channel when there is
-        one, else the trapezoidal integral of its speed (written out: scipy's would cost
-        ``cardan rig inspect`` 0.3 s of import for one sum)."""
+        """Angle turned by ``shaft`` [rad]: its angle channel, else the trapezoidal integral of its speed
+        (by hand: scipy's import would cost ``cardan rig inspect`` 0.3 s).
+        """
         angle = self.channels.get(f"angle_{shaft}")
         if angle is not None:
             return float(angle[-1] - angle[0])
@@ -142,13 +126,12 @@ class RigRecord:
         return float(np.sum(np.diff(self.time) * (speed[1:] + speed[:-1]) / 2.0))
 
     def revolutions(self, shaft: str = "in") -> float:
-        """Whole and partial revolutions turned by a shaft (absolute value) [-]."""
+        """Revolutions turned by ``shaft``, absolute [-]."""
         return abs(self.turned(shaft)) / (2.0 * math.pi)
 
 
 def _checked_time(time: Any, file: Any) -> np.ndarray:
-    """``time`` as floats: at least 4 samples, finite, increasing, uniform to :data:`RATE_TOLERANCE`;
-    :class:`RigDataError` naming the sample otherwise."""
+    """``time`` as floats (>= 4 samples, finite, increasing, uniform); RigDataError naming the sample."""
     t = np.asarray(time, dtype=float)
     if t.ndim != 1 or t.size < 4:
         raise RigDataError(f"needs at least 4 samples, got {t.size}", file=file, channel="time")
@@ -171,8 +154,7 @@ def _checked_time(time: Any, file: Any) -> np.ndarray:
 
 
 def _check_channel_names(channels: Mapping[str, Any], file: Any) -> None:
-    """:class:`RigDataError` for an unknown channel, or a record without both torques and, for each
-    shaft, a speed or an angle."""
+    """RigDataError for an unknown channel or a missing torque or shaft speed/angle."""
     unknown = set(channels) - set(CHANNELS)
     if unknown:
         raise RigDataError(f"unknown channels {sorted(unknown)}; expected {sorted(CHANNELS)}", file=file)
@@ -186,8 +168,9 @@ def _check_channel_names(channels: Mapping[str, Any], file: Any) -> None:
 
 
 def _checked_values(name: str, values: Any, t: np.ndarray, file: Any) -> np.ndarray:
-    """Channel ``name`` as read-only floats on the time grid ``t``; :class:`RigDataError` for
-    another length or a non-finite value (naming the first)."""
+    """Channel ``name`` as read-only floats on grid ``t``; RigDataError for wrong length or a non-finite
+    value.
+    """
     v = np.asarray(values, dtype=float)
     if v.shape != t.shape:
         raise RigDataError(f"has {v.size} samples, time has {t.size}", file=file, channel=name)

@@ -1,9 +1,7 @@
 """The rig's torque/speed transducers and acquisition: the numbers the uncertainty rests on.
 
-The paper (section 4.2) states the transducers' full scale (100 N m), torque sensitivity
-(100 mV per N m) and speed resolution (60 pulses per revolution). It does not state their
-accuracy, drift or noise; the defaults below for those are assumptions, each with its reason,
-and every one is a parameter (``cardan rig measure --accuracy-class ... --zero-drift ...``).
+Full scale, sensitivity and pulses per revolution are the paper's (section 4.2); accuracy, drift
+and noise are assumptions, each a parameter.
 """
 
 from __future__ import annotations
@@ -49,12 +47,11 @@ class Transducer:
     pulses_per_rev : int
         Speed pulses per revolution [-].
     accuracy_class : float
-        Limit of the combined torque error (linearity, hysteresis, calibration) as a fraction of
-        full scale [-]; constant over a record, independent between the two transducers.
+        Limit of the constant torque error as a fraction of full scale [-], independent per transducer.
     zero_drift : float
-        Limit of the zero's drift over one record [N m], a linear ramp from zero.
+        Limit of the zero's drift over a record [N m], a linear ramp from zero.
     adc_range : float
-        Acquisition input range +-``adc_range`` [V].
+        Acquisition input range +- [V].
     adc_bits : int
         Acquisition resolution [bit].
     """
@@ -103,7 +100,7 @@ class Transducer:
 
     @property
     def adc_step(self) -> float:
-        """One step of the acquisition card, in torque [N m]."""
+        """One acquisition step in torque [N m]."""
         return 2.0 * self.adc_range / 2 ** self.adc_bits / self.sensitivity
 
     def as_dict(self) -> dict:

@@ -1,27 +1,7 @@
-"""Units of measured channels: an explicit table of spellings and the units a header states.
+"""Units of measured channels: an explicit table of spellings (:data:`UNITS`) and header unit parsing.
 
-The table is written out by hand on purpose. A general unit library reads ``"Nm"`` as nanometre
-(pint does); on a torque rig it is always newton metre. Every spelling a rig file may carry is
-listed in :data:`UNITS` with the quantity it measures and its factor to SI; anything else is an
-error that lists what is accepted. The conversion of values (raw signals included) is
-:mod:`rigdata.conversion`.
-
-Quantities and their SI units:
-
-============== ============ ========================================================
-quantity       SI unit      converted to a record channel by
-============== ============ ========================================================
-``time``       s            factor
-``torque``     N m          factor
-``speed``      rad/s        factor
-``angle``      rad          factor
-``voltage``    V            torque = voltage / sensitivity [V/(N m)]
-``counts``     pulses       angle = counts * 2 pi / pulses per revolution (unwrapped)
-``pulse_rate`` pulses/s     speed = pulse rate * 2 pi / pulses per revolution
-============== ============ ========================================================
-
-``Hz`` is refused for speeds: on this rig it could mean revolutions per second or the pulse
-frequency of the 60-pulse speed output, a factor of 60 apart. Write ``rev/s`` or ``pulses/s``.
+Hand-written because unit libraries read ``"Nm"`` as nanometre. ``Hz`` is refused for speeds
+(revolutions or 60-pulse frequency per second?): write ``rev/s`` or ``pulses/s``.
 """
 
 from __future__ import annotations
@@ -91,18 +71,7 @@ AMBIGUOUS = {
 
 
 def normalise(spelling: str) -> str:
-    """Comparison key of a unit spelling: lower case, no blanks, no product signs or dots.
-
-    Parameters
-    ----------
-    spelling : str
-        Unit as written (``"N·m"``, ``" RPM "``, ``"µs"``).
-
-    Returns
-    -------
-    str
-        ``"nm"``, ``"rpm"``, ``"us"``.
-    """
+    """Comparison key of a unit spelling: lower case, no blanks, product signs or dots (``N·m`` -> ``nm``)."""
     s = spelling.strip().lower().replace("µ", "u").replace("μ", "u").replace("⁻¹", "^-1")
     return re.sub(r"[\s*·⋅×.]", "", s)
 
@@ -114,13 +83,13 @@ class Unit:
     Attributes
     ----------
     spelling : str
-        As written in the file or by the user.
+        As written.
     symbol : str
-        Canonical symbol (``"N m"``, ``"rpm"``).
+        Canonical symbol (``"N m"``).
     quantity : str
-        One of the keys of :data:`SI`.
+        A key of :data:`SI`.
     factor : float
-        Multiplier to the SI unit of the quantity (``rpm`` -> rad/s: 2 pi / 60).
+        Multiplier to the quantity's SI unit (``rpm``: 2 pi / 60).
     """
 
     spelling: str
@@ -148,13 +117,7 @@ def lookup(spelling: str) -> Unit | None:
 
 
 def accepted(quantities: tuple[str, ...] | None = None) -> str:
-    """Accepted spellings, grouped by quantity, on one line.
-
-    Parameters
-    ----------
-    quantities : tuple of str, optional
-        Restrict the list to these quantities (keys of :data:`SI`); all when None.
-    """
+    """Accepted spellings grouped by quantity on one line (only ``quantities`` when given)."""
     groups = []
     for quantity in quantities or tuple(SI):
         spellings = [s for sym, (q, _, others) in _TABLE.items() if q == quantity for s in (sym, *others)]
@@ -164,27 +127,10 @@ def accepted(quantities: tuple[str, ...] | None = None) -> str:
 
 def parse_unit(spelling: str, *, kind: str | None = None, column: str | None = None,
                file: object = None, channel: str | None = None) -> Unit:
-    """Recognise a unit spelling, checking that it suits a kind of channel.
+    """Unit of ``spelling``, whose quantity must be in ``ACCEPTS[kind]`` when ``kind`` is given.
 
-    Parameters
-    ----------
-    spelling : str
-        Unit as written (case and blanks do not matter).
-    kind : {"time", "torque", "speed", "angle"}, optional
-        Kind of record channel the unit is for; the unit's quantity must be one of
-        ``ACCEPTS[kind]``.
-    column, file, channel : optional
-        Named in the error message.
-
-    Returns
-    -------
-    Unit
-
-    Raises
-    ------
-    RigDataError
-        Unknown or ambiguous spelling (the message lists the accepted ones), or a unit of the
-        wrong quantity for ``kind``.
+    RigDataError (naming ``column``, ``file``, ``channel``) for an unknown, ambiguous or wrong-quantity
+    unit.
     """
     where = f" in column {column!r}" if column is not None else ""
     allowed = ACCEPTS[kind] if kind is not None else None
@@ -207,23 +153,10 @@ _SLASHED = re.compile(r"^(?P<name>.*?\S)\s+/\s*(?P<unit>\S.*?)\s*$")
 
 
 def split_header(header: str) -> tuple[str, str | None]:
-    """Split a column header into its bare name and the unit it states.
+    """Bare name and unit as written (None if none) of a column header.
 
-    Recognised forms: ``Torque In [N m]``, ``torque_in (Nm)``, ``Speed In {rpm}``,
-    ``angle <deg>`` (the last bracket of the header) and ``speed_out / rpm`` (blank before the
-    slash). The unit is returned as written, not checked: see :func:`parse_unit`.
-
-    Parameters
-    ----------
-    header : str
-        Column header as in the file.
-
-    Returns
-    -------
-    name : str
-        Header without the unit annotation, stripped.
-    unit : str or None
-        The unit as written, None when the header states none (or empty brackets).
+    Forms: ``Torque In [N m]``, ``torque_in (Nm)``, ``Speed In {rpm}``, ``angle <deg>`` (last
+    bracket), ``speed_out / rpm``.
     """
     text = header.strip()
     m = _BRACKETED.match(text)
