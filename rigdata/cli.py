@@ -1,12 +1,8 @@
 """``cardan rig``: inspect, measure and validate rig files; write synthetic ones.
 
-Registered into the ``cardan`` command through the ``cardan.commands`` entry point (see
-``pyproject.toml``), so that ``cardan_exudyn`` never imports ``rigdata``. ``cardan`` imports
-this module at every start, so it reaches rigdata's own modules (scipy, pandas: about a second)
-through the lazy package (``rigdata.read`` ...), loaded when a ``rig`` command runs.
-
-Exit status: 0 success; 2 bad input (one line naming the file, the channel and the problem);
-3 a model run failed (its status and reason are in the report).
+Registered through the ``cardan.commands`` entry point (``cardan_exudyn`` never imports rigdata);
+imported at every ``cardan`` start, so it reaches rigdata through the lazy package.
+Exit status: 0 success; 2 bad input (one line); 3 a model run failed.
 """
 
 from __future__ import annotations
@@ -153,8 +149,7 @@ def cmd_measure(args: argparse.Namespace) -> int:
 
 
 def _scene(args: argparse.Namespace) -> Scene:
-    """The joint the measurement drives: ``--scene`` (a named scene, or a scene file: the user's
-    own joint) with ``--angle`` and ``--friction`` when given (else the scene's own)."""
+    """The joint to drive: ``--scene`` (name or scene file) with ``--angle`` and ``--friction`` when given."""
     from rigdata.validation import as_scene  # rigdata's modules load when a rig command runs
 
     base = as_scene(args.scene)
@@ -197,8 +192,7 @@ def _print_validation(s: dict[str, Any]) -> None:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    """``cardan rig validate``: measured against computed efficiency, the report folder
-    (:func:`rigdata.validate`, :func:`rigdata.write_report`)."""
+    """``cardan rig validate``: measured against computed efficiency and the report folder."""
     engines = _engines(args.engines)
     arguments.out_folder(args.out)
     scene = _scene(args)

@@ -1,11 +1,6 @@
-"""The joint model driven by the measurement (the paper's section 4.2).
-
-The paper drove its model with the measured input angle, velocity and acceleration. Here every
-engine gets one scene: the joint at the rig's shaft angle and friction, the input angle history
-from the conditioned measurement (phase-corrected, so the model's yoke sits where the speed
-ratio says the real one was), and the measured output torque as the load, from the start of the
-measured whole-revolution window; the scene's span is that window's revolutions, so the
-computed mean efficiency covers exactly the revolutions the measured one does.
+"""The joint model driven by the measurement (paper, section 4.2): the rig joint with the phase-corrected
+measured input angle as drive and the measured output torque as load, over the measured
+whole-revolution window, so computed and measured mean efficiency cover the same revolutions.
 """
 
 from __future__ import annotations
@@ -32,26 +27,11 @@ MARGIN_REVOLUTIONS = 0.05
 
 def measured_scene(c: Conditioned, base: Scene, points_per_revolution: int = 120,
                    phase_shift: float = 0.0, load_offset: float = 0.0) -> Scene:
-    """``base`` (joint, friction, numerics) driven and loaded by the conditioned measurement.
+    """``base`` (joint, friction, numerics) driven and loaded by ``c``, named ``<base>-measured``.
 
-    Parameters
-    ----------
-    c : Conditioned
-    base : Scene
-        Supplies the joint, gravity, friction settings and numerics.
-    points_per_revolution : int
-        Knots of the drive and load histories per input revolution; the signals are low-passed
-        at ``c.cutoff`` (10 harmonics by default), so 120 knots per revolution resolve them
-        (12 per period of the highest harmonic kept).
-    phase_shift : float
-        Added to the estimated yoke phase [rad] (pi gives the other solution of the fit).
-    load_offset : float
-        Added to the measured load [N m] (for the model's sensitivity to the output transducer).
-
-    Returns
-    -------
-    Scene
-        Named ``<base>-measured``, its span the window's whole revolutions.
+    ``points_per_revolution`` knots per input revolution (12 per period of the 10th harmonic);
+    ``phase_shift`` [rad] added to the yoke phase (pi: the other fit); ``load_offset`` [N m] added to the
+    load.
     """
     t_a, t_b = c.window
     period = (t_b - t_a) / c.revolutions
@@ -68,24 +48,10 @@ def measured_scene(c: Conditioned, base: Scene, points_per_revolution: int = 120
 def computed_efficiency(result: Result) -> dict[str, Any]:
     """Mean and instantaneous computed efficiency from an engine result.
 
-    ``mean_efficiency`` is 1 - lost work / input work over the window; the instantaneous one is
-    the paper's: 1 - P_loss / P_in (its code "estimates the output power computing the power
-    loss at the kinematic pairs", footnote 2), next to P_out / P_in.
-
-    Parameters
-    ----------
-    result : Result
-        From :func:`cardan_exudyn.engines.run`.
-
-    Returns
-    -------
-    dict
-        ``status`` (:class:`~reference.results.summary.Status`), ``reason``, ``engine``,
-        ``mean_efficiency`` [-], ``work_ratio`` [-], ``mean_torque_in`` [N m] (None unless the
-        status is ok), ``wall_time_s`` [s], ``efficiency_error_estimate`` [-] (the engine's own
-        estimate of its mean-efficiency error, :class:`~reference.results.summary.Summary`); and when the
-        run is ok and recorded its time series, ``series``: ``t`` [s], ``theta_in`` [rad],
-        ``efficiency`` and ``power_ratio`` [-], ``torque_in`` [N m].
+    Mean: 1 - lost work / input work; instantaneous: the paper's 1 - P_loss / P_in (footnote 2) and
+    P_out / P_in. Keys: ``status``, ``reason``, ``engine``, ``mean_efficiency``, ``work_ratio``,
+    ``mean_torque_in`` (None unless ok), ``wall_time_s``, ``efficiency_error_estimate``; ``series``
+    (``t``, ``theta_in``, ``efficiency``, ``power_ratio``, ``torque_in``) when ok and recorded.
     """
     s = result.summary
     out = {"status": s.status, "reason": s.reason, "engine": s.engine,
@@ -109,27 +75,10 @@ def _series(table: Any) -> dict[str, np.ndarray]:
 
 def model_sensitivities(c: Conditioned, base: Scene, delta: float, baseline: float | None = None,
                         points_per_revolution: int = 120) -> dict[str, float]:
-    """What the computed efficiency owes to the measurement (reference engine).
+    """What the computed efficiency owes to the measurement (reference engine, ``baseline`` if already run).
 
-    Parameters
-    ----------
-    c : Conditioned
-    base : Scene
-    delta : float
-        Load offset to difference over [N m].
-    baseline : float, optional
-        The reference engine's mean efficiency on the measured scene [-], when already run (else
-        it is run here).
-    points_per_revolution : int
-        See :func:`measured_scene`.
-
-    Returns
-    -------
-    dict
-        ``load`` [1/(N m)]: the change per N m of load offset (the output transducer's error
-        drives the model too, so it is correlated with the measured efficiency's);
-        ``load_delta`` [N m]; ``phase_ambiguity`` [-]: the computed efficiency with the yoke half
-        a turn away minus at the estimate (the fit cannot tell them apart).
+    ``load`` [1/(N m)]: change per N m of load offset (differenced over ``delta``); ``load_delta`` [N m];
+    ``phase_ambiguity`` [-]: efficiency with the yoke half a turn away minus at the estimate.
     """
     def eta(**changes: float) -> float:
         result = engines.run(measured_scene(c, base, points_per_revolution, **changes), "reference")

@@ -1,10 +1,5 @@
-"""The report of a :class:`~rigdata.validation.Validation`: the paper's Figure 10, the text and
-the signals, written into a folder atomically.
-
-``report.md`` (measured efficiency with its budget, computed efficiency per engine, the
-comparison, assumptions), ``validation.json`` (:meth:`Validation.as_dict`), ``figure10.png``
-(:func:`figure`) and ``signals.csv`` (the conditioned signals with the measured and computed
-instantaneous efficiency).
+"""The report folder of a Validation, written atomically: ``report.md``, ``validation.json``,
+``figure10.png`` (the paper's Figure 10) and ``signals.csv``.
 """
 
 from __future__ import annotations
@@ -29,8 +24,7 @@ COLOURS = {"reference": "C0", "exudyn": "C1"}
 
 
 def _limits(eta: np.ndarray, u: np.ndarray) -> tuple[float, float]:
-    """Efficiency axis limits [-]: the k = 2 band's 1st and 99th percentiles, widened to show at
-    least [0.8, 1.05]."""
+    """Efficiency axis limits [-]: the k = 2 band's 1st and 99th percentiles, showing at least [0.8, 1.05]."""
     finite = np.isfinite(eta) & np.isfinite(u)
     lo = np.percentile((eta - K * u)[finite], 1) if finite.any() else 0.0
     hi = np.percentile((eta + K * u)[finite], 99) if finite.any() else 1.0
@@ -43,8 +37,7 @@ def _series(v: Validation) -> dict[str, dict[str, np.ndarray]]:
 
 
 def _over_time(ax: Any, v: Validation, t: np.ndarray, eta: np.ndarray, u: np.ndarray) -> None:
-    """Figure 10's top panel: the measured efficiency with its band, and the computed ones, over
-    time [s]."""
+    """Top panel: measured efficiency with its band and computed ones over time [s]."""
     ax.fill_between(t, eta - K * u, eta + K * u, color="0.85", label="measured, k = 2 band")
     ax.plot(t, eta, color="k", lw=0.8, label="measured P_out / P_in")
     for engine, series in _series(v).items():
@@ -98,17 +91,8 @@ def _pyplot() -> Any:
 
 
 def figure(v: Validation) -> Any:
-    """Figure 10: efficiency over time and over input angle, measured with its k = 2 band
-    against computed; and the difference.
-
-    Parameters
-    ----------
-    v : Validation
-        The validation (its measurement's instantaneous efficiency is computed here if not yet).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+    """Figure 10 of ``v``: efficiency over time and input angle, measured (k = 2 band) against computed, and
+    the difference.
     """
     inst = v.measured.instantaneous
     inside = v.conditioned.in_window()
@@ -228,16 +212,15 @@ def _signals(v: Validation) -> dict[str, np.ndarray]:
 
 
 def write_report(v: Validation, out: str | os.PathLike) -> dict[str, Any]:
-    """Write ``report.md``, ``validation.json``, ``figure10.png`` and ``signals.csv`` into
-    ``out``, atomically: built in a temporary folder beside it and swapped in whole, so an
-    interrupted or failed run leaves the previous report (or none), never half of one.
+    """Write ``report.md``, ``validation.json``, ``figure10.png`` and ``signals.csv`` into ``out`` atomically.
+
+    Built beside ``out`` and swapped in whole, so a failed run leaves the previous report or none.
 
     Parameters
     ----------
     v : Validation
-        From :func:`rigdata.validation.validate`.
     out : path-like
-        The report folder (replaced as a whole).
+        The report folder, replaced as a whole.
 
     Returns
     -------

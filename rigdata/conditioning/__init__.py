@@ -1,11 +1,6 @@
-"""Conditioning: from a raw record to conditioned signals on whole input revolutions.
+"""Conditioning: from a raw record to conditioned signals on whole input revolutions (:func:`condition`).
 
-:func:`condition` (:mod:`~rigdata.conditioning.pipeline`) runs the steps; each concept has its
-module: :mod:`~rigdata.conditioning.options` (:class:`Conditioning`),
-:mod:`~rigdata.conditioning.angles` (angles from pulse edges), :mod:`~rigdata.conditioning.filters`
-(zero-phase low-pass, speed of an angle), :mod:`~rigdata.conditioning.window` (whole-revolution
-window, integral weights over it), :mod:`~rigdata.conditioning.phase` (input yoke phase). The
-choices and their defaults: ``docs/rigdata.md``.
+The choices and their defaults: ``docs/rigdata.md``.
 """
 
 from __future__ import annotations

@@ -1,5 +1,4 @@
-"""Shaft angles on the record's sample grid: from pulse edges (a counted, staircase angle), from
-an angle channel as given, or from a speed channel by the trapezoidal integral."""
+"""Shaft angles on the sample grid: from pulse edges, an angle channel, or the integral of a speed channel."""
 
 from __future__ import annotations
 
@@ -15,24 +14,22 @@ __all__ = ["pulse_edges", "angle_on_grid"]
 def pulse_edges(t: np.ndarray, angle: np.ndarray, quantum: float) -> tuple[np.ndarray, np.ndarray]:
     """Instants and angles of the pulse edges of a counted (staircase) angle.
 
-    The count changes between two samples; the edge is placed midway (its timing uncertainty
-    is one sample interval, rectangular). Several pulses within one interval share the instant.
+    Each edge is placed midway between the samples where the count changes (timing uncertainty one
+    sample interval, rectangular); pulses within one interval share the instant.
 
     Parameters
     ----------
     t : ndarray, shape (n,)
         Sample times [s].
     angle : ndarray, shape (n,)
-        The counted angle [rad], a multiple of ``quantum`` at every sample.
+        Counted angle [rad], a multiple of ``quantum``.
     quantum : float
         Angle of one pulse [rad].
 
     Returns
     -------
-    times : ndarray, shape (m,)
-        Edge instants [s], increasing; empty when the count changes fewer than twice.
-    levels : ndarray, shape (m,)
-        The angle each edge reaches [rad].
+    times, levels : ndarray, shape (m,)
+        Edge instants [s] (empty if fewer than two changes) and the angles they reach [rad].
     """
     steps = np.flatnonzero(np.diff(angle) != 0.0)
     if steps.size < 2:
@@ -47,27 +44,24 @@ def pulse_edges(t: np.ndarray, angle: np.ndarray, quantum: float) -> tuple[np.nd
 def angle_on_grid(record: RigRecord, shaft: str) -> tuple[np.ndarray, np.ndarray | None]:
     """A shaft's angle on the record's grid and, for pulses, the edge instants.
 
-    Pulse counts go through their edges by monotone cubic (PCHIP) interpolation, extrapolated
-    linearly outside the first and last edge (that span is trimmed later).
+    Pulse counts: monotone cubic (PCHIP) through the edges, linear outside them.
 
     Parameters
     ----------
     record : RigRecord
-        The measurement.
     shaft : {"in", "out"}
-        Which shaft.
 
     Returns
     -------
     angle : ndarray, shape (n,)
-        The angle at every sample [rad].
+        Angle at every sample [rad].
     edges : ndarray or None
-        Pulse edge instants [s] for a counted angle, else None.
+        Pulse edge instants [s] for a counted angle.
 
     Raises
     ------
     RigDataError
-        Fewer than 4 pulse edges, or a count that goes back and forth.
+        Fewer than 4 pulse edges, or a count going back and forth.
     """
     t = record.time
     angle = record.channels.get(f"angle_{shaft}")

@@ -14,23 +14,18 @@ __all__ = ["lowpass", "angular_speed"]
 
 
 def lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray:
-    """Zero-phase Butterworth low-pass (forward and backward, ``scipy.signal.sosfiltfilt``).
+    """Zero-phase Butterworth low-pass (``scipy.signal.sosfiltfilt``) along the last axis.
 
     Parameters
     ----------
     x : ndarray, shape (..., n)
-        Signal, filtered along its last axis (any unit).
+        Signal, any unit.
     cutoff : float
-        Cut-off frequency [Hz]; at or above the Nyquist frequency ``x`` is returned as a copy.
+        Cut-off [Hz]; at or above Nyquist ``x`` is returned as a copy.
     rate : float
         Sampling rate [Hz].
     order : int
         Butterworth order of one pass.
-
-    Returns
-    -------
-    ndarray
-        The filtered signal, same shape and unit as ``x``.
     """
     nyquist = 0.5 * rate
     if cutoff >= nyquist:
@@ -40,11 +35,10 @@ def lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray
 
 
 def angular_speed(angle: np.ndarray, dt: float, cutoff: float, method: str) -> np.ndarray:
-    """Speed of a filtered angle.
+    """Speed [rad/s] of a filtered angle.
 
-    Savitzky-Golay: cubic over a window of half a cut-off period (odd, >= 7 samples), whose own
-    smoothing then stays above the cut-off. Spline: a cubic smoothing spline whose penalty puts
-    its half-power frequency at the cut-off.
+    Savitzky-Golay: cubic over half a cut-off period (odd, >= 7 samples), its smoothing above the
+    cut-off. Spline: cubic smoothing spline with its half-power frequency at the cut-off.
 
     Parameters
     ----------
@@ -53,14 +47,8 @@ def angular_speed(angle: np.ndarray, dt: float, cutoff: float, method: str) -> n
     dt : float
         Sampling interval [s].
     cutoff : float
-        The filter's cut-off [Hz].
+        Filter cut-off [Hz].
     method : {"savgol", "spline"}
-        See :data:`rigdata.conditioning.options.DERIVATIVES`.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        Speed [rad/s].
 
     Raises
     ------

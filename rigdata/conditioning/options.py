@@ -1,5 +1,6 @@
-"""The settings of the conditioning (:class:`Conditioning`), validated on construction; the
-defaults and why: ``docs/rigdata.md#choices-and-their-defaults``."""
+"""Settings of the conditioning (:class:`Conditioning`); defaults and why:
+``docs/rigdata.md#choices-and-their-defaults``.
+"""
 
 from __future__ import annotations
 
@@ -16,28 +17,20 @@ DERIVATIVES = ("savgol", "spline")
 
 @dataclass(frozen=True)
 class Conditioning:
-    """Settings of :func:`rigdata.conditioning.condition`.
+    """Settings of :func:`rigdata.conditioning.condition`; a bad setting raises TypeError/ValueError.
 
     Attributes
     ----------
     cutoff_harmonics : float
-        Low-pass cut-off as a multiple of the mean input shaft frequency [-]. Hooke's joint
-        puts the speed ratio's content at even harmonics decaying as tan^2(beta/2)^k: at 15 deg
-        the 2nd harmonic is 3.4 %, the 6th 1e-5; 10 keeps every harmonic above 1e-6 and rejects
-        the noise above.
+        Low-pass cut-off as a multiple of the mean input shaft frequency [-].
     filter_order : int
-        Butterworth order of one pass (the zero-phase filter applies it twice).
+        Butterworth order of one pass (applied twice).
     derivative : {"savgol", "spline"}
-        How a speed is taken from a filtered angle (a shaft without a speed channel).
+        Speed from a filtered angle (shaft without a speed channel).
     settle_revolutions : float
-        Input revolutions dropped at each end before the whole-revolution window [-].
+        Input revolutions dropped at each end before the window [-].
     phase : float or None
         Input yoke phase [rad] if known (skips the estimate).
-
-    Raises
-    ------
-    TypeError, ValueError
-        A setting of the wrong type or out of its range, naming it.
     """
 
     cutoff_harmonics: float = 10.0
@@ -64,7 +57,7 @@ class Conditioning:
             raise ValueError(f"`cutoff_harmonics` must be at most 1e6, got {self.cutoff_harmonics!r}")
 
     def _check_types(self) -> None:
-        """``TypeError`` for a number setting that is not one, or a ``derivative`` not a string."""
+        """TypeError for a number setting that is not a number, or a ``derivative`` not a string."""
         for name in ("cutoff_harmonics", "settle_revolutions", "phase"):
             value = getattr(self, name)
             if (value is not None or name != "phase") and (

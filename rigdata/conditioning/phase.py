@@ -1,6 +1,6 @@
-"""The input yoke phase. The encoder has no index pulse, so the input angle's zero is unknown; it
-is the phase at which Hooke's speed ratio best fits the measured output/input speed ratio,
-determined modulo 180 deg (Hooke's ratio has that period)."""
+"""The input yoke phase (no index pulse): where Hooke's speed ratio best fits the measured one,
+modulo 180 deg (the ratio's period).
+"""
 
 from __future__ import annotations
 
@@ -17,24 +17,22 @@ __all__ = ["estimate_phase"]
 def estimate_phase(angle_in: np.ndarray, ratio: np.ndarray, shaft_angle: float) -> dict:
     """Input yoke phase in [0, pi) that best fits Hooke's speed ratio to the measured one.
 
-    Least squares over the phase (a 360-point scan, then a bounded refinement); the shaft angle
-    that fits best at that phase is reported as a plausibility check.
+    Least squares: 360-point scan, then bounded refinement; the best-fitting shaft angle is a check.
 
     Parameters
     ----------
     angle_in : ndarray, shape (n,)
         Input angle [rad], zero unknown.
     ratio : ndarray, shape (n,)
-        Measured ``omega_out / omega_in`` at the same samples [-].
+        Measured ``omega_out / omega_in`` [-].
     shaft_angle : float
-        The joint's shaft angle [rad].
+        Shaft angle [rad].
 
     Returns
     -------
     dict
-        ``phase`` [rad] (the model's input angle is ``angle_in + phase``), ``rms`` residual of the
-        ratio [-], ``ratio_ripple`` (peak-to-peak of Hooke's ratio at ``shaft_angle``) [-],
-        ``shaft_angle_fit`` [rad] and ``source``.
+        ``phase`` [rad] (model input angle ``angle_in + phase``), ``rms`` ratio residual [-],
+        ``ratio_ripple`` [-], ``shaft_angle_fit`` [rad], ``source``.
     """
     def residual(phase: float, beta: float = shaft_angle) -> float:
         return float(np.mean((ratio - speed_ratio(angle_in + phase, beta)) ** 2))

@@ -1,15 +1,6 @@
-"""From a raw record to conditioned signals on whole input revolutions (:func:`condition`).
-
-Steps (each a parameter of :class:`~rigdata.conditioning.options.Conditioning`):
-
-1. **Angles** of both shafts on the sample grid (:mod:`~rigdata.conditioning.angles`).
-2. **Zero-phase low-pass** of angles, speeds and torques, the cut-off tied to the mean input
-   shaft frequency (``cutoff_harmonics`` times it): every channel gets the same filter, so
-   products such as powers see no relative phase or gain error.
-3. **Speeds**: a measured speed channel, where there is one, filtered; else the speed of the
-   filtered angle (Savitzky-Golay or a smoothing spline). The output angle serves only that.
-4. **Trimming** to whole input revolutions (:mod:`~rigdata.conditioning.window`).
-5. **Input yoke phase** (:mod:`~rigdata.conditioning.phase`), unless given.
+"""From a raw record to conditioned signals on whole input revolutions (:func:`condition`): angles,
+one zero-phase low-pass for every channel (powers see no relative phase or gain error), speeds
+(measured, else from the filtered angle), whole-revolution window, input yoke phase.
 """
 
 from __future__ import annotations
@@ -33,34 +24,30 @@ __all__ = ["Conditioned", "condition"]
 
 @dataclass(frozen=True)
 class Conditioned:
-    """Conditioned signals, on the record's grid cut to the settled span.
+    """Conditioned signals on the record's grid cut to the settled span.
 
     Attributes
     ----------
     t : ndarray, shape (n,)
         Times [s].
     angle_in : ndarray, shape (n,)
-        Filtered input angle [rad], from the first pulse, not phase-corrected.
+        Filtered input angle [rad] from the first pulse, not phase-corrected.
     speed_in, speed_out : ndarray, shape (n,)
         Filtered speeds [rad/s].
-    torque_in, torque_out : ndarray, shape (n,)
-        Filtered torques [N m].
-    raw_torque_in, raw_torque_out : ndarray, shape (n,)
-        Unfiltered torques on the same grid [N m] (for the noise estimate).
+    torque_in, torque_out, raw_torque_in, raw_torque_out : ndarray, shape (n,)
+        Filtered and unfiltered torques [N m].
     window : tuple of float
-        Whole-revolution window ``(t_a, t_b)`` [s], both on input pulse edges where there are
-        pulses.
+        Whole-revolution window ``(t_a, t_b)`` [s], on input pulse edges if any.
     revolutions : int
         Whole input revolutions in the window.
     phase : float
-        Input yoke phase [rad]: the model's input angle is ``angle_in + phase``.
+        Input yoke phase [rad]: model input angle ``angle_in + phase``.
     phase_fit : dict
-        How the phase was found: ``rms`` residual of the speed ratio, ``shaft_angle_fit`` [rad]
-        (the shaft angle that fits best, for a plausibility check) and ``source``.
+        ``rms``, ``shaft_angle_fit`` [rad], ``source``.
     cutoff : float
         Low-pass cut-off [Hz].
     settings : dict
-        The :class:`~rigdata.conditioning.options.Conditioning` used.
+        The Conditioning used.
     """
 
     t: np.ndarray
@@ -89,8 +76,7 @@ class Conditioned:
 
 
 def _check_arguments(record: RigRecord, shaft_angle: float, options: Conditioning | None) -> Conditioning:
-    """The options of :func:`condition` (default ones for None); ``TypeError``/``ValueError`` for
-    arguments of the wrong type or out of range."""
+    """Options of :func:`condition` (defaults for None); TypeError/ValueError for bad arguments."""
     if not isinstance(record, RigRecord):
         raise TypeError(f"`record` must be a RigRecord (rigdata.read(path) reads one), got "
                         f"{type(record).__name__} {record!r:.80}")
@@ -105,8 +91,7 @@ def _check_arguments(record: RigRecord, shaft_angle: float, options: Conditionin
 
 
 def _check_record(record: RigRecord, options: Conditioning) -> None:
-    """:class:`RigDataError` for a record too short for the filter, with absurd values or a dead
-    transducer."""
+    """RigDataError for a record too short for the filter, with absurd values or a dead transducer."""
     fewest = 3 * (2 * math.ceil(options.filter_order / 2) + 1) + 1  # sosfiltfilt's padding + 1
     if record.time.size < fewest:
         raise RigDataError(f"too short: {record.time.size} samples; the zero-phase filter of order "
@@ -122,8 +107,7 @@ def _check_record(record: RigRecord, options: Conditioning) -> None:
 
 
 def _shafts_turn_together(record: RigRecord, angles: dict[str, np.ndarray]) -> None:
-    """A Cardan joint's output turns as far as its input (to within the Hooke error, under a
-    quarter turn): refuse an output channel that says otherwise (dead, stuck or mis-scaled)."""
+    """Refuse an output angle that does not follow the input within a quarter turn (dead, stuck, mis-scaled)."""
     turned = {s: abs(float(angles[s][-1] - angles[s][0])) / (2 * math.pi) for s in SHAFTS}
     if not 0.5 * turned["in"] - 0.25 <= turned["out"] <= 2.0 * turned["in"] + 0.25:
         channel = "speed_out" if "speed_out" in record.channels else "angle_out"
@@ -135,8 +119,7 @@ def _shafts_turn_together(record: RigRecord, angles: dict[str, np.ndarray]) -> N
 
 def _speed(record: RigRecord, shaft: str, filtered_angle: Callable[[], np.ndarray], cutoff: float,
            options: Conditioning) -> np.ndarray:
-    """The shaft's speed [rad/s]: its measured speed channel filtered, else the speed of its
-    filtered angle [rad] (``filtered_angle()``: asked for only then)."""
+    """Shaft speed [rad/s]: its speed channel filtered, else the speed of ``filtered_angle()``."""
     measured = record.channels.get(f"speed_{shaft}")
     if measured is not None:
         return lowpass(measured, cutoff, 1.0 / record.dt, options.filter_order)
@@ -145,9 +128,7 @@ def _speed(record: RigRecord, shaft: str, filtered_angle: Callable[[], np.ndarra
 
 def _filtered(record: RigRecord, angles: dict[str, np.ndarray], cutoff: float,
               options: Conditioning) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """The low-passed input angle [rad]; per shaft the speed [rad/s] (:func:`_speed`) and the
-    low-passed torque [N m]; on the record's grid (``cutoff`` [Hz]). The output angle is
-    filtered only when its speed is taken from it."""
+    """Low-passed input angle [rad], and per shaft speed [rad/s] and torque [N m], at ``cutoff`` [Hz]."""
     rate = 1.0 / record.dt
     angle_in = lowpass(angles["in"], cutoff, rate, options.filter_order)
     speeds = {"in": _speed(record, "in", lambda: angle_in, cutoff, options),
@@ -164,11 +145,9 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
     Parameters
     ----------
     record : RigRecord
-        The measurement.
     shaft_angle : float
-        The joint's shaft angle [rad] (for the phase estimate).
+        Shaft angle [rad], for the phase estimate.
     options : Conditioning, optional
-        The settings (default: :class:`~rigdata.conditioning.options.Conditioning`).
 
     Returns
     -------
@@ -177,8 +156,7 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
     Raises
     ------
     RigDataError
-        A record that cannot be conditioned (too short, a dead transducer, shafts that do not
-        turn together, less than one whole revolution, ...).
+        A record that cannot be conditioned.
     """
     options = _check_arguments(record, shaft_angle, options)
     _check_record(record, options)

@@ -1,9 +1,7 @@
-"""The whole-revolution window, where the measured efficiency is averaged, and the weights of an
-integral over it.
+"""The whole-revolution window, where the measured efficiency is averaged, and integral weights over it.
 
-``settle`` revolutions are dropped at each end (filter transients, start-up); the window starts
-at the first input pulse edge after them (or at the settled angle, without pulses) and ends a
-whole number of revolutions later, also on an edge, so the input angle turned over it is exact.
+``settle`` revolutions dropped at each end; the window starts and ends on input pulse edges, so the
+input angle turned over it is exact.
 """
 
 from __future__ import annotations
@@ -19,8 +17,9 @@ __all__ = ["revolution_window", "window_weights"]
 
 def _window_start(t: np.ndarray, a: np.ndarray, edges: np.ndarray | None, first: float, last: float,
                   settle: float, file: object) -> float:
-    """The first instant [s] at or after the settled angle ``first``: an edge whose angle lies in
-    [``first``, ``last``] where there are edges."""
+    """First instant [s] at or after the settled angle ``first``: an edge in [``first``, ``last``] where there
+    are edges.
+    """
     if edges is None:
         return float(np.interp(first, a, t))
     edge_angle = np.interp(edges, t, a)
@@ -33,16 +32,16 @@ def _window_start(t: np.ndarray, a: np.ndarray, edges: np.ndarray | None, first:
 
 def revolution_window(t: np.ndarray, angle: np.ndarray, edges: np.ndarray | None, settle: float,
                       file: object) -> tuple[float, float, int]:
-    """The whole-revolution window of the input shaft (see the module docstring).
+    """The input shaft's whole-revolution window.
 
     Parameters
     ----------
     t : ndarray, shape (n,)
         Sample times [s].
     angle : ndarray, shape (n,)
-        Input angle on the grid [rad] (either sense of rotation).
+        Input angle [rad], either sense.
     edges : ndarray or None
-        Input pulse edge instants [s], None without pulses.
+        Input pulse edge instants [s].
     settle : float
         Revolutions dropped at each end [-].
     file : object
@@ -58,7 +57,7 @@ def revolution_window(t: np.ndarray, angle: np.ndarray, edges: np.ndarray | None
     Raises
     ------
     RigDataError
-        Less than one whole revolution after the settling.
+        Less than one whole revolution after settling.
     """
     sign = 1.0 if angle[-1] >= angle[0] else -1.0
     a = sign * angle
@@ -82,22 +81,16 @@ def revolution_window(t: np.ndarray, angle: np.ndarray, edges: np.ndarray | None
 
 
 def window_weights(t: np.ndarray, t_a: float, t_b: float) -> np.ndarray:
-    """Trapezoid weights of ``int_{t_a}^{t_b} y dt`` for samples ``y`` on the grid ``t``.
+    """Trapezoid weights [s] of ``int_{t_a}^{t_b} y dt`` on the grid ``t`` (``weights @ y``).
 
-    The ends are interpolated linearly between the samples that bracket them, so the weights
-    are exact for piecewise-linear ``y`` and the integral moves continuously with ``t_a, t_b``.
+    Ends interpolated linearly: exact for piecewise-linear ``y``, continuous in ``t_a, t_b``.
 
     Parameters
     ----------
     t : ndarray, shape (n,)
         Sample times [s], increasing, ``n >= 2``.
     t_a, t_b : float
-        The integral's limits [s], ``t[0] <= t_a < t_b <= t[-1]``.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        Weights [s]: ``weights @ y`` is the integral.
+        Limits [s], ``t[0] <= t_a < t_b <= t[-1]``.
     """
     grid = np.concatenate([[t_a], t[(t > t_a) & (t < t_b)], [t_b]])
     half = 0.5 * np.diff(grid)
