@@ -15,11 +15,8 @@ from rigdata.units import SI, Unit
 
 __all__ = ["LIMITS", "check_magnitudes", "Converted", "to_si", "unwrap_counter"]
 
-#: Largest magnitude of a record's values of each kind, in SI units: time 1e11 s (absolute clocks:
-#: LabVIEW counts seconds since 1904, about 3.8e9 s today; histories may start at any time),
-#: torque 1e8 N m (ten times the largest drive shafts built), speed 1e5 rad/s (1e6 rpm), angle
-#: 1e9 rad. Beyond these a value is a wrong unit or scale or a corrupt file, and squares of it
-#: (the uncertainty budget) would overflow.
+#: Largest magnitude of each kind in SI: time 1e11 s (LabVIEW clocks count from 1904), torque 1e8 N m,
+#: speed 1e5 rad/s, angle 1e9 rad; beyond is a wrong unit or corrupt file (and the budget's squares overflow).
 LIMITS = {"time": 1e11, "torque": 1e8, "speed": 1e5, "angle": 1e9}
 
 

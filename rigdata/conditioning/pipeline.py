@@ -107,7 +107,9 @@ def _check_record(record: RigRecord, options: Conditioning) -> None:
 
 
 def _shafts_turn_together(record: RigRecord, angles: dict[str, np.ndarray]) -> None:
-    """Refuse an output angle that does not follow the input within a quarter turn (dead, stuck, mis-scaled)."""
+    """Refuse an output angle that does not follow the input within a quarter turn (dead, stuck,
+    mis-scaled).
+    """
     turned = {s: abs(float(angles[s][-1] - angles[s][0])) / (2 * math.pi) for s in SHAFTS}
     if not 0.5 * turned["in"] - 0.25 <= turned["out"] <= 2.0 * turned["in"] + 0.25:
         channel = "speed_out" if "speed_out" in record.channels else "angle_out"

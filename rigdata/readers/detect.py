@@ -1,4 +1,6 @@
-"""A rig file's bytes, its format (extension or the caller's word, checked against the first bytes) and text."""
+"""A rig file's bytes, its format (extension or the caller's word, checked against the first bytes) and
+text.
+"""
 
 from __future__ import annotations
 

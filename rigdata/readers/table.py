@@ -112,7 +112,9 @@ def cell_value(text: str, decimal: str = ".") -> float:
 
 
 def find_text_cells(raw: Any, numbers: np.ndarray, lines: list[int] | None) -> TextCells | None:
-    """TextCells of ``raw`` cells that are neither numbers nor missing marks (``lines``: 1-based), else None."""
+    """TextCells of ``raw`` cells that are neither numbers nor missing marks (``lines``: 1-based), else
+    None.
+    """
     strings = np.asarray(raw, dtype=object)
     nan = np.flatnonzero(np.isnan(numbers))
     hits = [k for k in nan if isinstance(strings[k], str) and strings[k].strip().lower() not in MISSING]

@@ -61,7 +61,9 @@ def nptdms_warnings() -> Iterator[list[str]]:
 
 
 def channel_values(channel: Any) -> tuple[np.ndarray, TextCells | None, str | None]:
-    """A channel's values as floats, its text cells, and its type's unit (timestamps: seconds from the first)."""
+    """A channel's values as floats, its text cells, and its type's unit (timestamps: seconds from the
+    first).
+    """
     data = channel[:]
     if np.issubdtype(data.dtype, np.datetime64):
         seconds = (data - data[0]) / np.timedelta64(1, "s") if data.size else data.astype(float)
