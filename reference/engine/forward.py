@@ -1,25 +1,14 @@
 """Forward dynamics of a torque-driven scene at one state, from precomputed Fourier series.
 
-With one degree of freedom the Newton-Euler system of forward dynamics is
+With one degree of freedom the Newton-Euler system is
 
     K(theta) x = R0(theta) + theta_t^2 R2(theta) + T_load U(theta) - T_in e - W(theta) phi,
 
-its matrix (the acceleration's column included) and friction wrenches ``W`` depending on the
-input angle only, and the slot speeds are ``theta_t`` times functions of the angle. So
-``K^-1 R0``, ``K^-1 R2``, ``K^-1 U``, ``K^-1 e``, ``K^-1 W`` and the unit slot speeds, restricted
-to the rows the friction law and the acceleration need, are computed once on a grid of one
-revolution and held as Fourier series (:mod:`reference.engine.series`). A call evaluates the
-series and solves ``phi = G(x0 - S phi)`` (eqs. (3), (5)) by Newton's method
-(:mod:`reference.engine.friction_newton`), warm-started from the previous call; near
-self-locking it solves again as :func:`reference.engine.fixed_point.solve_friction` does, so the
-verdict is the direct solve's. Where no series can be built, :func:`right_hand_side` falls back
-to the direct solve (:func:`direct_acceleration`).
+``K`` and ``W`` depending on the input angle only, the slot speeds ``theta_t`` times functions of
+it. So ``K^-1 R0``, ``K^-1 R2``, ``K^-1 U``, ``K^-1 e``, ``K^-1 W`` and the unit slot speeds are
+held as Fourier series of one revolution (:mod:`reference.engine.series`), and a call solves
+``phi = G(x0 - S phi)`` (eqs. (3), (5)) by Newton's method, warm-started from the previous call.
 Measured: docs/engines.md#constants-of-the-reference-engine.
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation": Section 3 (Newton-Euler of the RCCC model), eqs. (3), (5) (friction).
 """
 
 from __future__ import annotations
@@ -61,30 +50,10 @@ Acceleration = Callable[[float, float, float], tuple[float, bool]]
 
 
 def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[str, np.ndarray]:
-    """The angle-only parts of the forward-dynamics system on ``n`` angles ``2 pi j / n``.
-
-    Parameters
-    ----------
-    scene : Scene
-        The torque-driven scene.
-    slots : list of (pair, "torque" | "force")
-        :func:`reference.engine.slots.friction_slots` (K of them).
-    n : int
-        Grid points per revolution.
-
-    Returns
-    -------
-    dict
-        ``x0``, ``x2``, ``xu``, ``xd`` (n, 18): ``K^-1`` times the right-hand side at rest, its
-        share per ``theta_t^2`` [1/s^2], per unit load torque and per unit drive torque
-        (:func:`reference.engine.newton_euler.unknowns` order, the input acceleration last); ``s`` (n, 18, K):
-        ``K^-1 W``, the solution's response to unit friction values; ``v`` (n, K): slot speeds
-        per unit input speed [m/rad] (:func:`reference.engine.slots.slot_speeds`).
-
-    Raises
-    ------
-    reference.physics.loop_closure.LoopClosureError
-        The loop with the joint's mounting errors does not close at some angle.
+    """The angle-only parts of the system on ``n`` angles ``2 pi j / n`` for ``scene``'s ``slots`` (K):
+    ``x0``, ``x2``, ``xu``, ``xd`` (n, 18), ``K^-1`` times the right-hand side at rest, per
+    ``theta_t^2`` [1/s^2], per unit load and per unit drive torque; ``s`` (n, 18, K), ``K^-1 W``; ``v``
+    (n, K), slot speeds per unit input speed [m/rad]. LoopClosureError where the loop does not close.
     """
     theta = TAU * np.arange(n) / n
     # four blocks: at rest, then a speed, an acceleration and a load so large that their parts
@@ -114,22 +83,10 @@ def angle_functions(scene: Scene, slots: list[tuple[str, str]], n: int) -> dict[
 
 @dataclass(frozen=True)
 class ForwardState:
-    """The forward dynamics at one state.
-
-    Attributes
-    ----------
-    acceleration : float
-        Input acceleration [rad/s^2].
-    friction : ndarray, shape (K,)
-        Friction values of :func:`reference.engine.slots.friction_slots` [N m or N].
-    converged : bool
-        Newton converged (:func:`reference.engine.fixed_point.solve_friction`'s rule).
-    loop_gain : float
-        Spectral radius of the friction loop's Jacobian, or an upper bound (its infinity norm
-        over the active slots) where that is below :data:`WARM_START_GAIN` (0.5 when solved from
-        ``solve_friction``'s start); infinite when Newton did not converge.
-    iterations : int
-        Newton iterations.
+    """The forward dynamics at one state: input ``acceleration`` [rad/s^2], ``friction`` (K,) [N m or N],
+    ``converged``, Newton's ``iterations``, and ``loop_gain``: the friction loop Jacobian's spectral
+    radius, or an upper bound where that is below :data:`WARM_START_GAIN` (infinite when not
+    converged).
     """
 
     acceleration: float
@@ -145,32 +102,12 @@ class ForwardState:
 
 
 class ForwardDynamics:
-    """The input acceleration of a torque-driven scene at one state, from precomputed series.
+    """The input acceleration of a torque-driven ``scene`` at one state, from the precomputed
+    ``series`` (:func:`_layout`'s ``parts``, 2 or 3 with a load history, side by side) of the ``active``
+    slots (those that can rub).
 
-    Build with :meth:`of_scene`; call as the integrator's ``(t, theta, theta_t) ->
-    (theta_tt, self_locking)`` or :meth:`solve` for the whole state. Not thread-safe (it keeps
-    the last call's friction as Newton's next start).
-
-    Attributes
-    ----------
-    series : TrigSeries
-        The fit: per active slot and pair component the friction response and the solution, the
-        acceleration's, the unit slot speeds (:func:`_layout`), for the base, per ``theta_t^2``
-        [s^2] and per load torque (a history) side by side.
-    active : ndarray of int
-        The friction slots that can rub (a slot whose speed is zero at every angle, the axial
-        friction of the ideal joint, has none).
-
-    Parameters
-    ----------
-    scene : Scene
-        The torque-driven scene.
-    series : TrigSeries
-        The fit of :func:`_layout`'s parts, side by side.
-    active : ndarray of int
-        See Attributes.
-    parts : int
-        How many parts ``series`` holds (2, or 3 with a load history).
+    Build with :meth:`of_scene`; call as the integrator's ``(t, theta, theta_t) -> (theta_tt,
+    self_locking)`` or :meth:`solve`. Not thread-safe (the last call's friction starts the next).
     """
 
     def __init__(self, scene: Scene, series: TrigSeries, active: np.ndarray, parts: int) -> None:
@@ -207,20 +144,8 @@ class ForwardDynamics:
 
     @classmethod
     def of_scene(cls, scene: Scene, torque_in: float) -> ForwardDynamics | None:
-        """Fit the series for a scene.
-
-        Parameters
-        ----------
-        scene : Scene
-            The torque-driven scene.
-        torque_in : float
-            Drive torque [N m].
-
-        Returns
-        -------
-        ForwardDynamics or None
-            None where the loop does not close at some angle or no grid of :data:`GRID_SIZES`
-            resolves the series.
+        """Fit the series for ``scene`` at drive torque ``torque_in`` [N m]; None where the loop does not
+        close at some angle or no grid of :data:`GRID_SIZES` resolves the series.
         """
         slots = friction_slots(scene)
         index = FrictionLaw(scene, slots).index
@@ -265,18 +190,8 @@ class ForwardDynamics:
         return float(last[k] - last[:k] @ phi), phi, converged, gain, iterations
 
     def solve(self, theta: float, theta_t: float, load: float | None = None) -> ForwardState:
-        """The forward dynamics at one state.
-
-        Parameters
-        ----------
-        theta, theta_t : float
-            Input angle [rad] and speed [rad/s].
-        load : float or None
-            Output load [N m]; None: the scene's constant load (a history needs it given).
-
-        Returns
-        -------
-        ForwardState
+        """:class:`ForwardState` at input angle ``theta`` [rad], speed ``theta_t`` [rad/s] and output
+        ``load`` [N m] (None: the scene's constant load).
         """
         if self._history is not None and load is None:
             raise ValueError("the scene's load is a torque history: pass `load` [N m]")
@@ -328,24 +243,9 @@ def _layout(scene: Scene, torque_in: float, f: dict[str, np.ndarray], rows: np.n
 
 def direct_acceleration(scene: Scene, torque_in: float, t: float, theta: float, theta_t: float,
                         bands: np.ndarray | None = None) -> tuple[float, bool]:
-    """The input acceleration at one state by :func:`reference.engine.dynamics.solve_dynamics`.
-
-    Parameters
-    ----------
-    scene : Scene
-        The torque-driven scene.
-    torque_in : float
-        Drive torque [N m].
-    t, theta, theta_t : float
-        Time [s] (the load history's), input angle [rad] and speed [rad/s].
-    bands : ndarray, shape (K,), or None
-        The slots' ramp widths [m/s] (:func:`reference.engine.slots.slot_bands`); None: looked up.
-
-    Returns
-    -------
-    theta_tt : float
-        [rad/s^2].
-    self_locking : bool
+    """``(theta_tt [rad/s^2], self_locking)`` at time ``t`` [s], ``theta`` [rad], ``theta_t`` [rad/s]
+    by :func:`reference.engine.dynamics.solve_dynamics`; ``bands`` (K,) [m/s] the slots' ramp widths
+    (None: looked up).
     """
     _, fixed = solve_dynamics(scene, np.array([theta]), np.array([theta_t]), torque_in=torque_in,
                               load_torque=scene.load.at(np.array([t])), bands=bands)
@@ -356,23 +256,9 @@ METHODS = ("auto", "series", "direct")
 
 
 def right_hand_side(scene: Scene, torque_in: float, method: str = "auto") -> Acceleration:
-    """The input acceleration as a function of the state.
-
-    Parameters
-    ----------
-    scene : Scene
-        The torque-driven scene.
-    torque_in : float
-        Drive torque [N m].
-    method : str
-        ``"series"`` (:class:`ForwardDynamics`; ValueError where it cannot be built),
-        ``"direct"`` (:func:`direct_acceleration`) or ``"auto"`` (the series, else the direct
-        solve).
-
-    Returns
-    -------
-    callable
-        ``(t [s], theta [rad], theta_t [rad/s]) -> (theta_tt [rad/s^2], self_locking)``.
+    """``(t, theta, theta_t) -> (theta_tt, self_locking)`` for ``scene`` at drive torque ``torque_in``
+    [N m]; ``method`` ``"series"`` (:class:`ForwardDynamics`, ValueError where it cannot be built),
+    ``"direct"`` (:func:`direct_acceleration`) or ``"auto"`` (the series, else direct).
     """
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")

@@ -1,12 +1,6 @@
-"""Adaptive Gauss-Legendre quadrature on panels: the reference engine's work integrals.
-
-:func:`adaptive_gauss` integrates a vector integrand over panels that break at every kink (the
-reference engine puts the edges of the friction sign ramps and the knots of histories there, so
-inside a panel the integrand is smooth and the rule converges exponentially); the samples of a
-dense load history enter through :class:`HistoryRule`'s weights instead, at a cost that does not
-grow with them. :func:`quadrature_summary` is how a run reports it
-(``summary.extras["quadrature"]``). The batched engine (:mod:`reference.engine.batch.quadrature`) uses
-the same panels, constants and report.
+"""Adaptive Gauss-Legendre quadrature on panels that break at every kink (friction ramp edges,
+history knots), the reference engine's work integrals; a dense load history's samples enter through
+:class:`HistoryRule`'s weights. :func:`quadrature_summary` is ``summary.extras["quadrature"]``.
 """
 
 from __future__ import annotations
@@ -23,21 +17,8 @@ __all__ = ["GROSS_SCALE", "DENSE_WIDTH", "DENSE_NODES", "MAX_OPEN_PANELS", "ROUN
 
 
 def initial_panels(edges: np.ndarray, max_width: float) -> tuple[np.ndarray, np.ndarray]:
-    """Panels covering the segments between consecutive edges, none wider than ``max_width``:
-    each segment cut into equal parts at ``np.linspace``'s cuts (vectorised: a history's samples
-    may make 10^5 segments).
-
-    Parameters
-    ----------
-    edges : ndarray, shape (E,)
-        Ascending edges [s]; repeated ones make no panel.
-    max_width : float
-        Widest panel [s].
-
-    Returns
-    -------
-    lo, hi : ndarray, shape (P,)
-        The panels' ends [s].
+    """Panels ``(lo, hi)`` [s] covering the segments between the ascending ``edges`` [s] (repeated ones
+    make none), none wider than ``max_width`` [s]; vectorised (a history may make 10^5 segments).
     """
     edges = np.asarray(edges, float)
     keep = edges[1:] > edges[:-1]
@@ -80,20 +61,11 @@ Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 
 class GaussRule:
-    """The ``nodes``-point Gauss-Legendre rule on panels, for an integrand of time alone.
+    """The ``nodes``-point Gauss-Legendre rule on panels, for an ``integrand`` of time (m,) [s] to (m, k).
 
     ``rule(lo, hi)`` gives the panels' integrals (P, k) and their own error bounds (zero: the
-    adaptive comparison of whole and halves is the estimate); ``rule.children(lo, hi, over)``
-    the panels a refinement splits them into (their halves), with each one's parent;
-    ``evaluations`` counts the integrand's instants so far, ``cut_panels`` the panels split
-    otherwise than in halves.
-
-    Parameters
-    ----------
-    integrand : callable
-        Times (m,) [s] to values (m, k).
-    nodes : int
-        Gauss nodes per panel.
+    comparison of whole and halves is the estimate); ``evaluations`` counts the instants evaluated,
+    ``cut_panels`` the panels split otherwise than in halves.
     """
 
     def __init__(self, integrand: Callable[[np.ndarray], np.ndarray], nodes: int) -> None:
@@ -118,21 +90,8 @@ class GaussRule:
 
     def children(self, lo: np.ndarray, hi: np.ndarray,
                  over: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The panels a refinement splits ``[lo, hi]`` into: their halves.
-
-        Parameters
-        ----------
-        lo, hi : ndarray, shape (P,)
-            The panels [s].
-        over : ndarray of bool, shape (P,)
-            The panels whose own bound failed (not needed here).
-
-        Returns
-        -------
-        lo, hi : ndarray, shape (2 P,)
-            All left halves, then all right ones [s].
-        parent : ndarray of int, shape (2 P,)
-            Each one's panel.
+        """``(lo, hi, parent)``: the halves (2 P,) [s] of the panels ``[lo, hi]``, all left ones first, and
+        each one's panel (``over`` is not needed here).
         """
         mid = 0.5 * (lo + hi)
         parent = np.arange(lo.size)
@@ -169,45 +128,16 @@ class _Pieces(NamedTuple):
 
 
 class HistoryRule(GaussRule):
-    """Panels of ``f(t, L(t))`` with ``L`` piecewise linear in time (a load history), at a cost
-    that does not grow with the samples where ``f`` is smooth in the load.
+    """Panels of ``integrand(t, L)`` with ``L`` the piecewise-linear history ``time`` [s], ``value``, at a
+    cost that does not grow with the samples where ``f`` is smooth in the load.
 
-    On a panel with samples inside, ``f`` is interpolated in time on the ``nodes`` Gauss nodes
-    (degree nodes - 1) and in the load by a Chebyshev series of degree :data:`LOAD_LEVELS` - 1
-    over the range the history takes on the panel (its values at the panel's ends and at the
-    samples inside, ``L`` being linear between them): ``nodes * LOAD_LEVELS`` evaluations. The
-    product of the time basis with each Chebyshev polynomial of the load along ``L(t)`` is a
-    polynomial between consecutive samples, integrated exactly by a Gauss rule on each such
-    piece: the samples cost arithmetic, not evaluations of ``f``. The panel's own error bound is
-    the integral of the last two Chebyshev terms' sizes (the load interpolation's truncation;
-    the time interpolation's shows in the adaptive comparison of whole and halves). On a panel
-    without samples inside ``L`` is linear, and ``f(t, L(t))`` is integrated by the
-    :data:`DENSE_NODES`-point Gauss rule; on one where the history is flat, by the ``nodes``-point
-    rule.
-
-    A panel whose bound fails is refined by halving, which shrinks the load's range with the
-    panel, until it holds at most :attr:`cut_samples` samples; then it is cut at its samples
-    (where noise spans the range, or ``f`` is not smooth in the load over it, e.g. a reaction
-    through zero, the samples become panel edges, as for a sparse history).
-
-    Why: with every sample a panel edge, a history costs 9 evaluations of the dynamics per
-    sample.
-
-    Parameters
-    ----------
-    integrand : callable
-        ``f(t, L)``: times [s] and loads, both (m,), to values (m, k).
-    nodes : int
-        Gauss nodes in time per panel.
-    time, value : ndarray, shape (n,)
-        The history's samples [s] and values, held at the end values outside.
-
-    Attributes
-    ----------
-    cut_samples : int
-        At most this many samples inside, a panel whose bound fails is cut at them: its pieces
-        (``DENSE_NODES`` evaluations each, then their halves) cost no more than one round of
-        interpolated halves.
+    On a panel with samples inside, ``f`` is interpolated on the ``nodes`` Gauss nodes in time and by
+    a Chebyshev series of degree :data:`LOAD_LEVELS` - 1 in the load over the panel's load range; the
+    products with ``L(t)`` are integrated exactly piece by piece between samples, so samples cost
+    arithmetic, not evaluations. The panel's bound is the size of the last two Chebyshev terms. A panel
+    without samples inside uses the :data:`DENSE_NODES` rule (the ``nodes`` rule where flat). A panel
+    whose bound fails is halved until it holds at most :attr:`cut_samples` samples, then cut at them.
+    Why: with every sample a panel edge, a history costs 9 evaluations of the dynamics per sample.
     """
 
     def __init__(self, integrand: Callable[[np.ndarray, np.ndarray], np.ndarray], nodes: int,
@@ -257,16 +187,6 @@ class HistoryRule(GaussRule):
                  over: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """:meth:`GaussRule.children`, except that a panel ``over`` its bound with at most
         :attr:`cut_samples` samples inside is cut at its samples rather than halved.
-
-        Parameters
-        ----------
-        lo, hi, over
-            As for :meth:`GaussRule.children`.
-
-        Returns
-        -------
-        lo, hi, parent : ndarray, shape (Q,)
-            The new panels [s] and each one's panel.
         """
         count = self._count(lo, hi)
         cut = over & (count > 0) & (count <= self.cut_samples)
@@ -347,15 +267,11 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
                    history: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, dict]:
     """Integrals of a vector integrand over the union of panels ``[a, b]``, adaptively.
 
-    Every open panel is integrated with the ``nodes``-point Gauss-Legendre rule as a whole and
-    as two halves; it is closed when the two agree within ``rtol * |I[scale_key]| * width /
-    total width``, or within ``ROUNDING_FLOOR * |I[scale_key]|``, in every component (the halves'
-    value is kept; their difference goes into the error estimate), otherwise its halves are the
-    next round's panels, whose whole-panel values are already known. All open panels of a round
-    are evaluated in one call. The scale is at least ``GROSS_SCALE`` times the integral of
-    ``|I[scale_key]|`` and at least ``scale_floor`` (so that an integral that cancels or
-    vanishes, e.g. the input work of a joint with no load and no loss, does not ask for
-    rounding-level accuracy), and at most ``MAX_OPEN_PANELS`` panels stay open.
+    Every open panel is integrated as a whole and as two halves and closed when they agree within
+    ``rtol * scale * width / total width`` or ``ROUNDING_FLOOR * scale`` in every component, else
+    halved. The scale is at least ``GROSS_SCALE`` times the integral of ``|I[scale_key]|`` and at
+    least ``scale_floor`` (an integral that cancels does not ask for rounding-level accuracy); at
+    most ``MAX_OPEN_PANELS`` stay open.
 
     Parameters
     ----------
@@ -374,17 +290,15 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
     scale_floor : float
         Least scale, in the units of component ``scale_key``'s integral.
     history : (ndarray, ndarray) or None
-        Sample times [s] and values of a piecewise-linear load ``L(t)``: the panels are
-        integrated and split by :class:`HistoryRule`, whose own error bounds are added to the
-        difference of whole and parts, in the closing test and in the error estimate.
+        Sample times [s] and values of a piecewise-linear load: panels integrated and split by
+        :class:`HistoryRule`, whose bounds join the error estimate.
 
     Returns
     -------
     integral : ndarray, shape (k,)
     info : dict
-        ``evaluations``, ``rounds``, ``panels`` (closed), ``cut_panels`` (split at the history's
-        samples), ``error_estimate`` (sum of the closed panels' whole-versus-halves differences,
-        per component; a conservative bound).
+        ``evaluations``, ``rounds``, ``panels`` (closed), ``cut_panels``, ``error_estimate`` (per
+        component, the closed panels' whole-versus-halves differences; conservative).
     """
     rule = GaussRule(integrand, nodes) if history is None else HistoryRule(integrand, nodes, *history)
     total_width = float(np.sum(b - a))
@@ -439,29 +353,9 @@ def _rounds(rule: GaussRule, a: np.ndarray, b: np.ndarray, whole: np.ndarray, wh
 
 def quadrature_summary(info: dict, nodes: int, rtol: float, sign_breakpoints: int, knots: int,
                        revolutions_integrated: int, weighted_load_samples: int = 0) -> dict:
-    """``summary.extras["quadrature"]``: how the works were integrated.
-
-    Parameters
-    ----------
-    info : dict
-        :func:`adaptive_gauss`' info; its error estimates of components 0 and 2 (the input and
-        lost work [J] of :data:`reference.engine.work.WORK_KEYS`) are reported.
-    nodes : int
-        Gauss nodes per panel.
-    rtol : float
-        The quadrature's tolerance.
-    sign_breakpoints : int
-        Friction ramp edges found.
-    knots : int
-        History samples that are panel edges.
-    revolutions_integrated : int
-        Whole revolutions integrated (one when a periodic motion's is multiplied).
-    weighted_load_samples : int
-        History samples that enter through :class:`HistoryRule`'s weights.
-
-    Returns
-    -------
-    dict
+    """``summary.extras["quadrature"]``: how the works were integrated, from :func:`adaptive_gauss`'
+    ``info`` (error estimates of the input and lost work [J]), ``nodes``, ``rtol``, the counts of
+    friction ramp edges, history knots and weighted load samples, and the revolutions integrated.
     """
     return {"method": "adaptive Gauss-Legendre panels", "nodes_per_panel": nodes, "rtol": rtol,
             "sign_breakpoints": sign_breakpoints, "knots": knots,

@@ -1,10 +1,6 @@
-"""Means over whole input revolutions: the window, its integrals, and the summary's mean values.
-
-The window spans whole input revolutions after the skipped ones; every integral over it is the
-trapezoid of the table's rows except across friction's sign jumps
-(:mod:`reference.results.quadrature`). The means are those of the direction the power flows over
-the window (:mod:`reference.results.power_flow`); the paper's eq. (18) and its time average
-assume the input is the source.
+"""Means over whole input revolutions: the window, its integrals (trapezoid except across friction's
+sign jumps, :mod:`reference.results.quadrature`) and the summary's mean values in the direction the
+power flows (the paper's eq. (18) assumes the input is the source).
 """
 
 from __future__ import annotations
@@ -25,39 +21,15 @@ __all__ = ["after_revolutions", "whole_revolution_window", "cumulative", "window
 
 
 def after_revolutions(theta_in: np.ndarray, skip_revolutions: float) -> np.ndarray:
-    """Mask of the rows after the first revolutions of the input (either sense).
-
-    Parameters
-    ----------
-    theta_in : ndarray, shape (n,)
-        Input angle [rad].
-    skip_revolutions : float
-        Revolutions [-] left out at the start.
-
-    Returns
-    -------
-    ndarray of bool, shape (n,)
+    """Mask of the rows past ``skip_revolutions`` [-] input revolutions (either sense) of ``theta_in`` [rad].
     """
     theta = np.asarray(theta_in, float)
     return np.abs(theta - theta[0]) >= 2.0 * math.pi * skip_revolutions
 
 
 def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tuple[float, float, int]:
-    """Input-angle window spanning whole revolutions after the skipped ones.
-
-    Parameters
-    ----------
-    theta_in : ndarray, shape (n,)
-        Input angle [rad], monotonic.
-    skip_revolutions : float
-        Revolutions [-] left out at the start.
-
-    Returns
-    -------
-    theta_0, theta_1 : float
-        The window's ends [rad], ``theta_1 = theta_0 + 2 pi n`` in the direction of motion.
-    n : int
-        Whole revolutions in it; 0 when less than one is available.
+    """``(theta_0, theta_1, n)``: the input-angle window [rad] of ``n`` whole revolutions after
+    ``skip_revolutions`` of the monotonic ``theta_in`` [rad] (``n = 0`` when less than one remains).
     """
     sign = 1.0 if theta_in[-1] >= theta_in[0] else -1.0
     theta_0 = theta_in[0] + sign * 2.0 * math.pi * skip_revolutions
@@ -68,22 +40,8 @@ def whole_revolution_window(theta_in: np.ndarray, skip_revolutions: float) -> tu
 
 
 def cumulative(y: np.ndarray, t: np.ndarray, breaks: Sequence[tuple[int, int, float]] = ()) -> np.ndarray:
-    """Integral of ``y dt`` from the first row to each row: trapezoidal, except across the
-    friction jumps.
-
-    Parameters
-    ----------
-    y : ndarray, shape (n,)
-        The integrand (e.g. a power [W]).
-    t : ndarray, shape (n,)
-        Time [s].
-    breaks : sequence of (int, int, float)
-        The friction jumps (:func:`reference.results.quadrature.jump_breaks`).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The running integral (e.g. a work [J]), 0 at the first row.
+    """Running integral of ``y dt`` over time ``t`` [s], 0 at the first row: trapezoidal except across
+    the friction jumps ``breaks`` (:func:`reference.results.quadrature.jump_breaks`).
     """
     out = np.zeros(np.shape(t), float)
     out[1:] = np.cumsum(segment_integrals(y, t, breaks))
@@ -93,21 +51,8 @@ def cumulative(y: np.ndarray, t: np.ndarray, breaks: Sequence[tuple[int, int, fl
 def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
                     theta_0: float, theta_1: float,
                     breaks: Sequence[tuple[int, int, float]] = ()) -> float:
-    """Integral of ``y dt`` between the instants where ``theta`` passes ``theta_0`` and ``theta_1``.
-
-    Parameters
-    ----------
-    y, t, theta : ndarray, shape (n,)
-        The integrand, time [s] and a monotonic angle [rad] (the input angle).
-    theta_0, theta_1 : float
-        The window's ends [rad]; the integral is interpolated linearly in ``theta`` there.
-    breaks : sequence of (int, int, float)
-        The friction jumps integrated across (:func:`cumulative`).
-
-    Returns
-    -------
-    float
-        The integral (unit of ``y`` times s).
+    """Integral of ``y dt`` between the instants the monotonic ``theta`` [rad] passes ``theta_0`` and
+    ``theta_1`` (interpolated linearly in ``theta``), across the friction jumps ``breaks``.
     """
     cum = cumulative(np.asarray(y, float), np.asarray(t, float), breaks)
     th = np.asarray(theta, float)
@@ -119,22 +64,7 @@ def window_integral(y: np.ndarray, t: np.ndarray, theta: np.ndarray,
 
 
 def window_duration(t: np.ndarray, theta: np.ndarray, theta_0: float, theta_1: float) -> float:
-    """Time between the instants where ``theta`` passes ``theta_0`` and ``theta_1``.
-
-    Parameters
-    ----------
-    t : ndarray, shape (n,)
-        The rows' time [s].
-    theta : ndarray, shape (n,)
-        A monotonic angle [rad] (the input angle).
-    theta_0, theta_1 : float
-        The window's ends [rad]; the instants are interpolated linearly in ``theta``.
-
-    Returns
-    -------
-    float
-        The duration [s].
-    """
+    """Time [s] between the instants the monotonic ``theta`` [rad] passes ``theta_0`` and ``theta_1``."""
     th = np.asarray(theta, float)
     if th[-1] < th[0]:
         th = -th
@@ -147,11 +77,9 @@ def mean_values(columns: Mapping[str, np.ndarray], skip_revolutions: float,
                 works: Mapping[str, float] | None = None) -> dict[str, Any]:
     """Mean values over whole input revolutions, in the direction the power flows.
 
-    ``power_flow`` comes from the signs of the works (:func:`reference.results.power_flow.classify_works`);
-    ``mean_efficiency`` is one minus lost over supplied work; ``mean_instantaneous_efficiency`` the
-    time average of eq. (18) over the same window for that direction (:func:`flow_time_average`);
-    ``work_ratio`` is received over supplied work (the rig's definition; it differs from
-    ``mean_efficiency`` by the change of mechanical energy and, without friction, measures it).
+    ``mean_efficiency`` is one minus lost over supplied work, ``mean_instantaneous_efficiency`` the time
+    average of eq. (18), ``work_ratio`` received over supplied work (the rig's definition; it differs
+    from ``mean_efficiency`` by the change of mechanical energy).
 
     Parameters
     ----------
@@ -160,16 +88,14 @@ def mean_values(columns: Mapping[str, np.ndarray], skip_revolutions: float,
     skip_revolutions : float
         Input revolutions left out at the start [-].
     works : mapping, optional
-        ``input_work``, ``output_work``, ``loss_work`` [J] (and ``loss_work_<pair>``, ...) of the
-        window from a better integration than the table's trapezoid (the reference engine's
-        quadrature): they replace the table's, and every mean is taken from them.
+        ``input_work``, ``output_work``, ``loss_work`` [J] (and ``loss_work_<pair>``, ...) of the window
+        from a better quadrature than the table's trapezoid; every mean is taken from them.
 
     Returns
     -------
     dict
-        The summary keys (:data:`reference.results.summary.MEAN_KEYS`,
-        :data:`reference.results.summary.FLOW_KEYS`, ``loss_work_<pair>``), ``warnings``
-        (list of str) and ``unphysical`` (why the means are impossible; empty when they are not);
+        The summary keys (:data:`reference.results.summary.MEAN_KEYS`, ``FLOW_KEYS``,
+        ``loss_work_<pair>``), ``warnings`` and ``unphysical`` (empty when the means are possible);
         ``revolutions`` 0 and ``mean_status`` when there is no whole revolution.
     """
     t = columns["t"]
@@ -204,27 +130,9 @@ def mean_values(columns: Mapping[str, np.ndarray], skip_revolutions: float,
 
 def flow_means(columns: Mapping[str, np.ndarray], works: Mapping[str, float], integral: Any,
                duration: float, inside: np.ndarray) -> dict[str, Any]:
-    """The means that depend on the direction of the power flow (:func:`mean_values`).
-
-    Parameters
-    ----------
-    columns : mapping
-        The table's columns (powers [W], energies [J], time [s]).
-    works : mapping
-        ``input_work``, ``output_work``, ``loss_work`` of the window [J].
-    integral : callable
-        ``integral(y)``: the window's integral of ``y dt``.
-    duration : float
-        The window's duration [s].
-    inside : ndarray of bool
-        The rows of the window (:func:`window_rows`).
-
-    Returns
-    -------
-    dict
-        ``mean_efficiency``, ``work_ratio``, ``mean_instantaneous_efficiency``, ``power_flow``,
-        ``power_reversals``, ``warnings`` and ``unphysical`` (why the means are impossible, with the
-        likely cause; empty when they are not).
+    """The means that depend on the power flow's direction, from the window's ``works`` [J],
+    ``integral(y)``, ``duration`` [s] and rows ``inside``: efficiency, work ratio, time average, flow,
+    reversals, ``warnings`` and ``unphysical``.
     """
     w_in = works["input_work"]
     w_out = works["output_work"]
@@ -249,20 +157,7 @@ def flow_means(columns: Mapping[str, np.ndarray], works: Mapping[str, float], in
 
 
 def window_rows(theta: np.ndarray, theta_0: float, theta_1: float) -> np.ndarray:
-    """Mask of the rows whose values enter the window's integrals.
-
-    Parameters
-    ----------
-    theta : ndarray, shape (n,)
-        A monotonic angle [rad] (the input angle).
-    theta_0, theta_1 : float
-        The window's ends [rad].
-
-    Returns
-    -------
-    ndarray of bool, shape (n,)
-        The rows between the ends and the row on either side that brackets an end.
-    """
+    """Mask of the rows between ``theta_0`` and ``theta_1`` [rad] plus the row bracketing each end."""
     sign = 1.0 if theta_1 >= theta_0 else -1.0
     th = sign * np.asarray(theta, float)
     lo = sign * theta_0
@@ -275,21 +170,7 @@ def window_rows(theta: np.ndarray, theta_0: float, theta_1: float) -> np.ndarray
 
 
 def pair_loss_works(columns: Mapping[str, np.ndarray], integral: Any) -> dict[str, float]:
-    """Each pair's loss work and its axial-friction part.
-
-    Parameters
-    ----------
-    columns : mapping of str to ndarray, shape (n,)
-        Result-schema columns; the pairs whose ``power_loss_<pair>`` (and friction force and
-        slide speed) are present count.
-    integral : callable
-        ``integral(y)``: the window's integral of ``y dt``.
-
-    Returns
-    -------
-    dict of str to float
-        ``loss_work_<pair>`` and ``loss_work_<pair>_sliding`` [J].
-    """
+    """Each pair's ``loss_work_<pair>`` and axial-friction part ``loss_work_<pair>_sliding`` [J]."""
     out = {}
     for p in PAIR_NAMES:
         key = f"power_loss_{p}"
@@ -303,34 +184,11 @@ def pair_loss_works(columns: Mapping[str, np.ndarray], integral: Any) -> dict[st
 
 def flow_time_average(columns: Mapping[str, np.ndarray], flow: str | None, inside: np.ndarray,
                       integral: Any, duration: float) -> tuple[float | None, int | None, str]:
-    """Time average of eq. (18) over the window for the direction of the power flow.
+    """``(average, reversals, note)``: time average of eq. (18), ``1 - P_loss / P_src`` with
+    ``P_src = P_in`` or ``-P_out`` by ``flow``, over the rows ``inside``.
 
-    Eq. (18) is ``1 - P_loss / P_src`` with the source power ``P_src`` = ``P_in``, or ``-P_out``
-    when the power flows from the output to the input. The average is defined only when
-    ``P_src > 0`` at every row of the window (it has poles where ``P_src`` changes sign) and is
-    reported only in [0, 1].
-
-    Parameters
-    ----------
-    columns : mapping
-        The table's columns.
-    flow : str or None
-        A :class:`reference.results.power_flow.PowerFlow` value.
-    inside : ndarray of bool
-        The rows of the window.
-    integral : callable
-        ``integral(y)``: the window's integral of ``y dt``.
-    duration : float
-        The window's duration [s].
-
-    Returns
-    -------
-    average : float or None
-        None where it is not reported.
-    reversals : int or None
-        Sign changes of the source power at the window's rows.
-    note : str
-        Why the average is not reported (empty when it is).
+    Defined only when ``P_src > 0`` at every row (it has poles where ``P_src`` changes sign) and
+    reported only in [0, 1]; else ``average`` is None and ``note`` says why.
     """
     if flow is None:
         return None, None, ""

@@ -1,10 +1,5 @@
-"""Checks of user input shared by every part of a scene, and the units it may be given in.
-
-The bottom of the scene modules (:mod:`reference.scene.joint`, :mod:`reference.scene.scene`,
-:mod:`reference.paper`, :mod:`reference.scene.files`): it imports none of them, so each validates
-its fields with the same kind of message (the field, the rule, the value given) and raises the
-same :class:`SceneError`. Values are SI inside; :data:`DEG` and :data:`RPM` convert the units
-users may give at the boundary.
+"""Checks of user input shared by every part of a scene, the one :class:`SceneError` they raise
+(naming the field, the rule and the value), and the units :data:`DEG`, :data:`RPM` (SI inside).
 """
 
 from __future__ import annotations
@@ -47,30 +42,14 @@ class SceneError(ValueError):
 
 
 class SceneTypeError(SceneError, TypeError):
-    """A scene field (or an argument where a scene is expected) of the wrong type: both a
-    :class:`SceneError` (the command line's one-line error, exit 2) and a ``TypeError``."""
+    """A scene field (or scene argument) of the wrong type: both a :class:`SceneError` (the command
+    line's one-line error, exit 2) and a ``TypeError``.
+    """
 
 
 def require_scene(value: Any, name: str = "scene") -> Any:
-    """``value`` when it is a :class:`reference.scene.scene.Scene` (the check of every public
-    function that takes a scene).
-
-    Parameters
-    ----------
-    value : Any
-        What arrived.
-    name : str
-        The argument's name, for the message.
-
-    Returns
-    -------
-    Scene
-        ``value``.
-
-    Raises
-    ------
-    SceneTypeError
-        Not a scene.
+    """``value`` when it is a :class:`reference.scene.scene.Scene`, else :class:`SceneTypeError` naming
+    ``name``.
     """
     if type(value).__name__ != "Scene" or not hasattr(value, "drive"):  # no import: scene.py imports this
         hint = " (a named scene: reference.named_scene(name); a file: reference.load_scene(path))" \
@@ -80,28 +59,8 @@ def require_scene(value: Any, name: str = "scene") -> Any:
 
 
 def require_instance(name: str, value: Any, cls: type | tuple[type, ...], what: str) -> Any:
-    """``value`` when it is an instance of ``cls``.
-
-    Parameters
-    ----------
-    name : str
-        The field's name, for the message.
-    value : Any
-        What arrived.
-    cls : type or tuple of type
-        The types allowed.
-    what : str
-        What it must be, for the message (e.g. "a Drive").
-
-    Returns
-    -------
-    Any
-        ``value``.
-
-    Raises
-    ------
-    SceneTypeError
-        Not an instance of ``cls``.
+    """``value`` when it is an instance of ``cls``, else :class:`SceneTypeError` naming ``name`` and
+    ``what`` it must be (e.g. "a Drive").
     """
     if not isinstance(value, cls):
         raise SceneTypeError(f"`{name}` must be {what}, got {type(value).__name__} {value!r:.80}")
@@ -114,20 +73,7 @@ def is_sequence(value: Any) -> bool:
 
 
 def finite(name: str, value: Any) -> float:
-    """``value`` as a float; :class:`SceneError` naming ``name`` unless it is a finite number.
-
-    Parameters
-    ----------
-    name : str
-        Field name for the message.
-    value : Any
-        A Python or numpy number, in the field's SI unit (booleans are refused).
-
-    Returns
-    -------
-    float
-        The value, unit unchanged.
-    """
+    """``value`` as a float; :class:`SceneError` naming ``name`` unless a finite number (booleans refused)."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
         raise SceneTypeError(f"`{name}` must be a number, got {value!r:.80}")
     try:
@@ -143,20 +89,7 @@ def finite(name: str, value: Any) -> float:
 
 
 def positive(name: str, value: Any) -> float:
-    """:func:`finite`, and > 0.
-
-    Parameters
-    ----------
-    name : str
-        Field name for the message.
-    value : Any
-        A number in the field's SI unit.
-
-    Returns
-    -------
-    float
-        The value, unit unchanged.
-    """
+    """:func:`finite`, and > 0."""
     value = finite(name, value)
     if value <= 0.0:
         raise SceneError(f"`{name}` must be positive, got {value!r}")
@@ -164,20 +97,7 @@ def positive(name: str, value: Any) -> float:
 
 
 def non_negative(name: str, value: Any) -> float:
-    """:func:`finite`, and >= 0.
-
-    Parameters
-    ----------
-    name : str
-        Field name for the message.
-    value : Any
-        A number in the field's SI unit.
-
-    Returns
-    -------
-    float
-        The value, unit unchanged.
-    """
+    """:func:`finite`, and >= 0."""
     value = finite(name, value)
     if value < 0.0:
         raise SceneError(f"`{name}` must be >= 0, got {value!r}")
@@ -185,21 +105,8 @@ def non_negative(name: str, value: Any) -> float:
 
 
 def vector(name: str, value: Any, shape: tuple[int, ...]) -> tuple:
-    """A finite numeric array of the given shape as (nested) tuples of Python floats.
-
-    Parameters
-    ----------
-    name : str
-        Field name for the message.
-    value : array_like
-        The values, in the field's SI unit.
-    shape : tuple of int
-        Required shape, ``(3,)`` or ``(3, 3)``.
-
-    Returns
-    -------
-    tuple
-        A tuple of floats, or of tuples of floats for a matrix (hashable, frozen-friendly).
+    """``value`` as (nested) tuples of finite floats of ``shape`` (``(3,)`` or ``(3, 3)``);
+    :class:`SceneError` naming ``name`` otherwise.
     """
     try:
         arr = np.asarray(value, dtype=float)
@@ -215,24 +122,8 @@ def vector(name: str, value: Any, shape: tuple[int, ...]) -> tuple:
 
 
 def float_array(name: str, value: Any) -> np.ndarray | None:
-    """A sequence as a float array.
-
-    Parameters
-    ----------
-    name : str
-        Field name for the message.
-    value : Any
-        A list, tuple or array of numbers (any unit), or anything else.
-
-    Returns
-    -------
-    ndarray or None
-        The values, unit unchanged; None when ``value`` is not a sequence.
-
-    Raises
-    ------
-    SceneTypeError
-        A sample is not a number.
+    """A sequence ``value`` as a float array, None when not a sequence; :class:`SceneTypeError` naming
+    ``name`` when a sample is not a number.
     """
     if not is_sequence(value):
         return None
@@ -247,21 +138,8 @@ def float_array(name: str, value: Any) -> np.ndarray | None:
 
 def check_history(t: np.ndarray | None, values: np.ndarray | None, raw_time: Any, raw_values: Any,
                   values_name: str, minimum: int, prefix: str = "") -> None:
-    """Refuse a history unless its times are strictly increasing, ``minimum`` or more, and it has
-    one finite value per time.
-
-    Parameters
-    ----------
-    t, values : ndarray or None
-        :func:`float_array` of the sample times [s] and of the values (any unit).
-    raw_time, raw_values : Any
-        The two fields as given, for the messages.
-    values_name : str
-        Name of the values' field (the times' is ``time``).
-    minimum : int
-        Fewest samples allowed.
-    prefix : str
-        Start of every field name in the messages, e.g. ``"load "``.
+    """Refuse a history unless its times ``t`` [s] increase strictly, number ``minimum`` or more and
+    ``values`` has one finite value per time; ``raw_*``, ``values_name`` and ``prefix`` word the messages.
     """
     if t is None or t.ndim != 1 or t.size < minimum:
         raise SceneError(f"{prefix}`time` must be a sequence of at least {minimum} numbers, "
@@ -281,35 +159,14 @@ def check_history(t: np.ndarray | None, values: np.ndarray | None, raw_time: Any
 
 
 def set_field(obj: Any, name: str, value: Any) -> None:
-    """Store a validated value on a frozen dataclass (from its ``__post_init__``).
-
-    Parameters
-    ----------
-    obj : dataclass instance
-        Frozen.
-    name : str
-        The field.
-    value : Any
-        Its validated value.
+    """Store a validated ``value`` as field ``name`` of the frozen dataclass ``obj`` (from its
+    ``__post_init__``).
     """
     object.__setattr__(obj, name, value)
 
 
 def check_steps(steps: float, what: str) -> None:
-    """Refuse more than :data:`MAX_STEPS` steps.
-
-    Parameters
-    ----------
-    steps : float
-        Steps asked for (inf and NaN refused too).
-    what : str
-        What needs them, for the message (e.g. "2 revolutions at dt = 1e-12 s").
-
-    Raises
-    ------
-    SceneError
-        Beyond :data:`MAX_STEPS`.
-    """
+    """Refuse ``steps`` beyond :data:`MAX_STEPS` (inf and NaN too); ``what`` needs them, for the message."""
     if not steps <= MAX_STEPS:
         raise SceneError(f"{what} needs {steps:.3g} steps; at most {MAX_STEPS:.0e} are allowed: give a "
                          "larger `numerics.dt` (or `numerics.accuracy`) or fewer `revolutions`")
@@ -317,23 +174,8 @@ def check_steps(steps: float, what: str) -> None:
 
 def refuse_steps_per_revolution(steps: float, revolutions: float, seconds_per_step: float,
                                 why: str) -> None:
-    """Refuse more than :data:`MAX_STEPS_PER_REVOLUTION` steps per input revolution.
-
-    Parameters
-    ----------
-    steps : float
-        Steps per input revolution asked for.
-    revolutions : float
-        Input revolutions of the run, for the predicted total.
-    seconds_per_step : float
-        Wall time of one step [s], for the predicted run time.
-    why : str
-        What needs them, for the message (e.g. "a speed-ratio error of 0.001 at 89.9 deg").
-
-    Raises
-    ------
-    SceneError
-        Beyond the limit, with the predicted steps and run time in one line.
+    """Refuse ``steps`` per input revolution beyond :data:`MAX_STEPS_PER_REVOLUTION`; the message
+    predicts the total over ``revolutions`` and the run time at ``seconds_per_step`` [s], and says ``why``.
     """
     if steps <= MAX_STEPS_PER_REVOLUTION:
         return
