@@ -1,23 +1,13 @@
 """Newton-Euler of the Cardan joint's three moving bodies, linear in 18 unknowns, batched over samples.
 
-For a given input motion the kinematics (:func:`reference.physics.joint_motion.joint_motion`: closed
-form for the ideal joint, the dual-number loop with mounting errors) give every body's motion.
-Newton-Euler for the three moving bodies (force balance and moment balance about the global
-origin O) is then linear in the 18 unknowns
+Force and moment balance about the global origin O, given every body's motion, is linear in
 
 - ``frame_input`` (revolute): fx, fy, fz, mx, my;
 - ``input_spider``, ``spider_output``, ``output_frame`` (cylindrical): fx, fy, mx, my;
-- the drive torque on the input about +x (inverse dynamics) or the input acceleration
-  (forward dynamics, the drive torque given),
+- the drive torque on the input about +x (inverse dynamics) or the input acceleration (forward),
 
-each reaction being the force and moment (about the pair origin) that body ``a`` exerts on body
-``b``, in the pair frame attached to body ``a`` (:func:`reference.physics.kinematics.pair_frames`). Body
-``b`` receives the wrench, body ``a`` its opposite.
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation": Section 3 (RCCC model, reactions in the joint frames, eqs. (8)-(9)).
+each reaction the force and moment (about the pair origin) body ``a`` exerts on body ``b``, in the
+pair frame attached to ``a``; body ``a`` receives the opposite (the paper's Section 3, eqs. (8)-(9)).
 """
 
 from __future__ import annotations
@@ -37,18 +27,7 @@ COMPONENTS = {"revolute": ("fx", "fy", "fz", "mx", "my"), "cylindrical": ("fx", 
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product over the last axis (``numpy.cross`` without its per-call overhead).
-
-    Parameters
-    ----------
-    a, b : ndarray, shape (..., 3)
-        Vectors, broadcast against each other.
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        ``a x b``.
-    """
+    """``a x b`` over the last axis, broadcast (``numpy.cross`` without its per-call overhead)."""
     a, b = np.broadcast_arrays(a, b)
     return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
                      a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
@@ -62,46 +41,16 @@ def unknowns() -> list[tuple[str, str]]:
 
 
 def body_kinematics(body: Body, motion: BodyMotion) -> dict[str, np.ndarray]:
-    """Centre-of-mass position, velocity, acceleration and inertia of a body, global components.
-
-    Parameters
-    ----------
-    body : Body
-        Mass properties; :meth:`Body.canonical` places them in the canonical body frame, whose
-        origin is the body's frame origin (the joint centre O for the ideal joint).
-    motion : reference.physics.rccc.motion.BodyMotion
-        Pose and motion of the body.
-
-    Returns
-    -------
-    dict
-        ``mass`` [kg]; ``r``, ``v``, ``a``: centre of mass relative to O [m], its velocity [m/s]
-        and acceleration [m/s^2], shape (..., 3); ``inertia`` about the centre of mass
-        [kg m^2], shape (..., 3, 3).
+    """Centre of mass relative to O ``r`` [m], ``v`` [m/s], ``a`` [m/s^2] (..., 3), ``mass`` [kg] and
+    ``inertia`` about it [kg m^2] (..., 3, 3) of ``body`` moving with ``motion``, global components.
     """
     return mass_kinematics(*body.canonical(), motion)
 
 
 def mass_kinematics(mass: float | np.ndarray, com: np.ndarray, inertia: np.ndarray,
                     motion: BodyMotion) -> dict[str, np.ndarray]:
-    """:func:`body_kinematics` from the canonical mass properties (:meth:`Body.canonical`).
-
-    Parameters
-    ----------
-    mass : float or ndarray, shape (...,)
-        Mass [kg].
-    com : ndarray, shape (3,) or (..., 3)
-        Centre of mass in the canonical body frame [m].
-    inertia : ndarray, shape (3, 3) or (..., 3, 3)
-        Inertia about the centre of mass, canonical body axes [kg m^2]; one per sample for many
-        scenes in one pass (:mod:`reference.engine.batch.model`).
-    motion : reference.physics.rccc.motion.BodyMotion
-        Pose and motion of the body.
-
-    Returns
-    -------
-    dict
-        As :func:`body_kinematics`.
+    """:func:`body_kinematics` from the canonical ``mass`` [kg], ``com`` [m] and ``inertia`` [kg m^2]
+    (:meth:`Body.canonical`; one per sample for many scenes in one pass).
     """
     rot = motion.rotation
     c = rot @ com if np.ndim(com) == 1 else np.einsum("...ij,...j->...i", rot, com)
@@ -113,26 +62,8 @@ def mass_kinematics(mass: float | np.ndarray, com: np.ndarray, inertia: np.ndarr
 
 def required_wrench(body: Body, motion: BodyMotion,
                     gravity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Force and moment about O the pairs, drive and load must apply to a body.
-
-    Newton-Euler with gravity moved to the left: ``F = m (a_c - g)``,
-    ``M_O = r_c x F + J alpha + omega x J omega`` (J about the centre of mass, global axes).
-
-    Parameters
-    ----------
-    body : Body
-        Mass properties.
-    motion : reference.physics.rccc.motion.BodyMotion
-        Pose and motion of the body.
-    gravity : ndarray, shape (3,) or (..., 3)
-        Gravitational acceleration [m/s^2].
-
-    Returns
-    -------
-    force : ndarray, shape (..., 3)
-        [N].
-    moment : ndarray, shape (..., 3)
-        About O [N m].
+    """Force [N] and moment about O [N m] the pairs, drive and load must apply to ``body`` moving with
+    ``motion`` under ``gravity`` [m/s^2]: ``F = m (a_c - g)``, ``M_O = r_c x F + J alpha + omega x J omega``.
     """
     k = body_kinematics(body, motion)
     force = k["mass"] * (k["a"] - gravity)
@@ -143,20 +74,7 @@ def required_wrench(body: Body, motion: BodyMotion,
 
 def mechanical_energy(scene: Scene,
                       motions: dict[str, BodyMotion]) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy of the three bodies.
-
-    Parameters
-    ----------
-    scene : Scene
-        Mass properties and gravity.
-    motions : dict of str to BodyMotion
-        Each body's motion (:attr:`reference.physics.joint_motion.JointMotion.bodies`).
-
-    Returns
-    -------
-    kinetic, potential : ndarray, shape (...)
-        [J]; the potential is zero at O.
-    """
+    """Kinetic and potential energy [J] (zero potential at O) of the three bodies' ``motions``."""
     gravity = np.asarray(scene.gravity)
     kinetic = 0.0
     potential = 0.0
@@ -170,23 +88,9 @@ def mechanical_energy(scene: Scene,
 
 
 def wrench_columns(motion: JointMotion, components: list[tuple[str, str]]) -> np.ndarray:
-    """Body wrenches of unit pair loads.
-
-    Each component ``(pair, "fx" | "fy" | "fz" | "mx" | "my" | "mz")`` is a unit force along
-    (at the pair origin) or moment about that axis of the pair frame, acting on body b; body a
-    receives the opposite. All components are built in one vectorised pass.
-
-    Parameters
-    ----------
-    motion : JointMotion
-        Pair frames and origins, per sample.
-    components : list of (pair, component)
-        The m unit loads.
-
-    Returns
-    -------
-    ndarray, shape (..., 18, m)
-        Rows as :func:`reaction_system`'s [N, N m per unit load].
+    """Body wrenches (..., 18, m), rows as :func:`reaction_system`'s, of the unit loads
+    ``components`` ``(pair, "fx" | ... | "mz")`` in the pair frames of ``motion``: on body b, the opposite
+    on body a.
     """
     shape = motion.bodies["input"].omega.shape[:-1]
     if not components:
@@ -208,25 +112,11 @@ def wrench_columns(motion: JointMotion, components: list[tuple[str, str]]) -> np
 
 def reaction_system(scene: Scene, motion: JointMotion,
                     load_torque: float | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Newton-Euler equations of the three bodies as ``matrix @ unknowns = rhs``.
+    """Newton-Euler of the three bodies as ``matrix @ unknowns = rhs`` at the samples of ``motion``.
 
-    Parameters
-    ----------
-    scene : Scene
-        Bodies and gravity (and the constant load).
-    motion : JointMotion
-        The joint's motion, per sample.
-    load_torque : float or ndarray, shape (...), or None
-        The output load at these samples [N m]; None: the scene's constant load (a history
-        needs it given: the motion has no time).
-
-    Returns
-    -------
-    matrix : ndarray, shape (..., 18, 18)
-        Rows: per body (input, spider, output) force x, y, z [N] and moment about O x, y, z
-        [N m]; columns: :func:`unknowns`.
-    rhs : ndarray, shape (..., 18)
-        Required wrench minus the known applied wrench (the load torque on the output).
+    ``matrix`` (..., 18, 18): rows per body (input, spider, output) force x, y, z [N] and moment about
+    O [N m], columns :func:`unknowns`; ``rhs`` (..., 18): required wrench minus the load torque on the
+    output. ``load_torque`` [N m]: None for the scene's constant load (a history needs it given).
     """
     shape = motion.bodies["input"].omega.shape[:-1]
     rows = {name: 6 * i for i, name in enumerate(BODY_NAMES)}

@@ -1,25 +1,10 @@
-"""Dual numbers, vectors and 3x3 matrices (``x + eps y`` with ``eps**2 = 0``), numpy-backed.
+"""Dual numbers, vectors and 3x3 matrices (``x + eps y``, ``eps**2 = 0``), numpy-backed.
 
-A :class:`Dual` holds two arrays of one shape: the real part and the dual ("moment") part. The
-trailing axes decide what it is: a scalar array ``(...)``, a 3-vector ``(..., 3)`` or a 3x3 matrix
-``(..., 3, 3)``; every operation broadcasts over the leading axes like numpy does.
-
-Geometric meaning, following section 3.2 of the paper:
-
-- a dual angle ``theta + eps s`` (eq. (13)) is a rotation ``theta`` [rad] about an axis and a
-  slide ``s`` [m] along it;
-- a line (screw axis) is the dual unit vector ``u + eps (p x u)`` (eq. (10)): its direction
-  ``u`` [-] and its moment about the origin [m], ``p`` any point of the line;
-- a velocity screw ``(omega + eps v) u`` (eq. (11)) has the angular velocity [rad/s] as real
-  part and, as dual part, the velocity [m/s] of the body point at the origin;
-- a rigid displacement (rotation ``R``, translation ``p``) is the dual orthogonal matrix
-  ``R + eps [p]x R``: it maps lines and screws from the moved frame to the fixed one, and the
-  product of two such matrices is the composed displacement.
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation", section 3.2, eqs. (10)-(14).
+A :class:`Dual`'s trailing axes make it a scalar ``(...)``, a 3-vector ``(..., 3)`` or a matrix
+``(..., 3, 3)``; operations broadcast over the leading axes. After the paper's section 3.2: a dual
+angle ``theta + eps s`` is a rotation [rad] and slide [m] (eq. (13)); a line is ``u + eps (p x u)``
+(eq. (10)); a velocity screw ``(omega + eps v) u`` (eq. (11)); a rigid displacement is
+``R + eps [p]x R``, mapping lines and screws from the moved frame to the fixed one.
 """
 
 from __future__ import annotations
@@ -35,15 +20,7 @@ __all__ = [
 
 
 class Dual:
-    """Array of dual numbers ``re + eps du`` (``eps**2 = 0``).
-
-    Parameters
-    ----------
-    re : array_like
-        Real part.
-    du : array_like, optional
-        Dual part, broadcast to the shape of ``re``; zero when omitted.
-    """
+    """Array of dual numbers ``re + eps du`` (``du`` broadcast to ``re``'s shape, zero when omitted)."""
 
     __array_ufunc__ = None  # numpy defers ``ndarray * Dual`` to Dual.__rmul__
 
@@ -120,90 +97,35 @@ def cos(x: Dual) -> Dual:
 
 
 def atan2(y: Dual, x: Dual) -> Dual:
-    """Dual angle whose sine and cosine are proportional to ``y`` and ``x``.
-
-    The dual part ``(x y' - y x') / (x^2 + y^2)`` does not change when ``y`` and ``x`` are
-    multiplied by one dual number with positive real part, so ``atan2(k sin t, k cos t) = t`` for
-    the dual angle ``t``.
-
-    Parameters
-    ----------
-    y, x : Dual
-        Of one shape.
-
-    Returns
-    -------
-    Dual
-        Angle ``arctan2(y, x)`` in (-pi, pi] [rad] + eps slide [m].
+    """Dual angle ``arctan2(y, x)`` in (-pi, pi] [rad] + eps slide [m]; ``atan2(k sin t, k cos t) = t``
+    for any dual ``k`` with positive real part.
     """
     return Dual(np.arctan2(y.re, x.re), (x.re * y.du - y.re * x.du) / (x.re**2 + y.re**2))
 
 
 def dot(u: Dual, v: Dual) -> Dual:
-    """Dot product over the last axis; of two lines: ``cos`` of their dual angle (eq. (13)).
-
-    Parameters
-    ----------
-    u, v : Dual, shape (..., 3)
-        Dual vectors.
-
-    Returns
-    -------
-    Dual, shape (...)
+    """Dot product over the last axis of dual vectors; of two lines, ``cos`` of their dual angle (eq. (13)).
     """
     return Dual(np.einsum("...i,...i->...", u.re, v.re),
                 np.einsum("...i,...i->...", u.re, v.du) + np.einsum("...i,...i->...", u.du, v.re))
 
 
 def cross(u: Dual, v: Dual) -> Dual:
-    """Cross product over the last axis; ``V x S`` is the rate of a line ``S`` moving with ``V``.
-
-    Parameters
-    ----------
-    u, v : Dual, shape (..., 3)
-        Dual vectors.
-
-    Returns
-    -------
-    Dual, shape (..., 3)
+    """Cross product over the last axis of dual vectors; ``V x S`` is the rate of a line ``S`` moving with
+    ``V``.
     """
     return Dual(np.cross(u.re, v.re), np.cross(u.re, v.du) + np.cross(u.du, v.re))
 
 
 def matvec(m: Dual, v: Dual) -> Dual:
-    """Matrix times vector, broadcast over the leading axes.
-
-    Parameters
-    ----------
-    m : Dual, shape (..., 3, 3)
-        Dual matrices.
-    v : Dual or ndarray, shape (..., 3)
-        Vectors (an array: zero dual part).
-
-    Returns
-    -------
-    Dual, shape (..., 3)
-    """
+    """Dual matrices (..., 3, 3) times vectors (..., 3) (an array: zero dual part), broadcast."""
     v = as_dual(v)
     return Dual(np.einsum("...ij,...j->...i", m.re, v.re),
                 np.einsum("...ij,...j->...i", m.re, v.du) + np.einsum("...ij,...j->...i", m.du, v.re))
 
 
 def stack(items: Sequence[Dual], axis: int = -1) -> Dual:
-    """Stack duals of one shape along a new axis (``numpy.stack``).
-
-    Parameters
-    ----------
-    items : sequence of Dual or array_like
-        Of one shape ``s``.
-    axis : int
-        Position of the new axis.
-
-    Returns
-    -------
-    Dual
-        Shape ``s`` with ``len(items)`` inserted at ``axis``.
-    """
+    """Stack duals (or arrays) of one shape along a new ``axis`` (``numpy.stack``)."""
     items = [as_dual(x) for x in items]
     return Dual(np.stack([x.re for x in items], axis), np.stack([x.du for x in items], axis))
 
@@ -234,27 +156,15 @@ def rot_x(angle: Dual) -> Dual:
 
 
 def screw_transform(theta: Dual, alpha: Dual) -> Dual:
-    """Denavit-Hartenberg link transform ``Z(theta) X(alpha)``, shape (..., 3, 3).
-
-    Parameters
-    ----------
-    theta : Dual
-        Joint angle [rad] + eps joint slide [m], about and along the joint's z axis.
-    alpha : Dual
-        Link twist [rad] + eps link offset [m], about and along the common normal (new x axis).
+    """Denavit-Hartenberg link transform ``Z(theta) X(alpha)`` (..., 3, 3): joint angle [rad] + eps
+    slide [m] ``theta``, link twist [rad] + eps offset [m] ``alpha`` (about and along the new x axis).
     """
     return rot_z(theta) @ rot_x(alpha)
 
 
 def line(direction: np.ndarray, point: np.ndarray) -> Dual:
-    """Plücker line ``u + eps (p x u)`` with ``u`` the normalised ``direction`` (..., 3) [-].
-
-    Parameters
-    ----------
-    direction : ndarray, shape (..., 3)
-        Direction of the line, non-zero [-].
-    point : ndarray, shape (..., 3)
-        Any point of the line [m].
+    """Plücker line ``u + eps (p x u)``: ``u`` the normalised non-zero ``direction`` (..., 3), ``p`` a
+    ``point`` [m].
     """
     u = np.asarray(direction, float)
     u = u / np.linalg.norm(u, axis=-1, keepdims=True)
@@ -274,20 +184,8 @@ def displacement(m: Dual) -> tuple[np.ndarray, np.ndarray]:
 
 
 def solve(a: Dual, b: Dual) -> Dual:
-    """Solution ``x`` of ``a x = b``.
-
-    ``a.re x.re = b.re``, then ``a.re x.du = b.du - a.du x.re`` (the eps part of ``a x = b``).
-
-    Parameters
-    ----------
-    a : Dual, shape (..., n, n)
-        Dual matrices, real part regular.
-    b : Dual or ndarray, shape (..., n)
-        Right-hand sides.
-
-    Returns
-    -------
-    Dual, shape (..., n)
+    """``x`` solving ``a x = b`` for dual matrices ``a`` (real part regular): ``a.re x.du = b.du - a.du
+    x.re``.
     """
     b = as_dual(b)
     x_re = np.linalg.solve(a.re, b.re[..., None])[..., 0]

@@ -1,23 +1,9 @@
 """Closed-form kinematics of the ideal Cardan (Hooke's) joint, vectorised over time.
 
-Conventions are those of :mod:`reference.scene.joint`: input axis global x, output axis
-``a2 = (cos b, sin b, 0)``; at input angle 0 the input yoke's trunnions lie along global y and
-the output yoke's along global z. With these conventions the canonical body frames are
-
-- input: ``Rx(theta)``;
-- spider: ``Rx(theta) Ry(gamma)`` with ``gamma = atan2(sin b sin theta, cos b)``, so its y axis
-  stays on the input yoke and its z axis on the output yoke;
-- output: ``Rz(b) Rx(theta_out)`` with ``tan(theta_out) = tan(theta) / cos b``.
-
-Every function takes arrays of any (common) shape; rotation matrices get two trailing axes of
-length 3 and vectors one. Angles are in radians, times in seconds.
-
-See also :mod:`reference.physics.rccc`: the same joint as an RCCC loop in dual numbers, with mounting errors.
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation", Section 3 (the ideal joint is the RCCC mechanism without errors).
+Input axis global x, output axis ``a2 = (cos b, sin b, 0)``; at input angle 0 the input yoke's
+trunnions lie along y, the output's along z. Canonical body frames: input ``Rx(theta)``; spider
+``Rx(theta) Ry(gamma)``, ``gamma = atan2(sin b sin theta, cos b)``; output ``Rz(b) Rx(theta_out)``,
+``tan(theta_out) = tan(theta) / cos b``. Angles [rad], times [s], arrays of any common shape.
 """
 
 from __future__ import annotations
@@ -67,21 +53,9 @@ def rot_z(angle: np.ndarray) -> np.ndarray:
 
 
 def output_angle(theta: np.ndarray, beta: float) -> np.ndarray:
-    """Output shaft angle of Hooke's joint, continuous in ``theta``.
-
-    Parameters
-    ----------
-    theta : ndarray
-        Input shaft angle [rad].
-    beta : float
-        Shaft angle between the two axes [rad], in [0, pi/2).
-
-    Returns
-    -------
-    ndarray
-        ``theta_out = atan2(sin theta, cos b cos theta)`` unwrapped [rad]: written as
-        ``theta`` plus the lag ``atan2((1 - cos b) sin theta cos theta, cos b cos^2 theta +
-        sin^2 theta)``, whose second argument is positive, so no branch jumps occur.
+    """Output shaft angle [rad] at input angles ``theta`` [rad] and shaft angle ``beta`` in [0, pi/2):
+    ``theta`` plus the lag ``atan2((1 - cos b) sin theta cos theta, cos b cos^2 theta + sin^2 theta)``,
+    continuous (the second argument is positive).
     """
     c = np.cos(theta)
     s = np.sin(theta)
@@ -90,57 +64,22 @@ def output_angle(theta: np.ndarray, beta: float) -> np.ndarray:
 
 
 def speed_ratio(theta: np.ndarray, beta: float) -> np.ndarray:
-    """Hooke's speed ratio ``omega_out / omega_in = cos b / (1 - sin^2 b cos^2 theta)``.
-
-    Parameters
-    ----------
-    theta : ndarray
-        Input shaft angle [rad].
-    beta : float
-        Shaft angle [rad].
-
-    Returns
-    -------
-    ndarray
-        The ratio [-], shape of ``theta``.
+    """Speed ratio ``omega_out / omega_in = cos b / (1 - sin^2 b cos^2 theta)`` [-] at ``theta``, ``beta``
+    [rad].
     """
     return np.cos(beta) / (1.0 - np.sin(beta) ** 2 * np.cos(theta) ** 2)
 
 
 def speed_ratio_slope(theta: np.ndarray, beta: float) -> np.ndarray:
-    """Derivative of :func:`speed_ratio` with respect to the input angle.
-
-    Parameters
-    ----------
-    theta : ndarray
-        Input shaft angle [rad].
-    beta : float
-        Shaft angle [rad].
-
-    Returns
-    -------
-    ndarray
-        ``d ratio / d theta`` [1/rad], shape of ``theta``.
-    """
+    """``d ratio / d theta`` [1/rad] of :func:`speed_ratio` at ``theta``, ``beta`` [rad]."""
     d = 1.0 - np.sin(beta) ** 2 * np.cos(theta) ** 2
     return -np.cos(beta) * np.sin(beta) ** 2 * np.sin(2.0 * theta) / d**2
 
 
 def output_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
                   beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Output angle [rad], speed [rad/s] and acceleration [rad/s^2] for a given input motion.
-
-    Parameters
-    ----------
-    theta, theta_t, theta_tt : ndarray
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
-    beta : float
-        Shaft angle [rad].
-
-    Returns
-    -------
-    theta_out, omega_out, alpha_out : ndarray
-        [rad], [rad/s], [rad/s^2], shape of ``theta``.
+    """Output angle [rad], speed [rad/s] and acceleration [rad/s^2] for the input motion ``theta``,
+    ``theta_t``, ``theta_tt`` and shaft angle ``beta`` [rad].
     """
     ratio = speed_ratio(theta, beta)
     return (output_angle(theta, beta), ratio * theta_t,
@@ -149,22 +88,9 @@ def output_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
 
 def spider_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
                   beta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Spider angle about the input yoke axis, relative to the input, and its rates.
-
-    ``gamma = atan2(sin b sin theta, cos b)`` [rad] (``|gamma| <= b``); its rate is
-    ``h(theta) theta_t`` with ``h = sin b cos b cos theta / (1 - sin^2 b cos^2 theta)``.
-
-    Parameters
-    ----------
-    theta, theta_t, theta_tt : ndarray
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2], same shape.
-    beta : float
-        Shaft angle [rad].
-
-    Returns
-    -------
-    gamma, gamma_t, gamma_tt : ndarray
-        [rad], [rad/s], [rad/s^2].
+    """Spider angle ``gamma = atan2(sin b sin theta, cos b)`` [rad] relative to the input and its rates
+    [rad/s], [rad/s^2], the rate being ``h theta_t``, ``h = sin b cos b cos theta / (1 - sin^2 b cos^2
+    theta)``.
     """
     sb = np.sin(beta)
     cb = np.cos(beta)
@@ -178,16 +104,8 @@ def spider_motion(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
 
 @dataclass(frozen=True)
 class BodyMotion:
-    """Orientation and angular motion of one body (global components).
-
-    Attributes
-    ----------
-    rotation : ndarray, shape (..., 3, 3)
-        Columns: the canonical body axes in global coordinates [-].
-    omega : ndarray, shape (..., 3)
-        Angular velocity [rad/s].
-    alpha : ndarray, shape (..., 3)
-        Angular acceleration [rad/s^2].
+    """One body's ``rotation`` (..., 3, 3) (columns: canonical axes, global), ``omega`` [rad/s] and
+    ``alpha`` [rad/s^2] (..., 3).
     """
 
     rotation: np.ndarray
@@ -197,20 +115,9 @@ class BodyMotion:
 
 def body_motions(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
                  beta: float) -> dict[str, BodyMotion]:
-    """Motion of ``ground``, ``input``, ``spider`` and ``output`` for a given input motion.
-
-    Parameters
-    ----------
-    theta, theta_t, theta_tt : ndarray
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2], same shape.
-    beta : float or ndarray
-        Shaft angle [rad] (an array: one per sample, broadcast with ``theta``).
-
-    Returns
-    -------
-    dict of str to BodyMotion
-        The spider's angular velocity is ``theta_t e_x + gamma_t u1`` with ``u1`` the input yoke
-        axis; its acceleration adds the transport term ``gamma_t (theta_t e_x x u1)``.
+    """:class:`BodyMotion` of ``ground``, ``input``, ``spider``, ``output`` for the input motion and shaft
+    angle ``beta`` [rad] (an array: one per sample). Spider: ``omega = theta_t e_x + gamma_t u1``, its
+    acceleration with the transport term ``gamma_t (theta_t e_x x u1)``.
     """
     theta, theta_t, theta_tt = np.broadcast_arrays(*(np.asarray(v, float)
                                                      for v in (theta, theta_t, theta_tt)))
@@ -239,12 +146,9 @@ def body_motions(theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.ndarray,
 
 
 def pair_frames_in_body_a() -> dict[str, np.ndarray]:
-    """Each pair's frame (columns x, y, z; z the pair axis) in body a's canonical axes [-].
-
-    In the reference configuration these are, in global axes: ``frame_input`` (e_y, e_z, e_x),
-    ``input_spider`` (e_z, e_x, e_y), ``spider_output`` (e_x, e_y, e_z) and ``output_frame``
-    ((-sin b, cos b, 0), e_z, a2); the last one is (e_y, e_z, e_x) in the output's canonical
-    axes, which are turned by b about z.
+    """Each pair's frame (columns x, y, z; z the pair axis) in body a's canonical axes [-]; in global
+    axes at rest: ``frame_input`` (e_y, e_z, e_x), ``input_spider`` (e_z, e_x, e_y), ``spider_output``
+    (e_x, e_y, e_z), ``output_frame`` ((-sin b, cos b, 0), e_z, a2).
     """
     e_x, e_y, e_z = np.eye(3)
     return {
@@ -262,9 +166,8 @@ def pair_frames(motions: dict[str, BodyMotion]) -> dict[str, np.ndarray]:
 
 
 def relative_speeds(motions: dict[str, BodyMotion]) -> dict[str, np.ndarray]:
-    """Angular speed of body b relative to body a about each pair's axis [rad/s].
-
-    In the ideal joint the pairs do not slide, so the relative sliding speeds are all zero.
+    """Angular speed [rad/s] of body b relative to body a about each pair's axis (the ideal joint does not
+    slide).
     """
     frames = pair_frames(motions)
     out = {}

@@ -24,14 +24,8 @@ __all__ = ["BodyMotion", "LoopRates", "PairMotion", "body_motions", "output_moti
 
 @dataclass(frozen=True)
 class LoopRates:
-    """First and second time derivatives of the joint variables, shape (..., 4) each.
-
-    Attributes
-    ----------
-    theta_t, theta_tt : ndarray
-        Joint angular speeds [rad/s] and accelerations [rad/s^2].
-    s_t, s_tt : ndarray
-        Joint sliding speeds [m/s] and accelerations [m/s^2] (zero for joint 1).
+    """Joint rates (..., 4): angular ``theta_t`` [rad/s], ``theta_tt`` [rad/s^2]; sliding ``s_t`` [m/s],
+    ``s_tt`` [m/s^2] (zero for joint 1).
     """
 
     theta_t: np.ndarray
@@ -42,16 +36,9 @@ class LoopRates:
 
 @dataclass(frozen=True)
 class BodyMotion:
-    """Pose and motion of one link, global components.
-
-    Attributes
-    ----------
-    rotation, origin : ndarray
-        As :class:`BodyPose` [-], [m].
-    omega, alpha : ndarray, shape (..., 3)
-        Angular velocity [rad/s] and acceleration [rad/s^2].
-    velocity, acceleration : ndarray, shape (..., 3)
-        Velocity [m/s] and acceleration [m/s^2] of the body point at ``origin``.
+    """Pose (``rotation``, ``origin`` as :class:`BodyPose`) and motion of one link, global components:
+    ``omega`` [rad/s], ``alpha`` [rad/s^2], ``velocity`` [m/s] and ``acceleration`` [m/s^2] of the body
+    point at ``origin``.
     """
 
     rotation: np.ndarray
@@ -64,14 +51,9 @@ class BodyMotion:
 
 @dataclass(frozen=True)
 class PairMotion:
-    """Motion of body ``b`` relative to body ``a`` along and about one pair's axis.
-
-    Attributes
-    ----------
-    angle, speed, acceleration : ndarray
-        Rotation since ``theta_1 = 0`` [rad], its speed [rad/s] and acceleration [rad/s^2].
-    slide, slide_speed, slide_acceleration : ndarray
-        Joint slide ``s_k`` [m] and its rates [m/s], [m/s^2] (constant for the revolute pair).
+    """Motion of body ``b`` relative to ``a`` about and along one pair's axis: ``angle`` since
+    ``theta_1 = 0`` [rad], ``speed``, ``acceleration``; ``slide`` ``s_k`` [m], ``slide_speed``,
+    ``slide_acceleration``.
     """
 
     angle: np.ndarray
@@ -95,24 +77,9 @@ def _screw_rates(screws: Dual, joint_rates: Dual) -> Dual:
 
 def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t: ArrayLike,
                 theta1_tt: ArrayLike) -> LoopRates:
-    """Joint speeds and accelerations for a given input motion (analytic, no differencing).
-
-    The relative velocity screws close the loop, ``sum_k (theta_k_t + eps s_k_t) S_k = 0``, six
-    linear equations for the rates of joints 2..4; differentiated once more with
-    ``dS_k/dt = V_k x S_k`` they give the accelerations with the same matrix.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        From :func:`solve_positions` for the same ``params``.
-    theta1_t, theta1_tt : array_like
-        Input speed [rad/s] and acceleration [rad/s^2], broadcastable to the input angles' shape.
-
-    Returns
-    -------
-    LoopRates
+    """:class:`LoopRates` of ``params`` at its ``positions`` for input speed ``theta1_t`` [rad/s] and
+    acceleration ``theta1_tt`` [rad/s^2]: six linear equations for joints 2..4, differentiated once
+    more with the same matrix for the accelerations (no differencing).
     """
     shape = positions.theta.shape[:-1]
     theta1_t = sample_array("theta1_t", theta1_t, shape)
@@ -128,45 +95,16 @@ def solve_rates(params: DHParameters, positions: LoopPositions, theta1_t: ArrayL
 
 def solve_motion(params: DHParameters, theta1: ArrayLike, theta1_t: ArrayLike, theta1_tt: ArrayLike,
                  branch: str = "hooke") -> tuple[LoopPositions, LoopRates]:
-    """:func:`solve_positions` and :func:`solve_rates` in one call.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    theta1, theta1_t, theta1_tt : array_like
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
-    branch : {"hooke", "flipped"}
-        Assembly branch.
-
-    Returns
-    -------
-    LoopPositions, LoopRates
-    """
+    """:func:`solve_positions` and :func:`solve_rates` in one call: ``(LoopPositions, LoopRates)``."""
     positions = solve_positions(params, theta1, branch)
     return positions, solve_rates(params, positions, theta1_t, theta1_tt)
 
 
 def body_motions(params: DHParameters, positions: LoopPositions,
                  rates: LoopRates) -> dict[str, BodyMotion]:
-    """Pose, velocity and acceleration of ``ground``, ``input``, ``spider`` and ``output``.
-
-    Link k's velocity screw is ``V_k = sum_{j<=k} (theta_j_t + eps s_j_t) S_j``; its real part is
-    the angular velocity, its dual part the velocity of the body point at the global origin.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions.
-    rates : LoopRates
-        Its solved rates.
-
-    Returns
-    -------
-    dict of str to BodyMotion
-        Global components, arrays of the samples' shape.
+    """:class:`BodyMotion` of ``ground``, ``input``, ``spider`` and ``output`` from the loop's
+    ``positions`` and ``rates``: link k's screw ``V_k`` gives the angular velocity (real part) and the
+    velocity of the body point at the origin (dual part).
     """
     screws = joint_screws(params, positions)
     joint_rates = Dual(rates.theta_t, rates.s_t)
@@ -188,20 +126,7 @@ def body_motions(params: DHParameters, positions: LoopPositions,
 
 
 def pair_motions(positions: LoopPositions, rates: LoopRates) -> dict[str, PairMotion]:
-    """Relative rotation (b relative to a, about the pair axis, from ``theta_1 = 0``) and slide.
-
-    Parameters
-    ----------
-    positions : LoopPositions
-        The loop's solved positions.
-    rates : LoopRates
-        Its solved rates.
-
-    Returns
-    -------
-    dict of str to PairMotion
-        Angle [rad], speed [rad/s], acceleration [rad/s^2], slide [m] and its rates, per pair.
-    """
+    """Per pair, :class:`PairMotion` of b relative to a from the loop's ``positions`` and ``rates``."""
     angle = positions.theta - positions.reference
     return {p: PairMotion(angle[..., k], rates.theta_t[..., k], rates.theta_tt[..., k],
                           positions.s[..., k], rates.s_t[..., k], rates.s_tt[..., k])
@@ -210,22 +135,8 @@ def pair_motions(positions: LoopPositions, rates: LoopRates) -> dict[str, PairMo
 
 def output_motion(positions: LoopPositions,
                   rates: LoopRates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Output shaft angle [rad], speed [rad/s], acceleration [rad/s^2] about its own axis.
-
-    Measured like :func:`reference.physics.kinematics.output_angle`: from the output's position at
-    ``theta_1 = 0``; it is minus the ``output_frame`` pair's rotation (ground relative to output).
-
-    Parameters
-    ----------
-    positions : LoopPositions
-        The loop's solved positions.
-    rates : LoopRates
-        Its solved rates.
-
-    Returns
-    -------
-    angle, speed, acceleration : ndarray
-        [rad], [rad/s], [rad/s^2].
+    """Output shaft angle [rad] since ``theta_1 = 0``, speed [rad/s] and acceleration [rad/s^2] about its
+    own axis: minus the ``output_frame`` pair's rotation.
     """
     pair = pair_motions(positions, rates)["output_frame"]
     return -pair.angle, -pair.speed, -pair.acceleration
@@ -233,21 +144,8 @@ def output_motion(positions: LoopPositions,
 
 def spider_motion(positions: LoopPositions,
                   rates: LoopRates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Spider angle ``gamma`` relative to the input about the input yoke [rad] and its rates.
-
-    The ``input_spider`` pair's rotation, as :func:`reference.physics.kinematics.spider_motion`.
-
-    Parameters
-    ----------
-    positions : LoopPositions
-        The loop's solved positions.
-    rates : LoopRates
-        Its solved rates.
-
-    Returns
-    -------
-    gamma, gamma_t, gamma_tt : ndarray
-        [rad], [rad/s], [rad/s^2].
+    """Spider angle ``gamma`` about the input yoke relative to the input [rad] and its rates: the
+    ``input_spider`` pair's rotation, as :func:`reference.physics.kinematics.spider_motion`.
     """
     pair = pair_motions(positions, rates)["input_spider"]
     return pair.angle, pair.speed, pair.acceleration

@@ -32,21 +32,9 @@ WINDING = np.array([1.0, 0.0, 0.0, -1.0])
 
 @dataclass(frozen=True)
 class LoopPositions:
-    """Solved configuration of the loop for an array of input angles.
-
-    Attributes
-    ----------
-    theta : ndarray, shape (..., 4)
-        Joint angles ``theta_1..theta_4`` [rad], continuous in ``theta_1``.
-    s : ndarray, shape (..., 4)
-        Joint slides ``s_1..s_4`` [m]; ``s_1`` is the constant parameter.
-    reference : ndarray, shape (4,) or (..., 4)
-        Joint angles at ``theta_1 = 0`` on the same branch [rad].
-    branch : str
-        One of :data:`BRANCHES`.
-    reference_slide : ndarray, shape (..., 4), or None
-        Joint slides at ``theta_1 = 0`` [m] when given with the positions (many parameter sets
-        in one array, :mod:`reference.engine.batch.solve`); None: solved from the parameters when needed.
+    """Solved loop at an array of input angles: joint angles ``theta`` [rad] continuous in ``theta_1`` and
+    slides ``s`` [m] (..., 4), their ``reference`` at ``theta_1 = 0``, the ``branch``, and
+    ``reference_slide`` [m] when given with the positions (None: solved when needed).
     """
 
     theta: np.ndarray
@@ -61,26 +49,7 @@ class LoopPositions:
 
 
 def sample_array(name: str, value, shape: tuple[int, ...] | None = None) -> np.ndarray:
-    """``value`` as a finite float array, broadcast to ``shape`` when given.
-
-    Parameters
-    ----------
-    name : str
-        The argument's name, for the message.
-    value : array_like
-        What arrived.
-    shape : tuple of int, optional
-        The shape of the solved input angles.
-
-    Returns
-    -------
-    ndarray
-
-    Raises
-    ------
-    ValueError
-        Not numeric, not finite, or not broadcastable to ``shape``.
-    """
+    """``value`` as a finite float array broadcast to ``shape``; ValueError naming ``name`` otherwise."""
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -103,23 +72,8 @@ def _solve(params: DHParameters, theta1: np.ndarray, branch: str, where: str) ->
 
 @functools.lru_cache(maxsize=256)
 def at_zero(params: DHParameters, branch: str) -> tuple[np.ndarray, np.ndarray]:
-    """Joint angles and slides at ``theta_1 = 0`` on a branch (cached).
-
-    Every solve and every pair-frame evaluation of a parameter set needs them; solved once.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    branch : {"hooke", "flipped"}
-        Assembly branch.
-
-    Returns
-    -------
-    theta : ndarray, shape (4,)
-        Joint angles [rad], read-only.
-    s : ndarray, shape (4,)
-        Joint slides [m], read-only.
+    """Joint angles [rad] and slides [m] (4,), read-only, at ``theta_1 = 0`` on ``branch`` of ``params``
+    (cached).
     """
     angles = _solve(params, np.zeros(1), branch, "the reference input angle")
     theta = angles.re[0].copy()
@@ -134,13 +88,9 @@ WINDING_SAMPLES = 1440
 
 @functools.lru_cache(maxsize=256)
 def _check_windings(params: DHParameters, branch: str) -> None:
-    """Raise unless every joint angle turns as the Cardan joint's do over one input turn.
-
-    The continuity rule (:mod:`reference.physics.rccc`) assumes that the spider stays near both shafts
-    and the output turns once per input turn (windings ``(1, 0, 0, -1)``). Large twist errors
-    can make the spherical loop a crank-rocker (e.g. an input twist below the shaft angle): the
-    loop still closes, but a joint angle then jumps by a full turn between neighbouring input
-    angles. Checked once per parameter set on a fine grid.
+    """Raise unless every joint angle of ``params`` on ``branch`` turns as the Cardan joint's over one input
+    turn, on a fine grid (a large twist error can make the loop a crank-rocker: it closes, but an angle
+    jumps a full turn).
     """
     theta1 = np.linspace(0.0, 2.0 * np.pi, WINDING_SAMPLES + 1)
     try:
@@ -158,22 +108,9 @@ def _check_windings(params: DHParameters, branch: str) -> None:
 
 
 def winding_jumps(raw: np.ndarray, reference: np.ndarray, theta1: np.ndarray) -> np.ndarray:
-    """Joint angles jumping a quarter turn or more between neighbours against the Cardan joint's
-    windings.
-
-    Parameters
-    ----------
-    raw : ndarray, shape (..., m, 4)
-        The wrapped loop solution at the input angles [rad].
-    reference : ndarray, shape (..., 4)
-        Its value at ``theta_1 = 0`` [rad].
-    theta1 : ndarray, shape (m,)
-        The input angles [rad].
-
-    Returns
-    -------
-    ndarray of bool, shape (..., m - 1, 3)
-        Per interval and joint 2..4 whether it jumps (any True: not a double crank).
+    """Per interval and joint 2..4 (..., m - 1, 3), whether the ``raw`` wrapped solution [rad] at input
+    angles ``theta1`` jumps a quarter turn or more against the Cardan windings from its ``reference``
+    (any True: not a double crank).
     """
     nominal = reference[..., None, :] + WINDING * theta1[:, None]
     deviation = np.remainder(raw - nominal + np.pi, 2.0 * np.pi) - np.pi
@@ -181,25 +118,9 @@ def winding_jumps(raw: np.ndarray, reference: np.ndarray, theta1: np.ndarray) ->
 
 
 def solve_positions(params: DHParameters, theta1: ArrayLike, branch: str = "hooke") -> LoopPositions:
-    """Joint angles and slides closing the loop for given input angles.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    theta1 : array_like
-        Input angles ``theta_1`` [rad], any shape.
-    branch : {"hooke", "flipped"}
-        Assembly branch (:mod:`reference.physics.rccc`).
-
-    Returns
-    -------
-    LoopPositions
-
-    Raises
-    ------
-    LoopClosureError
-        If the loop cannot close, or its branches meet, at some input angle or at 0.
+    """:class:`LoopPositions` closing the loop ``params`` at input angles ``theta1`` [rad] (any shape) on
+    assembly ``branch`` ``"hooke"`` or ``"flipped"``; LoopClosureError where the loop cannot close, or
+    its branches meet, at some input angle or at 0.
     """
     if branch not in BRANCHES:
         raise ValueError(f"`branch` must be one of {list(BRANCHES)}, got {branch!r}")
@@ -212,21 +133,8 @@ def solve_positions(params: DHParameters, theta1: ArrayLike, branch: str = "hook
 
 
 def continuous_angles(wrapped: np.ndarray, reference: np.ndarray, theta1: np.ndarray) -> np.ndarray:
-    """Joint angles continuous in ``theta_1`` (:mod:`reference.physics.rccc`).
-
-    Parameters
-    ----------
-    wrapped : ndarray, shape (..., 4)
-        The loop's solution in (-pi, pi] [rad].
-    reference : ndarray, shape (4,) or (..., 4)
-        Its value at ``theta_1 = 0`` on the same branch [rad].
-    theta1 : ndarray, shape (...)
-        The input angles [rad].
-
-    Returns
-    -------
-    ndarray, shape (..., 4)
-        Continuous joint angles [rad], the first equal to ``theta1``.
+    """Joint angles (..., 4) [rad] continuous in ``theta1`` (the first equal to it) from the ``wrapped``
+    solution in (-pi, pi] and its ``reference`` value at ``theta_1 = 0`` (:mod:`reference.physics.rccc`).
     """
     nominal = reference + WINDING * theta1[..., None]
     theta = nominal + np.remainder(wrapped - nominal + np.pi, 2.0 * np.pi) - np.pi
@@ -235,21 +143,8 @@ def continuous_angles(wrapped: np.ndarray, reference: np.ndarray, theta1: np.nda
 
 
 def loop_closure_residual(params: DHParameters, positions: LoopPositions) -> tuple[float, float]:
-    """Largest deviation of ``prod_k Z(theta_hat_k) X(alpha_hat_k)`` from the identity.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions.
-
-    Returns
-    -------
-    real : float
-        Max abs entry of the real part minus the identity, over all samples [-].
-    dual : float
-        Max abs entry of the dual part [m].
+    """Largest deviation of ``prod_k Z(theta_hat_k) X(alpha_hat_k)`` from the identity over the
+    ``positions``: of the real part [-] and of the dual part [m].
     """
     steps = dual.screw_transform(positions.dual_angles(), params.twists())
     loop = steps[..., 0, :, :] @ steps[..., 1, :, :] @ steps[..., 2, :, :] @ steps[..., 3, :, :]
