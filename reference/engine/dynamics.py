@@ -1,19 +1,9 @@
 """Dynamics of the Cardan joint with the paper's friction: reactions, friction and the drive unknown.
 
-Newton-Euler (:mod:`reference.engine.newton_euler`) gives ``K x = r - W phi``, ``phi`` the friction
-values (:mod:`reference.engine.slots`), and the law gives ``phi = G(x)``. Linear in ``x``:
-``x = x0 - S phi`` with ``x0 = K^-1 r`` and ``S = K^-1 W``, so the fixed point has at most seven
-unknowns, ``phi = G(x0 - S phi)`` (:mod:`reference.engine.fixed_point`). A sample without a
-converged fixed point, or with a loop gain (spectral radius of ``dG/dphi``) of 1 or more, is
-*self-locking*: the Coulomb problem has no unique finite solution. In the ideal joint no pair
-slides and the axial friction of eq. (5) vanishes; with mounting errors it does work
-(``power_loss_<pair>_sliding``).
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation": Section 3, eqs. (3), (5) (friction from the reactions) and eq. (18)
-(instantaneous efficiency).
+Newton-Euler gives ``K x = r - W phi`` with friction values ``phi = G(x)``, so ``x = x0 - S phi``
+(``x0 = K^-1 r``, ``S = K^-1 W``) and ``phi = G(x0 - S phi)`` has at most seven unknowns. A sample
+without a converged fixed point, or with loop gain (spectral radius of ``dG/dphi``) >= 1, is
+*self-locking*: the Coulomb problem has no unique finite solution.
 """
 
 from __future__ import annotations
@@ -66,33 +56,12 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                    method: str = "auto",
                    load_torque: float | np.ndarray | None = None,
                    bands: np.ndarray | None = None) -> tuple[JointMotion, FixedPoint]:
-    """Reactions, friction and the drive unknown for every sample.
+    """``(motion, fixed_point)``: reactions, friction and the drive unknown ``x[..., -1]`` per sample.
 
-    Parameters
-    ----------
-    scene : Scene
-        Joint, gravity, friction (and the constant load).
-    theta, theta_t : ndarray, shape (n,)
-        Input angle [rad] and speed [rad/s].
-    theta_tt : ndarray, shape (n,), or None
-        Input acceleration [rad/s^2]: inverse dynamics, the drive torque is the unknown.
-    torque_in : float or ndarray, shape (n,), or None
-        Drive torque [N m]: forward dynamics, the input acceleration is the unknown. Exactly one
-        of ``theta_tt`` and ``torque_in`` is given.
-    method : str
-        The kinematics (:func:`reference.physics.joint_motion.joint_motion`).
-    load_torque : float or ndarray, shape (n,), or None
-        The output load per sample [N m]; None: the scene's constant load.
-    bands : ndarray, shape (K,), or None
-        The sign ramps' widths [m/s]; None: :func:`slot_bands` (a caller solving one sample at
-        a time saves the scene's hash by passing them).
-
-    Returns
-    -------
-    motion : JointMotion
-        The joint's motion (with the solved acceleration in forward dynamics).
-    fixed_point : FixedPoint
-        ``x[..., -1]`` is the drive torque [N m] or the input acceleration [rad/s^2].
+    Exactly one of ``theta_tt`` [rad/s^2] (inverse dynamics: the drive torque [N m] is the unknown) and
+    ``torque_in`` [N m] (forward: the input acceleration is) is given, with ``theta`` [rad], ``theta_t``
+    [rad/s], the kinematics ``method``, ``load_torque`` [N m] (None: the scene's constant load) and
+    ``bands`` (K,) [m/s] (None: :func:`slot_bands`; passing them saves the scene's hash).
     """
     if (theta_tt is None) == (torque_in is None):
         raise ValueError("give exactly one of `theta_tt` (inverse) and `torque_in` (forward)")
@@ -114,8 +83,9 @@ def solve_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
 def _forward_system(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                     torque_in: float | np.ndarray, method: str,
                     load_torque: float | np.ndarray | None) -> _System:
-    """The system with the input acceleration as the last unknown (:func:`solve_dynamics`'
-    arguments): one batch at accelerations 0 and 1, the right-hand side being affine in it."""
+    """The system with the input acceleration as last unknown (:func:`solve_dynamics`' arguments): one
+    batch at accelerations 0 and 1, the right-hand side being affine in it.
+    """
     n = theta.size
     pair = joint_motion(scene.joint, np.tile(theta, 2), np.tile(theta_t, 2), np.repeat([0.0, 1.0], n),
                         method)
@@ -153,24 +123,10 @@ def dynamics_columns(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                      method: str = "auto",
                      load_torque: float | np.ndarray | None = None,
                      ) -> tuple[dict[str, np.ndarray], FixedPoint]:
-    """Result-schema columns (without ``t``) for the given motion, with friction.
-
-    Samples that self-lock carry NaN reactions, friction and powers.
-
-    Parameters
-    ----------
-    scene, theta, theta_t, theta_tt, torque_in, method, load_torque
-        As for :func:`solve_dynamics`: inverse dynamics when ``theta_tt`` is given, forward
-        dynamics when ``torque_in`` is.
-
-    Returns
-    -------
-    columns : dict of str to ndarray, shape (n,)
-        Every column of :func:`reference.results.columns.table_columns` but ``t``, plus
-        ``input_acceleration`` [rad/s^2], ``friction_loop_gain`` [-], ``self_locking`` and, per
-        pair, ``<pair>_slide`` [m] (the D-H slide; zero in the ideal joint) and the two parts of
-        its loss, ``power_loss_<pair>_rotation`` and ``power_loss_<pair>_sliding`` [W].
-    fixed_point : FixedPoint
+    """``(columns, fixed_point)``: the result-schema columns but ``t``, plus ``input_acceleration``,
+    ``friction_loop_gain``, ``self_locking``, ``<pair>_slide`` [m] and ``power_loss_<pair>_rotation`` /
+    ``_sliding`` [W], for :func:`solve_dynamics`' arguments; NaN reactions, friction and powers where a
+    sample self-locks.
     """
     motion, fixed = solve_dynamics(scene, theta, theta_t, theta_tt, torque_in, method, load_torque)
     theta = np.atleast_1d(np.asarray(theta, float))
@@ -191,29 +147,8 @@ def solution_columns(motion: JointMotion, fixed: FixedPoint, slots: list[tuple[s
                      inputs: tuple[np.ndarray, np.ndarray, np.ndarray], drive: np.ndarray,
                      load: float | np.ndarray,
                      energy: tuple[np.ndarray, np.ndarray]) -> dict[str, np.ndarray]:
-    """:func:`dynamics_columns`' columns from the solution.
-
-    Parameters
-    ----------
-    motion : JointMotion
-        The joint's motion at the n samples.
-    fixed : FixedPoint
-        The solved reactions and friction (NaN where a sample self-locks).
-    slots : list of (pair, "torque" | "force")
-        :func:`reference.engine.slots.friction_slots`.
-    inputs : tuple of three ndarray, shape (n,)
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
-    drive : ndarray, shape (n,)
-        Drive torque [N m].
-    load : float or ndarray, shape (n,)
-        Output load [N m].
-    energy : tuple of two ndarray, shape (n,)
-        Kinetic and potential energy [J].
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        As :func:`dynamics_columns`.
+    """:func:`dynamics_columns`' columns from the ``motion``, the ``fixed`` point, the ``slots``, the
+    ``inputs`` (angle, speed, acceleration), ``drive`` and ``load`` torques [N m] and ``energy`` [J].
     """
     (theta, theta_t, accel) = inputs
     locked = fixed.self_locking
@@ -265,13 +200,7 @@ def _pair_columns(motion: JointMotion, pair: str, applied: dict[tuple[str, str],
 
 def inverse_dynamics(scene: Scene, theta: np.ndarray, theta_t: np.ndarray,
                      theta_tt: np.ndarray) -> dict[str, np.ndarray]:
-    """Result-schema columns (without ``t``) for a prescribed input motion, with friction.
-
-    Parameters
-    ----------
-    scene : Scene
-        Joint, load, gravity and friction (the drive is replaced by the given motion).
-    theta, theta_t, theta_tt : ndarray, shape (n,)
-        Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
+    """Result-schema columns (without ``t``) of ``scene`` with friction for the prescribed input motion
+    ``theta`` [rad], ``theta_t`` [rad/s], ``theta_tt`` [rad/s^2] (the drive is replaced by it).
     """
     return dynamics_columns(scene, theta, theta_t, theta_tt=theta_tt)[0]

@@ -1,9 +1,5 @@
-"""The summary every engine reports about a run: :class:`Summary`, its :class:`Status` and its
-JSON shape on disk (:data:`SCHEMA_VERSION`).
-
-The summary's means are those of the direction power flows over the window
-(:func:`reference.results.means.mean_values`): ``power_flow`` says which; the paper's eq. (18) and
-its time average assume the input is the source.
+"""The summary every engine reports about a run: :class:`Summary`, its :class:`Status` and its JSON
+shape on disk (:data:`SCHEMA_VERSION`). Means are those of the direction the power flows.
 """
 
 from __future__ import annotations
@@ -33,8 +29,7 @@ power flows, and never writes one outside [0, 1] with status ``ok`` (status ``un
 
 
 class Status(str, Enum):
-    """How a run ended. Only :attr:`OK` carries mean values; every other status has a ``reason``.
-
+    """How a run ended; only :attr:`OK` carries mean values, every other status has a ``reason``.
     A ``str`` enum: ``Status.OK == "ok"`` and JSON writes the plain value.
     """
 
@@ -72,15 +67,7 @@ written only when the run has it (engine-specific, like :attr:`Summary.extras`).
 
 @dataclass
 class Summary:
-    """What every engine reports about a run, with the same fields for every engine.
-
-    Modelled on scipy's ``OdeResult``: the outcome (:attr:`status`, :attr:`reason`), the solution's
-    mean values over whole input revolutions (``None`` unless the status is ``ok``; definitions
-    in :func:`mean_values`), the cost counters next to them (``None`` where an engine has no
-    such counter), how a time-stepping engine's estimate was made (:attr:`accuracy`) and how its
-    friction coupling behaved (:attr:`friction`), and what is truly engine-specific in
-    :attr:`extras` (the reference's ``quadrature``, ...). The fields are listed in the order
-    :meth:`to_dict` writes them.
+    """What every engine reports about a run, the same fields for every engine, in :meth:`to_dict`'s order.
 
     Attributes
     ----------
@@ -89,27 +76,22 @@ class Summary:
         Why the run did not end ``ok`` (empty when it did).
     engine, engine_version : str
     scene, options : dict
-        The scene as :func:`reference.scene.mapping.scene_to_dict` gives it, and the engine's options.
+        The scene (:func:`reference.scene.mapping.scene_to_dict`) and the engine's options.
     wall_time_s : float
         Wall time of the whole run [s].
-    dt : float or None
-        Time step [s] (the reference engine: the table's sample spacing).
-    dt_choice : str or None
-        How the step was chosen.
+    dt, dt_choice : float or None, str or None
+        Time step [s] (the reference engine: the table's sample spacing) and how it was chosen.
     steps, newton_iterations, jacobian_evaluations, ode_evaluations : int or None
-        Cost counters: time steps, Newton iterations and Jacobian evaluations (Exudyn), right-hand
-        side evaluations of an ODE (the reference engine's torque-driven scenes).
+        Cost counters (None where an engine has none).
     max_constraint_violation_m, max_constraint_violation_rad : float or None
         Largest violation of the pair constraints over the run [m], [rad].
     max_friction_loop_gain : float or None
         Largest gain of the friction feedback loop (>= 1: no consistent friction).
     efficiency_error_estimate : float or None
-        The run's a-posteriori estimate of the absolute error of ``mean_efficiency`` [-] (Exudyn:
-        Richardson from a companion run at a coarser step; reference: its quadrature's error
-        estimate); None where an engine gives none or the run did not end ``ok``.
+        Estimated absolute error of ``mean_efficiency`` [-] (Exudyn: Richardson from a coarser
+        companion run; reference: its quadrature's estimate).
     accuracy_met : bool or None
-        Whether that estimate is within the scene's ``numerics.accuracy`` (None without an
-        estimate); ``cardan run`` exits 5 when it is False (``docs/accuracy.md``).
+        Estimate within ``numerics.accuracy``; ``cardan run`` exits 5 when False (``docs/accuracy.md``).
     revolutions : int
         Whole input revolutions averaged over.
     window_start_s, window_duration_s : float or None
@@ -117,40 +99,31 @@ class Summary:
     input_work, output_work, loss_work : float or None
         Works over the window [J].
     mean_efficiency : float or None
-        One minus lost over supplied work, the headline number, in [0, 1]: over the input work
-        when power flows from the input to the output (the paper's), over the work the output
-        supplies (``-output_work``) when it flows the other way, 0 when no shaft takes net work,
-        None (with a warning) when no work is transmitted or lost.
+        One minus lost over supplied work in [0, 1] (input work, or ``-output_work`` when power flows
+        from the output); 0 when no shaft takes net work; None (with a warning) when nothing is
+        transmitted or lost.
     mean_instantaneous_efficiency : float or None
-        Time average of eq. (18) over the window, in [0, 1], for the direction of ``power_flow``
-        (``-power_out`` the source power when it is ``output_to_input``); None, with a warning,
-        where it is not defined: the source power changes sign within the window, or the average
-        falls outside [0, 1].
+        Time average of eq. (18) for the direction of ``power_flow``; None, with a warning, where
+        the source power changes sign within the window or the average is outside [0, 1].
     work_ratio : float or None
-        Received over supplied work: output over input work when power flows from the input.
-    mean_torque_in : float or None
-        Input work over input angle [N m].
-    mean_speed_in : float or None
-        Input angle over time [rad/s].
+        Received over supplied work.
+    mean_torque_in, mean_speed_in : float or None
+        Input work over input angle [N m], input angle over time [rad/s].
     power_flow : str or None
-        ``input_to_output``, ``output_to_input`` or ``none`` (no shaft takes net work), from the
-        signs of the window's works (:class:`reference.results.power_flow.PowerFlow`).
+        ``input_to_output``, ``output_to_input`` or ``none``
+        (:class:`reference.results.power_flow.PowerFlow`).
     power_reversals : int or None
-        How often the source power changes sign within the window (table rows).
-    pair_loss_work : dict[str, float]
-        Loss work per pair [J] (``loss_work_<pair>`` on disk).
-    pair_sliding_loss_work : dict[str, float]
-        Its part from axial friction [J] (``loss_work_<pair>_sliding`` on disk).
+        Sign changes of the source power within the window (table rows).
+    pair_loss_work, pair_sliding_loss_work : dict[str, float]
+        Loss work per pair and its axial-friction part [J] (``loss_work_<pair>[_sliding]`` on disk).
     warnings : list of str
-        What a reader of the means must know (power flowing backwards, an undefined mean).
+        What a reader of the means must know.
     friction : FrictionDiagnostics or None
-        The friction coupling's counters and loop gains (Exudyn with friction); ``friction`` on
-        disk.
+        The friction coupling's counters and loop gains (Exudyn with friction).
     extras : dict
-        Engine-specific diagnostics, written at the top level of the JSON.
+        Engine-specific diagnostics (the reference's ``quadrature``, ...), top level of the JSON.
     accuracy : RunAccuracy or None
-        How :attr:`efficiency_error_estimate` was made: target, method, companion and pilot runs
-        (Exudyn); ``accuracy`` on disk.
+        How :attr:`efficiency_error_estimate` was made (Exudyn).
     """
 
     status: Status
@@ -215,23 +188,9 @@ class Summary:
 
     def whole_revolution_means(self, columns: Mapping[str, np.ndarray], skip_revolutions: float,
                                works: Mapping[str, float] | None = None) -> dict[str, Any] | None:
-        """The means of ``columns`` over whole input revolutions by every engine's rules.
-
-        Parameters
-        ----------
-        columns : mapping
-            The table's columns.
-        skip_revolutions : float
-            Input revolutions [-] left out at the start.
-        works : mapping, optional
-            The window's works from a better integration (:func:`~reference.results.means.mean_values`).
-
-        Returns
-        -------
-        dict or None
-            :func:`~reference.results.means.mean_values`' keys; None, with the status and reason set,
-            when there is no whole revolution (``no_whole_revolution``) or the means are impossible
-            (``unphysical``). Their warnings are added to :attr:`warnings` either way.
+        """:func:`~reference.results.means.mean_values` of ``columns`` after ``skip_revolutions`` (with the
+        window's better ``works``); None, with status and reason set, when there is no whole revolution or
+        the means are ``unphysical``. Their warnings join :attr:`warnings` either way.
         """
         means = mean_values(columns, skip_revolutions, works)
         if means["revolutions"] < 1:
@@ -256,15 +215,7 @@ class Summary:
         self.pair_sliding_loss_work.clear()
 
     def fail(self, status: Status | str, reason: str) -> None:
-        """End the run and forget its means.
-
-        Parameters
-        ----------
-        status : Status or str
-            Why it ended (not ``ok``).
-        reason : str
-            What happened, in one sentence.
-        """
+        """End the run with ``status`` (not ``ok``) and a one-sentence ``reason``, forgetting its means."""
         self.status = Status(status)
         self.reason = reason
         self.clear_means()
@@ -291,10 +242,9 @@ class Summary:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Summary:
-        """Inverse of :meth:`to_dict`; also reads versions 1 (no version key) and 2, whose
-        efficiencies it takes again from their works by version 3's rules (:meth:`upgrade`).
-        An ``accuracy`` or ``friction`` table with keys this version does not know stays
-        unchanged in :attr:`extras`."""
+        """Inverse of :meth:`to_dict`; reads schema versions 1 and 2 too, re-deriving their efficiencies
+        (:meth:`upgrade`). ``accuracy`` or ``friction`` tables with unknown keys stay in :attr:`extras`.
+        """
         names = {f.name for f in fields(cls)} - {"pair_loss_work", "pair_sliding_loss_work", "extras",
                                                  *_RECORDS}
         summary = cls(status=Status(data["status"]))
@@ -318,10 +268,9 @@ class Summary:
         return summary
 
     def upgrade(self) -> None:
-        """Version 3's rules on a version 1 or 2 summary that is ``ok`` and has its three works:
-        the power flow and the efficiencies of its direction; ``unphysical`` where they are out
-        of [0, 1]. The time average of eq. (18) is kept only where it is in [0, 1] (the table
-        that would say whether the source power changed sign is not in a summary)."""
+        """Schema version 3's rules on an ``ok`` version 1 or 2 summary with its three works: power flow,
+        efficiencies, ``unphysical`` out of [0, 1]; the eq. (18) average is kept only within [0, 1].
+        """
         works = (self.input_work, self.output_work, self.loss_work)
         if not self.success or any(w is None for w in works):
             return

@@ -1,28 +1,13 @@
-"""The Cardan joint of a scene: its three bodies, geometry, four pairs and mounting errors.
+"""The Cardan joint of a scene: its three bodies, geometry, four pairs and mounting errors (SI, rad).
 
-The part of a scene that describes the mechanism; :mod:`reference.scene.scene` adds what is done with
-it (drive, load, gravity, span, numerics). Every engine and the paper's data
-(:mod:`reference.paper`) build on these types, so they sit below both. SI units and radians.
-
-Conventions (used by every engine, documented in README "Conventions")
------------------------------------------------------------------------
-Global frame: origin at the joint centre (spider centre), x along the input shaft axis pointing
-towards the joint, gravity given as a global vector. The output shaft axis is
-``(cos(beta), sin(beta), 0)`` with ``beta`` the shaft angle, so the joint bends in the x-y plane.
-
-Canonical body frames (all with origin at the joint centre; they coincide with the global frame
-at input angle 0, except the output's, which is rotated by ``beta`` about global z):
-
-- ``input``: x along the input axis (towards the joint), y along the input yoke's trunnion axis.
-- ``spider``: y along the arm held by the input yoke, z along the arm held by the output yoke.
-- ``output``: x along the output axis (away from the joint), z along the output yoke's trunnions.
-
-A :class:`Body` gives its mass properties in its own *local* frame (for the paper, Table 1's
-frames), placed in the canonical frame by ``local_origin`` and ``local_axes``.
-
-Pairs, in chain order, each between a body ``a`` and a body ``b``:
-``frame_input`` (revolute, ground -> input), ``input_spider`` (cylindrical, input -> spider),
-``spider_output`` (cylindrical, spider -> output), ``output_frame`` (cylindrical, output -> ground).
+Conventions (every engine; README "Conventions"): origin at the joint centre, x along the input
+axis towards the joint, output axis ``(cos(beta), sin(beta), 0)``. Canonical body frames (origin
+at the joint centre, global at input angle 0 except the output's, turned by ``beta`` about z):
+``input`` x along its axis, y along its yoke's trunnions; ``spider`` y on the arm the input yoke
+holds, z on the output yoke's; ``output`` x along its axis away from the joint, z along its yoke's
+trunnions. A :class:`Body` gives its mass properties in its own local frame (``local_origin``,
+``local_axes``). Pairs in chain order (body ``a`` -> ``b``): ``frame_input`` (revolute, ground ->
+input), ``input_spider``, ``spider_output``, ``output_frame`` (cylindrical, -> ground).
 """
 
 from __future__ import annotations
@@ -79,15 +64,11 @@ class Body:
     mass : float
         Mass [kg], positive.
     inertia : tuple, shape (3, 3)
-        Inertia tensor in the local frame [kg m^2], about the point named by ``inertia_about``.
-    inertia_about : {"com", "origin"}
-        Reference point of ``inertia``: the centre of mass or the local frame's origin.
-    com : tuple, shape (3,)
-        Centre of mass in the local frame [m].
-    local_origin : tuple, shape (3,)
-        Position of the local frame's origin in the canonical body frame [m].
+        Inertia tensor in the local frame [kg m^2], about ``inertia_about``: ``"com"`` or ``"origin"``.
+    com, local_origin : tuple, shape (3,)
+        Centre of mass in the local frame, local origin in the canonical body frame [m].
     local_axes : tuple, shape (3, 3)
-        Rotation matrix whose columns are the local x, y, z axes in canonical coordinates.
+        Columns: the local x, y, z axes in canonical coordinates.
     """
 
     mass: float
@@ -142,15 +123,12 @@ class Pair:
     Attributes
     ----------
     friction_coefficient : float
-        Coulomb coefficient f [-], >= 0; zero means the pair is frictionless.
+        Coulomb coefficient f [-], >= 0 (0: frictionless).
     journal_diameter : float
         Journal diameter d [m] of eqs. (2), (3).
     moment_lever : float or "geometry"
-        Lever L [m] that turns a bending moment into a couple of forces, eq. (1); ``"geometry"``
-        (None is read as it): derived from the joint's geometry (:meth:`Joint.lever`): a spider
-        pair stands for two trunnion
-        bearings on opposite arms, which carry a bending moment as a couple over their spacing,
-        ``2 * arm_radius``; a frame pair for a shaft's two support bearings, ``support_spacing``.
+        Lever L [m] of eq. (1); ``"geometry"`` (or None): :meth:`Joint.lever`, ``2 * arm_radius`` for a
+        spider pair (two trunnion bearings on opposite arms), ``support_spacing`` for a frame pair.
     """
 
     friction_coefficient: float = 0.0
@@ -195,17 +173,13 @@ class Geometry:
     Attributes
     ----------
     shaft_angle : float
-        Angle beta between input and output shaft axes [rad], in [0, pi/2).
-    input_bearing : float
-        Distance from the joint centre to the frame-input bearing along the input axis [m].
-    output_bearing : float
-        Distance from the joint centre to the output-frame bearing along the output axis [m].
+        Angle beta between the shaft axes [rad], in [0, pi/2).
+    input_bearing, output_bearing : float
+        Joint centre to the frame-input / output-frame bearing along its shaft axis [m].
     arm_radius : float
-        Spider arm radius: joint centre to the middle of each trunnion bearing [m]. The moment
-        lever of a spider pair whose ``moment_lever`` is ``"geometry"`` is ``2 * arm_radius``.
+        Joint centre to the middle of each trunnion bearing [m].
     support_spacing : float
-        Distance between the two support bearings of each shaft [m], the frame pair's lumped
-        bearings; the moment lever of a frame pair whose ``moment_lever`` is ``"geometry"``.
+        Spacing of each shaft's two support bearings [m] (the frame pairs' lumped bearings).
     """
 
     shaft_angle: float = 0.0
@@ -237,25 +211,21 @@ ERROR_NAMES = ("a1", "a2", "a3", "a4", "alpha1", "alpha2", "alpha3", "alpha4", "
 
 @dataclass(frozen=True)
 class MountingErrors:
-    """Manufacturing and mounting errors as Denavit-Hartenberg parameter deviations (Figure 3).
+    """Manufacturing and mounting errors as Denavit-Hartenberg deviations (the paper's Figure 3).
 
-    Links are numbered as the pairs they carry (:mod:`reference.physics.rccc`): link 1 the input (from
-    the ``frame_input`` axis to the ``input_spider`` axis), 2 the spider (to ``spider_output``),
-    3 the output (to ``output_frame``), 4 the frame (from ``output_frame`` back to
-    ``frame_input``). All zero is the ideal joint. At the boundary ``a<k>_mm``,
-    ``alpha<k>_deg`` and ``s1_mm`` are accepted.
+    Link k carries pairs k and k + 1 (:mod:`reference.physics.rccc`): 1 the input, 2 the spider, 3 the
+    output, 4 the frame. All zero is the ideal joint; ``a<k>_mm``, ``alpha<k>_deg``, ``s1_mm`` are
+    accepted at the boundary.
 
     Attributes
     ----------
     a1, a2, a3, a4 : float
-        Offsets [m]: length of each link's common normal between its two pair axes (ideal 0:
-        the axes intersect at the joint centre). The paper's tolerance case has
-        ``a1 = a2 = a3 = 0.5 mm``.
+        Offsets [m]: each link's common normal between its pair axes (the paper's tolerance case:
+        ``a1 = a2 = a3 = 0.5 mm``).
     alpha1, alpha2, alpha3, alpha4 : float
-        Twist errors [rad], added to the ideal twists (90, 90, 90, -shaft angle) deg: the
-        paper's case has ``alpha1 = alpha2 = alpha3 = 6e-3 deg``.
+        Twist errors [rad] added to the ideal (90, 90, 90, -shaft angle) deg (paper: 6e-3 deg each of 1..3).
     s1 : float
-        Axial offset of the input along its axis [m] (moves the input and its yoke along x).
+        Axial offset of the input along x [m].
     """
 
     a1: float = 0.0
@@ -304,10 +274,9 @@ class Joint:
                              f"(-90, 90) deg, got {twist / DEG!r} deg")
 
     def lever(self, name: str) -> float:
-        """Moment lever of pair ``name`` [m]: its ``moment_lever``, or when that is ``"geometry"``
-        the one the joint's geometry gives (``2 * arm_radius`` for a spider pair,
-        ``support_spacing`` for a frame
-        pair; see :class:`Pair`)."""
+        """Moment lever [m] of pair ``name``: its ``moment_lever``, or under ``"geometry"`` ``2 * arm_radius``
+        (spider pair) or ``support_spacing`` (frame pair).
+        """
         pair = getattr(self.pairs, name)
         if pair.moment_lever != GEOMETRY_LEVER:
             return pair.moment_lever
@@ -316,8 +285,7 @@ class Joint:
         return self.geometry.support_spacing
 
     def friction_pairs(self) -> list[tuple[str, Pair]]:
-        """``(name, pair)`` in chain order with every moment lever resolved (:meth:`lever`): the
-        pairs as the friction law sees them."""
+        """``(name, pair)`` in chain order with every moment lever resolved (:meth:`lever`)."""
         return [(name, dataclasses.replace(pair, moment_lever=self.lever(name)))
                 for name, pair in self.pairs.items()]
 

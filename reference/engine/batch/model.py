@@ -1,12 +1,8 @@
 """Many constant-speed scenes as one model: per-sample parameters, one vectorised evaluation.
 
-:class:`SceneStack` holds what may differ between the scenes of a batch (speed, load, gravity,
-mass properties, geometry and mounting errors, friction coefficients, journal diameters, ramp
-widths); what they share (:func:`reference.engine.batch.solve.batch_key`) decides the code path.
-:meth:`SceneStack.columns` evaluates samples of many scenes in one pass, each sample's values
-those of :func:`reference.engine.table.columns_at` for its own scene, to rounding. A sample whose
-loop does not close puts its scene in :attr:`SceneStack.failed` (the caller runs it on its own)
-and is evaluated at input angle 0, so that the other scenes go on.
+:meth:`SceneStack.columns` gives each sample :func:`reference.engine.table.columns_at`'s values for
+its own scene, to rounding. A scene whose loop does not close goes to :attr:`SceneStack.failed`
+(the caller runs it on its own) and is evaluated at input angle 0 so the others go on.
 """
 
 from __future__ import annotations
@@ -53,16 +49,8 @@ calls leave the caches). Measured: docs/engines.md#constants-of-the-reference-en
 
 
 class StackedLoop:
-    """The loop parameters of many scenes, one row per sample; it stands in for
-    :class:`reference.physics.rccc.parameters.DHParameters` where :mod:`reference.physics.rccc`
-    only asks for the twists.
-
-    Parameters
-    ----------
-    alpha, a : ndarray, shape (n, 4)
-        Link twists [rad] and offsets [m].
-    s1 : ndarray, shape (n,)
-        Axial offset of the revolute joint [m].
+    """The loop parameters of many scenes, one row per sample: twists ``alpha`` [rad], offsets ``a`` [m]
+    (n, 4), ``s1`` [m] (n,); stands in for :class:`DHParameters` where only twists are asked for.
     """
 
     def __init__(self, alpha: np.ndarray, a: np.ndarray, s1: np.ndarray) -> None:
@@ -76,9 +64,9 @@ class StackedLoop:
 
 
 class StackedLaw:
-    """Eqs. (3) and (5) with per-sample coefficients, for :func:`reference.engine.fixed_point.solve_friction`
-    (which hands its ``signs`` argument through): ``signs`` packs, on a last axis of 3, each
-    slot's friction factor, ``k_force`` and ``k_moment``."""
+    """Eqs. (3) and (5) with per-sample coefficients for :func:`reference.engine.fixed_point.solve_friction`:
+    ``signs`` packs, on a last axis of 3, each slot's friction factor, ``k_force`` and ``k_moment``.
+    """
 
     def __init__(self, slots: list[tuple[str, str]]) -> None:
         position = {key: j for j, key in enumerate(unknowns()[:-1])}
@@ -90,19 +78,8 @@ class StackedLaw:
         return friction_law_values(x, self.index, packed[..., 0], packed[..., 1], packed[..., 2])
 
     def reduced(self, c: np.ndarray, packed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:func:`reference.engine.law_values.reduced_law_values` with per-sample coefficients.
-
-        Parameters
-        ----------
-        c : ndarray, shape (n, K, 4)
-            ``x[:, index]``: each slot's fx, fy [N], mx, my [N m].
-        packed : ndarray, shape (n, K, 3)
-            Each slot's friction factor, ``k_force`` and ``k_moment``.
-
-        Returns
-        -------
-        values : ndarray, shape (n, K)
-        slopes : ndarray, shape (n, K, 4)
+        """``(values, slopes)`` of :func:`reference.engine.law_values.reduced_law_values` on ``c`` (n, K, 4)
+        with the ``packed`` (n, K, 3) per-sample factors and coefficients.
         """
         return reduced_law_values(c, packed[..., 0], packed[..., 1], packed[..., 2])
 
@@ -120,18 +97,12 @@ def _slot_coefficients(scene: Scene, slots: list[tuple[str, str]]) -> np.ndarray
 
 
 class SceneStack:
-    """The parameters of constant-speed scenes with one :func:`reference.engine.batch.solve.batch_key`.
+    """The parameters of constant-speed ``scenes`` sharing one :func:`reference.engine.batch.solve.batch_key`.
 
-    Parameters
-    ----------
-    scenes : sequence of Scene
-        Constant speed, constant load (:func:`reference.engine.batch.solve.batch_key`).
-    sign_bands : sequence of dict, optional
-        Each scene's :func:`reference.physics.bands.sign_bands`, known from an earlier stack of the same
-        scenes (then the windings are not checked again); None: computed here for all scenes at
-        once, with the checks the engine makes on the way (:meth:`_sign_bands`). A scene that
-        fails a check is in :attr:`failed` and its bands are placeholders: evaluate a stack of
-        the others (a scene whose loop does not close makes the Newton-Euler matrices singular).
+    ``sign_bands``: each scene's :func:`reference.physics.bands.sign_bands` from an earlier stack (the
+    windings are then not checked again); None: computed here for all at once, with the engine's
+    checks. A scene failing a check is in :attr:`failed` with placeholder bands: evaluate a stack of
+    the others (a loop that does not close makes the matrices singular).
     """
 
     def __init__(self, scenes: Sequence[Scene], sign_bands: Sequence[dict] | None = None) -> None:
@@ -179,10 +150,9 @@ class SceneStack:
         self.zero_slide = np.nan_to_num(zero.du)
 
     def _check_windings(self) -> None:
-        """The windings check of :func:`reference.physics.rccc.positions.solve_positions` for every
-        scene at once (:data:`reference.physics.rccc.positions.WINDING_SAMPLES` input angles each): a
-        scene whose joint angles jump, or whose loop does not close at one of them, is added to
-        :attr:`failed` (run on its own, the engine reports why)."""
+        """:func:`reference.physics.rccc.positions.solve_positions`' windings check for every scene at once;
+        a scene whose angles jump or whose loop does not close joins :attr:`failed`.
+        """
         live = np.array([k for k in range(len(self.scenes)) if k not in self.failed], int)
         if live.size == 0:
             return
@@ -195,9 +165,9 @@ class SceneStack:
         self.failed.update(live[jumps | ~np.all(np.isfinite(raw), (-2, -1))].tolist())
 
     def _sign_bands(self) -> list[dict[str, PairBands]]:
-        """:func:`reference.physics.bands.sign_bands` of every scene, the characteristic speeds of all in
-        one pass (with mounting errors after :meth:`_check_windings`); a failed scene's (run on its
-        own) are placeholders."""
+        """Every scene's :func:`reference.physics.bands.sign_bands`, characteristic speeds in one pass
+        (a failed scene's are placeholders).
+        """
         if not self.ideal:
             self._check_windings()
         need = [k for k, s in enumerate(self.scenes)
@@ -217,9 +187,9 @@ class SceneStack:
                 for k, s in enumerate(self.scenes)]
 
     def _pair_speeds(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray) -> tuple[dict, dict]:
-        """Per pair the relative angular [rad/s] and sliding [m/s] speeds of the scenes ``idx`` at
-        input angles ``theta`` [rad] and speeds ``theta_t`` [rad/s] (speeds need no accelerations;
-        with mounting errors the loop's rates are all they need: no frames, no body motions)."""
+        """Per pair the relative angular [rad/s] and sliding [m/s] speeds of scenes ``idx`` at ``theta``
+        [rad], ``theta_t`` [rad/s] (only the loop's rates: no frames, no body motions).
+        """
         zero = np.zeros_like(theta)
         if self.ideal:
             motion = self.motion(idx, theta, theta_t, zero)
@@ -230,18 +200,8 @@ class SceneStack:
 
     def motion(self, idx: np.ndarray, theta: np.ndarray, theta_t: np.ndarray,
                theta_tt: np.ndarray) -> JointMotion:
-        """:func:`reference.physics.joint_motion.joint_motion` of each sample's scene.
-
-        Parameters
-        ----------
-        idx : ndarray of int, shape (n,)
-            Each sample's scene.
-        theta, theta_t, theta_tt : ndarray, shape (n,)
-            Input angle [rad], speed [rad/s] and acceleration [rad/s^2].
-
-        Returns
-        -------
-        JointMotion
+        """:func:`reference.physics.joint_motion.joint_motion` of each sample's scene ``idx`` at ``theta``
+        [rad], ``theta_t`` [rad/s], ``theta_tt`` [rad/s^2].
         """
         if self.ideal:
             beta = self.beta[idx]
@@ -319,38 +279,16 @@ class SceneStack:
 
     def slot_speeds(self, idx: np.ndarray, omega_rel: dict[str, np.ndarray],
                     slide_rel: dict[str, np.ndarray]) -> np.ndarray:
-        """:func:`reference.engine.slots.slot_speeds` with each sample's journal diameters.
-
-        Parameters
-        ----------
-        idx : ndarray of int, shape (n,)
-            Each sample's scene.
-        omega_rel, slide_rel : dict of str to ndarray, shape (n,)
-            Per pair the relative angular [rad/s] and sliding [m/s] speeds.
-
-        Returns
-        -------
-        ndarray, shape (n, K)
-            Speeds [m/s].
+        """:func:`reference.engine.slots.slot_speeds` (n, K) [m/s] with the journal diameters of each
+        sample's scene ``idx``.
         """
         out = [0.5 * self.diameter[idx, j] * omega_rel[pair] if kind == "torque"
                else slide_rel[pair] for j, (pair, kind) in enumerate(self.slots)]
         return np.stack(out, -1) if out else np.zeros(idx.shape + (0,))
 
     def ramp_speeds(self, idx: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """:func:`reference.engine.slots.ramp_speeds`, :data:`CHUNK_SAMPLES` at a time.
-
-        Parameters
-        ----------
-        idx : ndarray of int, shape (n,)
-            Each sample's scene.
-        t : ndarray, shape (n,)
-            Instants [s].
-
-        Returns
-        -------
-        ndarray, shape (n, K')
-            Speeds [m/s].
+        """:func:`reference.engine.slots.ramp_speeds` (n, K') [m/s] of scenes ``idx`` at instants ``t`` [s],
+        :data:`CHUNK_SAMPLES` at a time.
         """
         if idx.size <= CHUNK_SAMPLES:
             return self._ramp_speeds(idx, t)
@@ -381,22 +319,9 @@ class SceneStack:
         return solve_friction(law, both[..., 0], both[..., 1:], packed, exact_gain=exact_gain)
 
     def columns(self, idx: np.ndarray, t: np.ndarray, energy: bool = True) -> dict[str, np.ndarray]:
-        """:func:`reference.engine.table.columns_at` of each sample's scene, :data:`CHUNK_SAMPLES`
-        at a time.
-
-        Parameters
-        ----------
-        idx : ndarray of int, shape (n,)
-            Each sample's scene.
-        t : ndarray, shape (n,)
-            Instants [s].
-        energy : bool
-            False: the energy columns are left zero and the loop gain is exact only where it
-            decides self-locking (the work integrands need neither).
-
-        Returns
-        -------
-        dict of str to ndarray, shape (n,)
+        """:func:`reference.engine.table.columns_at` of scenes ``idx`` at instants ``t`` [s],
+        :data:`CHUNK_SAMPLES` at a time; ``energy`` False leaves the energy columns zero and the loop gain
+        exact only where it decides self-locking.
         """
         idx = np.asarray(idx, int)
         t = np.asarray(t, float)

@@ -32,15 +32,8 @@ _CANONICAL_IN_LINK = {
 
 @dataclass(frozen=True)
 class BodyPose:
-    """Canonical body frame (:mod:`reference.scene.joint`) of one link, global components.
-
-    Attributes
-    ----------
-    rotation : ndarray, shape (..., 3, 3)
-        Columns: the body's canonical axes [-].
-    origin : ndarray, shape (..., 3)
-        The link's D-H frame origin: the foot of its common normal on its first joint [m]
-        (the joint centre for the ideal joint; the global origin for the ground).
+    """Canonical body frame of one link, global components: ``rotation`` (..., 3, 3) (columns: the
+    canonical axes [-]) and ``origin`` (..., 3) [m], the foot of its common normal on its first joint.
     """
 
     rotation: np.ndarray
@@ -49,8 +42,9 @@ class BodyPose:
 
 
 def _joint_frames(params: DHParameters, positions: LoopPositions) -> Dual:
-    """``F_1..F_4`` as dual matrices in global components, shape (..., 4, 3, 3); kept with the
-    positions (frozen) for these parameters, since rates, poses and pair frames all need them."""
+    """``F_1..F_4`` as dual matrices (..., 4, 3, 3), global; cached with the (frozen) positions, since
+    rates, poses and pair frames all need them.
+    """
     cached = positions.__dict__.get("_frames")
     if cached is not None and cached[0] is params:
         return cached[1]
@@ -66,23 +60,8 @@ def _joint_frames(params: DHParameters, positions: LoopPositions) -> Dual:
 
 
 def joint_frames(params: DHParameters, positions: LoopPositions) -> tuple[np.ndarray, np.ndarray]:
-    """The D-H frames ``F_1..F_4``.
-
-    ``F_k`` is fixed in link k - 1, body ``a`` of joint k; its z axis is the joint axis.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
-
-    Returns
-    -------
-    rotation : ndarray, shape (..., 4, 3, 3)
-        Axes (columns) in global components [-].
-    origin : ndarray, shape (..., 4, 3)
-        Origins [m].
+    """The D-H frames ``F_1..F_4`` of ``params`` at its solved ``positions``: axes (..., 4, 3, 3) [-] and
+    origins (..., 4, 3) [m]; ``F_k`` is fixed in link k - 1 (body ``a`` of joint k), z on the joint axis.
     """
     return dual.displacement(_joint_frames(params, positions))
 
@@ -94,38 +73,18 @@ _PAIR_IN_F = np.stack([np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1
 
 
 def axial_positions(geometry: Geometry) -> tuple[float, float, float, float]:
-    """Where each pair's bearing sits along its axis from the D-H frame origin [m].
-
-    The frame bearings at ``-input_bearing`` (input axis, towards the input) and
-    ``+output_bearing`` (output axis); the spider pairs at the foot of the common normal.
+    """Each pair's bearing position [m] along its axis from the D-H frame origin: the frame bearings at
+    ``-input_bearing`` and ``+output_bearing`` of ``geometry``, the spider pairs at 0.
     """
     return (-geometry.input_bearing, 0.0, 0.0, geometry.output_bearing)
 
 
 def pair_frames(params: DHParameters, positions: LoopPositions,
                 axial: Sequence[float] = (0.0,) * 4) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each pair's frame (global components) and origin, the point reactions are taken about.
-
-    The frame is the D-H frame ``F_k`` of the pair's joint, fixed in body ``a``, with the axes of
-    :func:`reference.physics.kinematics.pair_frames` (z the pair axis). The origin is the point of body
-    ``b`` on the axis that sits ``axial[k]`` from ``F_k``'s origin at input angle 0
-    (:func:`axial_positions`; or one row per sample, shape (..., 4)); when the pair slides it
-    moves along the axis with body ``b``.
-    Body ``b`` carries the bearing of the ``spider_output`` (output yoke) and ``output_frame``
-    (frame) pairs; it is also the point Exudyn's joint reactions refer to.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
-    axial : sequence of 4 float, or ndarray, shape (..., 4)
-        The pairs' axial positions [m].
-
-    Returns
-    -------
-    dict of str to (rotation (..., 3, 3) [-], origin (..., 3) [m])
+    """Per pair ``(rotation (..., 3, 3) [-], origin (..., 3) [m])``, global: the pair's D-H frame (fixed
+    in body ``a``, axes of :func:`reference.physics.kinematics.pair_frames`) and the point of body ``b``
+    ``axial[k]`` [m] along the axis from its origin at input angle 0 (moving with ``b`` when the pair
+    slides); the point reactions are taken about, as Exudyn's.
     """
     rotation, origin = joint_frames(params, positions)
     axial = np.asarray(axial, float) if np.ndim(axial) > 1 else np.asarray(four_numbers("axial", axial))
@@ -137,63 +96,22 @@ def pair_frames(params: DHParameters, positions: LoopPositions,
 
 
 def joint_screws(params: DHParameters, positions: LoopPositions) -> Dual:
-    """Joint axes as unit lines ``u + eps (p x u)`` in global components, shape (..., 4, 3).
-
-    The direction is each pair's z axis of :func:`reference.physics.kinematics.pair_frames` [-]; the
-    moment is about the global origin [m].
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
-
-    Returns
-    -------
-    Dual, shape (..., 4, 3)
+    """Joint axes as unit lines ``u + eps (p x u)`` (..., 4, 3), global: the pair z axes [-], moments
+    about the origin [m].
     """
     return dual.matvec(_joint_frames(params, positions), E_Z)
 
 
 def pair_axes(params: DHParameters, positions: LoopPositions) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Each pair's axis.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
-
-    Returns
-    -------
-    dict of str to (ndarray, ndarray)
-        Per pair the unit direction [-] and its point closest to the origin [m], shape (..., 3)
-        each.
-    """
+    """Per pair the unit axis direction [-] and its point closest to the origin [m], (..., 3) each."""
     screws = joint_screws(params, positions)
     return {p: (screws.re[..., k, :], dual.line_point(screws[..., k, :]))
             for k, p in enumerate(PAIR_NAMES)}
 
 
 def body_poses(params: DHParameters, positions: LoopPositions) -> dict[str, BodyPose]:
-    """Canonical frames of ``ground``, ``input``, ``spider`` and ``output`` (global components).
-
-    For the ideal joint these are the rotations of :func:`reference.physics.kinematics.body_motions`
-    and all origins are the joint centre.
-
-    Parameters
-    ----------
-    params : DHParameters
-        The loop.
-    positions : LoopPositions
-        Its solved positions (:func:`~reference.physics.rccc.solve_positions`).
-
-    Returns
-    -------
-    dict of str to BodyPose
-        Rotation, shape (..., 3, 3) [-], and origin, shape (..., 3) [m], per body.
+    """:class:`BodyPose` of ``ground``, ``input``, ``spider``, ``output`` at the solved ``positions``
+    (for the ideal joint, :func:`reference.physics.kinematics.body_motions`' rotations at the joint centre).
     """
     links = _joint_frames(params, positions) @ dual.rot_z(positions.dual_angles())
     rotation, origin = dual.displacement(links)
