@@ -1,12 +1,9 @@
 """The friction fixed point of the inverse (and forward) dynamics, for many samples at once.
 
-With the friction values ``phi`` (one per slot of :func:`reference.engine.slots.friction_slots`) the
-reactions are ``x = x0 - S phi`` (``x0`` the frictionless solution, ``S`` its response to unit
-friction), and the law of eqs. (3) and (5) gives ``phi = G(x)``. :func:`solve_friction` solves
-``phi = G(x0 - S phi)`` by Newton's method per sample; the law reads four components of ``x`` per
-slot (the normal force and the bending moment in the pair frame), so the iteration runs on those,
-(n, K, 4) and (n, K, 4, K), never on all of ``x``. Its loop gain -- the spectral radius of
-``dG/dphi`` at the solution -- tells a joint that self-locks (gain >= 1: no consistent friction).
+With friction values ``phi`` the reactions are ``x = x0 - S phi`` and eqs. (3), (5) give
+``phi = G(x)``; :func:`solve_friction` solves ``phi = G(x0 - S phi)`` by Newton per sample on the
+four components of ``x`` each slot reads, (n, K, 4). Loop gain (spectral radius of ``dG/dphi``)
+>= 1: the joint self-locks.
 """
 
 from __future__ import annotations
@@ -34,13 +31,9 @@ class FixedPoint:
     friction : ndarray, shape (n, K)
         Friction values of :func:`friction_slots`.
     converged : ndarray of bool, shape (n,)
-        Newton converged to the relative tolerance.
     loop_gain : ndarray, shape (n,)
-        Spectral radius of ``dG/dphi`` at the solution (0 without friction); where an upper
-        bound is below ``exact_gain``, that bound is reported instead (enough to tell that the
-        sample does not lock): the infinity norm, and with ``exact_gain`` >= 1 (the verdict
-        only, as the quadrature asks) also :func:`power_bound`; infinite where Newton found no
-        solution.
+        Spectral radius of ``dG/dphi`` (0 without friction), or an upper bound where that is below
+        ``exact_gain`` (the infinity norm, or :func:`power_bound`); infinite where Newton failed.
     iterations : int
         Newton iterations of the slowest sample.
     """
@@ -58,23 +51,8 @@ class FixedPoint:
 
 
 def power_bound(g: np.ndarray, norm: np.ndarray) -> np.ndarray:
-    """Upper bounds of spectral radii: ``rho(G) = rho(G^m)^(1/m) <= ||G^m||^(1/m)`` (Gelfand),
-    with ``m = 2^POWER_SQUARINGS`` by squaring ``G / ||G||`` (whose powers cannot overflow).
-
-    The bound falls towards ``rho`` as ``m`` grows; where it stays at or above a threshold the
-    caller computes the eigenvalues.
-
-    Parameters
-    ----------
-    g : ndarray, shape (n, K, K)
-        The matrices.
-    norm : ndarray, shape (n,)
-        Their infinity norms (positive).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The bounds, at most ``norm``.
+    """Upper bounds (n,), at most ``norm``, of the spectral radii of ``g`` (n, K, K) with infinity norms
+    ``norm``: ``rho(G) <= ||G^m||^(1/m)`` (Gelfand), ``m = 2^POWER_SQUARINGS`` by squaring ``G / ||G||``.
     """
     p = g / norm[:, None, None]
     for _ in range(POWER_SQUARINGS):
@@ -85,13 +63,12 @@ def power_bound(g: np.ndarray, norm: np.ndarray) -> np.ndarray:
 def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
                    tolerance: float = 1e-13, max_iterations: int = 50,
                    exact_gain: float = 0.5) -> FixedPoint:
-    """Solve ``phi = G(x0 - S phi)`` for every sample by Newton's method.
+    """:class:`FixedPoint` of ``phi = G(x0 - S phi)`` for every sample by Newton's method.
 
     Parameters
     ----------
     law : reference.engine.slots.FrictionLaw or alike
-        ``G``: its ``index`` (K, 4), the columns of ``x`` each slot reads, and ``reduced(c, signs)``,
-        the values and derivatives of :func:`reduced_law_values`.
+        ``G``: its ``index`` (K, 4), the columns of ``x`` each slot reads, and ``reduced(c, signs)``.
     x0 : ndarray, shape (n, 18)
         Solution without friction.
     s : ndarray, shape (n, 18, K)
@@ -99,10 +76,9 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
     signs : ndarray, shape (n, K)
         Regularised signs of the relative motions.
     tolerance : float
-        Converged when the Newton update is at most ``tolerance`` times the largest friction
-        value of the sample (or of the frictionless estimate, whichever is larger).
+        Converged when the update is at most this times the sample's largest friction value (or the
+        frictionless estimate's, if larger).
     max_iterations : int
-        Newton iterations before a sample is declared not converged.
     exact_gain : float
         Loop gain: the spectral radius where its norm bound reaches this, else the bound.
     """
@@ -125,11 +101,10 @@ def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
 
 def _newton(law: Any, c0: np.ndarray, s_c: np.ndarray, signs: np.ndarray, phi: np.ndarray,
             tolerance: float, max_iterations: int) -> tuple[np.ndarray, int]:
-    """Newton on ``phi = G(c0 - S_c phi)`` per sample, the unconverged samples' data compacted as
-    samples converge (arguments as :func:`solve_friction`'s, ``c0`` (n, K, 4) and ``s_c``
-    (n, K, 4, K) restricted to the components the law reads). ``phi`` (n, K), the first iterate,
-    is overwritten with the solution. Returns ``converged`` (n,) and the iterations of the
-    slowest sample."""
+    """Newton on ``phi = G(c0 - S_c phi)`` per sample, compacting unconverged samples; ``phi`` (n, K), the
+    first iterate, is overwritten with the solution. Returns ``converged`` (n,) and the slowest's
+    iterations.
+    """
     n = phi.shape[0]
     converged = np.zeros(n, bool)
     active = np.arange(n)
@@ -165,7 +140,8 @@ def _newton(law: Any, c0: np.ndarray, s_c: np.ndarray, signs: np.ndarray, phi: n
 def _newton_step(law: Any, c: np.ndarray, s_c: np.ndarray, signs: np.ndarray, phi: np.ndarray,
                  eye: np.ndarray) -> np.ndarray:
     """Newton's update of ``phi`` (n, K) for ``phi = G(c - S_c phi)``: ``J^-1 (phi - G)`` with
-    ``J = I + d(G(c - S_c phi))/dphi``."""
+    ``J = I + d(G(c - S_c phi))/dphi``.
+    """
     k = eye.shape[0]
     shift = (s_c.reshape(s_c.shape[0], 4 * k, k) @ phi[..., None]).reshape(c.shape)
     g, g_c = law.reduced(c - shift, signs)
@@ -175,22 +151,9 @@ def _newton_step(law: Any, c: np.ndarray, s_c: np.ndarray, signs: np.ndarray, ph
 
 
 def loop_gain(g_c: np.ndarray, s_c: np.ndarray, exact_gain: float = 0.5) -> np.ndarray:
-    """The friction loop's gain per sample: the spectral radius of ``dG/dphi``, or an upper bound.
-
-    Parameters
-    ----------
-    g_c : ndarray, shape (n, K, 4)
-        Derivatives of each friction value by its pair's four reaction components at the solution.
-    s_c : ndarray, shape (n, K, 4, K)
-        Response of those components to unit friction values.
-    exact_gain : float
-        The spectral radius where the infinity-norm bound reaches this, else the bound; at 1 or
-        more only the verdict is asked for, and :func:`power_bound` may settle it first.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The gain [-]; infinite where the Jacobian is not finite.
+    """Loop gain (n,) [-] per sample: the spectral radius of ``dG/dphi`` from ``g_c`` (n, K, 4) and
+    ``s_c`` (n, K, 4, K), or an upper bound below ``exact_gain`` (at >= 1 only the verdict is asked);
+    infinite where the Jacobian is not finite.
     """
     with np.errstate(all="ignore"):
         gain_matrix = np.nan_to_num((g_c[:, :, None, :] @ s_c)[:, :, 0, :], nan=np.inf, posinf=np.inf,

@@ -1,15 +1,7 @@
-"""Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature.
-
-The mean values that matter (input, output and lost work, hence the mean efficiency) are not
-taken from the time table but by Gauss-Legendre quadrature over the whole-revolution window, on
-panels that break at every kink of the integrand: the edges of each friction sign ramp
-(relative surface speed = +- the pair's band, :mod:`reference.physics.bands`;
-:func:`reference.engine.breakpoints.sign_breakpoints`) and the knots of an angle or load history.
-Inside a panel the integrand is smooth, so the quadrature converges exponentially; the mean
-efficiency is stable to 1e-8 and better as the panels are refined (tested). A load history denser
-than :data:`reference.engine.gauss.HISTORY_SAMPLES_PER_PANEL` samples a panel enters through its
-samples' weights instead (:class:`reference.engine.gauss.HistoryRule`, the integrand interpolated
-in time and in the load), so that its cost does not grow with the samples.
+"""Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature, panels broken
+at every kink of the integrand (friction ramp edges, :func:`reference.engine.breakpoints.sign_breakpoints`;
+history knots), so the mean efficiency converges exponentially; a dense load history enters
+through :class:`reference.engine.gauss.HistoryRule`'s weights.
 """
 
 from __future__ import annotations
@@ -39,24 +31,9 @@ __all__ = ["WORK_KEYS", "time_at_angle", "window_times", "work_means", "work_qua
 
 
 def time_at_angle(motion: InputMotion, theta: float, lo: float, hi: float) -> float:
-    """The instant at which the input passes an angle, by Illinois regula falsi.
-
-    (Not ``scipy.optimize``: its import would cost every command that builds a ``mean_input``
-    scene about 0.3 s.)
-
-    Parameters
-    ----------
-    motion : InputMotion
-        The input's motion.
-    theta : float
-        The angle [rad].
-    lo, hi : float
-        A bracket of the instant [s].
-
-    Returns
-    -------
-    float
-        The instant [s], to rounding; the nearer end when the bracket holds no sign change.
+    """The instant [s] the input ``motion`` passes ``theta`` [rad] in the bracket ``[lo, hi]`` [s], by
+    Illinois regula falsi (the nearer end without a sign change). Why not ``scipy.optimize``: its
+    import costs every ``mean_input`` scene about 0.3 s.
     """
     a = lo
     b = hi
@@ -82,22 +59,8 @@ WORK_KEYS = ("power_in", "power_out", "power_loss", "self_locking",
 
 def window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
                   theta_0: float, theta_1: float) -> tuple[float, float]:
-    """The instants at which the input passes the window's ends.
-
-    Parameters
-    ----------
-    motion : InputMotion
-        The input's motion.
-    theta, t : ndarray, shape (n,)
-        The time table's input angles [rad] and instants [s]; each end is solved between the
-        rows that bracket it.
-    theta_0, theta_1 : float
-        The window's first and last input angle [rad].
-
-    Returns
-    -------
-    t_0, t_1 : float
-        The instants [s].
+    """Instants ``(t_0, t_1)`` [s] the input ``motion`` passes the window's ends ``theta_0``,
+    ``theta_1`` [rad], each solved between the table rows (``theta``, ``t``) that bracket it.
     """
     sign = 1.0 if theta[-1] >= theta[0] else -1.0
 
@@ -112,9 +75,9 @@ def window_times(motion: InputMotion, theta: np.ndarray, t: np.ndarray,
 def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.ndarray,
                       ends: dict[str, np.ndarray], options: ReferenceOptions,
                       nodes: int | None = None, history: bool = False) -> tuple[np.ndarray, dict]:
-    """:data:`WORK_KEYS` integrated over the panels ``[lo, hi]`` [s] (:func:`adaptive_gauss`,
-    ``nodes`` per panel, default ``options.gauss_nodes``); ``history``: the load history's
-    samples enter through :class:`reference.engine.gauss.HistoryRule`, not as panel edges."""
+    """:data:`WORK_KEYS` integrated over the panels ``[lo, hi]`` [s] (:func:`adaptive_gauss`, ``nodes``
+    per panel, default ``options.gauss_nodes``); ``history``: load samples through :class:`HistoryRule`.
+    """
     def integrand(times: np.ndarray, load: np.ndarray | None = None) -> np.ndarray:
         cols = columns_at(scene, motion, times, load)
         return np.stack([np.asarray(cols[k], float) for k in WORK_KEYS], -1)
@@ -129,21 +92,9 @@ def _integrate_powers(scene: Scene, motion: InputMotion, lo: np.ndarray, hi: np.
 
 
 def work_means(work: dict[str, float], ends: dict[str, np.ndarray]) -> dict[str, Any]:
-    """Summary keys from the works over the window.
-
-    Parameters
-    ----------
-    work : dict of str to float
-        The integrals of :data:`WORK_KEYS` [J].
-    ends : dict of str to ndarray, shape (2,)
-        ``energy_kinetic`` and ``energy_potential`` [J] at the window's ends.
-
-    Returns
-    -------
-    dict
-        ``input_work``, ``output_work``, ``loss_work``, ``loss_work_<pair>``,
-        ``loss_work_<pair>_sliding`` and ``energy_balance_residual`` [J]; the means derived from
-        them are :func:`reference.results.means.mean_values`'.
+    """``input_work``, ``output_work``, ``loss_work``, ``loss_work_<pair>[_sliding]`` and
+    ``energy_balance_residual`` [J] from the ``work`` integrals of :data:`WORK_KEYS` and the energies at
+    the window's ``ends``.
     """
     out = {"input_work": work["power_in"], "output_work": work["power_out"],
            "loss_work": work["power_loss"]}
@@ -170,28 +121,9 @@ def _panels(t_a: float, t_end: float, kinks: np.ndarray, knots: np.ndarray, widt
 
 def work_quadrature(scene: Scene, motion: InputMotion, table: dict[str, np.ndarray],
                     options: ReferenceOptions) -> dict:
-    """Work integrals over the whole-revolution window by panel Gauss-Legendre quadrature.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene on the run's clock.
-    motion : InputMotion
-        The input's motion (:func:`reference.engine.motion.input_motion`).
-    table : dict of str to ndarray
-        The time table's ``t`` [s] and ``theta_in`` [rad] (they locate the window).
-    options : ReferenceOptions
-        Panels per revolution, nodes per panel and the quadrature's tolerance.
-
-    Returns
-    -------
-    dict
-        The summary keys ``input_work``, ``output_work``, ``loss_work`` [J], ``loss_work_<pair>``
-        and its axial-friction part ``loss_work_<pair>_sliding`` [J] (zero in the ideal joint),
-        ``energy_balance_residual`` (W_in - W_out - W_loss - change of mechanical energy [J], zero
-        up to rounding for an exact solution), ``quadrature`` (how it was done) and
-        ``self_locking_nodes`` (friction locks at some node); empty when there is no whole
-        revolution.
+    """The window's works [J] of ``scene`` driven by ``motion``, located by the ``table``'s ``t`` and
+    ``theta_in``, with ``options``' panels, nodes and tolerance: :func:`work_means`' keys, ``quadrature``
+    (how) and ``self_locking_nodes``; empty without a whole revolution.
     """
     theta = table["theta_in"]
     t = table["t"]

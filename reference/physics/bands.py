@@ -1,38 +1,12 @@
-"""The width of each pair's friction sign ramp: relative to the pair's own speed, or absolute.
+"""The width of each pair's friction sign ramp ``clip(v / band, -1, 1)``, relative or absolute.
 
-The friction law (eqs. (3), (5); :mod:`reference.physics.friction`) takes ``sign()`` of a pair's relative
-surface speed (``omega_rel d / 2``) or sliding speed. Every engine replaces it by a linear ramp
-``clip(v / band, -1, 1)``: with the exact sign, the direction of friction in a pair that does not
-move (the spider pairs at 0 deg, the axial direction of the ideal joint) is decided by
-rounding-level speeds. Inside the ramp the friction is smaller than Coulomb's, so the band must
-be small against the speeds the pair actually has. A fixed band in m/s is not: the speeds scale
-with the input speed (measured: docs/paper.md#friction-at-every-speed).
-
-So by default each band is relative (``FrictionSettings.sign_band_relative``, default 1e-3,
-:data:`reference.scene.settings.DEFAULT_SIGN_BAND_RELATIVE`): ``band = sign_band_relative * v_char``,
-where ``v_char`` is the pair's *characteristic speed*, the RMS over one input revolution of its
-surface (or sliding) speed when the input turns uniformly at the scene's :func:`nominal_speed`.
-The kinematics are linear in the input speed, so these are the speeds at 1 rad/s (closed form
-for the ideal joint, the dual-number loop with mounting errors;
-:func:`reference.physics.joint_motion.joint_motion`) times the nominal speed. A pair that hardly moves
-(``v_char`` below :data:`SPEED_FLOOR` times the scene's fastest ``v_char``: the spider pairs at
-0 deg, the sliding of the ideal joint) gets the band of one moving at that floor, so its band
-stays far above rounding (relative speeds of pairs at rest in the Exudyn model are ~1e-13 of the
-frame journals' surface speed) and scales with the scene. Then the share of each pair's motion
-spent inside its ramp does not depend on the speed, and the mean efficiency converges to the
-exact-sign value as ``sign_band_relative`` shrinks, at every speed (``docs/paper.md``, "Friction
-at every speed").
-
-``FrictionSettings.sign_band`` [m/s], when given, is one absolute band for every pair (0: the
-exact sign).
-
-Under the resultant-slip law (``FrictionSettings.law = "resultant"``) one Coulomb force opposes
-the pair's slip velocity ``v = (omega_rel d / 2, v_slide)`` and is regularised as a vector,
-``v / max(|v|, band)``: its band (``PairBands.resultant``) is ``sign_band_relative *
-max(hypot(v_char rotation, v_char sliding), floor)``, or the absolute ``sign_band``. For a pair
-that does not slide it is the rotation's band, so the two laws then coincide even inside it.
-
-Every engine takes its bands from :func:`sign_bands`, so they regularise identically.
+By default ``band = sign_band_relative * max(v_char, SPEED_FLOOR * max v_char over the scene)``,
+``v_char`` the pair's RMS surface (or sliding) speed over one input revolution at the scene's
+:func:`nominal_speed`; why relative: the speeds scale with the input speed, so the share of motion
+inside the ramp does not (measured: docs/paper.md, "Friction at every speed"). The floor keeps a
+pair at rest far above rounding. ``FrictionSettings.sign_band`` [m/s] is one absolute band
+instead (0: exact sign). Resultant-slip law: one band per pair on ``hypot`` of its rotation's and
+sliding's ``v_char``. Every engine takes its bands from :func:`sign_bands`.
 """
 
 from __future__ import annotations
@@ -80,11 +54,8 @@ class PairBands(NamedTuple):
 
 
 def nominal_speed(scene: Scene) -> float:
-    """The input speed the bands are sized for [rad/s], > 0.
-
-    A constant-speed drive's speed; a torque drive's initial speed; for an angle history, the
-    input speed averaged over the angle turned in the simulated span, ``int w^2 dt / int |w| dt``
-    (time spent at rest does not lower it; the constant speed for a uniform history).
+    """The input speed [rad/s] (> 0) the bands are sized for: a constant drive's speed, a torque drive's
+    initial speed, an angle history's ``int w^2 dt / int |w| dt`` over the span.
     """
     drive = scene.drive
     if not isinstance(drive, AngleDrive):
@@ -100,15 +71,8 @@ def nominal_speed(scene: Scene) -> float:
 
 
 def characteristic_speeds(scene: Scene) -> dict[str, PairSpeeds]:
-    """RMS relative surface and sliding speed of every pair over one input revolution [m/s].
-
-    The input turns uniformly at :func:`nominal_speed`; the raw RMS, without the floor
-    :func:`sign_bands` applies.
-
-    Raises
-    ------
-    reference.physics.loop_closure.LoopClosureError
-        The joint's mounting errors keep the loop from closing at some angle.
+    """Raw RMS relative surface and sliding speed [m/s] of every pair over one input revolution at
+    :func:`nominal_speed` (no floor); LoopClosureError where mounting errors keep the loop open.
     """
     motion = joint_motion(scene.joint, profile_angles(), 1.0, 0.0)
     return speeds_from_profile(scene, motion.omega_rel, motion.slide_rel)
@@ -121,22 +85,8 @@ def profile_angles() -> np.ndarray:
 
 def speeds_from_profile(scene: Scene, omega_rel: dict[str, np.ndarray],
                         slide_rel: dict[str, np.ndarray]) -> dict[str, PairSpeeds]:
-    """:func:`characteristic_speeds` from the pairs' relative speeds over the speed profile.
-
-    Parameters
-    ----------
-    scene : Scene
-        Journal diameters and the nominal speed (:func:`nominal_speed`).
-    omega_rel : dict of str to ndarray, shape (PROFILE_SAMPLES,)
-        Per pair the relative angular speed [rad/s] at the :func:`profile_angles` for an input
-        turning at 1 rad/s.
-    slide_rel : dict of str to ndarray, shape (PROFILE_SAMPLES,)
-        Per pair the relative sliding speed [m/s] there.
-
-    Returns
-    -------
-    dict of str to PairSpeeds
-        Per pair [m/s].
+    """Per pair :class:`PairSpeeds` [m/s] (:func:`characteristic_speeds`) from the pairs' relative
+    ``omega_rel`` [rad/s] and ``slide_rel`` [m/s] at the :func:`profile_angles` for an input at 1 rad/s.
     """
     w = nominal_speed(scene)
 
@@ -154,19 +104,8 @@ def needs_speeds(scene: Scene) -> bool:
 
 
 def bands_from_speeds(scene: Scene, speeds: dict[str, PairSpeeds] | None) -> dict[str, PairBands]:
-    """:func:`sign_bands` from characteristic speeds a caller computed itself.
-
-    Parameters
-    ----------
-    scene : Scene
-        Its friction settings.
-    speeds : dict of str to PairSpeeds or None
-        :func:`characteristic_speeds` [m/s]; None where :func:`needs_speeds` is False.
-
-    Returns
-    -------
-    dict of str to PairBands
-        Per pair [m/s].
+    """Per pair :class:`PairBands` [m/s] (:func:`sign_bands`) of ``scene`` from characteristic ``speeds``
+    a caller computed (None where :func:`needs_speeds` is False).
     """
     return dict(zip(PAIR_NAMES, _from_speeds(scene, speeds), strict=True))
 
@@ -186,17 +125,8 @@ def _from_speeds(scene: Scene, speeds: dict[str, PairSpeeds] | None) -> tuple[Pa
 
 
 def sign_bands(scene: Scene) -> dict[str, PairBands]:
-    """Width of every pair's sign ramps [m/s], as every engine applies them.
-
-    ``FrictionSettings.sign_band`` given: that band for every ramp. Otherwise
-    ``sign_band_relative * max(v_char, SPEED_FLOOR * max(v_char over the scene))`` per ramp, with
-    ``v_char`` from :func:`characteristic_speeds` (for the resultant slip, ``v_char`` is the
-    hypotenuse of the pair's rotation and sliding ``v_char``).
-
-    Raises
-    ------
-    reference.physics.loop_closure.LoopClosureError
-        (relative bands) The joint's mounting errors keep the loop from closing at some angle.
+    """Per pair :class:`PairBands`: the width [m/s] of every sign ramp, as every engine applies them
+    (module doc); LoopClosureError (relative bands) where mounting errors keep the loop open.
     """
     return dict(zip(PAIR_NAMES, _bands(scene), strict=True))
 

@@ -1,31 +1,17 @@
 """Which way power flows through the joint over the averaging window, and the efficiency of that way.
 
-The paper's efficiency (eq. (18), ``1 - P_loss / P_in``, and its mean ``1 - W_loss / W_in``) takes
-the drive as the source and the load as the sink. A reversed joint is the same physics: run the
-scene with speed and load reversed (angle history, torque drive) and the mirror image of the
-joint in the plane of the shafts turns backwards with the same reactions, the same friction and
-the same efficiency. An aiding load (one that turns the output the way it already goes) or a
-drive that brakes makes the output shaft the source. So the efficiency is defined for the
-direction the work actually flows, from the signs of the window's works.
-
-Sign conventions (:mod:`reference.results.summary`): ``W_in`` is the work the drive does on the input
-shaft, ``W_out`` the work the output shaft does on the load, ``W_loss`` the friction losses
-(never negative); over the window ``W_in = W_out + W_loss + dE`` (``dE`` the change of mechanical
-energy, zero over whole revolutions of a periodic motion).
+``W_in`` is the drive's work on the input, ``W_out`` the output's on the load, ``W_loss >= 0``;
+``W_in = W_out + W_loss + dE`` over the window. Directions, from the works' signs:
 
 ``input_to_output`` (``W_in > 0``, ``W_out > 0``)
-    The drive supplies, the load takes: ``1 - W_loss / W_in`` (the paper's).
+    ``1 - W_loss / W_in`` (the paper's).
 ``output_to_input`` (``W_in < 0``, ``W_out < 0``)
-    The load drives the joint and the drive absorbs: the source supplies ``-W_out``, so
     ``1 - W_loss / (-W_out)``.
-``none`` (``W_in >= 0 >= W_out``: neither shaft takes net work, e.g. no load)
-    Nothing is transmitted: the efficiency is 0, or undefined (None) when no work is lost either
-    (frictionless and unloaded: every work is zero).
+``none`` (``W_in >= 0 >= W_out``)
+    Efficiency 0, or None when no work is lost either.
 
-Anything else (work leaves through a shaft and none enters) is impossible over a periodic
-window, and so is an efficiency outside [0, 1]: the summary's status is then ``unphysical``
-(:func:`likely_cause` says why it probably happened). A work within :data:`WORK_FLOOR` of the
-window's energy scale counts as zero.
+Anything else, or an efficiency outside [0, 1], is ``unphysical`` (:func:`likely_cause`). A work
+within :data:`WORK_FLOOR` of the window's energy scale counts as zero.
 """
 
 from __future__ import annotations
@@ -56,22 +42,9 @@ class PowerFlow(str, Enum):
 
 
 class FlowVerdict(NamedTuple):
-    """What the works of a window say.
-
-    Attributes
-    ----------
-    power_flow : PowerFlow or None
-        None when the works are impossible (``problem`` says why).
-    mean_efficiency, work_ratio : float or None
-        One minus lost over supplied work, and received over supplied work [-]; None when
-        undefined or impossible.
-    note : str
-        A sentence for the summary's warnings (empty for the paper's direction).
-    problem : str
-        Why the works are unphysical (empty when they are not).
-    excess_work : float
-        By how much they are [J]: the efficiency's distance from [0, 1] times the source work,
-        the work taken out that nobody supplied, or the work friction generated.
+    """What a window's works say: ``power_flow`` (None when impossible), ``mean_efficiency`` and
+    ``work_ratio`` [-] (None when undefined or impossible), a warning ``note``, the ``problem`` when
+    unphysical, and ``excess_work`` [J], by how much.
     """
 
     power_flow: PowerFlow | None
@@ -88,24 +61,9 @@ def _works(w_in: float, w_out: float, w_loss: float) -> str:
 
 def classify_works(input_work: float, output_work: float, loss_work: float,
                    energy_scale: float = 0.0) -> FlowVerdict:
-    """Direction of the power flow and its efficiency from the window's works [J].
-
-    Parameters
-    ----------
-    input_work, output_work, loss_work : float
-        ``W_in``, ``W_out``, ``W_loss`` over the window [J] (signs as in the module docstring).
-    energy_scale : float
-        ``int(|P_in| + |P_out| + |P_loss|) dt`` over the window plus the largest mechanical
-        energy [J]: works below ``WORK_FLOOR * energy_scale`` count as zero (0: only exact zeros
-        do).
-
-    Returns
-    -------
-    FlowVerdict
-
-    References
-    ----------
-    Eq. (18) of the paper, integrated over the window, for the direction the work flows.
+    """:class:`FlowVerdict` of the window's ``input_work``, ``output_work``, ``loss_work`` [J] (eq. (18)
+    integrated, for the direction the work flows); works below ``WORK_FLOOR * energy_scale`` [J] count
+    as zero.
     """
     w_in = float(input_work)
     w_out = float(output_work)
@@ -154,19 +112,7 @@ def _in_range(verdict: FlowVerdict, w_in: float, w_out: float, works: str) -> Fl
 
 
 def source_power(flow: PowerFlow | str | None, power_in: np.ndarray, power_out: np.ndarray) -> np.ndarray:
-    """Power the source shaft feeds into the joint.
-
-    Parameters
-    ----------
-    flow : PowerFlow, str or None
-        The window's power flow.
-    power_in, power_out : ndarray, shape (n,)
-        Input and output power [W].
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        ``P_in``, or ``-P_out`` when the power flows from the output to the input [W].
+    """Power [W] the source shaft feeds in: ``power_in``, or ``-power_out`` when ``flow`` is output to input.
     """
     if flow == PowerFlow.OUTPUT_TO_INPUT:
         return -np.asarray(power_out, float)
@@ -181,17 +127,8 @@ def sign_changes(values: np.ndarray) -> int:
 
 
 def likely_cause(excess_work: float, energy_change: float, residual: float) -> str:
-    """Why a window's works are unphysical.
-
-    Parameters
-    ----------
-    excess_work : float
-        The work by which they are impossible [J]: how far the efficiency is outside [0, 1]
-        times the source work, or the work the shafts take out that nobody supplied.
-    energy_change : float
-        ``dE``, change of mechanical energy over the window [J].
-    residual : float
-        The energy-balance residual ``W_in - W_out - W_loss - dE`` [J].
+    """Why a window's works are unphysical, from the ``excess_work``, the mechanical ``energy_change`` and
+    the balance ``residual`` ``W_in - W_out - W_loss - dE`` [J].
     """
     if abs(residual) >= 0.5 * excess_work:
         return (f"the works do not balance the change of mechanical energy (residual {residual:.3g} J "

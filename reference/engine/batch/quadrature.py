@@ -1,11 +1,7 @@
-"""The work quadrature of :func:`reference.engine.work.work_quadrature` for many scenes at once.
-
-Each scene keeps its own window, sign breakpoints, panels, Gauss rule, scale and closing rule;
-what is shared is the integrand call: every round evaluates the open panels of all scenes in one
-:meth:`reference.engine.batch.model.SceneStack.columns` pass, and the breakpoint search refines the
-brackets of all scenes together. Per scene the steps are those of the single engine, so the
-works agree with it to rounding, except where rounding moves a panel across the closing
-threshold: then they agree within the quadrature tolerance.
+"""The work quadrature of :func:`reference.engine.work.work_quadrature` for many scenes at once: each
+keeps its own window, breakpoints, panels and rules; one :meth:`SceneStack.columns` pass evaluates
+every scene's open panels per round. Works agree with the single engine to rounding (within the
+quadrature tolerance where rounding moves a panel across the closing threshold).
 """
 
 from __future__ import annotations
@@ -34,8 +30,9 @@ __all__ = ["adaptive_gauss", "sign_breakpoints", "work_quadratures"]
 
 
 def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) -> list[tuple]:
-    """Brackets of every ramp-edge crossing on each member's grid (:mod:`reference.engine.crossings`), with
-    the member's position: ``(member position, t_a, t_b, f_a, f_b, column, level)``."""
+    """Brackets ``(member position, t_a, t_b, f_a, f_b, column, level)`` of every ramp-edge crossing on
+    each member's grid (:mod:`reference.engine.crossings`).
+    """
     owner = np.repeat(np.asarray(members, int), [g.size for g in grids])
     values = np.split(stack.ramp_speeds(owner, np.concatenate(grids)),
                       np.cumsum([g.size for g in grids])[:-1])
@@ -56,22 +53,8 @@ def _scan(stack: SceneStack, members: Sequence[int], grids: list[np.ndarray]) ->
 
 def sign_breakpoints(stack: SceneStack, members: Sequence[int], t_a: np.ndarray,
                      t_b: np.ndarray) -> list[np.ndarray]:
-    """:func:`reference.engine.breakpoints.sign_breakpoints` of many scenes of a stack, the brackets
-    of all refined together.
-
-    Parameters
-    ----------
-    stack : SceneStack
-        The scenes.
-    members : sequence of int
-        The scenes searched (indices into ``stack.scenes``).
-    t_a, t_b : ndarray, shape (len(members),)
-        Each member's window [s].
-
-    Returns
-    -------
-    list of ndarray
-        Per member the sorted instants [s].
+    """:func:`reference.engine.breakpoints.sign_breakpoints` of the ``members`` of ``stack`` in their
+    windows ``[t_a, t_b]`` [s], brackets refined together: per member the sorted instants [s].
     """
     empty = [np.zeros(0) for _ in members]
     if not stack.slots:
@@ -123,8 +106,8 @@ def _gauss(integrand: Callable, rules: dict, nodes: np.ndarray, owner: np.ndarra
 def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.ndarray,
                    nodes: np.ndarray, rtol: float, scale_floor: np.ndarray,
                    max_rounds: int = 40) -> tuple[np.ndarray, list[dict]]:
-    """:func:`reference.engine.gauss.adaptive_gauss` for many scenes, each with its own rule,
-    scale and closing rule, all open panels of a round in one integrand call.
+    """:func:`reference.engine.gauss.adaptive_gauss` for many scenes, all open panels of a round in one
+    call.
 
     Parameters
     ----------
@@ -141,14 +124,12 @@ def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.
     scale_floor : ndarray, shape (S,)
         Least scale per scene.
     max_rounds : int
-        Rounds of halving at most.
 
     Returns
     -------
     integrals : ndarray, shape (S, k)
     infos : list of dict
-        Per scene the info of :func:`reference.engine.gauss.adaptive_gauss` (without
-        ``cut_panels``).
+        Per scene :func:`reference.engine.gauss.adaptive_gauss`' info (without ``cut_panels``).
     """
     count = nodes.size
     rules = {int(n): np.polynomial.legendre.leggauss(int(n)) for n in np.unique(nodes)}
@@ -219,26 +200,9 @@ def _window(scene: Scene, motion: InputMotion,
 
 def work_quadratures(stack: SceneStack, members: Sequence[int], motions: Sequence[InputMotion],
                      tables: Sequence[dict[str, np.ndarray]], options: ReferenceOptions) -> list[dict]:
-    """:func:`reference.engine.work.work_quadrature` of many scenes of a stack (constant speed and
-    load: one revolution integrated, times the revolutions).
-
-    Parameters
-    ----------
-    stack : SceneStack
-        The scenes.
-    members : sequence of int
-        The scenes to integrate (indices into ``stack.scenes``).
-    motions : sequence of InputMotion
-        Their motions.
-    tables : sequence of dict of str to ndarray
-        Their time tables' ``t`` [s] and ``theta_in`` [rad].
-    options : ReferenceOptions
-        Panels per revolution, nodes per panel and the quadrature's tolerance.
-
-    Returns
-    -------
-    list of dict
-        One per member, as :func:`reference.engine.work.work_quadrature`'s.
+    """:func:`reference.engine.work.work_quadrature` of the ``members`` of ``stack`` with their
+    ``motions``, ``tables`` and ``options`` (constant speed and load: one revolution integrated, times
+    the revolutions); one dict per member.
     """
     windows = [_window(stack.scenes[m], mo, tab) for m, mo, tab in zip(members, motions, tables, strict=True)]
     live = [i for i, w in enumerate(windows) if w is not None]
