@@ -1,17 +1,9 @@
 """Where sampled speeds cross the edges of friction's sign ramps: brackets for a root finder.
 
-Both reference engines (one scene, :func:`reference.engine.breakpoints.sign_breakpoints`; many,
-:func:`reference.engine.batch.quadrature.sign_breakpoints`) sample each ramp speed on a uniform grid of
-:data:`SCAN_PER_REVOLUTION` points per input revolution and refine every bracket to rounding.
-
-A sign change between two samples brackets one crossing. Two crossings between the same samples
-(a speed that dips across an edge and back, e.g. a pair that barely reverses) show no sign change;
-they show as a sampled extremum on the near side of the edge. :func:`grazing_candidates` fits a
-parabola through each such extremum and its two neighbours; where the parabola's vertex lies
-across the edge, the caller evaluates the speed at the vertex, and where the vertex really is
-across, :func:`grazing_brackets` gives the two brackets on either side of it. A finer grid would
-only make such misses rarer; the check makes a grazing crossing that the parabola resolves a found
-one at any grid.
+Each ramp speed is sampled at :data:`SCAN_PER_REVOLUTION` points per input revolution. A sign
+change brackets one crossing; two crossings between the same samples show as a sampled extremum
+near the edge, and :func:`grazing_candidates` fits a parabola through it whose vertex the caller
+evaluates; where it is really across, :func:`grazing_brackets` gives a bracket on either side.
 """
 
 from __future__ import annotations
@@ -29,21 +21,8 @@ crossing, e.g. the two spider pairs, converge to instants a few ulp apart)."""
 
 
 def sign_change_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray) -> list[tuple]:
-    """Cells of the grid where a column of ``values`` crosses its level.
-
-    Parameters
-    ----------
-    grid : ndarray, shape (m,)
-        Sample instants [s].
-    values : ndarray, shape (m, K)
-        Sampled speeds [m/s].
-    levels : ndarray, shape (K,)
-        Each column's level [m/s].
-
-    Returns
-    -------
-    list of tuple
-        ``(t_a, t_b, f_a, f_b, column, level)`` per crossing, ``f = value - level``.
+    """``(t_a, t_b, f_a, f_b, column, level)`` per cell of ``grid`` [s] where a column of ``values``
+    (m, K) [m/s] crosses its ``levels`` (K,), ``f = value - level``.
     """
     g = values - levels
     cell, col = np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)
@@ -53,22 +32,8 @@ def sign_change_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarra
 
 def grazing_candidates(grid: np.ndarray, values: np.ndarray,
                        levels: np.ndarray) -> list[tuple[float, int, int]]:
-    """Interior samples where a column has a sampled extremum on one side of its level and the
-    parabola through it and its neighbours crosses the level.
-
-    Parameters
-    ----------
-    grid : ndarray, shape (m,)
-        Equispaced sample instants [s].
-    values : ndarray, shape (m, K)
-        Sampled speeds [m/s].
-    levels : ndarray, shape (K,)
-        Each column's level [m/s].
-
-    Returns
-    -------
-    list of (float, int, int)
-        ``(t_vertex, sample, column)``: the parabola's vertex [s], the extremum's row, its column.
+    """``(t_vertex, sample, column)`` of each interior sampled extremum on one side of its level whose
+    parabola through its neighbours crosses it (``grid`` [s] equispaced, ``values`` (m, K), ``levels`` [m/s]).
     """
     g = values - levels
     if g.shape[0] < 3:
@@ -96,22 +61,8 @@ def grazing_candidates(grid: np.ndarray, values: np.ndarray,
 
 def grazing_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray,
                      candidates: list[tuple[float, int, int]], at_vertex: np.ndarray) -> list[tuple]:
-    """The two brackets of each grazing candidate whose speed at the vertex is across the level.
-
-    Parameters
-    ----------
-    grid, values, levels
-        As for :func:`grazing_candidates`.
-    candidates : list of (float, int, int)
-        From :func:`grazing_candidates`.
-    at_vertex : ndarray, shape (len(candidates),)
-        Each candidate column's speed at its ``t_vertex`` [m/s].
-
-    Returns
-    -------
-    list of tuple
-        Brackets as :func:`sign_change_brackets`'s, two per candidate across its level; the
-        other candidates are dropped.
+    """Two brackets (as :func:`sign_change_brackets`') per candidate whose speed ``at_vertex`` [m/s] is
+    across its level; the other candidates are dropped.
     """
     out = []
     for (t_v, k, col), v in zip(candidates, at_vertex, strict=True):
@@ -127,20 +78,7 @@ def grazing_brackets(grid: np.ndarray, values: np.ndarray, levels: np.ndarray,
 
 
 def distinct_instants(instants: np.ndarray, span: float) -> np.ndarray:
-    """Sorted instants, near duplicates merged.
-
-    Parameters
-    ----------
-    instants : ndarray, shape (n,)
-        Refined crossings [s].
-    span : float
-        The scanned span [s]; an instant within ``MERGE * span`` of the one before is dropped.
-
-    Returns
-    -------
-    ndarray, shape (m,)
-        The distinct instants [s], ascending.
-    """
+    """Sorted ``instants`` [s], dropping one within ``MERGE * span`` [s] of the one before."""
     t = np.unique(instants)
     if t.size < 2:
         return t

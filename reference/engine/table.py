@@ -24,23 +24,8 @@ EXTRA_COLUMNS = ("input_acceleration", "friction_loop_gain", "self_locking",
 
 def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray,
                load: np.ndarray | None = None) -> dict[str, np.ndarray]:
-    """Result-schema columns at the instants ``t`` (plus :data:`EXTRA_COLUMNS`).
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene on the run's clock.
-    motion : InputMotion
-        The input's motion (:func:`reference.engine.motion.input_motion`).
-    t : ndarray, shape (n,)
-        Instants [s].
-    load : ndarray, shape (n,), or None
-        The output load [N m] at each instant; None: the scene's load at ``t``.
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        ``t`` and every column of :func:`reference.engine.dynamics.dynamics_columns`.
+    """``t`` and every :func:`reference.engine.dynamics.dynamics_columns` column of ``scene`` driven by
+    ``motion`` at instants ``t`` [s], under output ``load`` [N m] (None: the scene's load at ``t``).
     """
     theta, theta_t, theta_tt = motion.state(t)
     theta = np.broadcast_to(np.asarray(theta, float), np.shape(t))
@@ -53,25 +38,8 @@ def columns_at(scene: Scene, motion: InputMotion, t: np.ndarray,
 
 
 def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str, np.ndarray]:
-    """:func:`columns_at` on the table's instants.
-
-    Summary only (no table recorded): a periodic motion's first period, repeated
-    (:mod:`reference.engine.periodic`); a recorded table is evaluated row by row, so that each
-    row's angle is the one its state was computed at.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene on the run's clock.
-    motion : InputMotion
-        The input's motion.
-    t : ndarray, shape (n,)
-        The table's instants [s] (:func:`table_times`).
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        As :func:`columns_at`.
+    """:func:`columns_at` on the table's instants ``t`` [s]; summary only: a periodic motion's first
+    period repeated (:mod:`reference.engine.periodic`); a recorded table row by row.
     """
     rows = period_rows(t, scene.drive.speed) if motion.periodic and not scene.record.timeseries else None
     if rows is None:
@@ -80,27 +48,9 @@ def table_columns(scene: Scene, motion: InputMotion, t: np.ndarray) -> dict[str,
 
 
 def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) -> np.ndarray:
-    """The time table's instants.
-
-    Parameters
-    ----------
-    scene : Scene
-        ``numerics.dt`` sets the spacing when the options give no samples per revolution (so that
-        the rows line up with a fixed-step engine's).
-    motion : InputMotion
-        The span ``[t0, t_end]`` [s] and the angle turned in it.
-    options : ReferenceOptions
-        ``samples_per_revolution`` (None: ``dt``, else 360).
-
-    Returns
-    -------
-    ndarray, shape (steps + 1,)
-        Equispaced instants from ``t0`` to ``t_end`` [s].
-
-    Raises
-    ------
-    SceneError
-        More steps than :data:`reference.scene.validation.MAX_STEPS`.
+    """Equispaced instants [s] of the time table over ``motion``'s span: ``options.samples_per_revolution``
+    (None: ``scene.numerics.dt``, lining up with a fixed-step engine's rows, else 360); SceneError
+    beyond :data:`reference.scene.validation.MAX_STEPS`.
     """
     span = motion.t_end - motion.t0
     if options.samples_per_revolution is None and scene.numerics.dt is not None:
@@ -119,18 +69,8 @@ def table_times(scene: Scene, motion: InputMotion, options: ReferenceOptions) ->
 
 def table_verdict(t: np.ndarray, columns: dict[str, np.ndarray], summary: Summary,
                   origin: float = 0.0) -> None:
-    """The table's step, sample count, self-locking samples and loop gain into the summary.
-
-    Parameters
-    ----------
-    t : ndarray, shape (n,)
-        The table's instants [s].
-    columns : dict of str to ndarray, shape (n,)
-        Its columns (``self_locking``, ``friction_loop_gain``, ``theta_in`` are read).
-    summary : Summary
-        Filled in place; failed with status ``self_locking`` when a sample locks.
-    origin : float
-        Added to the times reported [s] (:func:`reference.scene.histories.run_clock`).
+    """The table's step, sample count, self-locking samples and loop gain into ``summary`` (failed as
+    ``self_locking`` when a sample locks), times shifted by ``origin`` [s].
     """
     locked = columns["self_locking"]
     summary.dt = float(t[1] - t[0])

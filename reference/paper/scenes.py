@@ -3,12 +3,11 @@
 ``paper[-<set>][-<A>deg][-<R>rpm][-frictionless]``
     Section 4.1 multibody case (default 10 deg, 2000 rpm, f1 = 0.42, f2 = 0.20, 2 N m).
 ``rig[-<set>][-errors][-frictionless]``
-    Section 4.2 rig case (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m), ideal geometry
-    or, with ``-errors``, the section's manufacturing tolerances (:func:`paper_errors`).
+    Section 4.2 rig case (15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m), ideal or with the
+    section's tolerances (:func:`paper_errors`).
 
-``<set>`` is a parameter set (:mod:`reference.paper.parameter_sets`). A scene's own name spells the
-set out (``paper-10deg`` is ``paper-physical-10deg-2000rpm``) and ``Scene.parameter_set`` carries it
-into every result.
+``<set>`` is a parameter set (:mod:`reference.paper.parameter_sets`), spelled out in the scene's
+own name (``paper-10deg`` is ``paper-physical-10deg-2000rpm``) and in ``Scene.parameter_set``.
 """
 
 from __future__ import annotations
@@ -40,27 +39,21 @@ __all__ = ["named_scene", "paper_errors", "paper_scene", "rig_scene"]
 def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
                 friction: bool = True, reading: str = "origin",
                 parameters: str | dict[str, Any] = DEFAULT_PARAMETER_SET) -> Scene:
-    """Section 4.1 scene: constant input speed, the case's 2 N m, under a parameter set.
+    """Section 4.1 scene ``paper-<set>-<A>deg-<R>rpm[-frictionless]``: constant speed, 2 N m.
 
     Parameters
     ----------
     shaft_angle_deg : float
         Shaft angle [deg].
     speed_rpm : float or None
-        Input speed [rpm]; None: the case's 2000 rpm.
+        Input speed [rpm]; None: 2000 rpm.
     friction : bool
-        The case's friction coefficients or none (``-frictionless``).
+        The case's friction coefficients, or none.
     reading : {"origin", "com"}
         Reference point of Table 1's inertia tensors (:func:`reference.paper.joint.table1_body`).
     parameters : str or dict
-        A parameter set of :data:`reference.paper.parameter_sets.PARAMETER_SETS` (default
-        ``physical``), or parameter values as :func:`reference.paper.apply.apply_parameters`
-        takes them, applied to the literal reading (used by the fits).
-
-    Returns
-    -------
-    Scene
-        Named ``paper-<set>-<A>deg-<R>rpm[-frictionless]`` (``custom`` for values given).
+        A set of :data:`reference.paper.parameter_sets.PARAMETER_SETS` (default ``physical``), or
+        values for :func:`reference.paper.apply.apply_parameters` (name ``custom``).
     """
     shaft_angle_deg = finite("shaft_angle_deg", shaft_angle_deg)
     if speed_rpm is not None:
@@ -84,10 +77,8 @@ def paper_scene(shaft_angle_deg: float = 10.0, speed_rpm: float | None = None,
 
 
 def paper_errors() -> dict[str, float]:
-    """Section 4.2's tolerances as scene overrides: ``a_i = 0.5 mm``, ``alpha_i`` errors 6e-3 deg.
-
-    The paper gives magnitudes for i = 1, 2, 3 without signs; all are taken positive (the
-    Monte Carlo study of ``cardan tolerance`` draws both signs).
+    """Section 4.2's tolerances as scene overrides: ``a_i = 0.5 mm``, ``alpha_i`` 6e-3 deg, i = 1..3, all
+    positive (the paper gives no signs).
     """
     a = value("case.rig.offset_error")
     alpha = value("case.rig.twist_error") * DEG
@@ -97,24 +88,17 @@ def paper_errors() -> dict[str, float]:
 
 def rig_scene(friction: bool = True, parameters: str | dict[str, Any] = DEFAULT_PARAMETER_SET,
               errors: bool = False) -> Scene:
-    """Section 4.2 rig case: 15 deg, 6 rad/s, f = 0.42 in every pair, 0.2 N m.
+    """Section 4.2 rig scene ``rig-<set>[-errors][-frictionless]``: 15 deg, 6 rad/s, 0.2 N m.
 
     Parameters
     ----------
     friction : bool
-        f = 0.42 in every pair, or none (``-frictionless``).
+        f = 0.42 in every pair, or none.
     parameters : str or dict
-        A parameter set of :data:`reference.paper.parameter_sets.PARAMETER_SETS` (default
-        ``physical``) or parameter values (:func:`reference.paper.apply.apply_parameters`); the
-        set's reading of the torque applies to the rig's 0.2 N m ("mean input torque" in
-        Section 4.2).
+        A parameter set (default ``physical``) or values, as for :func:`paper_scene`; the set's
+        reading of the torque applies to the rig's 0.2 N m.
     errors : bool
-        Apply the section's tolerances (:func:`paper_errors`); otherwise the ideal geometry.
-
-    Returns
-    -------
-    Scene
-        Named ``rig-<set>[-errors][-frictionless]``.
+        The section's tolerances (:func:`paper_errors`), else the ideal geometry.
     """
     for name, flag in (("friction", friction), ("errors", errors)):
         if not isinstance(flag, bool):
@@ -150,27 +134,9 @@ _FORMS = ("'paper[-<set>][-<A>deg][-<R>rpm][-frictionless]' (e.g. 'paper-10deg-2
 
 
 def named_scene(name: str) -> Scene:
-    """A scene by name.
-
-    Parameters
-    ----------
-    name : str
-        ``paper[-<set>][-<A>deg][-<R>rpm][-frictionless]`` (parameter set ``<set>`` of
-        :data:`reference.paper.parameter_sets.PARAMETER_SETS`, default ``physical``; shaft angle
-        ``A`` [deg], input speed ``R`` [rpm]; default 10 deg, 2000 rpm) or
-        ``rig[-<set>][-errors][-frictionless]``. The scene's own name spells every part out
-        (``paper-10deg`` is ``paper-physical-10deg-2000rpm``).
-
-    Returns
-    -------
-    Scene
-        :func:`paper_scene` or :func:`rig_scene`; no engine runs when the set's load is stored
-        (:mod:`reference.paper.loads`).
-
-    Raises
-    ------
-    SceneError
-        An unknown name or parameter set.
+    """:func:`paper_scene` or :func:`rig_scene` by ``name`` (module doc: ``paper...`` or ``rig...``);
+    no engine runs when the set's load is stored (:mod:`reference.paper.loads`). SceneError for an
+    unknown name or parameter set.
     """
     if not isinstance(name, str):
         raise SceneTypeError(f"`name` must be a scene name (a string such as 'paper-10deg'), got "

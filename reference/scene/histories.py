@@ -1,17 +1,9 @@
 """Evaluating prescribed histories (an input angle, a load torque) cheaply and exactly.
 
-An engine that steps in time evaluates the drive's angle and the load's torque at every residual
-evaluation, one instant at a time, from Python (Exudyn's user functions): that evaluation must
-cost O(log n) in the number of samples ``n``, not O(n). :class:`LinearHistory` and
-:class:`CubicPieces` find the sample interval by bisection in precomputed lists and evaluate one
-linear or cubic piece in plain floats, a fraction of a spline call's cost (measured:
-docs/engines.md#constants-of-the-reference-engine). Arrays of instants go to ``np.interp`` / the spline itself
-(vectorised, O(m log n)).
-
-:func:`largest_slope` and :func:`first_turn` answer the two questions engines ask of a whole
-angle history (its highest speed, when it has turned a given angle) exactly from the cubic
-pieces' coefficients, in O(n) vectorised work, instead of sampling the spline 20-50 times per
-sample interval (10^7 - 10^8 evaluations for a 10^6-sample history).
+A time stepper evaluates them one instant at a time from Python, so that must cost O(log n):
+:class:`LinearHistory` and :class:`CubicPieces` bisect precomputed lists and evaluate one piece in
+plain floats (measured: docs/engines.md#constants-of-the-reference-engine). :func:`largest_slope`
+and :func:`first_turn` answer exactly from the cubic pieces' coefficients in O(n) vectorised work.
 """
 
 from __future__ import annotations
@@ -26,14 +18,8 @@ __all__ = ["CubicPieces", "LinearHistory", "first_turn", "largest_slope", "run_c
 
 
 class LinearHistory:
-    """Samples ``(time, value)`` interpolated linearly, held at the end values outside.
-
-    Parameters
-    ----------
-    time : array_like, shape (n,)
-        Strictly increasing sample times [s], n >= 2.
-    value : array_like, shape (n,)
-        Values at those times.
+    """Samples ``(time, value)`` interpolated linearly, held at the end values outside; ``time`` [s]
+    strictly increasing, n >= 2.
     """
 
     __slots__ = ("time", "value", "_t", "_v", "_k")
@@ -46,8 +32,9 @@ class LinearHistory:
         self._k = 1
 
     def __call__(self, t: float) -> float:
-        """The value at one instant ``t`` [s] (plain floats, O(log n); O(1) when ``t`` falls in
-        the interval of the previous call, as a time stepper's calls do)."""
+        """The value at one instant ``t`` [s] (plain floats, O(log n); O(1) in the previous call's
+        interval).
+        """
         times = self._t
         values = self._v
         k = self._k
@@ -69,14 +56,8 @@ class LinearHistory:
 
 
 class CubicPieces:
-    """A ``scipy.interpolate.CubicSpline`` (or any cubic ``PPoly``) evaluated at one instant in
-    plain floats: bisection for the piece, Horner's rule for the value, the end pieces extended
-    outside the breakpoints as the spline itself does.
-
-    Parameters
-    ----------
-    spline : scipy.interpolate.PPoly
-        Cubic pieces: ``spline.c`` of shape (4, n - 1), breakpoints ``spline.x`` of shape (n,).
+    """A cubic ``PPoly`` ``spline`` (e.g. ``CubicSpline``) evaluated at one instant in plain floats:
+    bisection for the piece, Horner's rule, the end pieces extended outside as the spline does.
     """
 
     __slots__ = ("_x", "_c0", "_c1", "_c2", "_c3", "_last", "_k")
@@ -91,8 +72,9 @@ class CubicPieces:
         self._k = 0
 
     def __call__(self, t: float) -> float:
-        """The spline's value at one instant ``t`` (plain floats, O(log n); O(1) when ``t``
-        falls in the piece of the previous call)."""
+        """The spline's value at one instant ``t`` (plain floats, O(log n); O(1) in the previous call's
+        piece).
+        """
         x = self._x
         k = self._k
         if not (x[k] <= t < x[k + 1]):
@@ -102,10 +84,8 @@ class CubicPieces:
 
 
 def largest_slope(spline: Any) -> float:
-    """Largest ``|s'(t)|`` of a cubic spline over its breakpoints' span, exactly.
-
-    ``s'`` is quadratic on each piece: its largest magnitude is at an end of the piece or at the
-    vertex ``-c1 / (3 c0)`` when that lies inside.
+    """Largest ``|s'(t)|`` of a cubic ``spline`` over its span, exactly: at a piece's end or at the vertex
+    ``-c1 / (3 c0)`` of the quadratic ``s'``.
     """
     c = np.asarray(spline.c, dtype=float)
     h = np.diff(np.asarray(spline.x, dtype=float))
@@ -138,23 +118,8 @@ def _turning_points(spline: Any) -> np.ndarray:
 
 
 def first_turn(spline: Any, angle: float) -> float | None:
-    """First time at which the spline has moved ``angle`` either way from its start.
-
-    Between consecutive breakpoints and interior extrema the spline is monotone, so the first
-    such point where ``|s - s(x0)|`` reaches ``angle`` brackets exactly one crossing.
-
-    Parameters
-    ----------
-    spline : scipy.interpolate.PPoly
-        Cubic pieces of an angle history [rad] over time [s].
-    angle : float
-        Angle to turn [rad], > 0.
-
-    Returns
-    -------
-    float or None
-        The time [s], refined to rounding; None if the spline never moves that far within its
-        span.
+    """First time [s] the angle ``spline`` [rad] has moved ``angle`` [rad] (> 0) either way from its
+    start, refined to rounding within the monotone piece bracketing it; None if it never does.
     """
     from scipy.optimize import brentq  # scipy.optimize takes ~0.5 s to import
 
@@ -171,11 +136,8 @@ def first_turn(spline: Any, angle: float) -> float | None:
 
 
 def time_origin(scene: Any) -> float:
-    """Where a scene's clock starts [s]: the angle history's first sample, else the load
-    history's first sample, else 0 (constant speed or torque drive, constant load).
-
-    The drive's and the load's histories share one clock, so a measured angle and torque keep
-    their alignment; only the origin moves.
+    """Where ``scene``'s clock starts [s]: the angle history's first sample, else the load history's, else
+    0 (drive and load histories share one clock).
     """
     if scene.drive.kind == "angle":
         return float(scene.drive.time[0])
@@ -185,14 +147,8 @@ def time_origin(scene: Any) -> float:
 
 
 def run_clock(scene: Any) -> tuple[Any, float]:
-    """The scene with its histories on a clock that starts at 0, and the origin moved [s].
-
-    Engines run on this clock, so that a history starting at t = 1e9 s gives what the same
-    history starting at 0 gives: at 1e9 s doubles are 1.2e-7 s apart, the step's own instants
-    would round by a part in 10^4 at a 1 ms step, and every time difference (speeds from
-    positions, the step, the friction log's matching of instants) with them. The shift subtracts
-    the first sample from every sample time, exactly for samples within a factor two of it; the
-    engines add the origin back to the time column they return.
+    """``scene`` with its histories on a clock starting at 0, and the origin moved [s]. Why: at t = 1e9 s
+    doubles are 1.2e-7 s apart; engines add the origin back to the time column.
     """
     origin = time_origin(scene)
     if origin == 0.0:

@@ -20,12 +20,10 @@ class Numerics:
     Attributes
     ----------
     dt : float or None
-        Time step [s]; None lets the engine choose it from ``accuracy`` and the scene.
+        Time step [s]; None: the engine chooses it from ``accuracy``.
     accuracy : float
-        Target absolute error of the mean efficiency [-] (the headline number), also the target
-        relative error of omega_out/omega_in. A time-stepping engine chooses its step to meet
-        both when ``dt`` is None, and every run reports its estimated mean-efficiency error
-        (``Summary.efficiency_error_estimate``, ``accuracy_met``; ``docs/accuracy.md``).
+        Target absolute error of the mean efficiency [-], also the target relative error of
+        omega_out/omega_in (``docs/accuracy.md``).
     richardson : bool
         Time stepping at ``h`` and ``h / 2``, extrapolated (``docs/bench.md``); reference: ignored.
     """
@@ -58,42 +56,27 @@ class FrictionSettings:
     Attributes
     ----------
     coupling : str
-        ``"extrapolated"`` (default): one Newton solve per step, the law on extrapolated inputs
-        (``cardan_exudyn.model.coupling``); ``"converged"``: within each time step, friction and
-        reactions are iterated to a fixed point (the friction of the step's own reactions);
-        ``"lagged"``: the paper's scheme (section 3.1), the reactions at the end of a step set the
-        friction applied during the next step; ``"uncoupled"``: friction is *not* applied to the
-        dynamics, eqs. (3), (5) are evaluated on the frictionless reactions and their power is
-        the loss (a first-order estimate, used to explain the paper's tolerance figure; the energy
-        balance then misses the loss). The reference solves the fixed point for the others.
+        ``"extrapolated"`` (default): one Newton solve per step, the law on extrapolated inputs;
+        ``"converged"``: friction and reactions iterated to a fixed point within each step;
+        ``"lagged"``: the paper's scheme (section 3.1), a step's end reactions set the next step's
+        friction; ``"uncoupled"``: eqs. (3), (5) evaluated on the frictionless reactions, not applied
+        (a first-order estimate). The reference solves the fixed point for all but the last.
     sign_band : float or None
-        One absolute ramp width [m/s] for every pair: below it ``sign()`` of eqs. (3), (5) is
-        replaced by a linear ramp ``clip(v / sign_band, -1, 1)`` of the relative surface speed
-        ``v`` (``omega_rel d / 2`` for the rotation of a journal, the sliding speed for axial
-        friction); 0 means the exact sign. None (default): the relative band below.
+        One absolute ramp width [m/s] for every pair, ``clip(v / sign_band, -1, 1)`` of the relative
+        surface or sliding speed; 0: exact sign; None (default): the relative band.
     sign_band_relative : float or None
-        Ramp width of each pair as a fraction of the pair's characteristic speed [-] (its RMS
-        surface, or sliding, speed over an input revolution at the drive's speed;
-        :func:`reference.physics.bands.sign_bands`), so that the regularisation removes the same share
-        of friction at every speed; 0 means the exact sign. None: 1e-3
-        (:data:`DEFAULT_SIGN_BAND_RELATIVE`) unless ``sign_band`` is given. Give at most
-        one of the two.
+        Ramp width as a fraction of each pair's characteristic speed [-]
+        (:func:`reference.physics.bands.sign_bands`); 0: exact sign; None:
+        :data:`DEFAULT_SIGN_BAND_RELATIVE` unless ``sign_band`` is given. At most one of the two.
     tolerance : float
-        Converged coupling: the fixed point is accepted when the largest change of a friction
-        load is below ``tolerance`` times the largest friction load (forces counted as the
-        torque they make at the journal radius, ``F d / 2``).
+        Converged coupling: accepted when the largest change of a friction load is below this times
+        the largest one (forces as torque at the journal radius, ``F d / 2``).
     max_iterations : int
-        Converged coupling: friction updates per step before the step is declared not converged.
+        Converged coupling: friction updates per step before it is declared not converged.
     law : str
-        Direction of the friction of a pair that rotates and slides (a cylindrical pair of a joint
-        with mounting errors). ``"paper"`` (default): eqs. (3), (5) as written, a Coulomb torque
-        ``-s(omega_rel d/2) f (d/2) N`` about the axis and, independently, a Coulomb force
-        ``-s(v_slide) f N`` along it, ``N = |F| + 2 |M| / L`` (the full load in both directions at
-        once). ``"resultant"``: one Coulomb force ``f N`` opposing the resultant slip velocity
-        ``v = (omega_rel d/2, v_slide)`` of the contact, regularised as a vector,
-        ``-f N v / max(|v|, band)``: torque ``(d/2)`` times its circumferential, axial force its
-        axial component (:func:`reference.physics.bands.sign_bands`, ``resultant`` band). Both laws agree
-        for a revolute pair and a pair that does not slide (``docs/scenes.md``, "Friction law").
+        ``"paper"`` (default): eqs. (3), (5) as written, torque and axial force each with the full
+        Coulomb load; ``"resultant"``: one Coulomb force ``f N`` opposing the contact's resultant slip
+        (``docs/scenes.md``, "Friction law"). They agree for a pair that does not slide.
     """
 
     coupling: str = "extrapolated"
@@ -126,8 +109,9 @@ class FrictionSettings:
 
     @property
     def relative_band(self) -> float | None:
-        """The relative ramp width in effect [-]: ``sign_band_relative``, its default 1e-3, or
-        None when the absolute ``sign_band`` is given."""
+        """The relative ramp width in effect [-]: ``sign_band_relative``, its default, or None when
+        ``sign_band`` is given.
+        """
         if self.sign_band is not None:
             return None
         return DEFAULT_SIGN_BAND_RELATIVE if self.sign_band_relative is None else self.sign_band_relative
@@ -140,11 +124,11 @@ class Record:
     Attributes
     ----------
     timeseries : bool
-        Return the time table; when False only the summary is produced.
+        Return the time table (False: only the summary).
     every : int
-        Keep every n-th step in the time table (the summary always uses every step).
+        Keep every n-th step in the table (the summary always uses every step).
     skip_revolutions : float
-        Input revolutions at the start excluded from the mean values [-], >= 0.
+        Input revolutions at the start excluded from the means [-], >= 0.
     """
 
     timeseries: bool = True

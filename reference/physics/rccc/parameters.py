@@ -18,24 +18,7 @@ LINK_NAMES = ("input", "spider", "output", "ground")
 
 
 def finite_number(name: str, value) -> float:
-    """``value`` as a float, refused unless it is a finite real number.
-
-    Parameters
-    ----------
-    name : str
-        The argument's name, for the message.
-    value : object
-        What arrived.
-
-    Returns
-    -------
-    float
-
-    Raises
-    ------
-    ValueError
-        Not a number (a bool counts as none), or not finite.
-    """
+    """``value`` as a float; ValueError naming ``name`` unless a finite real number (a bool is none)."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"`{name}` must be a number, got {value!r}")
     if not math.isfinite(value):
@@ -44,24 +27,7 @@ def finite_number(name: str, value) -> float:
 
 
 def four_numbers(name: str, values) -> tuple[float, float, float, float]:
-    """``values`` as four floats, one per link (:func:`finite_number` each).
-
-    Parameters
-    ----------
-    name : str
-        The argument's name, for the message.
-    values : sequence
-        What arrived.
-
-    Returns
-    -------
-    tuple of 4 float
-
-    Raises
-    ------
-    ValueError
-        Not a sequence of four finite numbers.
-    """
+    """``values`` as four finite floats, one per link; ValueError naming ``name`` otherwise."""
     if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)) \
             or len(values) != 4:
         raise ValueError(f"`{name}` must be a sequence of 4 numbers (one per link), got {values!r}")
@@ -75,13 +41,12 @@ class DHParameters:
     Attributes
     ----------
     alpha : tuple of 4 float
-        Twists of the input, spider, output and frame links [rad]: the angle from joint k's axis
-        to joint k + 1's about link k's common normal. The first three in (0, 180) deg, the frame
-        link's (minus the shaft angle) in (-90, 90) deg.
+        Twists of the input, spider, output and frame links [rad] (joint k's axis to joint k + 1's about
+        link k's common normal): the first three in (0, 180) deg, the frame's in (-90, 90) deg.
     a : tuple of 4 float
-        Offsets of the same links [m]: the signed length of each common normal.
+        Signed lengths of the same links' common normals [m].
     s1 : float
-        Axial offset of the revolute joint 1 [m]: from the frame link's normal to the input's.
+        Axial offset of the revolute joint 1 [m], from the frame link's normal to the input's.
     """
 
     alpha: tuple[float, float, float, float]
@@ -103,12 +68,8 @@ class DHParameters:
 
     @classmethod
     def ideal(cls, shaft_angle: float) -> DHParameters:
-        """The ideal Cardan joint: twists (90, 90, 90, -shaft_angle) deg, no offsets.
-
-        Parameters
-        ----------
-        shaft_angle : float
-            Angle between the input and output shafts [rad], in [0, pi/2).
+        """The ideal Cardan joint at ``shaft_angle`` [rad] in [0, pi/2): twists (90, 90, 90, -shaft_angle)
+        deg, no offsets.
         """
         beta = finite_number("shaft_angle", shaft_angle)
         if not 0.0 <= beta < 0.5 * math.pi:
@@ -117,20 +78,8 @@ class DHParameters:
 
     def with_errors(self, a: Sequence[float] = (0.0,) * 4, alpha: Sequence[float] = (0.0,) * 4,
                     s1: float = 0.0) -> DHParameters:
-        """These parameters with errors added.
-
-        Parameters
-        ----------
-        a : sequence of 4 float
-            Link offset errors [m].
-        alpha : sequence of 4 float
-            Link twist errors [rad].
-        s1 : float
-            Slide error of the revolute pair [m].
-
-        Returns
-        -------
-        DHParameters
+        """These parameters plus link offset errors ``a`` [m], twist errors ``alpha`` [rad] (4 each) and
+        ``s1`` [m].
         """
         d_a = four_numbers("a", a)
         d_alpha = four_numbers("alpha", alpha)
