@@ -1,10 +1,6 @@
-"""The input's motion over a run for each drive kind: constant speed, angle history, torque.
-
-A prescribed motion (speed, angle history) is known in closed form or from the history's spline.
-A torque-driven scene is one degree of freedom in minimal coordinates: the input angle and speed
-are integrated with :func:`scipy.integrate.solve_ivp` (DOP853, the tolerances of
-:class:`reference.engine.options.ReferenceOptions`), the acceleration at every instant from the
-forward dynamics (:mod:`reference.engine.forward`).
+"""The input's motion over a run for each drive kind: constant speed and angle history in closed form,
+a torque drive integrated by ``solve_ivp`` (DOP853) with the forward dynamics'
+(:mod:`reference.engine.forward`) acceleration.
 """
 
 from __future__ import annotations
@@ -26,12 +22,8 @@ __all__ = ["InputMotion", "SelfLocking", "input_motion"]
 
 
 class SelfLocking(Exception):
-    """Friction has no finite consistent value at some instant (raised inside the integrator).
-
-    Parameters
-    ----------
-    t, theta : float
-        The instant [s] and input angle [rad].
+    """Friction has no finite consistent value at instant ``t`` [s], input angle ``theta`` [rad] (raised
+    inside the integrator).
     """
 
     def __init__(self, t: float, theta: float) -> None:
@@ -42,29 +34,26 @@ class SelfLocking(Exception):
 
 @dataclass
 class InputMotion:
-    """The input's motion over the run: ``state(t)`` gives angle, speed and (prescribed motion)
-    acceleration, or None for the acceleration when the dynamics must supply it (torque drive).
+    """The input's motion over the run.
 
     Attributes
     ----------
     t0, t_end : float
         Span [s].
     state : callable
-        ``t -> (theta, theta_t, theta_tt | None)``, vectorised.
+        ``t -> (theta, theta_t, theta_tt | None)``, vectorised (None: the dynamics supply it).
     torque_in : float or None
-        The given drive torque [N m] of a torque-driven scene.
+        Drive torque [N m] of a torque-driven scene.
     knots : ndarray
         Instants where the motion is less smooth (angle-history knots) [s].
     status, reason : str
         Why the span ends early, if it does.
     ode_evaluations : int
-        Right-hand-side evaluations of the integrator (torque drive).
+        Right-hand-side evaluations (torque drive).
     periodic : bool
-        Every input revolution takes the same time and repeats the first (constant speed and
-        constant load).
+        Every input revolution repeats the first (constant speed and load).
     tabulated : bool
-        False when there is no state to tabulate: the integration stopped inside the integrator
-        (self-locking, the evaluation budget) or failed at its first step.
+        False when there is no state to tabulate (stopped inside the integrator or at its first step).
     """
 
     t0: float
@@ -117,7 +106,8 @@ def _torque_motion(scene: Scene, drive: TorqueDrive, options: ReferenceOptions) 
 def _torque_rhs(scene: Scene, drive: TorqueDrive,
                 budget: EvaluationBudget) -> Callable[[float, np.ndarray], np.ndarray]:
     """The ODE ``(t, [theta, theta_t]) -> [theta_t, theta_tt]``, each call counted on ``budget``;
-    raises :class:`SelfLocking` where friction has no consistent value."""
+    :class:`SelfLocking` where friction has no consistent value.
+    """
     from reference.engine.forward import right_hand_side  # scipy.linalg: imported with scipy.integrate
 
     acceleration = right_hand_side(scene, drive.torque)
@@ -136,8 +126,9 @@ def _torque_rhs(scene: Scene, drive: TorqueDrive,
 
 def _integrate(scene: Scene, drive: TorqueDrive, options: ReferenceOptions,
                rhs: Callable[[float, np.ndarray], np.ndarray]) -> Any:
-    """``solve_ivp``'s solution from rest at angle 0, stopped where the input has turned the
-    scene's revolutions either way (as Exudyn's stop) or at the time every engine allows."""
+    """``solve_ivp``'s solution from rest at angle 0, stopped once the input has turned the scene's
+    revolutions either way or at the time every engine allows.
+    """
     from scipy.integrate import solve_ivp  # scipy.integrate takes ~0.5 s to import
 
     target = 2.0 * math.pi * scene.revolutions
@@ -182,19 +173,8 @@ def _integrated(scene: Scene, drive: TorqueDrive, sol: Any, evaluations: int) ->
 
 
 def input_motion(scene: Scene, options: ReferenceOptions) -> InputMotion:
-    """The input's motion for the scene's drive (integrating it for a torque drive).
-
-    Parameters
-    ----------
-    scene : Scene
-        A scene on the run's clock (:func:`reference.scene.histories.run_clock`).
-    options : ReferenceOptions
-        The ODE tolerances of a torque drive.
-
-    Returns
-    -------
-    InputMotion
-        Its span, state function and, for a torque drive that stops early, the status and why.
+    """:class:`InputMotion` for ``scene``'s drive (on the run's clock), a torque drive integrated with
+    ``options``' ODE tolerances.
     """
     drive = scene.drive
     if isinstance(drive, SpeedDrive):

@@ -1,8 +1,5 @@
-"""What a torque drive's integration needs besides the dynamics: its speed tolerance and its budget.
-
-A tolerance on the speed relative to the speeds the run reaches (:func:`speed_tolerance`), and a
-bound on the integration's cost (:class:`EvaluationBudget`): a drive that cannot turn its joint
-ends as an incomplete run with a reason, not after the whole time allowed.
+"""A torque drive's integration needs besides the dynamics: its speed tolerance and an evaluation
+budget, so a drive that cannot turn its joint ends as an incomplete run with a reason.
 """
 
 from __future__ import annotations
@@ -28,52 +25,18 @@ acceleration). Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 def speed_tolerance(atol: float, initial_speed: float, initial_acceleration: float,
                     angle: float) -> float:
-    """Absolute tolerance on a torque drive's speed.
-
-    ``atol`` relative to the initial speed, but at least the speed error that, held for the time
-    the initial acceleration takes to turn ``angle`` from rest, ``sqrt(2 angle /
-    |initial_acceleration|)``, moves the angle by ``atol``. Why: a drive that starts (almost) at
-    rest reaches speeds set by its acceleration, not by its initial speed, and a tolerance
-    relative to the initial speed alone vanishes with it.
-    Measured: docs/engines.md#constants-of-the-reference-engine.
-
-    Parameters
-    ----------
-    atol : float
-        Absolute tolerance of the angle [rad], relative tolerance of the speed [-].
-    initial_speed : float
-        Input speed at the start [rad/s].
-    initial_acceleration : float
-        Input acceleration at the start [rad/s^2].
-    angle : float
-        The angle the run is to turn [rad] (positive).
-
-    Returns
-    -------
-    float
-        The tolerance [rad/s].
+    """Absolute tolerance [rad/s] on a torque drive's speed: ``atol`` relative to ``initial_speed``
+    [rad/s], but at least the speed error that moves the angle by ``atol`` [rad] in the time
+    ``sqrt(2 angle / |initial_acceleration|)`` [s]. Why: a drive starting at rest reaches speeds set by
+    its acceleration. Measured: docs/engines.md#constants-of-the-reference-engine.
     """
     return max(atol * abs(initial_speed), atol * math.sqrt(abs(initial_acceleration) / (2.0 * angle)))
 
 
 class Stalled(Exception):
-    """A torque drive's integration spent its evaluation budget (raised inside the integrator).
-
-    Parameters
-    ----------
-    scene : Scene
-        The torque-driven scene (its revolutions and drive go into the reason).
-    t, theta, theta_t : float
-        The evaluation refused: time [s], input angle [rad], speed [rad/s].
-    evaluations : int
-        Evaluations spent.
-
-    Attributes
-    ----------
-    t, theta, theta_t : float
-        Time [s], input angle [rad] and speed [rad/s] of the evaluation refused.
-    reason : str
-        How far the drive got, and what to change.
+    """A torque drive's integration spent its evaluation budget (raised inside the integrator) at time
+    ``t`` [s], angle ``theta`` [rad], speed ``theta_t`` [rad/s] after ``evaluations``; ``reason`` says
+    how far ``scene``'s drive got and what to change.
     """
 
     def __init__(self, scene: Scene, t: float, theta: float, theta_t: float, evaluations: int) -> None:
@@ -92,14 +55,9 @@ class Stalled(Exception):
 
 
 class EvaluationBudget:
-    """Counts a torque drive's right-hand-side evaluations and stops the integration past
-    :data:`ODE_EVALUATIONS_PER_REVOLUTION` per requested revolution plus
-    :data:`ODE_EVALUATIONS_PER_KNOT` per load-history sample passed.
-
-    Attributes
-    ----------
-    count : int
-        Evaluations made so far.
+    """Counts (``count``) a torque drive's right-hand-side evaluations and stops past
+    :data:`ODE_EVALUATIONS_PER_REVOLUTION` per revolution plus :data:`ODE_EVALUATIONS_PER_KNOT` per
+    load-history sample passed.
     """
 
     def __init__(self, scene: Scene) -> None:
@@ -109,17 +67,8 @@ class EvaluationBudget:
         self._knots = scene.load.knots.tolist()
 
     def spend(self, t: float, theta: float, theta_t: float) -> None:
-        """Count one evaluation.
-
-        Parameters
-        ----------
-        t, theta, theta_t : float
-            Time [s], input angle [rad] and speed [rad/s] of the evaluation.
-
-        Raises
-        ------
-        Stalled
-            The budget is spent (the evaluation is not counted).
+        """Count one evaluation at ``t`` [s], ``theta`` [rad], ``theta_t`` [rad/s]; :class:`Stalled` (not
+        counted) when the budget is spent.
         """
         if self.count >= self._base and (
                 self.count >= self._base + ODE_EVALUATIONS_PER_KNOT * bisect.bisect_right(self._knots, t)):

@@ -1,24 +1,10 @@
 """Every body's and pair's motion for a given input motion: what the dynamics need from kinematics.
 
-Two sources give the same :class:`JointMotion`:
-
-- the ideal joint (no mounting errors): the closed form of :mod:`reference.physics.kinematics`; every
-  body turns about the joint centre O and no pair slides;
-- a joint with mounting errors (:class:`reference.scene.joint.MountingErrors`): the dual-number RCCC
-  loop of :mod:`reference.physics.rccc` from the Denavit-Hartenberg parameters. The bodies' frames
-  translate, the pair axes do not meet, and the cylindrical pairs slide.
-
-``method="auto"`` takes the closed form when the joint is ideal (it is exact there and cheaper)
-and the loop otherwise; ``"loop"`` forces the loop, which for the ideal joint agrees with the
-closed form to rounding (a test checks it, reactions included).
-
-Conventions shared by both: a body's mass properties (:meth:`reference.scene.joint.Body.canonical`) are
-given in its canonical frame, whose origin is the body's D-H link-frame origin (the joint centre O
-for the ideal joint). Each pair's frame is attached to body ``a`` of the pair
-(:data:`reference.scene.joint.PAIR_BODIES`), z along the pair axis; its origin, the point about
-which reaction moments are taken, is where the bearing sits
-(:func:`reference.physics.rccc.frames.axial_positions`) and moves with body ``b`` when the pair
-slides (:func:`reference.physics.rccc.frames.pair_frames`).
+The ideal joint uses the closed form of :mod:`reference.physics.kinematics` (no pair slides); a
+joint with mounting errors the dual-number RCCC loop of :mod:`reference.physics.rccc`. ``"auto"``
+takes the closed form when ideal; ``"loop"`` agrees with it to rounding there. Mass properties are
+in each body's canonical frame; each pair's frame is attached to its body ``a``, z on the axis, its
+origin at the bearing (:func:`reference.physics.rccc.frames.pair_frames`), moving with body ``b``.
 """
 
 from __future__ import annotations
@@ -38,23 +24,18 @@ METHODS = ("auto", "closed_form", "loop")
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Motion of the joint at a batch of samples (global components, arrays of shape (..., ...)).
+    """Motion of the joint at a batch of samples, global components.
 
     Attributes
     ----------
     bodies : dict of str to reference.physics.rccc.motion.BodyMotion
-        ``ground``, ``input``, ``spider``, ``output``: rotation (canonical axes), frame origin and
-        its velocity and acceleration, angular velocity and acceleration.
-    frames : dict of str to ndarray, shape (..., 3, 3)
-        Pair frames attached to body a [-].
-    origins : dict of str to ndarray, shape (..., 3)
-        Pair origins [m].
-    omega_rel : dict of str to ndarray
-        Angular speed of body b relative to body a about the pair axis [rad/s].
+        ``ground``, ``input``, ``spider``, ``output``.
+    frames, origins : dict of str to ndarray, shape (..., 3, 3) and (..., 3)
+        Pair frames attached to body a [-] and pair origins [m].
+    omega_rel, slide_rel : dict of str to ndarray
+        Angular [rad/s] and sliding [m/s] speed of body b relative to a about/along the pair axis.
     slide : dict of str to ndarray
-        D-H slide of each joint [m] (constant ``s1`` for the revolute pair; 0 in the ideal joint).
-    slide_rel : dict of str to ndarray
-        Sliding speed of body b relative to body a along the pair axis [m/s].
+        D-H slide of each joint [m] (``s1`` for the revolute pair; 0 in the ideal joint).
     output : tuple of 3 ndarray
         Output shaft angle [rad], speed [rad/s], acceleration [rad/s^2] about its own axis.
     """
@@ -101,23 +82,8 @@ def _loop(joint: Joint, theta: np.ndarray, theta_t: np.ndarray, theta_tt: np.nda
 
 def loop_motion(params: rccc.DHParameters, positions: rccc.LoopPositions, rates: rccc.LoopRates,
                 axial) -> JointMotion:
-    """The joint's motion from the loop's solved positions and rates.
-
-    Parameters
-    ----------
-    params : reference.physics.rccc.DHParameters
-        The loop.
-    positions : reference.physics.rccc.LoopPositions
-        Its solved positions at the samples.
-    rates : reference.physics.rccc.LoopRates
-        Its solved rates there.
-    axial : sequence of 4 float, or ndarray, shape (..., 4)
-        The pairs' axial positions [m] (:func:`reference.physics.rccc.axial_positions`), one set
-        or one per sample.
-
-    Returns
-    -------
-    JointMotion
+    """:class:`JointMotion` from the loop ``params``' solved ``positions`` and ``rates`` with the pairs'
+    ``axial`` positions [m] (:func:`reference.physics.rccc.axial_positions`; one set or one per sample).
     """
     frames = rccc.pair_frames(params, positions, axial)
     return JointMotion(
@@ -133,26 +99,9 @@ def loop_motion(params: rccc.DHParameters, positions: rccc.LoopPositions, rates:
 
 def joint_motion(joint: Joint, theta: ArrayLike, theta_t: ArrayLike, theta_tt: ArrayLike,
                  method: str = "auto") -> JointMotion:
-    """The joint's motion for input angles, speeds and accelerations (broadcast together).
-
-    Parameters
-    ----------
-    joint : Joint
-        Geometry and mounting errors.
-    theta, theta_t, theta_tt : array_like
-        Input angle [rad], speed [rad/s], acceleration [rad/s^2].
-    method : {"auto", "closed_form", "loop"}
-        See the module documentation; ``"closed_form"`` refuses a joint with errors.
-
-    Returns
-    -------
-    JointMotion
-        Arrays of the broadcast shape of the inputs.
-
-    Raises
-    ------
-    reference.physics.loop_closure.LoopClosureError
-        The loop with these errors does not close at some input angle.
+    """:class:`JointMotion` of ``joint`` at input angles ``theta`` [rad], speeds ``theta_t`` [rad/s] and
+    accelerations ``theta_tt`` [rad/s^2] (broadcast together) by ``method`` ``"auto"``, ``"closed_form"``
+    (refuses mounting errors) or ``"loop"``; LoopClosureError where the loop does not close.
     """
     if method not in METHODS:
         raise ValueError(f"`method` must be one of {METHODS}, got {method!r}")

@@ -1,20 +1,10 @@
 """Closing the RCCC loop at given input angles: its input-output equation in dual numbers.
 
-The loop ``prod_{k=1..4} Z(theta_hat_k) X(alpha_hat_k) = I`` of :mod:`reference.physics.rccc` fixes
-joints 2..4 once the input angle ``theta_1`` (and the constant slide ``s_1``) is given. Its real
-part is a spherical four-bar whose input-output equation ``A cos theta_4 + B sin theta_4 = C``
-(quadratic in ``tan(theta_4 / 2)``) has the two roots
-``atan2(B, A) -+ atan2(sqrt(A^2 + B^2 - C^2), C)``, one per assembly branch; the equation's dual
-part is linear in the slide ``s_4``. With joint 4 known, joints 2 and 3 follow as the angles
-that turn known lines onto their joint axes.
-
-Where the discriminant ``A^2 + B^2 - C^2`` is negative the loop cannot be assembled; where it
-vanishes the two branches meet and ``s_4`` is undetermined (its coefficient is
-``-+sqrt(A^2 + B^2 - C^2)``). Both are a :class:`LoopClosureError` naming the input angles.
-
-This module solves one input angle at a time (vectorised), with every angle wrapped into
-(-pi, pi]; :mod:`reference.physics.rccc` names the branches, makes the angles continuous in ``theta_1``
-and derives frames and motions from them.
+The real part of ``prod_k Z(theta_hat_k) X(alpha_hat_k) = I`` is a spherical four-bar,
+``A cos theta_4 + B sin theta_4 = C``, with roots ``atan2(B, A) -+ atan2(sqrt(A^2 + B^2 - C^2), C)``
+(one per assembly branch); the dual part is linear in ``s_4``; joints 2 and 3 follow as the angles
+turning known lines onto their axes. A negative discriminant (no assembly) or a zero one
+(branches meet, ``s_4`` undetermined) is a :class:`LoopClosureError`. Angles wrapped into (-pi, pi].
 """
 
 from __future__ import annotations
@@ -37,20 +27,7 @@ E_Z = Dual(np.array([0.0, 0.0, 1.0]))
 
 
 class LoopClosureError(ValueError):
-    """The loop cannot close, or its two branches meet, at some input angles.
-
-    Parameters
-    ----------
-    message : str
-        What failed, for the user.
-    angles : ndarray
-        The offending input angles [rad].
-
-    Attributes
-    ----------
-    angles : ndarray
-        The offending input angles ``theta_1`` [rad].
-    """
+    """The loop cannot close, or its branches meet, at the input ``angles`` ``theta_1`` [rad]."""
 
     def __init__(self, message: str, angles: np.ndarray) -> None:
         super().__init__(message)
@@ -90,13 +67,13 @@ def _angle_about_z(v: Dual) -> Dual:
 
 def solve_wrapped(twists: Dual, s1: float | np.ndarray, theta1: np.ndarray, sign: float, where: str,
                   strict: bool = True) -> Dual:
-    """Dual joint angles closing the loop, real parts in (-pi, pi] (``theta_1`` as given).
+    """Dual joint angles ``theta_k + eps s_k`` (..., 4) [rad] + eps [m] closing the loop, real parts in
+    (-pi, pi].
 
     Parameters
     ----------
     twists : Dual, shape (4,) or (..., 4)
-        Dual link twists ``alpha_k + eps a_k`` [rad] + eps [m] (per sample: broadcast with
-        ``theta1``, as ``s1``).
+        Link twists ``alpha_k + eps a_k`` [rad] + eps [m] (per sample: broadcast with ``theta1``).
     s1 : float or ndarray
         Slide of the revolute joint 1 [m].
     theta1 : ndarray
@@ -106,18 +83,8 @@ def solve_wrapped(twists: Dual, s1: float | np.ndarray, theta1: np.ndarray, sign
     where : str
         What the angles are, for the error message.
     strict : bool
-        False: no error; the samples where the loop does not close (or its branches meet) get
-        NaN angles and slides instead (many scenes in one pass, :mod:`reference.engine.batch.solve`).
-
-    Returns
-    -------
-    Dual, shape (..., 4)
-        ``theta_k + eps s_k`` [rad] + eps [m] of joints 1..4.
-
-    Raises
-    ------
-    LoopClosureError
-        At input angles where the loop cannot close or the branches meet (``strict``).
+        True: :class:`LoopClosureError` where the loop does not close or the branches meet; False:
+        NaN angles and slides there (many scenes in one pass).
     """
     tw = twists
     t1 = Dual(theta1, np.full_like(theta1, s1))

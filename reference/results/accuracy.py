@@ -1,10 +1,6 @@
-"""How a run's estimate of its mean-efficiency error was made: :class:`RunAccuracy`.
-
-The estimate itself and the verdict are the summary's common fields
-(``efficiency_error_estimate``, ``accuracy_met``); this record says how they came about: the
-target, the method, the a-priori model, the companion run the estimate compares with and the
-pilot run that planned an automatic step. On disk it is the summary's ``accuracy`` table, with the
-companion's fields flattened as ``companion_<field>`` and the pilot nested (``docs/outputs.md``).
+"""How a run's estimate of its mean-efficiency error was made: :class:`RunAccuracy`, the summary's
+``accuracy`` table (companion fields flattened as ``companion_<field>``, the pilot nested;
+``docs/outputs.md``).
 """
 
 from __future__ import annotations
@@ -18,18 +14,8 @@ __all__ = ["CompanionRun", "PilotRun", "RunAccuracy"]
 
 @dataclass(frozen=True)
 class CompanionRun:
-    """The run at a coarser step that the main run's estimate compares with.
-
-    Attributes
-    ----------
-    dt : float or None
-        Its time step [s] (None: it never integrated, e.g. the loop did not close).
-    status : str
-        How it ended (a :class:`reference.results.summary.Status` value).
-    mean_efficiency : float or None
-        Its mean efficiency [-] (None unless it ended ``ok``).
-    wall_time_s : float
-        Its wall time [s].
+    """The coarser-step run the estimate compares with: ``dt`` [s] (None: it never integrated),
+    ``status``, ``mean_efficiency`` [-] (None unless ``ok``), ``wall_time_s`` [s].
     """
 
     dt: float | None
@@ -40,18 +26,8 @@ class CompanionRun:
 
 @dataclass(frozen=True)
 class PilotRun:
-    """The coarse run whose losses planned an automatic step.
-
-    Attributes
-    ----------
-    dt : float or None
-        Its time step [s].
-    mean_efficiency : float or None
-        Its mean efficiency [-] (None unless it ended ``ok``).
-    wall_time_s : float
-        Its wall time [s].
-    is_companion : bool
-        Whether it also served as the companion of the main run.
+    """The coarse run that planned an automatic step: ``dt`` [s], ``mean_efficiency`` [-] (None unless
+    ``ok``), ``wall_time_s`` [s], ``is_companion`` (it also served as companion).
     """
 
     dt: float | None
@@ -62,29 +38,27 @@ class PilotRun:
 
 @dataclass(frozen=True)
 class RunAccuracy:
-    """How a run's mean-efficiency error was estimated; a field is None where the run did not
-    get that far (an automatic step without an estimate records only its pilot).
+    """How a run's mean-efficiency error was estimated; a field is None where the run did not get
+    that far.
 
     Attributes
     ----------
     target : float or None
         The scene's ``numerics.accuracy`` [-].
     order : int or None
-        Order of convergence of the mean efficiency in the step the estimate assumes [-].
+        Order of convergence in the step the estimate assumes [-].
     loss_fraction : float or None
         ``1 - mean_efficiency`` of the main run [-].
     steps_per_revolution : float or None
-        The main run's steps per input revolution at the drive's top speed [-].
+        Steps per input revolution at the drive's top speed [-].
     model : float or None
-        The a-priori error of the mean efficiency at those steps and losses [-].
+        The a-priori error at those steps and losses [-].
     companion : CompanionRun or None
-        The run at a coarser step the estimate compares with.
     richardson : float or None
         The Richardson estimate from the two runs [-] (None when the companion failed).
     method : str or None
         How the estimate was made, or why there is none, in one sentence.
     pilot : PilotRun or None
-        The run that planned an automatic step.
     """
 
     target: float | None = None
@@ -98,8 +72,9 @@ class RunAccuracy:
     pilot: PilotRun | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The summary's ``accuracy`` table: the fields that are set, in order, the companion's
-        as ``companion_<field>``, the pilot as a nested table."""
+        """The summary's ``accuracy`` table: the set fields in order, the companion's as
+        ``companion_<field>``, the pilot nested.
+        """
         out: dict[str, Any] = {}
         for f in fields(self):
             value = getattr(self, f.name)
