@@ -1,8 +1,6 @@
-"""The friction fixed point of one sample by Newton's method, LAPACK called directly.
-
-The forward dynamics' right-hand side (:mod:`reference.engine.forward`) solves
-``phi = G(x0 - S phi)`` (eqs. (3), (5)) for at most seven friction values per call: the same rule
-as :func:`reference.engine.fixed_point.solve_friction`, without its batched arrays.
+"""The friction fixed point ``phi = G(x0 - S phi)`` of one sample by Newton's method, LAPACK called
+directly: :func:`reference.engine.fixed_point.solve_friction`'s rule without its batched arrays, for
+the forward dynamics' right-hand side.
 """
 
 from __future__ import annotations
@@ -37,9 +35,9 @@ def _spectral_radius(matrix: np.ndarray) -> float:
 
 
 def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
-    """:func:`reference.engine.fixed_point.solve_friction`'s loop gain of one sample: the spectral radius,
-    or an upper bound where that is below ``exact_from`` (the infinity norm; for ``exact_from`` >= 1
-    also :func:`reference.engine.fixed_point.power_bound`)."""
+    """One sample's loop gain: the spectral radius, or an upper bound below ``exact_from`` (infinity norm;
+    for ``exact_from`` >= 1 also :func:`reference.engine.fixed_point.power_bound`).
+    """
     norm = float(np.abs(matrix).sum(1).max())
     if not math.isfinite(norm):
         return math.inf
@@ -54,36 +52,22 @@ def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
 
 def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
                     start: np.ndarray | None = None) -> tuple[np.ndarray, bool, float, int]:
-    """The friction fixed point of one sample, as :func:`reference.engine.fixed_point.solve_friction`.
+    """``(phi, converged, loop_gain, iterations)``: one sample's friction fixed point, as
+    :func:`reference.engine.fixed_point.solve_friction`.
 
     Parameters
     ----------
     sxa : ndarray, shape (4 K, K + 1)
-        Row ``4 j + i``: pair component i (fx, fy, mx, my [N, N m]) of slot j's pair, its
-        response to unit friction values (columns ``:K``) and its value without friction (column
-        K): ``c = sxa @ [-phi, 1]``.
+        Row ``4 j + i``: component i (fx, fy, mx, my) of slot j's pair, its response to unit friction
+        (columns ``:K``) and its frictionless value (column K): ``c = sxa @ [-phi, 1]``.
     ks : ndarray, shape (2 K,)
-        Factors of ``|F|`` and ``|M|`` in each friction value, signs included
-        (``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``).
+        ``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``, signs included.
     coupled : bool
-        False: the friction of the frictionless reactions (coupling ``"uncoupled"``).
+        False: the friction of the frictionless reactions (``"uncoupled"``).
     start : ndarray, shape (K,), or None
-        None: :func:`reference.engine.fixed_point.solve_friction` exactly (first iterate the friction of the
-        frictionless reactions, stop when an update is at most :data:`NEWTON_TOLERANCE` of the
-        largest value, loop gain at the solution). Else the first iterate (a close one: the
-        previous call's), and Newton also stops where its quadratic convergence puts the next
-        update below that tolerance, with the loop gain of the last Jacobian (about the update's
-        relative size off, and the infinity norm where that is below :data:`WARM_START_GAIN`;
-        callers re-solve with ``start=None`` where the verdict is close).
-
-    Returns
-    -------
-    phi : ndarray, shape (K,)
-        Friction values [N m or N].
-    converged : bool
-    loop_gain : float
-        As :func:`reference.engine.fixed_point.loop_gain`'s; infinite when not converged.
-    iterations : int
+        None: ``solve_friction`` exactly. Else the first iterate (the previous call's); Newton also
+        stops where quadratic convergence puts the next update below :data:`NEWTON_TOLERANCE`, with
+        the last Jacobian's gain (the infinity norm below :data:`WARM_START_GAIN`).
     """
     k = sxa.shape[1] - 1
     ops = _OPERATORS[k]
@@ -132,10 +116,9 @@ def _products_at(phi: np.ndarray, p: np.ndarray, sxa: np.ndarray, ks: np.ndarray
 
 def _iterate(phi: np.ndarray, p: np.ndarray, sxa: np.ndarray, ks: np.ndarray,
              ops: _Operators) -> tuple[np.ndarray, np.ndarray, int]:
-    """Newton's next iterate from ``phi`` (K,) (``p`` as for :func:`_products_at`): G is
-    homogeneous in the pair components, ``G = W c`` with ``W`` the unit components times their
-    factors, so the iterate is ``(I + W sx)^-1 W c0`` (one product gives both). Returns the
-    iterate, the loop's Jacobian ``-dG/dphi`` at ``phi`` (K, K) and LAPACK's ``info``."""
+    """``(iterate, -dG/dphi (K, K), info)``: Newton's next iterate from ``phi``; ``G = W c`` is
+    homogeneous in the components, so it is ``(I + W sx)^-1 W c0``.
+    """
     k = phi.size
     both = _products_at(phi, p, sxa, ks, ops)
     gm = both[:, :k]

@@ -22,14 +22,9 @@ LEVER_PAIRS = (("spider_lever", ("input_spider", "spider_output"), "arm_radius")
 
 
 def lever_changes(values: dict[str, Any]) -> dict[str, Any]:
-    """Scene changes (dotted path -> value) for the levers and the dimensions in ``values``: a
-    dimension [m] sets the geometry and makes its pairs' lever derive from it; a lever [m] is
-    set directly on its pairs.
-
-    Raises
-    ------
-    SceneError
-        A lever and the dimension it derives from are both given.
+    """Scene changes (dotted path -> value) for the levers and dimensions in ``values``: a dimension [m]
+    sets the geometry and its pairs' lever derives from it, a lever [m] is set on its pairs; SceneError
+    when both are given.
     """
     changes: dict[str, Any] = {}
     for key, pairs, geometry in LEVER_PAIRS:
@@ -44,20 +39,8 @@ def lever_changes(values: dict[str, Any]) -> dict[str, Any]:
 
 
 def body_changes(scene: Scene, values: dict[str, Any]) -> dict[str, Any]:
-    """Scene changes for the bodies' centres of mass.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene the changes apply to (its bodies).
-    values : dict of str to Any
-        Parameter values; ``input_eccentricity`` [m] and ``spider_com_offset`` [m] are read
-        (None or absent: Table 1's).
-
-    Returns
-    -------
-    dict of str to Any
-        Dotted scene path -> value (SI units), for :func:`reference.scene.mapping.replace`.
+    """Scene changes (dotted path -> SI value) for the bodies' centres of mass of ``scene`` from
+    ``input_eccentricity`` and ``spider_com_offset`` [m] in ``values`` (None or absent: Table 1's).
     """
     changes: dict[str, Any] = {}
     if values.get("input_eccentricity") is not None:
@@ -91,33 +74,16 @@ def _check_values(values: dict[str, Any]) -> None:
 
 
 def apply_parameters(scene: Scene, values: dict[str, Any]) -> Scene:
-    """``scene`` with the open values of a parameter set applied.
+    """``scene`` (a paper scene) with the open values of a parameter set applied.
 
-    Parameters
-    ----------
-    scene : Scene
-        A paper scene (:mod:`reference.paper.scenes`), its load the case's torque [N m].
-    values : dict
-        Any of :data:`reference.paper.parameter_sets.NUMBER_PARAMETERS` [m] and the
-        :data:`reference.paper.parameter_sets.CHOICES` (``gravity``, ``torque_reading``,
-        ``friction_law``): ``arm_radius`` and ``support_spacing`` set the geometry and make the
-        spider and frame levers derive from it; ``spider_lever`` and ``frame_lever`` set the levers
-        directly; ``input_eccentricity`` moves the input's centre of mass that far off its axis
-        (centroidal inertia kept, products dropped; None: Table 1's); ``spider_com_offset`` puts
-        the spider's centre of mass that far from the centre along its normal. ``torque_reading``
-        ``mean_input`` turns the scene's load into the constant output load whose mean input
-        torque equals it (:func:`reference.paper.loads.mean_input_load`), last, after every other
-        change.
-
-    Returns
-    -------
-    Scene
-        The changed scene; its description says which load the ``mean_input`` reading chose.
-
-    Raises
-    ------
-    SceneError
-        An unknown parameter or choice, or a value outside a choice's options.
+    ``values`` holds any of :data:`reference.paper.parameter_sets.NUMBER_PARAMETERS` [m] and
+    :data:`reference.paper.parameter_sets.CHOICES`: ``arm_radius``, ``support_spacing`` set the geometry
+    the spider and frame levers derive from; ``spider_lever``, ``frame_lever`` set the levers;
+    ``input_eccentricity`` moves the input's centre of mass off its axis (centroidal inertia kept);
+    ``spider_com_offset`` moves the spider's along its normal; ``torque_reading = "mean_input"`` turns
+    the load into the constant output load with that mean input torque
+    (:func:`reference.paper.loads.mean_input_load`), last; the description says which. SceneError for
+    an unknown parameter or choice.
     """
     _check_values(values)
     changes = {**lever_changes(values), **body_changes(scene, values)}
@@ -132,8 +98,9 @@ def apply_parameters(scene: Scene, values: dict[str, Any]) -> Scene:
 
 
 def _with_mean_input_load(scene: Scene) -> Scene:
-    """``scene`` with the constant output load whose mean input torque is its load torque; a
-    joint that locks keeps its load (the run will say it locks) and the description says why."""
+    """``scene`` with the constant output load whose mean input torque is its load torque; a joint that
+    locks keeps its load and the description says why.
+    """
     target = scene.load.torque
     try:
         load = mean_input_load(scene)

@@ -1,21 +1,10 @@
 """Integrals over a time table that know where friction jumps.
 
-A time-stepping engine samples the powers at its steps; the mean efficiency is their integral
-over whole revolutions. Where a pair's relative motion reverses, its friction changes sign
-within a sign ramp far narrower than a step (:mod:`reference.physics.bands`), and the drive torque and
-every pair's reaction jump with it. The trapezoid between the two rows around such a jump
-integrates a straight line across the step, an error of half the jump times the step at every
-reversal: first order in the step, whatever the engine's own order.
-
-:func:`jump_breaks` finds every reversal from the table's relative speeds (the crossing instant
-interpolated linearly between the rows around it) and :func:`segment_integrals` integrates each
-side of it along the line through the two nearest rows on that side. A row closer than :data:`NEAR` of a
-step to the crossing (in particular a row exactly at it, as on a constant-speed grid of 4k steps
-per revolution, where the crossings of a symmetric joint fall on rows) may lie inside the sign
-ramp, where its value belongs to neither side: it is left out and the two steps around it are
-integrated as one; so are the rows of a ramp the steps partly resolve (:data:`RAMP_GROWTH`).
-Measured on the reference engine's exact rows: docs/accuracy.md#step-model-constants
-(``tests/test_reference_quadrature.py`` pins the gain over the plain trapezoid).
+Why: where a pair reverses, friction (and the reactions and drive torque) jumps within a ramp far
+narrower than a step, and the trapezoid across it errs by half the jump times the step, first
+order. :func:`jump_breaks` finds each reversal; :func:`segment_integrals` integrates each side
+along the line through its two nearest rows, leaving out rows within :data:`NEAR` of the crossing
+or on a partly resolved ramp (:data:`RAMP_GROWTH`). Measured: docs/accuracy.md#step-model-constants.
 """
 
 from __future__ import annotations
@@ -52,10 +41,9 @@ _MOTIONS = (("friction_torque", "omega_rel"), ("friction_force", "slide_rel"))
 
 
 def _crossings(w: np.ndarray, f: np.ndarray, t: np.ndarray, noise: float) -> list[tuple[int, int, float]]:
-    """``(a, b, t*)``: consecutive clear rows ``a < b`` with opposite signs of the speed ``w``,
-    and the crossing instant ``t*`` interpolated linearly between them. A row is clear when its
-    speed is above ``noise`` and its friction ``f`` above :data:`RAMP_SHARE` of the pair's
-    largest: rows in between (in the sign ramp, or exactly at the crossing) are skipped."""
+    """``(a, b, t*)``: consecutive clear rows with opposite signs of speed ``w`` and the crossing instant
+    between them; a row is clear when ``|w|`` > ``noise`` and ``f`` above :data:`RAMP_SHARE` of its max.
+    """
     clear = (np.abs(w) > noise) & (np.abs(f) >= RAMP_SHARE * np.max(np.abs(f)))
     rows = np.flatnonzero(clear)
     if rows.size < 2:
@@ -68,9 +56,9 @@ def _crossings(w: np.ndarray, f: np.ndarray, t: np.ndarray, noise: float) -> lis
 
 
 def _off_ramp(f: np.ndarray, row: int, away: int) -> int:
-    """The first row from ``row`` in the direction ``away`` that is off the sign ramp (its
-    friction within :data:`RAMP_GROWTH` of the next row's, going away from the crossing; at
-    most :data:`RESOLVED_ROWS` + 1 rows away)."""
+    """The first row from ``row`` in direction ``away`` off the sign ramp (friction ``f`` within
+    :data:`RAMP_GROWTH` of the next row's; at most :data:`RESOLVED_ROWS` + 1 rows away).
+    """
     for _ in range(RESOLVED_ROWS + 1):
         beyond = row + away
         if not 0 <= beyond < f.size or abs(f[beyond]) <= (1.0 + RAMP_GROWTH) * abs(f[row]):
@@ -80,14 +68,9 @@ def _off_ramp(f: np.ndarray, row: int, away: int) -> int:
 
 
 def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float]]:
-    """Where the integrand jumps: ``(a, b, t*)`` for every reversal of a pair with friction.
-
-    Rows ``a`` and ``b`` are the nearest on either side whose values are used (a row within
-    :data:`NEAR` of a step of the crossing is skipped); ``t*`` is the crossing [s]. Pairs whose
-    friction column is zero throughout (or absent) give none, and so do speeds that only
-    scatter around zero (below :data:`NOISE` of the input speed, per metre for sliding: a pair
-    that does not move, e.g. the spider pairs of a straight joint); two reversals that would
-    share a step keep the first (the trapezoid takes the other).
+    """``(a, b, t*)`` for every reversal of a pair with friction in ``columns``: the nearest used rows
+    either side and the crossing [s]. Speeds below :data:`NOISE` of the input speed give none; of two
+    reversals sharing a step the first is kept.
     """
     t = np.asarray(columns["t"], float)
     last = t.size - 1
@@ -120,26 +103,9 @@ def jump_breaks(columns: Mapping[str, np.ndarray]) -> list[tuple[int, int, float
 
 def segment_integrals(y: np.ndarray, t: np.ndarray,
                       breaks: Sequence[tuple[int, int, float]] = ()) -> np.ndarray:
-    """Integral of ``y dt`` over each step: the trapezoid, except across the friction jumps.
-
-    Across a break each side of the crossing follows the straight line through the row on its
-    side and the next one beyond it (a constant at the table's ends). A jump is then integrated
-    exactly to second order, and so is a sign ramp that the steps resolve (where the trapezoid
-    is right too): either way the error stays O(h^2).
-
-    Parameters
-    ----------
-    y : ndarray, shape (n,)
-        The integrand (e.g. a power [W]).
-    t : ndarray, shape (n,)
-        Time [s].
-    breaks : sequence of (int, int, float)
-        :func:`jump_breaks`: rows ``a < b`` and the crossing instant [s].
-
-    Returns
-    -------
-    ndarray, shape (n - 1,)
-        Per step the integral (e.g. a work [J]).
+    """Per step (n - 1,) the integral of ``y dt`` over time ``t`` [s]: the trapezoid, except across the
+    ``breaks`` (:func:`jump_breaks`), where each side follows the line through its row and the next
+    beyond it (O(h^2) either way).
     """
     y = np.asarray(y, float)
     t = np.asarray(t, float)

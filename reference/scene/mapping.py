@@ -1,9 +1,6 @@
-"""A scene as a plain dictionary (and so TOML / JSON), and back; changes by dotted path.
-
-Unknown keys are rejected; angles, speeds and lengths may be given at the boundary with unit
-suffixes (``shaft_angle_deg``, ``speed_rpm``, ``a1_mm``: :data:`UNIT_ALIASES`). Reading TOML files
-and starting from a named scene (``base = "paper"``), which needs the paper, is
-:mod:`reference.scene.files`, one level up.
+"""A scene as a plain dictionary (and so TOML / JSON), and back; changes by dotted path. Unknown keys
+are rejected; unit-suffixed aliases (:data:`UNIT_ALIASES`: ``shaft_angle_deg``, ``speed_rpm``,
+``a1_mm``) are accepted at the boundary.
 """
 
 from __future__ import annotations
@@ -104,32 +101,16 @@ def _build_drive(data: Mapping[str, Any], path: str) -> Drive:
 
 
 def scene_from_dict(data: Mapping[str, Any]) -> Scene:
-    """Build and validate a scene from a (TOML-shaped) dictionary; unknown keys are errors.
-
-    Parameters
-    ----------
-    data : Mapping
-        Tables and values as in a scene TOML file: SI units, or the unit-suffixed aliases of
-        :data:`UNIT_ALIASES` (``shaft_angle_deg``, ``speed_rpm``, ...). A named ``base`` is not
-        resolved here (:func:`reference.scene.files.scene_from_mapping` does).
-
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    SceneError
-        An unknown, missing or invalid key; the message names its table and the value.
+    """Build and validate a scene from a TOML-shaped dictionary ``data`` (SI units or
+    :data:`UNIT_ALIASES`; a named ``base`` is :func:`reference.scene.files.scene_from_mapping`'s);
+    SceneError naming the table and value of an unknown, missing or invalid key.
     """
     return _build(Scene, data, "")
 
 
 def scene_to_dict(obj: Any) -> Any:
-    """The fully resolved scene (or part) as plain JSON/TOML-ready data, SI units.
-
-    Dataclasses become dictionaries (fields that are None are left out) and tuples lists;
-    :func:`scene_from_dict` reads the result back to an equal scene.
+    """The fully resolved scene (or part) as JSON/TOML-ready data, SI units: dataclasses as dicts (None
+    fields left out), tuples as lists; :func:`scene_from_dict` reads it back to an equal scene.
     """
     if dataclasses.is_dataclass(obj):
         out = {}
@@ -145,26 +126,9 @@ def scene_to_dict(obj: Any) -> Any:
 
 
 def replace(scene: Scene, **changes: Any) -> Scene:
-    """Copy of ``scene`` with dotted-path fields changed, validated again.
-
-    Example: ``replace(scene, **{"joint.geometry.shaft_angle": 0.2, "load.torque": 1.0})``.
-    Unknown leaf names are rejected by the validation of the rebuilt scene.
-
-    Parameters
-    ----------
-    scene : Scene
-    **changes
-        Dotted field path to new value, SI units (or a unit-suffixed alias of
-        :data:`UNIT_ALIASES` as the leaf, e.g. ``"joint.geometry.shaft_angle_deg"``).
-
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    SceneError
-        An unknown path or an invalid value.
+    """Copy of ``scene`` with dotted-path ``changes`` (SI, or a unit-suffixed leaf such as
+    ``"joint.geometry.shaft_angle_deg"``), validated again; SceneError for an unknown path or an
+    invalid value. Example: ``replace(scene, **{"load.torque": 1.0})``.
     """
     data = scene_to_dict(require_scene(scene))
     for dotted, value in changes.items():

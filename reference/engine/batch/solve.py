@@ -1,16 +1,10 @@
 """Many scenes through the reference engine at once.
 
-Contract (the sweep runner and the tolerance study build on it):
-
-- :func:`batch_key` is a hashable key; scenes with equal keys share one vectorised pass
-  (constant speed and load, the same friction slots, law and coupling, ideal joint or not).
-  None: the scene runs on its own.
-- :func:`run_batch` returns one :class:`reference.results.result.Result` per scene, in order, each
-  equal to :func:`reference.engine.solve.run`'s (to rounding, or to the quadrature tolerance where
-  the adaptivity differs). A scene that locks, fails or does not close its loop gets its own
-  failed Result (from :func:`reference.engine.solve.run`) and does not spoil the others; invalid
-  scenes raise before anything runs, naming the scene's index. ``summary.wall_time_s`` of a
-  batched scene is its share of its chunk's time.
+Scenes with equal :func:`batch_key` (None: runs alone) share one vectorised pass; :func:`run_batch`
+returns per scene, in order, :func:`reference.engine.solve.run`'s Result (to rounding, or to the
+quadrature tolerance). A scene that locks, fails or does not close its loop gets its own failed
+Result; invalid scenes raise before anything runs, naming the index. ``summary.wall_time_s`` is
+the scene's share of its chunk's time.
 """
 
 from __future__ import annotations
@@ -52,19 +46,8 @@ def batch_key(scene: Scene) -> Hashable | None:
 
 
 def run_batch(scenes: Sequence, options: ReferenceOptions | None = None) -> list[Result]:
-    """Run many scenes, sharing vectorised passes where their :func:`batch_key` agrees.
-
-    Parameters
-    ----------
-    scenes : sequence of Scene
-        Any scenes.
-    options : ReferenceOptions or None
-        Resolution, the same for all; None: the defaults.
-
-    Returns
-    -------
-    list of Result
-        One per scene, in order (see the module's contract).
+    """One Result per scene of ``scenes``, in order, sharing vectorised passes where :func:`batch_key`
+    agrees; ``options`` the same for all (None: the defaults).
     """
     scenes = list(scenes)
     options = check_scenes(scenes, options)
@@ -85,25 +68,8 @@ def run_batch(scenes: Sequence, options: ReferenceOptions | None = None) -> list
 
 
 def check_scenes(scenes: Sequence, options: ReferenceOptions | None = None) -> ReferenceOptions:
-    """Refuse, before anything runs, what :func:`run_batch` would refuse.
-
-    Parameters
-    ----------
-    scenes : sequence
-        What should be scenes.
-    options : ReferenceOptions or None
-        What should be options (None: the defaults).
-
-    Returns
-    -------
-    ReferenceOptions
-        The options in effect.
-
-    Raises
-    ------
-    TypeError, OptionsError, SceneError
-        A non-scene, options that are not :class:`ReferenceOptions`, a scene whose table or
-        integration exceeds the step limit (each message names the scene's index).
+    """The options in effect (None: defaults), after refusing what :func:`run_batch` would refuse:
+    TypeError for a non-scene, OptionsError, SceneError beyond the step limit (naming the index).
     """
     for i, scene in enumerate(scenes):
         require_scene(scene, f"scenes[{i}]")
@@ -119,8 +85,9 @@ def check_scenes(scenes: Sequence, options: ReferenceOptions | None = None) -> R
 
 
 def _check_steps(scene: Scene, options: ReferenceOptions) -> None:
-    """The engine's step-limit checks, without running: a torque drive's before its integration,
-    any other drive's on its time table (:func:`reference.engine.table.table_times`)."""
+    """The engine's step-limit checks without running: a torque drive's before integrating, any other's
+    on its time table.
+    """
     if scene.drive.kind == "torque":
         spr = options.samples_per_revolution or 360
         check_steps(scene.revolutions * spr,
