@@ -1,11 +1,6 @@
-"""The reference engine: any scene in, the shared result schema out, without time stepping error.
-
-A prescribed input motion is pure inverse dynamics, every sample solved on its own
-(:mod:`reference.engine.dynamics`); a torque drive's motion is integrated
-(:mod:`reference.engine.motion`). The works, hence the mean efficiency, come from quadrature
-(:mod:`reference.engine.work`); the time-averaged instantaneous efficiency from the table
-(:mod:`reference.engine.table`), as in every engine (it has poles where the input power crosses
-zero, so no exact value to converge to).
+"""The reference engine: any scene in, the shared result schema out, without time-stepping error.
+Prescribed motions are inverse dynamics sample by sample, a torque drive's is integrated; the
+works come from quadrature, the time-averaged efficiency from the table, as in every engine.
 """
 
 from __future__ import annotations
@@ -35,27 +30,12 @@ __all__ = ["ENGINE_NAME", "ENGINE_VERSION", "means_from_works", "run"]
 
 
 def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
-    """Solve ``scene`` with the reference engine.
+    """:class:`Result` of ``scene`` by the reference engine, ``options`` (None: defaults) its resolution.
 
-    Scripts should usually call ``cardan_exudyn.run(scene, engine="reference")``, the same for
-    every engine; this is the engine itself, for users without Exudyn.
-
-    Parameters
-    ----------
-    scene : Scene
-        Any scene: constant-speed, angle-history or torque drive, with or without mounting errors.
-    options : ReferenceOptions or None
-        Resolution; None: the defaults.
-
-    Returns
-    -------
-    Result
-        Time table (the schema's columns plus :data:`EXTRA_COLUMNS`, every
-        ``scene.record.every``-th row; None when ``record.timeseries`` is off) and summary: the
-        keys of :func:`reference.results.means.mean_values` taken from :func:`work_quadrature`'s works,
-        ``self_locking_samples`` and, when friction locks, status ``self_locking`` with the first
-        input angle where it does; status ``unphysical`` when the means are impossible; status
-        ``loop_does_not_close`` (no table) when mounting errors keep the loop from closing.
+    For scripts ``cardan_exudyn.run(scene, engine="reference")`` is the same for every engine. The
+    table: the schema's columns plus :data:`EXTRA_COLUMNS`, every ``record.every``-th row (None without
+    ``record.timeseries``). Status ``self_locking`` (with the first angle), ``unphysical`` or
+    ``loop_does_not_close`` (no table) where they apply.
     """
     require_scene(scene)
     if options is not None and not isinstance(options, ReferenceOptions):
@@ -76,8 +56,9 @@ def run(scene: Scene, options: ReferenceOptions | None = None) -> Result:
 
 
 def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: float = 0.0) -> Any:
-    """Fill ``summary``; return the time table (or None), its times ``origin`` [s] later than
-    the scene's (:func:`reference.scene.histories.run_clock`)."""
+    """Fill ``summary``; return the time table (or None), its times ``origin`` [s] later than the
+    scene's.
+    """
     if scene.drive.kind == "torque":  # the ODE's cost grows with the revolutions: refuse first
         spr = options.samples_per_revolution or 360
         check_steps(scene.revolutions * spr,
@@ -102,20 +83,9 @@ def _run(scene: Scene, options: ReferenceOptions, summary: Summary, origin: floa
 
 def means_from_works(scene: Scene, works: dict, columns: dict[str, np.ndarray],
                      options: ReferenceOptions, summary: Summary) -> None:
-    """The means over whole revolutions from the works, into the summary.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene (its skipped revolutions, accuracy and drive kind).
-    works : dict
-        :func:`work_quadrature`'s output; consumed.
-    columns : dict of str to ndarray, shape (n,)
-        The time table's columns (the window and the time-averaged efficiency).
-    options : ReferenceOptions
-        The ODE's ``rtol`` enters a torque drive's error estimate.
-    summary : Summary
-        Filled in place; failed with status ``self_locking`` when friction locks at a node.
+    """The means over whole revolutions from the quadrature's ``works`` (consumed) and the table's
+    ``columns`` into ``summary`` (failed ``self_locking`` when friction locks at a node); ``options``'
+    ``rtol`` enters a torque drive's error estimate.
     """
     if works.pop("self_locking_nodes", False):
         # as when it locks at a sample: no means (they would be NaN or meaningless)
@@ -130,9 +100,9 @@ def means_from_works(scene: Scene, works: dict, columns: dict[str, np.ndarray],
 
 
 def _efficiency_error(scene: Scene, summary: Summary, options: ReferenceOptions) -> None:
-    """The quadrature's error estimate of the mean efficiency into the summary (a first-order
-    propagation of the input and lost works' estimates, plus the ODE's ``rtol`` for a torque
-    drive), and whether it meets ``numerics.accuracy``."""
+    """The mean efficiency's error estimate into ``summary`` (first-order propagation of the works'
+    estimates, plus the ODE's ``rtol`` for a torque drive) and whether it meets ``numerics.accuracy``.
+    """
     q = summary.extras.get("quadrature")
     w_in = summary.input_work
     w_loss = summary.loss_work

@@ -23,24 +23,8 @@ LOCAL_AXES = {
 
 
 def com_from_static_moments(static_moments: np.ndarray, mass: float) -> np.ndarray:
-    """Centre of mass from Table 1's static moments, read as ``S_k = m d_k`` with ``d_k`` the
-    distance of the centre of mass from axis k.
-
-    Solves d_k^2 = r^2 - r_k^2 for the squared coordinates; a coordinate whose square comes out
-    slightly negative from rounding in Table 1 is set to zero. Signs are taken positive (the
-    table gives none).
-
-    Parameters
-    ----------
-    static_moments : ndarray, shape (3,)
-        ``S_k`` [kg m].
-    mass : float
-        [kg].
-
-    Returns
-    -------
-    ndarray, shape (3,)
-        Centre of mass in the body's local axes [m].
+    """Centre of mass [m] in local axes from Table 1's ``static_moments`` ``S_k = m d_k`` [kg m] and
+    ``mass`` [kg]: ``d_k^2 = r^2 - r_k^2``, squares negative from rounding set to zero, signs positive.
     """
     d2 = (np.asarray(static_moments, dtype=float) / mass) ** 2
     r2 = 0.5 * d2.sum()
@@ -48,15 +32,8 @@ def com_from_static_moments(static_moments: np.ndarray, mass: float) -> np.ndarr
 
 
 def table1_body(name: str, reading: str = "origin", com_at_centre: bool = False) -> Body:
-    """One body of Table 1 as a :class:`Body` under the chosen reading.
-
-    Parameters
-    ----------
-    name : {"input", "spider", "output"}
-    reading : {"origin", "com"}
-        Reference point of Table 1's inertia tensors (see the assumption register).
-    com_at_centre : bool
-        Place the local origin so that the centre of mass sits at the joint centre.
+    """One body ``name`` of Table 1 as a :class:`Body`, its inertia about ``reading`` ``"origin"`` or
+    ``"com"``; ``com_at_centre`` puts the centre of mass at the joint centre.
     """
     raw = paper_data()["table1"][name]
     mass = raw["mass"]["value"]
@@ -75,17 +52,8 @@ def table1_body(name: str, reading: str = "origin", com_at_centre: bool = False)
 
 def paper_joint(shaft_angle_deg: float = 10.0, reading: str = "origin",
                 friction: bool = True) -> Joint:
-    """The Section 4.1 joint under the assumption register's choices.
-
-    Parameters
-    ----------
-    shaft_angle_deg : float
-        Shaft angle [deg].
-    reading : {"origin", "com"}
-        Reference point of Table 1's inertia tensors (:func:`table1_body`).
-    friction : bool
-        The case's friction coefficients (f1 = 0.42 in the spider pairs, f2 = 0.20 in the frame
-        pairs) or none.
+    """The Section 4.1 joint at ``shaft_angle_deg`` [deg], Table 1 ``reading`` as for
+    :func:`table1_body`, with ``friction`` (f1 = 0.42 spider pairs, f2 = 0.20 frame pairs) or none.
     """
     bodies = {
         "input": table1_body("input", reading),

@@ -14,19 +14,8 @@ __all__ = ["DeferredTable", "Result", "result_table"]
 
 
 class DeferredTable:
-    """The columns of a time table, turned into a pandas DataFrame only when someone reads it.
-
-    Why: importing pandas costs about 0.4 s, ten times a short run's solve; a run whose table
-    nobody writes or returns should not pay it.
-
-    Parameters
-    ----------
-    columns : mapping of str to ndarray, shape (n,)
-        The run's columns, every step.
-    every : int
-        Keep every ``every``-th row.
-    names : list of str
-        The columns kept, in table order.
+    """A time table's ``columns`` (every ``every``-th row of ``names``), turned into a pandas DataFrame
+    only when read. Why: importing pandas costs about 0.4 s, ten times a short run's solve.
     """
 
     def __init__(self, columns: Mapping[str, np.ndarray], every: int, names: list[str]) -> None:
@@ -40,14 +29,13 @@ class DeferredTable:
 
 
 class Result:
-    """What every engine returns: a time table (or None) and a :class:`Summary`.
+    """What every engine returns: a ``table`` and a :class:`Summary`.
 
     Parameters
     ----------
     table : pandas.DataFrame, DeferredTable or None
-        The columns of :func:`table_columns` (and engine extras), every ``record.every``-th row;
-        None when the scene does not record the time series or the run failed. A
-        :class:`DeferredTable` is built on first access of :attr:`table`.
+        :func:`table_columns` (and engine extras), every ``record.every``-th row; None without a
+        recorded time series or after a failure. A :class:`DeferredTable` is built on first access.
     summary : Summary
     """
 
@@ -103,17 +91,8 @@ class Result:
 
 
 def result_table(columns: Mapping[str, np.ndarray], every: int, extra: tuple[str, ...] = ()) -> Any:
-    """The time table of a result, built as a pandas DataFrame when first read
-    (:class:`DeferredTable`).
-
-    Parameters
-    ----------
-    columns : mapping of str to ndarray
-        At least :func:`~reference.results.columns.table_columns`.
-    every : int
-        Keep every ``every``-th row.
-    extra : tuple of str
-        An engine's extra columns, after the schema's.
+    """A :class:`DeferredTable` of ``columns`` (at least :func:`table_columns`, then the engine's
+    ``extra``), every ``every``-th row.
     """
     return DeferredTable(columns, every, table_columns() + list(extra))
 

@@ -1,10 +1,6 @@
-"""Scenes as users write them: TOML files and tables that may start from a named scene.
-
-A file (or a table in a sweep spec) may begin with ``base = "paper-10deg"`` (any name of
-:func:`reference.paper.scenes.named_scene`) and override only what differs; the rest of the table is
-the dictionary form of :func:`reference.scene.mapping.scene_from_dict`. Resolving the base needs the
-paper's data, which itself is built from scenes, so this module sits above both
-:mod:`reference.scene.mapping` and :mod:`reference.paper` and neither imports it.
+"""Scenes as users write them: TOML files and tables that may start from a named scene
+(``base = "paper-10deg"``) and override what differs. It needs the paper's data, so it sits above
+:mod:`reference.scene.mapping` and :mod:`reference.paper`.
 """
 
 from __future__ import annotations
@@ -47,17 +43,8 @@ def _merge(base: dict, over: Mapping) -> dict:
 
 def read_toml(path: str | pathlib.Path, what: str, noun: str,
               error: type[Exception]) -> dict[str, Any]:
-    """The table of a UTF-8 TOML file, or ``error`` with one line naming ``what`` and the path.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-    what : str
-        What the file is, for messages ("scene file", "sweep spec").
-    noun : str
-        What such a file holds, for the not-text message ("a scene").
-    error : type
-        The exception to raise (the caller's own input-error type).
+    """The table of a UTF-8 TOML file at ``path``, or ``error`` in one line naming ``what`` the file is
+    (and ``noun``, what it holds, when it is not text).
     """
     if not isinstance(path, (str, pathlib.PurePath)) or not str(path).strip():
         raise error(f"the {what} must be a path (str or pathlib.Path) naming a file, got {path!r:.80}")
@@ -76,24 +63,8 @@ def read_toml(path: str | pathlib.Path, what: str, noun: str,
 
 
 def load_scene(path: str | pathlib.Path) -> Scene:
-    """Load a scene from a TOML file.
-
-    A file may start from a named scene with ``base = "paper-10deg"`` and override any part.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The scene file (UTF-8 TOML, SI units or unit-suffixed aliases).
-
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    SceneError
-        The file cannot be read, is not TOML, or does not describe a valid scene; the message
-        starts with the path.
+    """The scene of a TOML file at ``path`` (SI or unit-suffixed aliases; may start from ``base``);
+    SceneError, starting with the path, when it cannot be read, is not TOML or is not a valid scene.
     """
     if not isinstance(path, (str, pathlib.PurePath)):
         raise SceneTypeError(f"`path` must be a str or pathlib.Path naming a scene file, got "
@@ -106,17 +77,8 @@ def load_scene(path: str | pathlib.Path) -> Scene:
 
 
 def scene_from_mapping(data: Mapping[str, Any]) -> Scene:
-    """Like :func:`reference.scene.mapping.scene_from_dict`, resolving an optional ``base`` named scene
-    first.
-
-    Parameters
-    ----------
-    data : Mapping
-        A scene table; ``base`` (optional) names the scene the other keys override.
-
-    Returns
-    -------
-    Scene
+    """:func:`reference.scene.mapping.scene_from_dict` of ``data`` after resolving its optional ``base``
+    named scene, which the other keys override.
     """
     if not isinstance(data, Mapping):
         raise SceneTypeError(f"`data` must be a mapping (a scene table), got {type(data).__name__} "

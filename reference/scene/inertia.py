@@ -1,7 +1,4 @@
-"""Rigid-body mass properties: frame changes, the parallel-axis theorem, and checks.
-
-Pure functions on numpy arrays; SI units throughout.
-"""
+"""Rigid-body mass properties: frame changes, the parallel-axis theorem, and checks (numpy, SI)."""
 
 from __future__ import annotations
 
@@ -17,21 +14,8 @@ def skew(v: np.ndarray) -> np.ndarray:
 
 
 def shift_inertia_to_com(inertia: np.ndarray, mass: float, com: np.ndarray) -> np.ndarray:
-    """Inertia about the centre of mass from the inertia about a point.
-
-    Parameters
-    ----------
-    inertia : ndarray, shape (3, 3)
-        Inertia tensor about point P [kg m^2].
-    mass : float
-        Mass [kg].
-    com : ndarray, shape (3,)
-        Centre of mass relative to P, same axes [m].
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-        Inertia tensor about the centre of mass, same axes [kg m^2].
+    """Inertia [kg m^2] about the centre of mass from ``inertia`` about a point P, ``mass`` [kg] and
+    ``com`` relative to P [m], same axes.
     """
     s = skew(com)
     # J_P = J_C + m * skew(c)^T skew(c)  (Steiner)
@@ -39,41 +23,14 @@ def shift_inertia_to_com(inertia: np.ndarray, mass: float, com: np.ndarray) -> n
 
 
 def rotate_inertia(inertia: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """Express an inertia tensor in other axes: ``R J R^T``.
-
-    Parameters
-    ----------
-    inertia : ndarray, shape (3, 3)
-        Inertia tensor in the old axes [kg m^2].
-    rotation : ndarray, shape (3, 3)
-        ``R``, mapping old to new coordinates [-].
-
-    Returns
-    -------
-    ndarray, shape (3, 3)
-        The tensor in the new axes [kg m^2].
-    """
+    """``inertia`` [kg m^2] in new axes, ``R J R^T``, ``rotation`` ``R`` mapping old to new coordinates."""
     r = np.asarray(rotation, dtype=float)
     return r @ np.asarray(inertia, dtype=float) @ r.T
 
 
 def inertia_problems(inertia: np.ndarray, rtol: float = 1e-9) -> list[str]:
-    """Reasons why a tensor is not a physical inertia tensor (empty list when it is).
-
-    Checks symmetry, positive definiteness and the triangle inequality on the principal
-    moments (J1 <= J2 + J3 for every permutation).
-
-    Parameters
-    ----------
-    inertia : array_like, shape (3, 3)
-        The tensor [kg m^2].
-    rtol : float
-        Tolerance of the symmetry and triangle checks, relative to the largest entry [-].
-
-    Returns
-    -------
-    list of str
-        One sentence per problem.
+    """One sentence per reason ``inertia`` [kg m^2] is not a physical tensor (symmetry, positive
+    definiteness, triangle inequality of the principal moments, to ``rtol`` of the largest entry).
     """
     j = np.asarray(inertia, dtype=float)
     if j.shape != (3, 3):
