@@ -24,28 +24,9 @@ __all__ = ["sign_breakpoints"]
 
 def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
                      per_revolution: int = SCAN_PER_REVOLUTION) -> np.ndarray:
-    """Instants where a friction sign ramp starts or ends.
-
-    Each ramp speed (:func:`reference.engine.slots.ramp_speeds`) is sampled on a grid, every
-    crossing of its ramp edges ``+-band`` (of 0 for the exact sign) is bracketed
-    (:mod:`reference.engine.crossings`: sign changes, and grazing crossings between two samples)
-    and refined to rounding.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene on the run's clock.
-    motion : InputMotion
-        The input's motion (:func:`reference.engine.motion.input_motion`).
-    t_a, t_b : float
-        The span searched [s].
-    per_revolution : int
-        Grid samples per input revolution (at least 64 in all).
-
-    Returns
-    -------
-    ndarray, shape (m,)
-        The distinct instants in ``(t_a, t_b)`` [s], ascending.
+    """The distinct instants [s] in ``(t_a, t_b)``, ascending, where a friction sign ramp of ``scene``
+    driven by ``motion`` starts or ends: each ramp speed sampled at ``per_revolution`` (at least 64 in
+    all), crossings of ``+-band`` bracketed (:mod:`reference.engine.crossings`) and refined to rounding.
     """
     slots = friction_slots(scene)
     if not slots or t_b <= t_a:
@@ -69,9 +50,9 @@ def sign_breakpoints(scene: Scene, motion: InputMotion, t_a: float, t_b: float,
 
 def _brackets(grid: np.ndarray, values: np.ndarray, bands: np.ndarray,
               speeds: Callable[[np.ndarray], np.ndarray]) -> list[tuple]:
-    """Brackets of every crossing of ``+-bands`` (K,) by the sampled ``values`` (m, K) on
-    ``grid`` (m,) [s]: sign changes, and grazing crossings checked at their vertices by
-    ``speeds`` (instants to speeds (., K))."""
+    """Brackets of every crossing of ``+-bands`` (K,) by ``values`` (m, K) on ``grid`` [s]: sign changes,
+    and grazing crossings checked at their vertices by ``speeds``.
+    """
     brackets = []
     grazing = []
     for levels in (-bands, bands):  # twice 0 for the exact sign: duplicates merge later

@@ -1,11 +1,6 @@
-"""One revolution of a periodic time table, repeated.
-
-At a constant input speed and load every column repeats with the period ``T = 2 pi / |omega|``
-except ``t`` and the two shaft angles, which advance by ``T`` and one turn. When the rows fall on
-the same input angles in every revolution, the first period is evaluated and the others are copies
-(the same values to rounding, at ``1 / revolutions`` of the cost). Summary-only runs use it: in a
-recorded table a copied row's angle is ``theta + 2 pi k`` rounded, not the angle its state was
-computed at. Measured: docs/engines.md#constants-of-the-reference-engine.
+"""One revolution of a periodic time table, repeated: at constant speed and load every column but
+``t`` and the shaft angles repeats with ``T = 2 pi / |omega|``, so summary-only runs evaluate the
+first period and copy it. Measured: docs/engines.md#constants-of-the-reference-engine.
 """
 
 from __future__ import annotations
@@ -22,20 +17,8 @@ the period; every other column repeats."""
 
 
 def period_rows(t: np.ndarray, speed: float) -> int | None:
-    """Rows of a uniform time table in one period of the input speed.
-
-    Parameters
-    ----------
-    t : ndarray, shape (n,)
-        Equispaced instants [s].
-    speed : float
-        Constant input speed [rad/s].
-
-    Returns
-    -------
-    int or None
-        Rows per period; None unless the rows repeat on the same angles (a whole number of steps
-        per period, at least one period after the first).
+    """Rows per period of the speed [rad/s] in the equispaced instants ``t`` [s]; None unless the rows
+    repeat on the same angles (a whole number of steps, at least one period after the first).
     """
     if t.size < 3 or speed == 0.0:
         return None
@@ -48,21 +31,8 @@ def period_rows(t: np.ndarray, speed: float) -> int | None:
 
 
 def repeat_period(first: dict[str, np.ndarray], t: np.ndarray, speed: float) -> dict[str, np.ndarray]:
-    """The whole table from its first period.
-
-    Parameters
-    ----------
-    first : dict of str to ndarray, shape (rows,)
-        The columns at ``t[:rows]`` (one period, :func:`period_rows`).
-    t : ndarray, shape (n,)
-        The whole table's instants [s], taken as given.
-    speed : float
-        Input speed [rad/s]; the shaft angles advance by ``2 pi`` per period in its direction.
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        Every column of ``first`` over the whole table.
+    """Every column of ``first`` (one period, :func:`period_rows`) over the whole table's instants ``t``
+    [s], the shaft angles advancing ``2 pi`` per period in the direction of ``speed``.
     """
     rows = next(iter(first.values())).shape[0]
     k = np.arange(t.size)

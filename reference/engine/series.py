@@ -21,20 +21,9 @@ samples' rounding noise is about 1e-17 of it at
 
 @dataclass(frozen=True)
 class TrigSeries:
-    """Real Fourier series of many periodic functions of the input angle, evaluated in one product.
-
-    ``f(theta) = sum_k a_k cos(k theta) + b_k sin(k theta)``, k = 0..H.
-
-    Attributes
-    ----------
-    frequencies : ndarray, shape (2 (H + 1),)
-        ``k`` twice: cosine rows, then sine rows.
-    phases : ndarray, shape (2 (H + 1),)
-        0 for the cosine rows, pi/2 for the sine rows (``sin x = cos(x - pi/2)``).
-    table : ndarray, shape (2 (H + 1), M)
-        The coefficients ``a_k`` then ``b_k`` of the M functions.
-    grid : int
-        Grid points per revolution the series was fitted on.
+    """Real Fourier series ``f(theta) = sum_k a_k cos(k theta) + b_k sin(k theta)``, k = 0..H, of M
+    functions evaluated in one product: ``frequencies`` and ``phases`` (0, then pi/2) of the 2 (H + 1)
+    rows, coefficients ``table`` (2 (H + 1), M), and the ``grid`` points per revolution fitted on.
     """
 
     frequencies: np.ndarray
@@ -48,21 +37,9 @@ class TrigSeries:
 
 
 def fit_periodic(values: np.ndarray, scale: np.ndarray) -> TrigSeries | None:
-    """The Fourier series of functions sampled on ``n`` equispaced angles ``2 pi j / n``.
-
-    Parameters
-    ----------
-    values : ndarray, shape (n, M)
-        Samples; n even.
-    scale : ndarray, shape (M,)
-        Each function's scale: its group's largest sample (a function that is zero up to
-        rounding has rounding-level harmonics, judged against its group, not against itself).
-
-    Returns
-    -------
-    TrigSeries or None
-        Harmonics kept up to the last one above :data:`KEEP_TOLERANCE` times the scale; None when
-        some harmonic from ``n / 4`` on exceeds :data:`RESOLVED_TOLERANCE` (not resolved).
+    """:class:`TrigSeries` of ``values`` (n, M) on ``n`` (even) angles ``2 pi j / n``, harmonics kept up to
+    the last above :data:`KEEP_TOLERANCE` times each function's group ``scale``; None when one from
+    ``n / 4`` on exceeds :data:`RESOLVED_TOLERANCE`.
     """
     n = values.shape[0]
     c = np.fft.rfft(values, axis=0) / n  # (n/2 + 1, M)

@@ -15,37 +15,17 @@ def case_key(case: dict[str, Any]) -> str:
 
 
 def in_fit(case: dict[str, Any], fit: list[str] | tuple[str, ...]) -> bool:
-    """Whether a case is one of the fit cases or the same scene (angle and speed) as one.
-
-    The speed study's 10 deg, 2000 rpm case is Table 2's 10 deg case.
-
-    Parameters
-    ----------
-    case : dict of str to Any
-        One of :func:`paper_cases` (``shaft_angle_deg`` [deg], ``speed_rpm`` [rpm]).
-    fit : list or tuple of str
-        :func:`case_key` keys.
-
-    Returns
-    -------
-    bool
+    """Whether ``case`` (one of :func:`paper_cases`) is one of the ``fit`` case keys or the same scene
+    (angle and speed) as one.
     """
     scene = (float(case["shaft_angle_deg"]), float(case["speed_rpm"]))
     return any((float(k.split(":")[1]), float(k.split(":")[2])) == scene for k in fit)
 
 
 def envelope() -> list[dict[str, Any]]:
-    """The lowest and highest mean efficiency the model gives for each of the paper's eleven
-    numbers over the plausible box (:func:`plausible_box`), as stored in ``[envelope]`` of the
-    data file by ``cardan calibrate --envelope``.
-
-    Returns
-    -------
-    list of dict
-        Per case of :func:`paper_cases`: ``case`` (:func:`case_key`), ``paper``, ``lowest``,
-        ``highest`` [-], ``reachable`` (the paper's value inside ``[lowest, highest]``),
-        ``closest`` (the nearest plausible value), and ``lowest_at`` / ``highest_at`` (the
-        parameter values where the extremes were found). Empty when nothing is stored.
+    """Per case of :func:`paper_cases`, the stored (``cardan calibrate --envelope``) lowest and highest mean
+    efficiency over :func:`plausible_box`: ``case``, ``paper``, ``lowest``, ``highest`` [-],
+    ``reachable``, ``closest``, ``lowest_at``/``highest_at``; empty when nothing is stored.
     """
     stored = paper_data().get("envelope", {}).get("cases", {})
     out = []

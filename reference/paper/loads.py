@@ -1,15 +1,6 @@
-"""The output load of the ``mean_input`` torque reading: stored for the named scenes, else solved.
-
-Under the reading ``mean_input`` (``[plausible.torque_reading]`` of the data file) the case's
-2 N m is the mean input torque, and the scene's load is the constant output load that gives it.
-That load is a result of the reference engine (:func:`solve_mean_input_load`, two runs, about
-0.1 s). Building a scene runs no engine when the load is stored: ``[loads]`` of the data file
-holds it for every named scene that needs it (the paper's eleven cases under the ``physical`` set,
-and its two rig scenes), each entry keyed by the fingerprint of the scene it was solved for
-(:func:`scene_key`), so a stored value is used only for the very scene it belongs to. Any other
-scene (another angle or speed, ``cardan run --angle 27``, a fit's trial values, a changed data
-file) is solved on first use and cached for the process: the value is the same either way
-(``tests/test_paper_loads.py`` recomputes the stored ones).
+"""The output load of the ``mean_input`` torque reading (the case's torque is the mean input torque):
+stored in ``[loads]`` of the data file for the named scenes, keyed by :func:`scene_key`, else
+solved by the reference engine on first use and cached for the process.
 """
 
 from __future__ import annotations
@@ -31,9 +22,9 @@ UNKEYED_FIELDS = ("name", "description", "parameter_set")
 
 
 def scene_key(scene: Scene) -> str:
-    """A fingerprint of everything in ``scene`` that the load depends on: the first 16 hex digits
-    of the SHA-256 of its dictionary form (JSON, sorted keys, :data:`UNKEYED_FIELDS` left out;
-    floats written exactly, so equal scenes and only equal scenes share a key)."""
+    """Fingerprint of what the load depends on in ``scene``: the first 16 hex digits of the SHA-256 of
+    its dictionary form (sorted JSON, :data:`UNKEYED_FIELDS` left out, floats exact).
+    """
     data = {k: v for k, v in scene_to_dict(scene).items() if k not in UNKEYED_FIELDS}
     text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
@@ -47,14 +38,8 @@ def stored_loads() -> dict[str, float]:
 
 
 def mean_input_load(scene: Scene) -> float:
-    """The constant output load [N m] under which the scene's mean input torque equals the
-    scene's load torque: the stored value for this scene (:func:`stored_loads`), else
-    :func:`solve_mean_input_load`.
-
-    Raises
-    ------
-    SceneError
-        As :func:`solve_mean_input_load`, when the load is not stored.
+    """The constant output load [N m] under which ``scene``'s mean input torque equals its load torque:
+    stored (:func:`stored_loads`), else :func:`solve_mean_input_load` (and its SceneError).
     """
     stored = stored_loads().get(scene_key(scene))
     return solve_mean_input_load(scene) if stored is None else stored
@@ -62,20 +47,9 @@ def mean_input_load(scene: Scene) -> float:
 
 @functools.lru_cache(maxsize=256)
 def solve_mean_input_load(scene: Scene) -> float:
-    """The constant output load [N m] under which the scene's mean input torque (over whole
-    revolutions at its constant input speed) equals the scene's load torque, from the reference
-    engine (default options).
-
-    Over whole revolutions the output turns as far as the input, so the mean input torque is
-    ``load / eta`` with ``eta`` the mean efficiency: the load is ``target * eta(load)``. Two
-    reference-engine runs (at the target and at ``target * eta``) and a secant step through them
-    give it to about 1e-6 of the target (the mean input torque is nearly linear in the load).
-    A frictionless scene gives the target.
-
-    Raises
-    ------
-    SceneError
-        The drive is not a constant speed, or the reference engine's run fails (the joint locks).
+    """:func:`mean_input_load` by the reference engine: the load is ``target * eta(load)``; two runs and a
+    secant step give it to about 1e-6 of the target (the target without friction). SceneError unless a
+    constant-speed drive, or when the run fails.
     """
     target = scene.load.torque
     if not isinstance(scene.drive, SpeedDrive) or not scene.load.constant:
@@ -99,8 +73,9 @@ def solve_mean_input_load(scene: Scene) -> float:
 
 
 def _secant(target: float, loads: list[float], torques: list[float]) -> float:
-    """The load [N m] where the line through ``(loads[k], torques[k])`` reaches ``target`` [N m]
-    (the mean input torque is nearly linear in the load); the second load if the line is flat."""
+    """The load [N m] where the line through ``(loads[k], torques[k])`` reaches ``target`` [N m]; the second
+    load if the line is flat.
+    """
     l0, l1 = loads
     t0, t1 = torques
     return l1 + (target - t1) * (l1 - l0) / (t1 - t0) if t1 != t0 else l1

@@ -50,17 +50,8 @@ def table_columns() -> list[str]:
 
 
 def instantaneous_efficiency(power_in: np.ndarray, power_loss: np.ndarray) -> np.ndarray:
-    """Eq. (18): ``1 - P_loss / P_in``.
-
-    Parameters
-    ----------
-    power_in, power_loss : ndarray, shape (n,)
-        Input power and friction loss [W].
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The instantaneous efficiency [-]; NaN where ``P_in`` is exactly zero.
+    """Eq. (18), ``1 - P_loss / P_in`` [-] from ``power_in``, ``power_loss`` [W]; NaN where ``P_in`` is
+    exactly zero.
     """
     p_in = np.asarray(power_in, float)
     with np.errstate(divide="ignore", invalid="ignore"):

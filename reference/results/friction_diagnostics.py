@@ -1,7 +1,5 @@
-"""How a time-stepping engine's friction coupling behaved over a run: :class:`FrictionDiagnostics`.
-
-On disk it is the summary's ``friction`` table (``docs/outputs.md``); the coupling schemes are
-described in :mod:`cardan_exudyn.model.coupling` and its schemes.
+"""How a time-stepping engine's friction coupling behaved over a run: :class:`FrictionDiagnostics`,
+the summary's ``friction`` table (``docs/outputs.md``).
 """
 
 from __future__ import annotations
@@ -15,37 +13,29 @@ __all__ = ["FrictionDiagnostics"]
 
 @dataclass(frozen=True)
 class FrictionDiagnostics:
-    """The friction coupling's counters and loop-gain estimates of one run.
-
-    A field is None where the coupling does not measure it, or where a summary read from disk
-    did not have it.
+    """The friction coupling's counters and loop-gain estimates of one run; None where not measured.
 
     Attributes
     ----------
     coupling : str
-        The scene's ``friction.coupling`` (``extrapolated``, ``converged``, ``lagged``).
+        The scene's ``friction.coupling``.
     sign_bands_m_s : mapping of str to (float, float, float)
-        Per pair with friction, the half-widths of its sign ramps [m/s]: rotation (surface
-        speed), sliding, resultant.
+        Per pair with friction, its ramp half-widths [m/s]: rotation, sliding, resultant.
     pairs_with_friction : tuple of str
-        The pairs with a non-zero friction coefficient, in order.
     tolerance : float or None
-        Relative tolerance of the per-step fixed point [-]; None for the lagged coupling.
+        Relative tolerance of the per-step fixed point [-] (None: lagged).
     mean_iterations_per_step, max_iterations_in_a_step : float, int
-        Friction evaluations (Newton solves) per accepted step: mean and largest [-].
+        Friction evaluations per accepted step.
     unconverged_steps : int
-        Steps whose fixed-point iteration reached its limit but still contracted.
+        Steps that reached the iteration limit but still contracted.
     escalated_to_converged_at : float or None
-        Time [s] at which the extrapolated coupling switched to the converged one (a probed loop
-        gain above its limit, or growth of the friction); None when it never did.
+        Time [s] the extrapolated coupling switched to the converged one.
     steps_iterated_at_reversals : int
-        Extrapolated coupling: steps solved to their fixed point because a motion reversed.
+        Extrapolated coupling: steps solved to their fixed point at a motion reversal.
     loop_gain_estimate, loop_gain_estimate_max : float or None
-        Median and largest estimate of the friction feedback's loop gain [-] (friction ->
-        reactions -> friction; >= 1: no consistent friction); None when nothing was measured.
+        Median and largest loop-gain estimate [-] (>= 1: no consistent friction).
     gain_probes : int
-        Extrapolated coupling: steps solved twice to probe the loop gain (a probe whose friction
-        did not move beyond rounding gives no estimate).
+        Extrapolated coupling: steps solved twice to probe the loop gain.
     """
 
     coupling: str
@@ -70,8 +60,7 @@ class FrictionDiagnostics:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> FrictionDiagnostics | None:
-        """Inverse of :meth:`to_dict`; None for a table with keys this version does not know
-        (or without ``coupling``)."""
+        """Inverse of :meth:`to_dict`; None for a table with unknown keys or without ``coupling``."""
         if "coupling" not in data or not set(data) <= {f.name for f in fields(cls)}:
             return None
         values = dict(data)
