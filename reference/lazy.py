@@ -1,8 +1,5 @@
-"""One lazy package face (PEP 562) for every package of the project: public names imported on
-first use, so that importing a package costs nothing until a name is used.
-
-Lives in ``reference`` (the bottom of the import order) so that ``cardan_exudyn`` and
-``rigdata`` faces can use it too; it imports only the standard library.
+"""One lazy package face (PEP 562) for every package of the project: public names imported on first
+use. Standard library only, at the bottom of the import order, so every package can use it.
 """
 
 from __future__ import annotations
@@ -17,20 +14,9 @@ __all__ = ["lazy_face"]
 
 def lazy_face(package: str, homes: Mapping[str, str]) -> tuple[Callable[[str], Any],
                                                                 Callable[[], list[str]]]:
-    """``__getattr__`` and ``__dir__`` for ``package``'s ``__init__``.
-
-    Parameters
-    ----------
-    package : str
-        The package's ``__name__``.
-    homes : mapping
-        Public name -> the module that defines it; a name whose home is the module
-        ``<package>.<name>`` itself (``"sweep": "cardan_exudyn.sweep"``) is that module.
-
-    Returns
-    -------
-    (__getattr__, __dir__)
-        Assign both at module level. A name is looked up once and then cached in the package.
+    """``(__getattr__, __dir__)`` for ``package``'s ``__init__`` (assign both at module level) from
+    ``homes``, public name -> defining module (a home ``<package>.<name>`` is that module); names are
+    cached in the package on first use.
     """
     def __getattr__(name: str) -> Any:
         home = homes.get(name)

@@ -18,19 +18,17 @@ class ReferenceOptions:
     Attributes
     ----------
     samples_per_revolution : int or None
-        Rows of the time table per input revolution; None: the scene's ``numerics.dt`` when set
-        (so the rows line up with a fixed-step engine), else 360.
+        Table rows per input revolution; None: the scene's ``numerics.dt`` when set, else 360.
     panels_per_revolution : int
-        Initial Gauss-Legendre panels per revolution for the work integrals (more where kinks
-        split them; refined adaptively).
+        Initial Gauss-Legendre panels per revolution for the work integrals (refined adaptively).
     gauss_nodes : int
         Nodes per panel.
     quadrature_rtol : float
-        A panel is accepted when its two halves and the whole agree to this fraction of the
-        input work (scaled by the panel's share of the window).
+        A panel is accepted when its halves and the whole agree to this fraction of the input work,
+        scaled by its share of the window.
     ode_rtol, ode_atol : float
-        Tolerances of ``solve_ivp`` for torque-driven scenes (atol applies to the angle [rad]
-        and, as :func:`reference.engine.torque_ode.speed_tolerance`, to the speed).
+        ``solve_ivp`` tolerances of torque-driven scenes (atol on the angle [rad] and, by
+        :func:`reference.engine.torque_ode.speed_tolerance`, the speed).
     """
 
     samples_per_revolution: int | None = None

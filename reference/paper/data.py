@@ -1,10 +1,6 @@
-"""The paper's data file (``data/paper.toml``): every entry with value, unit and source or assumption.
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita: A multibody dynamic model of a Cardan joint with
-experimental validation (not part of this repository; sections, tables and equations cited
-here are the paper's).
+"""The paper's data file (``data/paper.toml``): every entry with value, unit and source or assumption
+(Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
+experimental validation").
 """
 
 from __future__ import annotations
@@ -30,8 +26,9 @@ def paper_data() -> dict[str, Any]:
 
 
 def value(path: str) -> Any:
-    """Value of a dotted entry of the data file, e.g. ``value("bearings.frame.length")``, in the
-    entry's own ``unit`` (mostly SI; angles in [deg], the multibody speeds in [rpm])."""
+    """Value of a dotted entry of the data file, e.g. ``value("bearings.frame.length")``, in its own
+    ``unit`` (mostly SI; angles [deg], multibody speeds [rpm]).
+    """
     node: Any = paper_data()
     for key in path.split("."):
         node = node[key]

@@ -1,7 +1,5 @@
-"""The stored loads of ``[loads]`` in the data file: which scenes, and the text to store.
-
-Regenerate after a change to the data file, the scenes or the engine (``tests/test_paper_loads.py``
-says when)::
+"""The stored loads of ``[loads]`` in the data file: which scenes, and the text to store. Regenerate
+when ``tests/test_paper_loads.py`` says so::
 
     python -c "from reference.paper.load_table import loads_toml; print(loads_toml())"
 
@@ -30,13 +28,9 @@ def mean_input_sets() -> list[str]:
 
 
 def stored_scenes() -> dict[str, Scene]:
-    """Named scene -> the scene its load is solved for (before the load is set), for every named
-    scene with friction whose set reads the torque as ``mean_input``: the paper's cases (each
-    angle and speed once) and the rig scene with and without the tolerances.
-
-    The scenes are built with the set's values but the reading ``output_load`` (so that building
-    them solves nothing); their labels differ from the named scenes', which
-    :func:`reference.paper.loads.scene_key` leaves out.
+    """Named scene -> the scene its load is solved for, for every named scene with friction whose set
+    reads the torque as ``mean_input`` (built with the reading ``output_load``, so building solves
+    nothing; labels differ, which :func:`reference.paper.loads.scene_key` leaves out).
     """
     out: dict[str, Scene] = {}
     for name in mean_input_sets():
@@ -52,17 +46,18 @@ def stored_scenes() -> dict[str, Scene]:
 
 
 def load_entries() -> dict[str, dict[str, Any]]:
-    """Named scene -> ``key`` (:func:`reference.paper.loads.scene_key`), ``target`` (the case's
-    mean input torque [N m]) and ``torque`` (the output load [N m], solved by the reference
-    engine: about 0.1 s a scene)."""
+    """Named scene -> ``key`` (:func:`reference.paper.loads.scene_key`), ``target`` (mean input torque
+    [N m]) and ``torque`` (the output load [N m], solved by the reference engine).
+    """
     return {name: {"key": scene_key(scene), "target": float(scene.load.torque),
                    "torque": solve_mean_input_load(scene)}
             for name, scene in stored_scenes().items()}
 
 
 def loads_toml() -> str:
-    """``[loads]`` of the data file, solved afresh (:func:`load_entries`); floats written with
-    every digit (``repr``), so that the stored value is the solved one exactly."""
+    """``[loads]`` of the data file, solved afresh, floats with every digit (``repr``) so the stored
+    value is the solved one exactly.
+    """
     from reference.engine.solve import ENGINE_VERSION  # the paper's data sit below the engine
 
     lines = [

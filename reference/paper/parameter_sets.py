@@ -1,19 +1,15 @@
-"""The paper's parameter sets: the open values that decide its numbers, fixed with reasons.
-
-The paper leaves open values that decide its numbers (the moment lever of eq. (1), the shafts'
-balance, the spider's centre of mass, gravity, what "input torque 2 Nm" means). A parameter set
-fixes all of them (``[sets.<name>]`` in ``data/paper.toml``, each value with its reason):
+"""The paper's parameter sets: its open values (the moment lever of eq. (1), the shafts' balance, the
+spider's centre of mass, gravity, the reading of "input torque 2 Nm") fixed with reasons
+(``[sets.<name>]`` in ``data/paper.toml``):
 
 ``physical`` (default)
-    Every open value a dimension or physical quantity inside its plausible range
-    (``[plausible]``; :func:`plausible_box`), the levers from the geometry (2 x arm radius,
-    support spacing), fitted on a stated subset of the paper's numbers and checked on the rest.
+    Every value inside its plausible range (:func:`plausible_box`), levers from the geometry,
+    fitted on a stated subset of the paper's numbers and checked on the rest.
 ``literal``
-    The paper read literally with the assumption register (bearing length as the lever, Table 1's
-    8.6 mm input eccentricity, gravity normal to the shafts): kept as evidence.
+    The paper read literally with the assumption register, kept as evidence.
 ``matched``
-    Fitted to the paper's numbers without holding the values to plausible dimensions; its
-    description lists every non-physical ingredient.
+    Fitted to the paper's numbers regardless of plausibility; its description lists every
+    non-physical ingredient.
 """
 
 from __future__ import annotations
@@ -56,8 +52,7 @@ input torque (``mean_input``: the constant output load that gives it,
 
 
 def parameter_set_name(name: Any) -> str:
-    """``name`` checked against :data:`PARAMETER_SETS` (a renamed set is refused with its new
-    name)."""
+    """``name`` checked against :data:`PARAMETER_SETS` (a renamed set is refused with its new name)."""
     if not isinstance(name, str):
         raise SceneTypeError(f"`parameters` must be one of {list(PARAMETER_SETS)} or a dict of "
                              f"parameter values, got {name!r:.80}")
@@ -70,9 +65,9 @@ def parameter_set_name(name: Any) -> str:
 
 
 def parameter_set(name: str) -> dict[str, Any]:
-    """One parameter set as stored: ``description``, ``fit_cases`` (``study:angle:rpm`` keys, empty
-    when nothing was fitted) and ``values`` (name -> entry with ``value`` and ``reason``, numbers
-    also ``unit`` and ``fitted``)."""
+    """One parameter set as stored: ``description``, ``fit_cases`` (``study:angle:rpm`` keys) and
+    ``values`` (name -> ``value``, ``reason``; numbers also ``unit``, ``fitted``).
+    """
     return paper_data()["sets"][parameter_set_name(name)]
 
 
@@ -82,8 +77,9 @@ def set_values(name: str) -> dict[str, Any]:
 
 
 def plausible_box() -> dict[str, dict[str, Any]]:
-    """The plausible range of every open value: name -> ``range`` (numbers, [m]) or ``options``
-    (choices), with ``unit`` and ``reason`` (``[plausible]`` of the data file)."""
+    """Every open value's plausible ``range`` [m] or ``options``, with ``unit`` and ``reason``
+    (``[plausible]`` of the data file).
+    """
     return dict(paper_data()["plausible"])
 
 
@@ -101,9 +97,9 @@ def set_of(parameters: str | dict[str, Any]) -> tuple[str, dict[str, Any]]:
 
 
 def parameter_table(name: str) -> list[dict[str, Any]]:
-    """Rows for a report: name, value, unit, plausible range, inside it, fitted, reason. A lever
-    given as a number is checked against the range of the dimension it stands for
-    (:data:`LEVER_DIMENSIONS`)."""
+    """Report rows of set ``name``: name, value, unit, plausible range, inside it, fitted, reason (a lever
+    checked against its dimension's range, :data:`LEVER_DIMENSIONS`).
+    """
     box = plausible_box()
     rows = []
     for key, entry in parameter_set(name)["values"].items():

@@ -33,16 +33,9 @@ class SpeedDrive:
 
 @dataclass(frozen=True)
 class AngleDrive:
-    """Input angle prescribed by a history, interpolated by a C2 cubic spline.
-
-    Attributes
-    ----------
-    time : tuple of float
-        Sample times [s], strictly increasing, at least 4 samples. The run starts at the first
-        (engines run on a clock that starts there: :func:`reference.scene.histories.run_clock`), so
-        a history may start at any time.
-    angle : tuple of float
-        Input angle at those times [rad].
+    """Input angle prescribed by a history, interpolated by a C2 cubic spline: ``time`` [s] strictly
+    increasing, at least 4 samples (any start: engines run on :func:`reference.scene.histories.run_clock`),
+    ``angle`` [rad].
     """
 
     time: tuple
@@ -57,8 +50,7 @@ class AngleDrive:
         set_field(self, "angle", tuple(a.tolist()))
 
     def spline(self) -> Any:
-        """The history as a ``scipy.interpolate.CubicSpline``: angle [rad] of time [s] (built once,
-        then cached)."""
+        """The history as a cached ``CubicSpline``: angle [rad] of time [s]."""
         cached = self.__dict__.get("_spline")
         if cached is None:
             from scipy.interpolate import CubicSpline  # scipy.interpolate takes ~1 s to import
@@ -68,8 +60,9 @@ class AngleDrive:
         return cached
 
     def evaluator(self) -> CubicPieces:
-        """The spline at one instant in plain floats, O(log n) per call (engines' user
-        functions; :class:`reference.scene.histories.CubicPieces`)."""
+        """The spline at one instant in plain floats, O(log n) per call
+        (:class:`reference.scene.histories.CubicPieces`).
+        """
         return CubicPieces(self.spline())
 
     def shifted(self, origin: float) -> AngleDrive:
@@ -81,18 +74,17 @@ class AngleDrive:
         return largest_slope(self.spline())
 
     def time_to_turn(self, angle: float) -> float:
-        """First time [s] at which the input has turned ``angle`` [rad] either way from its
-        start, to rounding; the history's last time if it never turns that far."""
+        """First time [s] the input has turned ``angle`` [rad] either way from its start; the last time if
+        it never does.
+        """
         t = first_turn(self.spline(), angle)
         return float(self.time[-1]) if t is None else t
 
 
 @dataclass(frozen=True)
 class TorqueDrive:
-    """Constant torque ``torque`` [N m] on the input shaft about its axis, free speed.
-
-    ``initial_speed`` [rad/s] is the input speed at t = 0 (non-zero so that the time span, given in
-    revolutions, is finite).
+    """Constant ``torque`` [N m] on the input shaft about its axis, free speed, from a non-zero
+    ``initial_speed`` [rad/s] (so the span in revolutions is finite).
     """
 
     torque: float
@@ -111,8 +103,9 @@ class TorqueDrive:
         return abs(self.initial_speed)
 
     def time_allowed(self, angle: float) -> float:
-        """Time [s] every engine allows the drive to turn ``angle`` [rad]: four times the time
-        at the initial speed (the joint may decelerate); engines stop earlier once it has."""
+        """Time [s] every engine allows to turn ``angle`` [rad]: four times the time at the initial speed
+        (the joint may decelerate).
+        """
         return 4.0 * angle / abs(self.initial_speed)
 
 

@@ -20,14 +20,11 @@ class Load:
     Attributes
     ----------
     torque : float or tuple of float
-        A constant torque [N m], or with ``time`` its history: one value per sample,
-        interpolated linearly in between and held at the end values outside (a measured brake
-        torque, :mod:`rigdata`; linear so that the load never overshoots its samples).
+        A constant torque [N m], or with ``time`` one value per sample, linear in between (it never
+        overshoots its samples) and held at the end values outside.
     time : tuple of float or None
-        Sample times [s] of a torque history, strictly increasing, at least 2. The load shares
-        the scene's clock with an angle history (the run starts at the angle history's first
-        sample); with any other drive the run starts at the load history's first sample
-        (:func:`reference.scene.histories.time_origin`), so histories may start at any time.
+        Sample times [s] of a history, strictly increasing, at least 2; it shares the scene's clock
+        (:func:`reference.scene.histories.time_origin`).
     """
 
     torque: float | tuple = 0.0
@@ -57,8 +54,9 @@ class Load:
         return self.evaluator().at(t)
 
     def evaluator(self) -> LinearHistory | None:
-        """A history at one instant in plain floats, O(log n) per call (engines' user
-        functions; :class:`reference.scene.histories.LinearHistory`, built once); None when constant."""
+        """A history at one instant in plain floats, O(log n) per call
+        (:class:`reference.scene.histories.LinearHistory`); None when constant.
+        """
         if self.time is None:
             return None
         cached = self.__dict__.get("_history")

@@ -1,10 +1,5 @@
-"""The scene: one plain, validated description of a Cardan-joint simulation for every engine.
-
-A scene is a tree of frozen dataclasses, SI units and radians inside: the joint
-(:mod:`reference.scene.joint`), its drive (:mod:`reference.scene.drives`), load
-(:mod:`reference.scene.load`), gravity, span, numerics, friction coupling and what to record
-(:mod:`reference.scene.settings`). Its dictionary form and changes by dotted path are
-:mod:`reference.scene.mapping`.
+"""The scene: one plain, validated description of a Cardan-joint simulation for every engine, a tree
+of frozen dataclasses in SI units and radians.
 """
 
 from __future__ import annotations
@@ -28,15 +23,12 @@ class Scene:
     Attributes
     ----------
     revolutions : float
-        Simulated span in input revolutions [-] (>= 1 + ``record.skip_revolutions`` so that at
-        least one whole revolution is averaged).
+        Simulated span in input revolutions [-], >= 1 + ``record.skip_revolutions``.
     gravity : tuple, shape (3,)
-        Gravitational acceleration in the global frame [m/s^2].
+        Gravitational acceleration, global frame [m/s^2].
     parameter_set : str
-        The paper's parameter set the scene was built with
-        (:data:`reference.paper.parameter_sets.PARAMETER_SETS`, ``"custom"`` for values given by
-        hand), or ``""`` for a scene that is not the paper's; every result carries it, and
-        ``cardan run`` prints it.
+        The paper's parameter set the scene was built with (``"custom"`` for values given by hand,
+        ``""`` for a scene not the paper's); every result carries it.
     """
 
     joint: Joint
