@@ -1,8 +1,6 @@
 """reference: the paper's data, the scene format, the result schema and an independent engine.
 
-numpy/scipy only: never imports exudyn, cardan_exudyn or rigdata, so everything here works
-without Exudyn. The public face: describe a scene, run it with the reference engine, read one
-typed result::
+numpy/scipy only (never exudyn, cardan_exudyn or rigdata), so it works without Exudyn::
 
     import reference
 
@@ -12,16 +10,7 @@ typed result::
     if result.success:
         print(result.summary.mean_efficiency)
 
-To run the same scene with Exudyn or MuJoCo, use ``cardan_exudyn.run(scene, engine=...)``.
-
-Subpackages, bottom up: ``scene`` (the scene: joint, drives, load, settings, its dictionary form
-and TOML files), ``paper`` (the paper's data, parameter sets and named scenes), ``results`` (the
-result schema and the means every engine shares), ``physics`` (kinematics, the RCCC loop, joint
-motion, friction laws, sign bands) and ``engine`` (the reference engine; ``engine.batch``: many
-scenes at once).
-
-Names are imported on first use (PEP 562): every ``import reference.<module>`` runs this file
-first, so it imports nothing itself (the engine's modules and scipy load only when needed).
+Other engines: ``cardan_exudyn.run(scene, engine=...)``. Names are imported on first use (PEP 562).
 """
 
 from __future__ import annotations

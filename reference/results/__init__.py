@@ -1,14 +1,4 @@
-"""The result every engine returns, and the means over whole input revolutions.
-
-- :mod:`~reference.results.columns`: the time table's columns;
-- :mod:`~reference.results.summary`: :class:`Summary`, :class:`Status`, the JSON shape on disk;
-- :mod:`~reference.results.accuracy`, :mod:`~reference.results.friction_diagnostics`: the
-  summary's typed records of a run's error estimate and friction coupling;
-- :mod:`~reference.results.result`: :class:`Result` (table and summary);
-- :mod:`~reference.results.means`: the window over whole revolutions and the mean values;
-- :mod:`~reference.results.power_flow`, :mod:`~reference.results.quadrature`: the direction of
-  the power flow, the window integral across friction's jumps.
-"""
+"""The result every engine returns, its summary, and the means over whole input revolutions."""
 
 from __future__ import annotations
 
