@@ -22,20 +22,10 @@ Measured: docs/engines.md#constants-of-the-reference-engine."""
 
 @dataclass
 class FixedPoint:
-    """Outcome of the friction fixed point, per sample.
-
-    Attributes
-    ----------
-    x : ndarray, shape (n, 18)
-        Reactions and the drive unknown, :func:`unknowns` order.
-    friction : ndarray, shape (n, K)
-        Friction values of :func:`friction_slots`.
-    converged : ndarray of bool, shape (n,)
-    loop_gain : ndarray, shape (n,)
-        Spectral radius of ``dG/dphi`` (0 without friction), or an upper bound where that is below
-        ``exact_gain`` (the infinity norm, or :func:`power_bound`); infinite where Newton failed.
-    iterations : int
-        Newton iterations of the slowest sample.
+    """Outcome of the friction fixed point per sample: ``x`` (n, 18) reactions and drive unknown,
+    ``friction`` (n, K), ``converged`` (n,), ``loop_gain`` (n,) (spectral radius of ``dG/dphi``, or an
+    upper bound below ``exact_gain``; infinite where Newton failed), and the slowest sample's
+    ``iterations``.
     """
 
     x: np.ndarray
@@ -63,24 +53,11 @@ def power_bound(g: np.ndarray, norm: np.ndarray) -> np.ndarray:
 def solve_friction(law: Any, x0: np.ndarray, s: np.ndarray, signs: np.ndarray,
                    tolerance: float = 1e-13, max_iterations: int = 50,
                    exact_gain: float = 0.5) -> FixedPoint:
-    """:class:`FixedPoint` of ``phi = G(x0 - S phi)`` for every sample by Newton's method.
-
-    Parameters
-    ----------
-    law : reference.engine.slots.FrictionLaw or alike
-        ``G``: its ``index`` (K, 4), the columns of ``x`` each slot reads, and ``reduced(c, signs)``.
-    x0 : ndarray, shape (n, 18)
-        Solution without friction.
-    s : ndarray, shape (n, 18, K)
-        Response of the solution to unit friction values.
-    signs : ndarray, shape (n, K)
-        Regularised signs of the relative motions.
-    tolerance : float
-        Converged when the update is at most this times the sample's largest friction value (or the
-        frictionless estimate's, if larger).
-    max_iterations : int
-    exact_gain : float
-        Loop gain: the spectral radius where its norm bound reaches this, else the bound.
+    """:class:`FixedPoint` of ``phi = G(x0 - S phi)`` per sample by Newton's method: ``law`` gives ``G``
+    (its ``index`` (K, 4) and ``reduced(c, signs)``), ``x0`` (n, 18) the frictionless solution, ``s``
+    (n, 18, K) its response to unit friction, ``signs`` (n, K); converged when the update is at most
+    ``tolerance`` times the sample's largest friction value, within ``max_iterations``; ``exact_gain``
+    as for :func:`loop_gain`.
     """
     n = x0.shape[0]
     k = s.shape[-1]

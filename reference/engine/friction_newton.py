@@ -52,22 +52,13 @@ def _gain(matrix: np.ndarray, exact_from: float = 0.5) -> float:
 
 def friction_newton(sxa: np.ndarray, ks: np.ndarray, coupled: bool = True,
                     start: np.ndarray | None = None) -> tuple[np.ndarray, bool, float, int]:
-    """``(phi, converged, loop_gain, iterations)``: one sample's friction fixed point, as
-    :func:`reference.engine.fixed_point.solve_friction`.
-
-    Parameters
-    ----------
-    sxa : ndarray, shape (4 K, K + 1)
-        Row ``4 j + i``: component i (fx, fy, mx, my) of slot j's pair, its response to unit friction
-        (columns ``:K``) and its frictionless value (column K): ``c = sxa @ [-phi, 1]``.
-    ks : ndarray, shape (2 K,)
-        ``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``, signs included.
-    coupled : bool
-        False: the friction of the frictionless reactions (``"uncoupled"``).
-    start : ndarray, shape (K,), or None
-        None: ``solve_friction`` exactly. Else the first iterate (the previous call's); Newton also
-        stops where quadratic convergence puts the next update below :data:`NEWTON_TOLERANCE`, with
-        the last Jacobian's gain (the infinity norm below :data:`WARM_START_GAIN`).
+    """``(phi, converged, loop_gain, iterations)`` of one sample, as
+    :func:`reference.engine.fixed_point.solve_friction`: ``sxa`` (4 K, K + 1) row ``4 j + i`` the
+    component i of slot j's pair, its response to unit friction and frictionless value (``c = sxa @
+    [-phi, 1]``); ``phi_j = ks[2j] |F_j| + ks[2j + 1] |M_j|``; ``coupled`` False: friction of the
+    frictionless reactions. ``start`` None: ``solve_friction`` exactly; else the first iterate, and
+    Newton also stops where quadratic convergence puts the next update below
+    :data:`NEWTON_TOLERANCE` (gain of the last Jacobian, the norm below :data:`WARM_START_GAIN`).
     """
     k = sxa.shape[1] - 1
     ops = _OPERATORS[k]

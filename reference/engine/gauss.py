@@ -265,40 +265,13 @@ def adaptive_gauss(integrand: Callable[..., np.ndarray], a: np.ndarray, b: np.nd
                    nodes: int, rtol: float, scale_key: int = 0,
                    max_rounds: int = 40, scale_floor: float = 0.0,
                    history: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, dict]:
-    """Integrals of a vector integrand over the union of panels ``[a, b]``, adaptively.
-
-    Every open panel is integrated as a whole and as two halves and closed when they agree within
-    ``rtol * scale * width / total width`` or ``ROUNDING_FLOOR * scale`` in every component, else
-    halved. The scale is at least ``GROSS_SCALE`` times the integral of ``|I[scale_key]|`` and at
-    least ``scale_floor`` (an integral that cancels does not ask for rounding-level accuracy); at
-    most ``MAX_OPEN_PANELS`` stay open.
-
-    Parameters
-    ----------
-    integrand : callable
-        Times (m,) [s] to values (m, k); with ``history``, times and loads (m,) to values (m, k).
-    a, b : ndarray, shape (P,)
-        The initial panels [s].
-    nodes : int
-        Gauss nodes per panel.
-    rtol : float
-        Tolerance relative to the scale, shared out by width.
-    scale_key : int
-        The component that sets the scale.
-    max_rounds : int
-        Rounds of halving at most.
-    scale_floor : float
-        Least scale, in the units of component ``scale_key``'s integral.
-    history : (ndarray, ndarray) or None
-        Sample times [s] and values of a piecewise-linear load: panels integrated and split by
-        :class:`HistoryRule`, whose bounds join the error estimate.
-
-    Returns
-    -------
-    integral : ndarray, shape (k,)
-    info : dict
-        ``evaluations``, ``rounds``, ``panels`` (closed), ``cut_panels``, ``error_estimate`` (per
-        component, the closed panels' whole-versus-halves differences; conservative).
+    """``(integral (k,), info)``: the integrals of ``integrand`` (times (m,) [s], with ``history`` also
+    loads, to (m, k)) over the panels ``[a, b]`` [s], each ``nodes``-point panel closed when whole and
+    halves agree within ``rtol * scale * width / total width`` or ``ROUNDING_FLOOR * scale``, else halved
+    (at most ``max_rounds``). The scale: at least ``GROSS_SCALE`` times the integral of
+    ``|I[scale_key]|`` and ``scale_floor``. ``history`` (times [s], values): a piecewise-linear load
+    through :class:`HistoryRule`. ``info``: ``evaluations``, ``rounds``, ``panels``, ``cut_panels``,
+    ``error_estimate`` (per component, conservative).
     """
     rule = GaussRule(integrand, nodes) if history is None else HistoryRule(integrand, nodes, *history)
     total_width = float(np.sum(b - a))

@@ -34,26 +34,10 @@ class SelfLocking(Exception):
 
 @dataclass
 class InputMotion:
-    """The input's motion over the run.
-
-    Attributes
-    ----------
-    t0, t_end : float
-        Span [s].
-    state : callable
-        ``t -> (theta, theta_t, theta_tt | None)``, vectorised (None: the dynamics supply it).
-    torque_in : float or None
-        Drive torque [N m] of a torque-driven scene.
-    knots : ndarray
-        Instants where the motion is less smooth (angle-history knots) [s].
-    status, reason : str
-        Why the span ends early, if it does.
-    ode_evaluations : int
-        Right-hand-side evaluations (torque drive).
-    periodic : bool
-        Every input revolution repeats the first (constant speed and load).
-    tabulated : bool
-        False when there is no state to tabulate (stopped inside the integrator or at its first step).
+    """The input's motion over the span ``[t0, t_end]`` [s]: ``state(t) -> (theta, theta_t, theta_tt |
+    None)`` vectorised (None: the dynamics supply it), ``torque_in`` [N m] of a torque drive,
+    ``knots`` [s], ``status``/``reason`` of an early end, ``ode_evaluations``, ``periodic`` (every
+    revolution repeats the first) and ``tabulated`` (False: no state to tabulate).
     """
 
     t0: float

@@ -24,20 +24,10 @@ METHODS = ("auto", "closed_form", "loop")
 
 @dataclass(frozen=True)
 class JointMotion:
-    """Motion of the joint at a batch of samples, global components.
-
-    Attributes
-    ----------
-    bodies : dict of str to reference.physics.rccc.motion.BodyMotion
-        ``ground``, ``input``, ``spider``, ``output``.
-    frames, origins : dict of str to ndarray, shape (..., 3, 3) and (..., 3)
-        Pair frames attached to body a [-] and pair origins [m].
-    omega_rel, slide_rel : dict of str to ndarray
-        Angular [rad/s] and sliding [m/s] speed of body b relative to a about/along the pair axis.
-    slide : dict of str to ndarray
-        D-H slide of each joint [m] (``s1`` for the revolute pair; 0 in the ideal joint).
-    output : tuple of 3 ndarray
-        Output shaft angle [rad], speed [rad/s], acceleration [rad/s^2] about its own axis.
+    """Motion of the joint at a batch of samples, global components: ``bodies`` (``ground``, ``input``,
+    ``spider``, ``output``: :class:`BodyMotion`), pair ``frames`` (on body a) and ``origins`` [m],
+    ``omega_rel`` [rad/s], ``slide`` [m], ``slide_rel`` [m/s] of b relative to a, and ``output``
+    (angle [rad], speed, acceleration about its own axis).
     """
 
     bodies: dict[str, rccc.BodyMotion]

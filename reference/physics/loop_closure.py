@@ -67,24 +67,10 @@ def _angle_about_z(v: Dual) -> Dual:
 
 def solve_wrapped(twists: Dual, s1: float | np.ndarray, theta1: np.ndarray, sign: float, where: str,
                   strict: bool = True) -> Dual:
-    """Dual joint angles ``theta_k + eps s_k`` (..., 4) [rad] + eps [m] closing the loop, real parts in
-    (-pi, pi].
-
-    Parameters
-    ----------
-    twists : Dual, shape (4,) or (..., 4)
-        Link twists ``alpha_k + eps a_k`` [rad] + eps [m] (per sample: broadcast with ``theta1``).
-    s1 : float or ndarray
-        Slide of the revolute joint 1 [m].
-    theta1 : ndarray
-        Input angles [rad], any shape.
-    sign : {-1.0, 1.0}
-        The root of the input-output equation (the assembly branch).
-    where : str
-        What the angles are, for the error message.
-    strict : bool
-        True: :class:`LoopClosureError` where the loop does not close or the branches meet; False:
-        NaN angles and slides there (many scenes in one pass).
+    """Dual joint angles ``theta_k + eps s_k`` (..., 4) closing the loop at input angles ``theta1`` [rad],
+    real parts in (-pi, pi], from dual ``twists`` ``alpha_k + eps a_k`` and the slide ``s1`` [m], on
+    root ``sign`` (the branch). ``strict``: :class:`LoopClosureError` (naming ``where``) where the loop
+    does not close or the branches meet; else NaN there.
     """
     tw = twists
     t1 = Dual(theta1, np.full_like(theta1, s1))

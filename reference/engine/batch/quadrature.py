@@ -106,30 +106,9 @@ def _gauss(integrand: Callable, rules: dict, nodes: np.ndarray, owner: np.ndarra
 def adaptive_gauss(integrand: Callable, owner: np.ndarray, a: np.ndarray, b: np.ndarray,
                    nodes: np.ndarray, rtol: float, scale_floor: np.ndarray,
                    max_rounds: int = 40) -> tuple[np.ndarray, list[dict]]:
-    """:func:`reference.engine.gauss.adaptive_gauss` for many scenes, all open panels of a round in one
-    call.
-
-    Parameters
-    ----------
-    integrand : callable
-        Scene indices and times (m,) [s] to values (m, k).
-    owner : ndarray of int, shape (P,)
-        Each panel's scene, 0 .. S - 1.
-    a, b : ndarray, shape (P,)
-        The initial panels [s].
-    nodes : ndarray of int, shape (S,)
-        Gauss nodes per panel, per scene.
-    rtol : float
-        Tolerance relative to each scene's scale.
-    scale_floor : ndarray, shape (S,)
-        Least scale per scene.
-    max_rounds : int
-
-    Returns
-    -------
-    integrals : ndarray, shape (S, k)
-    infos : list of dict
-        Per scene :func:`reference.engine.gauss.adaptive_gauss`' info (without ``cut_panels``).
+    """``(integrals (S, k), infos)``: :func:`reference.engine.gauss.adaptive_gauss` for S scenes, all open
+    panels of a round in one call of ``integrand(scenes, times)``; the panels ``[a, b]`` [s] belong to
+    scenes ``owner``; ``nodes`` and ``scale_floor`` per scene, ``rtol`` and ``max_rounds`` shared.
     """
     count = nodes.size
     rules = {int(n): np.polynomial.legendre.leggauss(int(n)) for n in np.unique(nodes)}
