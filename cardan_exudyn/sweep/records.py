@@ -1,13 +1,7 @@
 """A sweep's records on disk: ``cases.jsonl``, resume, atomic appends, the results table.
 
-A record is one flat JSON object per finished case: the keys of :data:`RECORD_KEYS` (set by the
-runner) and the case function's scalar outputs. The driver appends each record as soon as its
-case finishes (flushed and fsync'ed, :class:`RecordWriter`), so that an interrupted sweep resumes
-where it stopped (:func:`existing_records`); an incomplete last line (a kill during the write) is
-dropped on resume (:func:`read_records`).
-
-The default case function, :func:`summary_outputs`, records the scalars of an engine's summary
-(:func:`scalar_summary`).
+A record is one flat JSON object per finished case (:data:`RECORD_KEYS` plus the case function's
+scalar outputs), appended and fsync'ed as the case finishes so that an interrupted sweep resumes.
 """
 
 from __future__ import annotations
@@ -50,15 +44,7 @@ ERROR = "error"
 
 
 def write_text(path: Path, text: str) -> None:
-    """Write a text file atomically (temporary sibling, fsync, rename).
-
-    Parameters
-    ----------
-    path : Path
-        Target file; its folder must exist.
-    text : str
-        Written as UTF-8.
-    """
+    """Write ``text`` (UTF-8) to ``path`` atomically (temporary sibling, fsync, rename)."""
     atomic_write(path, lambda f: f.write(text.encode("utf-8")))
 
 
@@ -70,18 +56,18 @@ def read_records(path: str | os.PathLike, *, truncate: bool = False) -> dict[str
     path : path
         The ``cases.jsonl`` file; a missing file has no records.
     truncate : bool
-        Cut off an incomplete last line (no newline: the driver was killed while writing it),
-        so that the next record starts on a line of its own; it is ignored either way.
-
-    Raises
-    ------
-    SweepError
-        A complete line that is not a JSON record with a string ``id``.
+        Cut off an incomplete last line (a kill during the write) so the next record starts on its
+        own line; the line is ignored either way.
 
     Returns
     -------
     dict of str to dict
         Case id -> record.
+
+    Raises
+    ------
+    SweepError
+        A complete line that is not a JSON record with a string ``id``.
     """
     path = Path(path)
     if not path.exists():
@@ -114,9 +100,7 @@ class RecordWriter:
         self._file = open(path, "ab")
 
     def write(self, record: Mapping[str, Any]) -> None:
-        """Append one record; it is on disk when this returns. Ctrl-C and SIGTERM wait until it
-        is (:func:`cardan_exudyn.interrupts.deferred_signals`): a finished case is never lost
-        to an interruption."""
+        """Append one record; on disk when this returns (Ctrl-C and SIGTERM wait for it)."""
         line = json.dumps(to_jsonable(record), allow_nan=False, separators=(",", ":")) + "\n"
         with deferred_signals():
             self._file.write(line.encode("utf-8"))
@@ -138,25 +122,8 @@ class RecordWriter:
 
 
 def existing_records(out: Path, plan: Plan) -> dict[str, dict[str, Any]]:
-    """Records already in ``out`` for this plan.
-
-    Parameters
-    ----------
-    out : Path
-        The sweep's folder.
-    plan : Plan
-        The plan about to run.
-
-    Returns
-    -------
-    dict of str to dict
-        Case id -> record (empty for a new sweep).
-
-    Raises
-    ------
-    SweepError
-        ``out`` holds another sweep (a different plan, records without a plan, records of cases
-        not in the plan): the message says what differs and suggests ``--restart``.
+    """Case id -> record already in folder ``out`` for ``plan`` (empty for a new sweep); SweepError,
+    suggesting ``--restart``, when ``out`` holds another sweep.
     """
     plan_path = out / PLAN_FILE
     cases_path = out / CASES_FILE
@@ -200,30 +167,17 @@ _INTERRUPTED_REASON = "Error in Python USER FUNCTION"
 
 
 def interrupted_record(record: Mapping[str, Any]) -> bool:
-    """Whether a stored record is a case stopped by Ctrl-C rather than a result: status
-    ``integration_failure`` with Exudyn's user-function failure as reason. The friction update
-    records its own exceptions as ``error``, so only an interruption gives that reason; such a
-    case runs again on resume (records of this kind are read, never written)."""
+    """Whether a stored record is a case stopped by Ctrl-C (``integration_failure`` with Exudyn's
+    user-function failure as reason; the friction update records its own exceptions as ``error``);
+    such a case runs again on resume.
+    """
     return (record.get("status") == Status.INTEGRATION_FAILURE
             and _INTERRUPTED_REASON in str(record.get("reason") or ""))
 
 
 def error_record(case: Case, error_type: str, error: str) -> dict[str, Any]:
-    """The record of a case that produced none (its worker process died).
-
-    Parameters
-    ----------
-    case : Case
-        The case.
-    error_type : str
-        ``"WorkerCrash"`` or ``"KilledWorker"``.
-    error : str
-        What happened, in words.
-
-    Returns
-    -------
-    dict
-        A record with status :data:`ERROR`.
+    """The :data:`ERROR` record of ``case`` whose worker died: ``error_type`` (``"WorkerCrash"``,
+    ``"KilledWorker"``) and ``error`` in words.
     """
     return {**case.to_dict(), "status": ERROR, "reason": f"{error_type}: {error}",
             "error_type": error_type, "error": error, "case_wall_s": None}
@@ -232,13 +186,11 @@ def error_record(case: Case, error_type: str, error: str) -> dict[str, Any]:
 def results_table(plan: Plan, records: Mapping[str, Mapping[str, Any]]):
     """One row per recorded case in plan order: id, engine, parameters, status, outputs.
 
-    A parameter whose value is not a scalar is written as JSON text; an output named like a
-    parameter becomes ``result.<name>``.
+    Non-scalar parameters are JSON text; an output named like a parameter becomes ``result.<name>``.
 
     Parameters
     ----------
     plan : Plan
-        The sweep's plan (the row order and the parameters).
     records : mapping of str to mapping
         Case id -> record.
 
@@ -288,8 +240,8 @@ def statistics(table, parameters: Sequence[str] = ()) -> dict[str, dict[str, flo
     Returns
     -------
     dict
-        Output -> n, mean, std, min, p05, p50, p95, max (in the output's unit); ``case_wall_s``
-        (s) over every recorded case: n, mean, min, p50, max.
+        Output -> n, mean, std, min, p05, p50, p95, max (the output's unit); ``case_wall_s`` [s]
+        over every recorded case: n, mean, min, p50, max.
     """
     import pandas as pd  # as in results_table: the driver's last step only
 
@@ -324,12 +276,8 @@ def _is_text(value: Any) -> bool:
 
 
 def scalar_summary(summary: Summary | Mapping[str, Any]) -> dict[str, Any]:
-    """The scalar values of an engine summary.
-
-    Numbers, strings, booleans and None at the top level, and those of nested tables
-    (``extras``, ``pair_loss_work``, ...) as ``table.key``; ``warnings`` as one text joined by
-    "; "; the scene, the schema version and other lists are dropped. Units are those of the
-    summary's fields.
+    """The scalar values of an engine summary: top-level numbers, strings, booleans and None, those of
+    nested tables as ``table.key``, ``warnings`` joined by "; "; lists and the scene dropped.
     """
     out: dict[str, Any] = {}
     if isinstance(summary, Summary):
@@ -352,18 +300,5 @@ def _is_scalar(value: Any) -> bool:
 
 
 def summary_outputs(scene: Scene, engine: str) -> dict[str, Any]:
-    """Default case function: run the scene and keep the summary's scalar values.
-
-    Parameters
-    ----------
-    scene : Scene
-        The case's scene.
-    engine : str
-        Engine name of :data:`cardan_exudyn.engines.ENGINES`.
-
-    Returns
-    -------
-    dict
-        :func:`scalar_summary` of the run's summary.
-    """
+    """Default case function: :func:`scalar_summary` of running ``scene`` with ``engine``."""
     return scalar_summary(engines.run(scene, engine).summary)

@@ -1,14 +1,7 @@
 """What a worker runs: one case, or a batch of cases through the engine's batched pass.
 
-A sweep's cases become *tasks* (:func:`plan_tasks`): a :class:`Case` runs on its own
-(:func:`run_case`); a :class:`Batch` holds cases of one engine with a batched pass
-(:func:`cardan_exudyn.engines.run_batch`) and the default case function, and runs them together
-(:func:`run_batch_cases`). Either way a task returns one record per case, the same record
-:func:`run_case` makes, so the executors, the records and resume see cases only.
-
-Only the default case function is batched: it keeps nothing but the summary's scalars, which the
-batched pass gives per scene. A custom function may do anything with its scene (write files, run
-other engines), so its cases run one at a time.
+Either way a task returns one record per case, so executors, records and resume see cases only.
+Only the default case function is batched: a custom one may do anything with its scene.
 """
 
 from __future__ import annotations
@@ -74,8 +67,7 @@ def task_key(task: Task) -> str:
 
 
 def batched_function(function: CaseFunction) -> bool:
-    """Whether the cases of ``function`` may run in batches: the default case function, no
-    arguments (by either of its names)."""
+    """Whether the cases of ``function`` may run in batches: the default case function, no arguments."""
     if function.args:
         return False
     return function.name == DEFAULT_FUNCTION or resolve_function(function.name) is resolve_function(
@@ -83,37 +75,22 @@ def batched_function(function: CaseFunction) -> bool:
 
 
 def batch_size_for(cases: int, workers: int, batch_size: int = BATCH_SIZE) -> int:
-    """Cases per batch: at most ``batch_size``, and small enough that each worker gets
-    :data:`BATCHES_PER_WORKER` batches.
-
-    Parameters
-    ----------
-    cases : int
-        Cases of one engine to cut into batches.
-    workers : int
-        Processes or Dask threads that run tasks at once.
-    batch_size : int
-        The most cases per batch.
-
-    Returns
-    -------
-    int
-        At least 1.
+    """Cases per batch (at least 1) for ``cases`` cases of one engine: at most ``batch_size``, and
+    small enough that each of ``workers`` gets :data:`BATCHES_PER_WORKER` batches.
     """
     return max(1, min(batch_size, math.ceil(cases / (BATCHES_PER_WORKER * max(workers, 1)))))
 
 
 def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
                batch_size: int | None = None) -> list[Task]:
-    """The tasks of ``cases``: the cases of each engine with a batched pass cut into
-    :class:`Batch` es in plan order (the default case function only), every other case on its own.
+    """The tasks of ``cases``: each engine's cases with a batched pass cut into :class:`Batch` es in plan
+    order (default case function only), every other case on its own.
 
     Parameters
     ----------
     cases : sequence of Case
         The plan's cases, in order.
     function : CaseFunction
-        The case function (only the default one is batched).
     workers : int
         Processes or Dask threads that run tasks at once.
     batch_size : int, optional
@@ -122,7 +99,6 @@ def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
     Returns
     -------
     list of Task
-        Cases and batches, each engine's in plan order.
     """
     by_engine: dict[str, list[Case]] = {}
     for case in cases:
@@ -141,21 +117,8 @@ def plan_tasks(cases: Sequence[Case], function: CaseFunction, workers: int,
 
 def run_task(task: Task, base: Scene,
              function: CaseFunction | str = DEFAULT_FUNCTION) -> list[dict[str, Any]]:
-    """The records of a task's cases, in order (runs where the task is executed).
-
-    Parameters
-    ----------
-    task : Task
-        A case, or a batch (run by :func:`run_batch_cases`).
-    base : Scene
-        The sweep's base scene.
-    function : CaseFunction or str
-        The case function (a batch always runs the default one).
-
-    Returns
-    -------
-    list of dict
-        One record per case (:func:`run_case`).
+    """The records of ``task``'s cases, in order, on the sweep's ``base`` scene with ``function``
+    (a batch always runs the default one).
     """
     if isinstance(task, Batch):
         return run_batch_cases(task, base)
@@ -165,13 +128,9 @@ def run_task(task: Task, base: Scene,
 def run_case(case: Case, base: Scene, function: CaseFunction | str = DEFAULT_FUNCTION) -> dict[str, Any]:
     """Run one case and return its record; an exception becomes a record with status ``error``.
 
-    Runs where the case is executed (the driver, a pool process or a Dask worker); nothing is
-    written here.
-
     Parameters
     ----------
     case : Case
-        Id, engine and overrides of the base scene.
     base : Scene
         The sweep's base scene.
     function : CaseFunction or str
@@ -180,8 +139,8 @@ def run_case(case: Case, base: Scene, function: CaseFunction | str = DEFAULT_FUN
     Returns
     -------
     dict
-        The record: :data:`cardan_exudyn.sweep.records.RECORD_KEYS`, the function's outputs and,
-        after an exception, its ``traceback``.
+        :data:`cardan_exudyn.sweep.records.RECORD_KEYS`, the function's outputs and, after an
+        exception, its ``traceback``.
     """
     function = CaseFunction(function) if isinstance(function, str) else function
     start = time.perf_counter()
@@ -195,25 +154,11 @@ def run_case(case: Case, base: Scene, function: CaseFunction | str = DEFAULT_FUN
 
 
 def run_batch_cases(batch: Batch, base: Scene) -> list[dict[str, Any]]:
-    """The default case function's records of a batch's cases, from one
-    :func:`cardan_exudyn.engines.run_batch` (records equal to :func:`run_case`'s).
+    """Records of ``batch``'s cases on ``base``, from one :func:`cardan_exudyn.engines.run_batch`, equal
+    to :func:`run_case`'s.
 
-    A case whose scene cannot be built is recorded as ``error`` on its own; if the batched run
-    raises, every case runs again on its own (:func:`run_case`), so that a failure is recorded
-    for the case that causes it only. ``case_wall_s`` is the case's share of the batch: its wall
-    time (scene builds and the batched run) over its cases.
-
-    Parameters
-    ----------
-    batch : Batch
-        Cases of one engine with a batched pass.
-    base : Scene
-        The sweep's base scene.
-
-    Returns
-    -------
-    list of dict
-        One record per case, in order.
+    If the batched run raises, every case runs again on its own so a failure is recorded for its
+    own case only. ``case_wall_s`` is the batch's wall time over its cases.
     """
     start = time.perf_counter()
     records: dict[int, dict[str, Any]] = {}

@@ -1,16 +1,9 @@
 """Assertions for a test suite: a run's mean efficiency, and engines agreeing on a scene.
 
-Without a tolerance from the test, it comes from the runs' own accuracy
-(:mod:`cardan_exudyn.model.error_estimate`): a value may differ by
-:data:`~cardan_exudyn.model.error_estimate.SAFETY_FACTOR` times its estimated error (the sum of both runs'
-errors when two runs are compared). A tolerance the test gives (``rtol``, ``atol``) is used as
-given, never widened: where ``SAFETY_FACTOR`` times the estimate exceeds it, the runs cannot
-resolve it and the check fails, naming the tolerance asked and the one the runs support. A check
-never passes by default without an estimate, nor with an estimate over :data:`MAX_RELATIVE_ERROR`
-of the value's scale: it fails and says so.
-A run that did not end ``ok`` fails the check with its status and reason, and so does one whose
-efficiency is undefined (its warnings say why); engines that disagree on the direction of the
-power flow (``power_flow``) disagree.
+Default tolerance: :data:`~cardan_exudyn.model.error_estimate.SAFETY_FACTOR` times the runs' estimated
+error (summed over both runs). A tolerance given (``rtol``, ``atol``) is used as given, never
+widened: below what the runs resolve, the check fails. No estimate, an estimate over
+:data:`MAX_RELATIVE_ERROR` of the scale, a run not ``ok`` or opposite power flows: the check fails.
 """
 
 from __future__ import annotations
@@ -50,24 +43,13 @@ DEFAULT_COLUMNS = ("mean_efficiency", "work_ratio", "input_work", "output_work",
 
 
 class CardanToleranceWarning(UserWarning):
-    """Not emitted: a tolerance the test gives is used as given, and a check fails where the
-    runs cannot resolve it. Defined so that warning filters naming it
-    (``-W error::cardan_exudyn.testing.CardanToleranceWarning``) still load."""
+    """Not emitted; defined so that warning filters naming it still load."""
 
 
 @dataclass(frozen=True)
 class Limit:
-    """A tolerance and where it comes from.
-
-    Attributes
-    ----------
-    value : float
-        The largest difference that passes (units of the value checked): ``asked`` when the
-        test gave a tolerance, else the estimate (at least the rounding floor).
-    asked : float or None
-        ``max(atol, rtol * scale)`` when the test gave a tolerance.
-    estimated : float or None
-        ``SAFETY_FACTOR`` times the estimated error, when there is an estimate.
+    """A tolerance and where it comes from: ``value`` (the largest difference that passes), ``asked``
+    (``max(atol, rtol * scale)``, or None) and ``estimated`` (``SAFETY_FACTOR`` times the estimate, or None).
     """
 
     value: float
@@ -85,8 +67,7 @@ class Limit:
 
 @dataclass(frozen=True)
 class Check:
-    """One value compared: the two values, their difference, the tolerance, or why it cannot be
-    compared (``problem``)."""
+    """One value compared: the two values, their difference, the tolerance, or ``problem``."""
 
     name: str
     values: tuple[float | None, float | None]
@@ -109,23 +90,8 @@ class Check:
 
 def tolerance(scale: float, errors: Sequence[float | None], rtol: float | None = None,
               atol: float | None = None) -> Limit | str:
-    """The tolerance of a difference between two values, or why there is none.
-
-    Parameters
-    ----------
-    scale : float
-        Magnitude of the value (units of the value): ``rtol`` and the limits are relative to it.
-    errors : sequence of float or None
-        Estimated errors of the values compared (None: no estimate; an exact value has 0).
-    rtol, atol : float, optional
-        The test's tolerance, ``max(atol, rtol * scale)``, used as given.
-
-    Returns
-    -------
-    Limit or str
-        The tolerance, or the reason the value cannot be checked: among them a tolerance asked
-        below ``SAFETY_FACTOR`` times the estimate (the runs cannot resolve it; a smaller
-        difference would pass by chance, a larger one blame the physics for the numerics).
+    """The :class:`Limit` of a difference at ``scale`` with estimated ``errors`` (None: none) and the
+    test's ``rtol``, ``atol``; or, as a str, why the value cannot be checked.
     """
     asked = None if rtol is None and atol is None else max(atol or 0.0, (rtol or 0.0) * scale)
     estimated = SAFETY_FACTOR * float(sum(errors)) if all(e is not None for e in errors) else None
@@ -157,18 +123,7 @@ def check_values(name: str, values: tuple[Any, Any], scale: float | None,
 
 
 def check_tolerances(rtol: float | None, atol: float | None) -> None:
-    """Refuse a tolerance that is not a finite number >= 0 (a usage error, not a failure).
-
-    Parameters
-    ----------
-    rtol, atol : float or None
-        The test's tolerances (None: not given).
-
-    Raises
-    ------
-    ValueError
-        Naming the tolerance and showing what arrived.
-    """
+    """Raise ValueError unless ``rtol`` and ``atol`` are None or finite numbers >= 0."""
     for name, value in (("rtol", rtol), ("atol", atol)):
         if value is not None and not (is_number(value) and value >= 0):
             raise ValueError(f"`{name}` must be a finite number >= 0 or None, got {value!r}")
@@ -192,23 +147,8 @@ def failed_runs(results: Mapping[str, Result]) -> str:
 
 def failure_message(title: str, checks: Sequence[Check], labels: Sequence[str],
                     estimates: Mapping[str, ErrorEstimate | None]) -> str:
-    """The title, the failed checks as a table, and how the errors were estimated.
-
-    Parameters
-    ----------
-    title : str
-        The first line.
-    checks : sequence of Check
-        Every check made; the failed ones make the table.
-    labels : sequence of str
-        Titles of the two value columns (``"expected"``, an engine).
-    estimates : mapping
-        Engine -> its error estimate (None: none).
-
-    Returns
-    -------
-    str
-        The assertion message.
+    """The assertion message: ``title``, the failed ``checks`` as a table with value columns ``labels``,
+    and each engine's error ``estimates``.
     """
     columns = ["quantity", *labels, "difference", "tolerance", "from"]
     formats = {labels[0]: ".8g", labels[1]: ".8g", "difference": "+.3e", "tolerance": ".3e"}
@@ -225,24 +165,19 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
     Parameters
     ----------
     result : Result
-        The run (any engine).
     expected : float
         The expected mean efficiency [-].
     rtol, atol : float, optional
-        A tolerance relative to ``|expected|`` [-] and an absolute one [-], used as given (the
-        check fails where ``SAFETY_FACTOR`` times the run's estimated error exceeds it). Default:
-        from the run's own accuracy alone, ``SAFETY_FACTOR`` times its estimated error.
+        Relative (to ``|expected|``) and absolute tolerances [-], used as given. Default:
+        ``SAFETY_FACTOR`` times the run's estimated error.
     run : callable, optional
-        ``run(scene, engine, options) -> Result`` for the rerun at half the step that estimates
-        a fixed-step engine's error; pass the plugin's ``cardan_run`` to reuse its cache.
+        ``run(scene, engine, options) -> Result`` for the half-step rerun that estimates a
+        fixed-step engine's error; pass the plugin's ``cardan_run`` to reuse its cache.
 
     Raises
     ------
     AssertionError
-        The run did not end ``ok``; its error cannot be estimated and no tolerance was given;
-        the tolerance given is below what the run resolves; or the mean efficiency differs
-        from ``expected`` by more than the tolerance. The message is a table: value, expected,
-        difference, tolerance and its origin.
+        With a table: value, expected, difference, tolerance and its origin.
     """
     __tracebackhide__ = True
     check_tolerances(rtol, atol)
@@ -268,21 +203,8 @@ def assert_efficiency(result: Result, expected: float, *, rtol: float | None = N
 
 
 def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
-    """The scale of a mean value: a work's is the larger of the input and output works (the
-    source's, whichever way the power flows; a zero loss has a scale too), any other's its
-    magnitude (None).
-
-    Parameters
-    ----------
-    name : str
-        The mean value (``input_work``, ``loss_work_<pair>``, ...).
-    values : mapping of str to float
-        The base run's mean values (works [J]).
-
-    Returns
-    -------
-    float or None
-        The scale [J] of a work; None: the value's own magnitude.
+    """Scale [J] of mean value ``name`` in the base run's ``values``: for a work, the larger of input
+    and output works; else None (the value's own magnitude).
     """
     if name.endswith("_work") or name.startswith("loss_work_"):
         return max(abs(values.get(name, 0.0)), abs(values.get("input_work", 0.0)),
@@ -291,18 +213,7 @@ def mean_scale(name: str, values: Mapping[str, float]) -> float | None:
 
 
 def check_flow(base: Result, other: Result) -> list[Check]:
-    """A failed check when the two runs' power flows in different directions.
-
-    Parameters
-    ----------
-    base, other : Result
-        The two runs.
-
-    Returns
-    -------
-    list of Check
-        One failed check, or none when the flows agree.
-    """
+    """One failed :class:`Check` when runs ``base`` and ``other`` have opposite power flows, else none."""
     flows = (base.summary.power_flow, other.summary.power_flow)
     if flows[0] == flows[1]:
         return []
@@ -322,8 +233,9 @@ def check_means(names: Sequence[str], base: Result, other: Result,
 def check_columns(names: Sequence[str], base: Result, other: Result,
                   errors: tuple[ErrorEstimate | None, ErrorEstimate | None],
                   rtol: float | None, atol: float | None, skip_revolutions: float) -> list[Check]:
-    """The time-table columns ``names`` of two runs compared where they differ most (rows
-    joined on the input angle; the first ``skip_revolutions`` left out)."""
+    """The time-table columns ``names`` of two runs compared where they differ most (rows joined on
+    the input angle; the first ``skip_revolutions`` left out).
+    """
     if not names:
         return []
     joined, _ = join_on_input_angle(base.table, other.table)
@@ -362,38 +274,32 @@ def assert_engines_agree(scene: Scene, engines: Sequence[str] = ("exudyn", "refe
                          run: Callable[..., Result] | None = None) -> None:
     """Assert that engines agree on a scene, within their own accuracy.
 
-    Every engine after the first is compared with the first (the base), as
-    :func:`cardan_exudyn.compare` does: same scene, every step recorded, the reference
-    engine sampled at the base engine's step, rows joined on the input angle.
+    Each engine after the first is compared with the first, as :func:`cardan_exudyn.compare` does
+    (every step recorded, rows joined on the input angle).
 
     Parameters
     ----------
     scene : Scene
     engines : sequence of str
-        At least two engines; the first is the base.
+        At least two; the first is the base.
     columns : sequence of str, optional
-        Mean values (:data:`DEFAULT_COLUMNS` by default, ``mean_torque_in``,
-        ``loss_work_<pair>``) and time-table columns (``omega_out``, ``torque_in``, ...; each
-        compared where the two differ most, over the rows after ``skip_revolutions``).
+        Mean values (default :data:`DEFAULT_COLUMNS`) and time-table columns (``omega_out``, ...;
+        compared where the two differ most, after ``skip_revolutions``).
     rtol, atol : float, optional
-        A tolerance relative to the base's value (a work: the base's input work; a column: its
-        largest magnitude) and an absolute one, in the units of each value; used as given (a
-        value fails where ``SAFETY_FACTOR`` times the sum of the runs' estimated errors exceeds
-        it). Default: from the runs' own accuracy alone, ``SAFETY_FACTOR`` times that sum.
+        Relative (a work: to the base's input work; a column: its largest magnitude) and absolute
+        tolerances, used as given. Default: ``SAFETY_FACTOR`` times the sum of the runs' errors.
     options : mapping, optional
-        Engine name -> options of that engine.
+        Engine name -> its options.
     skip_revolutions : float
         Input revolutions left out of the time-table comparisons [-].
     run : callable, optional
-        ``run(scene, engine, options) -> Result`` (:func:`cardan_exudyn.engines.run` by
-        default); pass the plugin's ``cardan_run`` to reuse its cache.
+        ``run(scene, engine, options) -> Result`` (default :func:`cardan_exudyn.engines.run`);
+        pass the plugin's ``cardan_run`` to reuse its cache.
 
     Raises
     ------
     AssertionError
-        A run did not end ``ok``; or some value differs by more than its tolerance, or cannot
-        be checked (among them: a tolerance given below what the runs resolve). The message
-        is a table of those values: each engine's value, difference, tolerance and its origin.
+        With a table of the failed values: each engine's value, difference, tolerance, origin.
     ValueError
         Fewer than two engines, an engine twice, an unknown column or a bad tolerance.
     """

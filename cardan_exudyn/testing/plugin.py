@@ -1,18 +1,7 @@
-"""The pytest plugin of cardan-exudyn: the harness in a user's own test suite.
+"""The pytest plugin of cardan-exudyn (entry point ``pytest11``; ``-p no:cardan_exudyn`` leaves it out).
 
-Installed with the package (entry point ``pytest11``, name ``cardan_exudyn``), so every pytest
-run where cardan-exudyn is installed loads it; ``-p no:cardan_exudyn`` leaves it out. It adds:
-
-- fixtures (session scope, so module- and session-scoped fixtures can use them too):
-  ``cardan_scene`` (a factory: named scene or TOML file plus overrides -> scene) and
-  ``cardan_run`` (a :class:`~cardan_exudyn.testing.runner.CachingRunner`: each scene, engine
-  and options run once per session);
-- the marker ``cardan_slow`` for tests with slow engine runs;
-- the options ``--cardan-skip-slow``, ``--cardan-no-cache`` and ``--cardan-runs`` (see
-  ``pytest --help``).
-
-The assertions are plain functions: ``from cardan_exudyn.testing import assert_efficiency``.
-See ``docs/pytest.md``.
+Session fixtures ``cardan_scene`` and ``cardan_run``, the marker ``cardan_slow`` and the options
+``--cardan-skip-slow``, ``--cardan-no-cache``, ``--cardan-runs``. See ``docs/pytest.md``.
 """
 
 from __future__ import annotations
@@ -93,8 +82,9 @@ def cardan_scene(pytestconfig: pytest.Config) -> SceneFactory:
 
 @pytest.fixture(scope="session")
 def cardan_run(pytestconfig: pytest.Config) -> CachingRunner:
-    """The session's runner: ``cardan_run(scene, engine="exudyn", options=None) -> Result``,
-    each (scene, engine, options) computed once; every call returns its own copy."""
+    """The session's :class:`~cardan_exudyn.testing.runner.CachingRunner`: ``cardan_run(scene,
+    engine="exudyn", options=None) -> Result``, each run once, each call its own copy.
+    """
     if RUNNER not in pytestconfig.stash:
         from cardan_exudyn.testing.runner import CachingRunner  # on first use, as make_scene
 

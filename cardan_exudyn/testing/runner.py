@@ -1,9 +1,7 @@
 """A runner that runs each (scene, engine, options) once and hands out copies of the result.
 
-Scenes and engine options are frozen dataclasses, compared and hashed by value: two scenes built
-separately with the same values are the same key, and any changed value (the step, a friction
-coefficient, the name) is another. Options are resolved before the key is made, so no options,
-the engine's default options and the same values given as keywords are one key.
+The key is by value (scenes and options are frozen dataclasses); options are resolved first, so
+no options, the default options and the same values as keywords are one key.
 """
 
 from __future__ import annotations
@@ -25,9 +23,9 @@ __all__ = ["RunRecord", "CachingRunner"]
 
 @dataclass
 class RunRecord:
-    """One engine run of a session: what ran (scene name, revolutions, engine, step [s]), how it
-    ended, its wall time [s], and how often its result was handed out again from the cache
-    (``reused``)."""
+    """One engine run of a session: scene name, revolutions, engine, step [s], status, wall time [s]
+    and ``reused`` (times handed out again from the cache).
+    """
 
     scene: str
     revolutions: float
@@ -43,18 +41,15 @@ class CachingRunner:
     """``runner(scene, engine=None, options=None, **option_values) -> Result``, each distinct run
     computed once.
 
+    Every call returns its own deep copy, so a test may change it. Failed runs (status not ``ok``)
+    are cached; exceptions are not.
+
     Parameters
     ----------
     run : callable, optional
-        ``run(scene, engine, options) -> Result``; :func:`cardan_exudyn.engines.run` by default.
+        ``run(scene, engine, options) -> Result``; default :func:`cardan_exudyn.engines.run`.
     cache : bool
         False runs the engine on every call (the records still list each run).
-
-    Notes
-    -----
-    Every call returns its own deep copy of the result: a test may change it (add a column,
-    drop rows) without another test seeing the change. Failed runs (status not ``ok``) are
-    results too and are cached; exceptions (bad scene, options or engine) are not.
     """
 
     def __init__(self, run: Callable[..., Result] | None = None, cache: bool = True) -> None:
@@ -66,11 +61,8 @@ class CachingRunner:
 
     def __call__(self, scene: Scene, engine: str | None = None, options: Any = None,
                  **option_values: Any) -> Result:
-        """Run ``scene`` with ``engine`` (default ``"exudyn"``, or the engine of ``options``),
-        or return a copy of the result of an earlier identical run.
-
-        Raises the errors of :func:`cardan_exudyn.engines.run` (``EngineUnavailable``,
-        ``OptionsError``, ``SceneError``).
+        """Run ``scene`` with ``engine`` (default ``"exudyn"``, or the engine of ``options``), or return a
+        copy of an identical earlier run; raises what :func:`cardan_exudyn.engines.run` raises.
         """
         key = self.key(scene, engine, options, **option_values)
         if self.cache and key in self._results:
@@ -89,31 +81,8 @@ class CachingRunner:
     @staticmethod
     def key(scene: Scene, engine: str | None = None, options: Any = None,
             **option_values: Any) -> tuple[Scene, str, Any]:
-        """``(scene, engine, options)`` with the engine and its options resolved: the cache key.
-
-        Parameters
-        ----------
-        scene : Scene
-            The scene.
-        engine : str, optional
-            A key of :data:`cardan_exudyn.engines.ENGINES` (default: the engine of ``options``,
-            else ``"exudyn"``).
-        options : optional
-            Options of the engine.
-        **option_values
-            Or their fields, as keywords.
-
-        Returns
-        -------
-        tuple
-            ``(scene, engine, options)``; equal tuples are one run.
-
-        Raises
-        ------
-        TypeError
-            ``scene`` is not a :class:`reference.scene.scene.Scene`.
-        OptionsError
-            Both ``options`` and option keywords, or options of another engine's class.
+        """The cache key ``(scene, engine, options)``, engine and options resolved (``options`` or its fields
+        as keywords). Raises TypeError for a non-Scene, OptionsError for both or for another engine's options.
         """
         if not isinstance(scene, Scene):
             raise TypeError(f"`scene` must be a reference.scene.scene.Scene, got {type(scene).__name__}")
@@ -121,8 +90,7 @@ class CachingRunner:
         return scene, engine, options
 
     def error_estimate(self, result: Result) -> ErrorEstimate | None:
-        """:func:`cardan_exudyn.model.error_estimate.error_estimate` with this runner for the rerun at half
-        the step, so an estimate is computed once per run."""
+        """:func:`cardan_exudyn.model.error_estimate.error_estimate` with this runner for the half-step rerun."""
         return error_estimate(result, run=self)
 
     @property

@@ -20,15 +20,13 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
     Parameters
     ----------
     source : str, pathlib.Path or Scene
-        A named scene (``"paper-10deg"``, ``"rig-frictionless"``, see
-        :func:`reference.paper.scenes.named_scene`), a TOML scene file (a ``Path``, or a string ending
-        in ``.toml`` or holding a ``/``), or a scene to change.
+        A named scene (:func:`reference.paper.scenes.named_scene`), a TOML file (a ``Path``, or a
+        string ending in ``.toml`` or holding a ``/``), or a scene.
     root : str or pathlib.Path, optional
-        The folder a relative file path is taken from (the current folder by default).
+        Folder of a relative file path (default: the current folder).
     **changes
-        Scene fields by dotted path, as :func:`reference.scene.mapping.replace` takes them; a double
-        underscore stands for the dot, so ``numerics__accuracy=1e-4`` is
-        ``**{"numerics.accuracy": 1e-4}``. Unit-suffixed names work (``shaft_angle_deg``).
+        Scene fields by dotted path (:func:`reference.scene.mapping.replace`); ``__`` stands for the
+        dot (``numerics__accuracy=1e-4``); unit-suffixed names work (``shaft_angle_deg``).
 
     Returns
     -------
@@ -37,8 +35,7 @@ def make_scene(source: str | Path | Scene, root: str | Path | None = None, **cha
     Raises
     ------
     SceneError
-        Unknown name, unreadable or invalid file, unknown field or invalid value; the message
-        names the source.
+        The message names the source.
     """
     try:
         scene = _source(source, root)
