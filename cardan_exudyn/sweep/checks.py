@@ -1,5 +1,4 @@
-"""What every check of a sweep specification shares: the error it raises, the largest sweep, and
-the number check."""
+"""What every check of a sweep specification shares: the error, the largest sweep, the number check."""
 
 from __future__ import annotations
 
@@ -20,19 +19,7 @@ class SweepError(ValueError):
 
 
 def finite_number(where: str, value: Any) -> float:
-    """``value`` as a float; :class:`SweepError` naming ``where`` unless a finite number.
-
-    Parameters
-    ----------
-    where : str
-        The key the value came from, as the message names it (e.g. ``"`low`"``).
-    value : Any
-        What arrived; booleans are refused.
-
-    Returns
-    -------
-    float
-    """
+    """``value`` as a float; SweepError naming key ``where`` unless a finite number (booleans refused)."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise SweepError(f"{where} must be a number, got {value!r}")
     value = float(value)

@@ -1,15 +1,8 @@
 """Where a sweep's cases run: in the driver, in a local process pool, or on a Dask cluster.
 
-Every executor runs tasks (:mod:`~cardan_exudyn.sweep.tasks`: a case, or a batch of cases) with
-:func:`run_task` where they run and hands the records of each task to ``emit`` in the driver as
-the task finishes; only the driver writes files. A worker process that dies is a record too
-(``WorkerCrash`` locally, ``KilledWorker`` on Dask), so one bad case never stops the others; a
-batch whose worker dies is run again case by case, so that the record is the failing case's only.
-
-An interruption (Ctrl-C, SIGTERM: a :class:`KeyboardInterrupt`) is never a record: it passes
-through :func:`run_task`; the executors then emit the tasks already finished, cancel the others
-(a batch in flight is not recorded: it runs again on resume) and stop the local workers at once
-(they ignore Ctrl-C themselves, so that the driver decides), and re-raise it.
+Each executor hands every finished task's records to ``emit`` in the driver (only the driver
+writes). A dead worker is a record (``WorkerCrash``, ``KilledWorker``); a Ctrl-C never is: the
+finished tasks are emitted, the rest cancelled, the local workers stopped, and it is re-raised.
 """
 
 from __future__ import annotations
@@ -44,17 +37,8 @@ class SweepIncomplete(RuntimeError):
 
 
 class SweepInterrupted(KeyboardInterrupt):
-    """Ctrl-C or SIGTERM stopped the sweep: every case finished before is recorded, no case was
-    recorded as failed for it, and the same command resumes.
-
-    Attributes
-    ----------
-    done, total : int
-        Cases recorded, and cases in the sweep.
-    out : path-like
-        The sweep's folder.
-    signum : int
-        The signal that stopped it.
+    """Ctrl-C or SIGTERM stopped the sweep (``done`` of ``total`` cases recorded in folder ``out``,
+    signal ``signum``); the same command resumes.
     """
 
     def __init__(self, done: int, total: int, out: os.PathLike | str, signum: int = signal.SIGINT) -> None:
@@ -75,18 +59,8 @@ def default_workers() -> int:
 
 
 def run_in_process(tasks: Sequence[Task], base: Scene, function: CaseFunction, emit: Emit) -> None:
-    """Run the tasks one after the other in this process.
-
-    Parameters
-    ----------
-    tasks : sequence of Task
-        Cases or batches (:mod:`~cardan_exudyn.sweep.tasks`).
-    base : Scene
-        The sweep's base scene; each case's overrides apply to it.
-    function : CaseFunction
-        The case function.
-    emit : callable
-        ``emit(records)`` in the driver as each task finishes (:data:`Emit`).
+    """Run ``tasks`` on scene ``base`` with ``function`` one after the other in this process, calling
+    ``emit(records)`` as each finishes.
     """
     for task in tasks:
         emit(run_task(task, base, function))
@@ -94,18 +68,10 @@ def run_in_process(tasks: Sequence[Task], base: Scene, function: CaseFunction, e
 
 def run_pool(tasks: Sequence[Task], base: Scene, function: CaseFunction, workers: int,
              emit: Emit) -> None:
-    """Run tasks in spawned processes, at most ``2 workers`` submitted at a time.
+    """Run tasks in ``workers`` spawned processes, at most ``2 workers`` submitted at a time.
 
-    A worker that dies (crash, ``os._exit``, out of memory) breaks the pool and every task in
-    flight; their cases are rerun one at a time in a fresh process, where a case that kills the
-    process is the one running, and is recorded as ``WorkerCrash``.
-
-    Parameters
-    ----------
-    tasks, base, function, emit
-        As for :func:`run_in_process`.
-    workers : int
-        Processes of the pool.
+    A dying worker breaks the pool; the tasks in flight are rerun one case at a time in a fresh
+    process, so the case that kills it is recorded as ``WorkerCrash``.
     """
     # spawn, not fork: a worker inherits nothing from the driver (threads, locks, open files)
     context = multiprocessing.get_context("spawn")
@@ -117,15 +83,13 @@ def run_pool(tasks: Sequence[Task], base: Scene, function: CaseFunction, workers
 
 
 def ignore_interrupts() -> None:
-    """Pool worker initializer: Ctrl-C reaches the whole process group, and the driver alone
-    decides what an interruption stops (it terminates the workers)."""
+    """Pool worker initializer: the driver alone decides what an interruption stops."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 @contextlib.contextmanager
 def _pool(workers: int, context) -> Iterator[ProcessPoolExecutor]:
-    """A process pool; on any exception its workers are terminated instead of awaited (a running
-    case would otherwise hold the driver until it ends)."""
+    """A process pool whose workers are terminated, not awaited, on any exception."""
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=ignore_interrupts)
     try:
         yield pool
@@ -140,8 +104,7 @@ def _pool(workers: int, context) -> Iterator[ProcessPoolExecutor]:
 
 
 def _emit_finished(running: dict[Any, Task], emit: Emit) -> None:
-    """Emit the records of the futures in ``running`` that finished with one (at an interruption:
-    cases done meanwhile are kept)."""
+    """Emit the records of the futures in ``running`` that finished with one."""
     for future in list(running):
         if future.done() and not future.cancelled() and future.exception() is None:
             emit(future.result())
@@ -181,8 +144,9 @@ def _pool_round(queue: deque, base: Scene, function: CaseFunction, workers: int,
 
 
 def _run_one_at_a_time(queue: deque, base: Scene, function: CaseFunction, context, emit: Emit) -> None:
-    """Run the cases of ``queue`` one at a time, each in a pool of one process: a case that kills
-    its process is recorded as ``WorkerCrash``, and a fresh pool runs the next."""
+    """Run the cases of ``queue`` one at a time, each in a fresh pool of one process (a case that kills
+    it is recorded as ``WorkerCrash``).
+    """
     while queue:
         with _pool(1, context) as pool:
             while queue:
@@ -201,12 +165,8 @@ def _run_one_at_a_time(queue: deque, base: Scene, function: CaseFunction, contex
 
 
 def connect(scheduler: Any):
-    """A :class:`distributed.Client` for an address (``tcp://host:port``) or the client given.
-
-    Raises
-    ------
-    SweepError
-        ``distributed`` is not installed, or the scheduler does not answer within 10 s.
+    """A :class:`distributed.Client` for ``scheduler`` (``tcp://host:port``) or the client given;
+    SweepError without ``distributed`` or without an answer in 10 s.
     """
     try:
         from distributed import Client  # an optional dependency, needed only for a cluster
@@ -221,24 +181,10 @@ def connect(scheduler: Any):
 
 
 def run_dask(tasks: Sequence[Task], base: Scene, function: CaseFunction, client, emit: Emit) -> None:
-    """Submit every task to the cluster and record them as they complete.
+    """Submit every task to ``client``'s cluster and emit them as they complete.
 
-    A task whose worker dies repeatedly (Dask's ``KilledWorker``) is recorded as failed if it is
-    one case; a batch's cases are submitted again one by one, so that only the case that kills
-    its worker is recorded. Any other failure of the cluster stops the sweep, recording nothing
-    for the tasks in flight.
-
-    Parameters
-    ----------
-    tasks, base, function, emit
-        As for :func:`run_in_process`.
-    client : distributed.Client
-        The cluster (:func:`connect`).
-
-    Raises
-    ------
-    SweepIncomplete
-        The cluster failed other than by killing a worker; the records so far are kept.
+    A case Dask gave up on (``KilledWorker``) is recorded as failed; a batch's cases are submitted
+    again one by one. Any other cluster failure raises :class:`SweepIncomplete`.
     """
     from distributed import KilledWorker, as_completed  # optional, as in connect
 
@@ -278,8 +224,9 @@ def _killed_batch(future, task: Task, killed: type) -> bool:
 
 
 def _emit_dask(future, result, task: Task, emit: Emit, killed: type) -> None:
-    """Emit a finished task's records, or a failed case's ``KilledWorker`` record; any other
-    failure stops the sweep (:class:`SweepIncomplete`)."""
+    """Emit a finished task's records, or a failed case's ``KilledWorker`` record; any other failure
+    raises :class:`SweepIncomplete`.
+    """
     if future.status == "finished":
         emit(result)
         return

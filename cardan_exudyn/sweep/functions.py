@@ -1,5 +1,6 @@
-"""A sweep's case function by name: what worker processes and Dask workers receive, and the
-checks that it imports back to the same callable and that its arguments are JSON."""
+"""A sweep's case function by name (what workers receive), checked to import back to the same
+callable with JSON arguments.
+"""
 
 from __future__ import annotations
 
@@ -27,15 +28,15 @@ CASE_ARGUMENTS = ("scene", "engine")
 class CaseFunction:
     """A case function by name, with keyword arguments: ``name(scene, engine, **args)``.
 
-    What the driver sends to worker processes and Dask workers (a name and plain data pickle
-    anywhere the package is installed), like :func:`functools.partial` of an importable function.
+    Like :func:`functools.partial` of an importable function, but a name and plain data, so it
+    pickles anywhere the package is installed.
 
     Attributes
     ----------
     name : str
         ``"module:qualname"`` of a top-level callable ``fn(scene, engine, **args) -> dict``.
     args : dict
-        Keyword arguments (JSON-able values), e.g. a folder the function writes files into.
+        Keyword arguments (JSON-able values).
     """
 
     name: str = DEFAULT_FUNCTION
@@ -47,13 +48,8 @@ class CaseFunction:
 
 
 def function_args(args: Any) -> dict[str, Any]:
-    """``function_args`` checked: a table of keyword names to JSON-able values.
-
-    Raises
-    ------
-    SweepError
-        Not a table, a key that is no argument name or one of :data:`CASE_ARGUMENTS`, or a
-        value that is not JSON.
+    """``function_args`` checked: a table of keyword names to JSON-able values; SweepError for
+    anything else or a name of :data:`CASE_ARGUMENTS`.
     """
     if not isinstance(args, Mapping):
         raise SweepError(f"`function_args` must be a table, got {args!r}")
@@ -71,23 +67,8 @@ def function_args(args: Any) -> dict[str, Any]:
 
 
 def function_name(function: Any) -> str:
-    """``"module:qualname"`` of a case function, checked to import back to the same object.
-
-    Parameters
-    ----------
-    function : str or callable
-        The name, or a top-level callable.
-
-    Returns
-    -------
-    str
-        ``"module:qualname"``.
-
-    Raises
-    ------
-    SweepError
-        A name that does not import, or a callable that cannot be imported by its name (a
-        lambda, a nested function): worker processes could not run it.
+    """``"module:qualname"`` of ``function`` (a name or a top-level callable), checked to import back
+    to the same object (workers import it); SweepError otherwise.
     """
     if isinstance(function, str):
         resolve_function(function)

@@ -1,8 +1,6 @@
 """A sweep's plan: the spec expanded into cases with stable ids, validated before any case runs.
 
-A :class:`Plan` is what ``plan.json`` holds: the spec, the base scene's hash, the case function
-and every case. A rerun into the same folder resumes only when its plan equals the stored one
-(:func:`plan_difference`).
+A rerun into the same folder resumes only when its plan equals the stored ``plan.json``.
 """
 
 from __future__ import annotations
@@ -60,11 +58,8 @@ class Case:
 
 
 def expand_cases(spec: SweepSpec) -> list[Case]:
-    """Every case of the sweep, in order.
-
-    Ids are ``0000``, ``0001``, ... (wider when there are more than 10,000 cases) unless the
-    explicit cases give their own: the same spec always gives the same ids, which is what lets
-    a sweep resume.
+    """Every case of the sweep, in order; ids ``0000``, ``0001``, ... (or the explicit cases' own),
+    the same for the same spec so that a sweep can resume.
     """
     if spec.cases:
         return _explicit_cases(spec.cases, spec.engine)
@@ -81,8 +76,9 @@ def expand_cases(spec: SweepSpec) -> list[Case]:
 
 
 def _explicit_cases(cases: Sequence, engine: str) -> list[Case]:
-    """The spec's explicit ``cases``, each with its own id (or its index) and engine (or the
-    spec's ``engine``); :class:`SweepError` for a case that is no table or an id used twice."""
+    """The spec's explicit ``cases`` with their ids (or index) and engines (or ``engine``); SweepError
+    for a case that is no table or an id used twice.
+    """
     width = max(4, len(str(len(cases) - 1)))
     out = []
     seen = set()
@@ -146,15 +142,15 @@ class Plan:
 
 
 def make_plan(spec: SweepSpec | Mapping[str, Any]) -> Plan:
-    """Validate a spec and expand it.
+    """Validate a spec and expand it into a :class:`Plan`.
 
     The scene, the engines, the first case's scene, every grid value and the 1e-9, 0.5 and
-    1 - 1e-9 quantiles of every random parameter must be valid before any case runs.
+    1 - 1e-9 quantiles of every random parameter are checked before any case runs.
 
     Parameters
     ----------
     spec : SweepSpec or dict
-        A dictionary is read by :func:`cardan_exudyn.sweep.spec_from_mapping`.
+        A dict is read by :func:`cardan_exudyn.sweep.spec_from_mapping`.
 
     Raises
     ------
@@ -189,20 +185,8 @@ def _check_scene(base: Scene, overrides: dict[str, Any], what: str) -> None:
 
 
 def plan_difference(stored: Mapping[str, Any], new: Mapping[str, Any]) -> str:
-    """What makes a stored ``plan.json`` another sweep than ``new``.
-
-    Parameters
-    ----------
-    stored : mapping
-        The content of the folder's ``plan.json``.
-    new : mapping
-        The new plan's :meth:`Plan.to_dict`.
-
-    Returns
-    -------
-    str
-        The first difference, in words; "" when a rerun may resume the stored sweep (same
-        format, case function, base scene, cases and arguments).
+    """The first difference, in words, between ``stored`` ``plan.json`` content and ``new``
+    (:meth:`Plan.to_dict`); "" when a rerun may resume the stored sweep.
     """
     if stored.get("format") != PLAN_FORMAT:
         return f"plan format {stored.get('format')!r}, expected {PLAN_FORMAT!r}"

@@ -1,27 +1,8 @@
 """Running a sweep: :func:`run_sweep` plans, resumes, runs the missing cases, and writes the tables.
 
-A sweep is a base scene, an engine and a list of *cases*; a case is an id, an engine name and a
-dictionary of dotted scene paths to values (``{"joint.geometry.shaft_angle_deg": 20}``). Each case
-runs ``function(replace(base, **overrides), engine, **function_args)`` (by default
-:func:`cardan_exudyn.sweep.summary_outputs`, the scalar values of the engine's summary) and
-becomes one flat record.
-
-Files in the output folder ``OUT``:
-
-- ``plan.json``: the specification, the base scene's hash and every case, written before the
-  first case runs; a rerun with the same ``OUT`` must have the same plan (or ``restart``).
-- ``cases.jsonl``: one JSON record per finished case, appended (flushed and fsync'ed) by the
-  driver as soon as the case finishes, so that an interrupted sweep resumes where it stopped; an
-  incomplete last line (a kill during the write) is dropped on resume.
-- ``results.csv`` (one row per case in plan order, parameters as columns) and ``sweep.json``
-  (specification, counts, wall time, per-output statistics, environment), written atomically
-  when every case has a record.
-
-Cases run in the driver (``workers=1``), in a local process pool (``workers=N``, spawned
-processes), or on a Dask distributed cluster (``scheduler="tcp://host:port"``). Workers return
-records; only the driver writes files. Cases of an engine with a batched pass (the reference
-engine) and the default case function run in batches (:mod:`~cardan_exudyn.sweep.tasks`): one
-record per case all the same, written as its batch finishes.
+Each case runs ``function(replace(base, **overrides), engine, **function_args)`` and becomes one
+record. Files in ``OUT`` (``plan.json``, ``cases.jsonl``, ``results.csv``, ``sweep.json``):
+``docs/sweep.md``.
 """
 
 from __future__ import annotations
@@ -83,38 +64,36 @@ def run_sweep(spec: SweepSpec | Mapping[str, Any], out: str | os.PathLike, *,
     Parameters
     ----------
     spec : SweepSpec or dict
-        What to sweep; a dictionary is read by :func:`cardan_exudyn.sweep.spec_from_mapping`.
+        A dict is read by :func:`cardan_exudyn.sweep.spec_from_mapping`.
     out : path
-        Output folder; if it holds records of the same plan, only the missing cases run.
+        Output folder; with records of the same plan, only the missing cases run.
     workers : int, optional
-        Local processes (default: every available core); 1 runs the cases in this process.
+        Local processes (default: every available core); 1 runs in this process.
     scheduler : str or distributed.Client, optional
-        Dask scheduler address (``tcp://host:port``) or client; the cases then run on that cluster.
+        Dask scheduler address (``tcp://host:port``) or client.
     restart : bool
-        Discard the sweep files in ``out`` (plan, records, tables) and start over.
+        Discard the sweep files in ``out`` and start over.
     retry_failed : bool
         Also rerun cases recorded with a status other than ``ok``.
     progress : bool, optional
         Progress bar on stderr; default when stderr is a terminal.
     batch_size : int, optional
         Most cases per batch of the batched engines (default
-        :data:`cardan_exudyn.sweep.tasks.BATCH_SIZE`, smaller when each worker would get fewer than
-        four batches); 1 runs every case on its own.
+        :data:`cardan_exudyn.sweep.tasks.BATCH_SIZE`); 1 runs every case on its own.
 
     Returns
     -------
     dict
-        The content of ``sweep.json``: spec, counts, wall time (s), statistics per output.
+        Spec, counts, wall time [s], statistics per output.
 
     Raises
     ------
     SweepError, SceneError, EngineUnavailable
-        Invalid spec or output folder; raised before anything is written.
+        Before anything is written.
     SweepIncomplete
-        The Dask cluster failed; the records so far are kept, rerun to resume.
+        The Dask cluster failed; rerun to resume.
     SweepInterrupted
-        Ctrl-C or SIGTERM (a :class:`KeyboardInterrupt`): the cases finished before it are
-        recorded, none is recorded as failed for it, the workers are stopped; rerun to resume.
+        Ctrl-C or SIGTERM; finished cases are recorded; rerun to resume.
     """
     start = time.perf_counter()
     for name, value in (("workers", workers), ("batch_size", batch_size)):
@@ -158,9 +137,9 @@ def _prepare(out: Path, plan: Plan, restart: bool) -> dict[str, dict[str, Any]]:
 
 def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, sizes: tuple[int | None, int | None],
              client, progress: bool | None) -> dict[str, Any]:
-    """Run ``todo``, appending each task's records as they arrive (``records`` is updated too);
-    returns how the cases were run (:func:`_dispatch`). ``sizes``: ``workers`` and
-    ``batch_size`` of :func:`run_sweep`."""
+    """Run ``todo``, appending each task's records as they arrive (also into ``records``); returns
+    :func:`_dispatch`'s answer. ``sizes``: ``workers`` and ``batch_size``.
+    """
     rerun = {c.id for c in todo}
     failed = sum(r.get("status") != Status.OK for i, r in records.items() if i not in rerun)
     show = sys.stderr.isatty() if progress is None else progress
@@ -193,8 +172,9 @@ def _execute(plan: Plan, todo: list[Case], records: dict, out: Path, sizes: tupl
 
 def _dispatch(plan: Plan, todo: list[Case], workers: int, client, emit: Emit,
               batch_size: int | None = None) -> dict[str, Any]:
-    """Hand ``todo`` to the executor (the cluster, this process, or a local pool) as tasks;
-    returns the executor and how many cases ran in batches."""
+    """Hand ``todo`` as tasks to the cluster, this process or a local pool; returns the executor and
+    the number of cases run in batches.
+    """
     function = plan.spec.case_function()
     if client is not None:
         executor = {"kind": "dask", "scheduler": client.scheduler.address,

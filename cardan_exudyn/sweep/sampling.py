@@ -1,6 +1,6 @@
-"""Random samples of a sweep: the distribution of one parameter and N reproducible samples of
-several (independent uniform draws or a Latin hypercube, mapped through each distribution's
-inverse distribution function)."""
+"""Random samples of a sweep: one parameter's distribution, and N reproducible samples of several
+(independent uniform draws or a Latin hypercube, through each inverse distribution function).
+"""
 
 from __future__ import annotations
 
@@ -28,11 +28,10 @@ class Distribution:
     Attributes
     ----------
     dist : {"uniform", "loguniform", "normal"}
-        ``uniform``: on [low, high); ``loguniform``: log-uniform on [low, high), 0 < low;
-        ``normal``: mean and standard deviation, optionally truncated to [low, high] (either
-        bound may be given alone).
+        ``uniform`` on [low, high); ``loguniform`` on [low, high), 0 < low; ``normal``: mean and
+        std, optionally truncated to [low, high] (either bound alone).
     low, high, mean, std : float or None
-        In the parameter's own unit (the unit of its scene path, e.g. deg for ``..._deg``).
+        In the parameter's unit (that of its scene path, e.g. deg for ``..._deg``).
     """
 
     dist: str
@@ -48,8 +47,7 @@ class Distribution:
         self._check_ranges()
 
     def _set_parameters(self) -> None:
-        """The given parameters as floats; :class:`SweepError` for one the distribution does not
-        take, or one it needs that is missing."""
+        """The given parameters as floats; SweepError for one not taken or one needed and missing."""
         allowed = DISTRIBUTIONS[self.dist]
         for name in ("low", "high", "mean", "std"):
             value = getattr(self, name)
@@ -63,8 +61,9 @@ class Distribution:
             raise SweepError(f"{self.dist!r} needs {list(required)}, missing {missing}")
 
     def _check_ranges(self) -> None:
-        """:class:`SweepError` for a non-positive ``std`` or log-uniform ``low``, ``low >= high``,
-        or a truncated normal with no probability between its bounds."""
+        """SweepError for a non-positive ``std`` or log-uniform ``low``, ``low >= high``, or a truncated
+        normal with no probability between its bounds.
+        """
         if self.std is not None and self.std <= 0.0:
             raise SweepError(f"`std` must be positive, got {self.std!r}")
         if self.low is not None and self.high is not None and not self.low < self.high:
@@ -93,18 +92,7 @@ class Distribution:
         return float(ndtr(hi) - ndtr(lo))
 
     def ppf(self, u: np.ndarray) -> np.ndarray:
-        """Inverse distribution function.
-
-        Parameters
-        ----------
-        u : array_like
-            Probabilities in [0, 1).
-
-        Returns
-        -------
-        numpy.ndarray
-            The values, in the parameter's unit.
-        """
+        """Inverse distribution function: values (the parameter's unit) at probabilities ``u`` in [0, 1)."""
         u = np.clip(np.asarray(u, dtype=float), np.finfo(float).tiny, 1.0 - np.finfo(float).epsneg)
         if self.dist == "uniform":
             return self.low + u * (self.high - self.low)
@@ -133,13 +121,11 @@ class RandomSpec:
     samples : int
         Number of samples N, >= 1.
     seed : int
-        Seed of :func:`numpy.random.default_rng`; the same seed gives the same samples.
+        Seed of :func:`numpy.random.default_rng`.
     parameters : dict of str to Distribution
-        Dotted scene path -> distribution. The order matters: parameter j takes column j of the
-        unit-cube samples.
+        Dotted scene path -> distribution; parameter j takes column j of the unit-cube samples.
     method : {"random", "lhs"}
-        Independent uniform draws, or a Latin hypercube (:class:`scipy.stats.qmc.LatinHypercube`),
-        mapped through each distribution's inverse distribution function.
+        Independent uniform draws, or a Latin hypercube (:class:`scipy.stats.qmc.LatinHypercube`).
     """
 
     samples: int

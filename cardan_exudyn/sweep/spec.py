@@ -1,10 +1,7 @@
 """What a sweep runs: the specification (:class:`SweepSpec`), its grids, and reading it from TOML.
 
-A :class:`SweepSpec` names a base scene, an engine, overrides applied to every case (``fixed``),
-and the cases: a ``grid`` (cartesian product), ``random`` samples
-(:class:`~cardan_exudyn.sweep.sampling.RandomSpec`), both, or an explicit list; and its case
-function by name (:mod:`~cardan_exudyn.sweep.functions`). Everything here validates on
-construction and raises :class:`~cardan_exudyn.sweep.checks.SweepError` naming the key.
+Everything validates on construction and raises :class:`~cardan_exudyn.sweep.checks.SweepError`
+naming the key.
 """
 
 from __future__ import annotations
@@ -44,26 +41,23 @@ class SweepSpec:
     Attributes
     ----------
     scene : str, dict or Scene
-        Named scene (``reference.paper.scenes.named_scene``), path to a scene TOML, a scene table, or a
-        scene.
+        Named scene, path to a scene TOML, a scene table, or a scene.
     engine : str
         Engine of :data:`cardan_exudyn.engines.ENGINES` (a grid or a case may set ``engine``).
     fixed : dict
-        Overrides applied to the base scene for every case (dotted path -> value).
+        Overrides of the base scene for every case (dotted path -> value).
     grid : dict
-        Dotted path -> list of values (or ``{"linspace": [start, stop, num]}``,
-        ``{"geomspace": [...]}``); the cases are the cartesian product, last path fastest.
+        Dotted path -> list of values (or ``{"linspace": [start, stop, num]}``, ``{"geomspace": ...}``);
+        cases are the cartesian product, last path fastest.
     random : RandomSpec or None
-        Random samples; with a grid, every grid point takes every sample (common samples).
+        Random samples; with a grid, every grid point takes every sample.
     cases : tuple of dict
-        Explicit cases (dotted path -> value; optional ``id`` and ``engine``); excludes grid
-        and random.
+        Explicit cases (dotted path -> value; optional ``id``, ``engine``); excludes grid and random.
     function : str or callable
-        Case function ``fn(scene, engine, **function_args) -> dict`` of scalars, a top-level
-        callable or its ``"module:name"``; default :func:`cardan_exudyn.sweep.summary_outputs`.
+        Case function ``fn(scene, engine, **function_args) -> dict`` of scalars, or its
+        ``"module:name"``; default :func:`cardan_exudyn.sweep.summary_outputs`.
     function_args : dict
-        Keyword arguments of the case function (JSON-able values); part of the plan, so a sweep
-        resumes only with the same arguments.
+        JSON-able keyword arguments of the case function; part of the plan.
     """
 
     scene: Any
@@ -126,20 +120,7 @@ def _check_disjoint(spec: SweepSpec) -> None:
 
 
 def grid_values(path: str, spec: Any) -> tuple:
-    """The values of one grid parameter.
-
-    Parameters
-    ----------
-    path : str
-        Dotted scene path (named in errors).
-    spec : list or dict
-        The values, or ``{linspace|geomspace = [start, stop, num]}``.
-
-    Returns
-    -------
-    tuple
-        The values, in the parameter's unit.
-    """
+    """The values of grid parameter ``path`` from ``spec``: a list or ``{linspace|geomspace = [start, stop, num]}``."""
     where = f"`grid.\"{path}\"`"
     if isinstance(spec, Mapping):
         return _spaced_values(where, spec)
@@ -170,22 +151,8 @@ def _spaced_values(where: str, spec: Mapping) -> tuple:
 
 def flatten_paths(table: Mapping[str, Any], is_leaf: Callable[[Any], bool] | None = None,
                   prefix: str = "") -> dict[str, Any]:
-    """Dotted paths of a nested table, so that TOML's unquoted dotted keys mean what they look like.
-
-    Parameters
-    ----------
-    table : mapping
-        The nested table.
-    is_leaf : callable, optional
-        A sub-table for which ``is_leaf(sub)`` is true is kept as one value (a grid's
-        ``{linspace = ...}``, a distribution).
-    prefix : str
-        Prepended to every path.
-
-    Returns
-    -------
-    dict
-        Dotted path -> value.
+    """Dotted path -> value of a nested ``table`` (TOML's unquoted dotted keys), each path prefixed by
+    ``prefix``; a sub-table for which ``is_leaf(sub)`` is true stays one value.
     """
     out = {}
     for key, value in table.items():
@@ -248,23 +215,8 @@ def _distribution(path: str, dist: Any) -> Distribution:
 
 
 def spec_from_mapping(data: Mapping[str, Any], base_dir: str | os.PathLike | None = None) -> SweepSpec:
-    """A :class:`SweepSpec` from a (TOML-shaped) dictionary; unknown keys are errors.
-
-    Parameters
-    ----------
-    data : mapping
-        The keys of :data:`SPEC_KEYS`.
-    base_dir : path, optional
-        Folder a relative scene path is taken relative to (the spec file's folder).
-
-    Returns
-    -------
-    SweepSpec
-
-    Raises
-    ------
-    SweepError
-        An unknown key or an invalid value, naming the key.
+    """A :class:`SweepSpec` from a TOML-shaped ``data`` (keys of :data:`SPEC_KEYS`), a relative scene
+    path taken from ``base_dir``; SweepError naming an unknown key or invalid value.
     """
     unknown = sorted(set(data) - set(SPEC_KEYS))
     if unknown:
