@@ -1,5 +1,4 @@
-"""Where a result was computed: versions, CPU, date and commit, for the head of every results
-file (sweeps, benchmarks, stress reports)."""
+"""Where a result was computed: versions, CPU, date and commit, for the head of every results file."""
 
 from __future__ import annotations
 

@@ -1,8 +1,6 @@
 """The one number and table formatter of every report and of the CLI.
 
-A value that is not a finite number (None, NaN, infinity, a string where a number belongs)
-prints as ``missing`` ("-" by default), never as "nan": a report never shows an undefined number
-as if it were one.
+A value that is not a finite number prints as ``missing`` ("-" by default), never as "nan".
 """
 
 from __future__ import annotations
@@ -25,21 +23,7 @@ def is_number(value: Any) -> bool:
 
 
 def number(value: Any, spec: str = ".4g", missing: str = "-") -> str:
-    """``value`` formatted with ``spec``, or ``missing`` when it is not a finite number.
-
-    Parameters
-    ----------
-    value : Any
-        The value.
-    spec : str
-        A format spec (``".4f"``).
-    missing : str
-        What a value that is not a finite number prints as.
-
-    Returns
-    -------
-    str
-    """
+    """``value`` formatted with format spec ``spec`` (``".4f"``), or ``missing`` when it is not a finite number."""
     return format(value, spec) if is_number(value) else missing
 
 
@@ -58,12 +42,11 @@ def _cell(value: Any, spec: str | None, missing: str) -> str:
 def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[str],
                    formats: Mapping[str, str] | None = None, headers: Sequence[str] | None = None,
                    missing: str = "-") -> str:
-    """A GitHub-flavoured markdown table.
+    """A GitHub-flavoured markdown table, ending in a line end.
 
     Parameters
     ----------
     rows : iterable of mappings, or a pandas DataFrame
-        One mapping (or DataFrame row) per table row.
     columns : sequence of str
         Keys to show, in order.
     formats : mapping, optional
@@ -72,11 +55,6 @@ def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[st
         Column titles (default: the keys).
     missing : str
         What a value that is not a finite number prints as.
-
-    Returns
-    -------
-    str
-        The table, one line per row, ending in a line end.
     """
     if hasattr(rows, "to_dict") and hasattr(rows, "columns"):  # a DataFrame
         rows = rows.to_dict("records")

@@ -1,5 +1,6 @@
-"""Plots: functions take data (and, where they draw one panel, an optional Axes) and return the
-Figure; axis labels carry units. Importing this module selects matplotlib's Agg backend."""
+"""Plots: functions take data (and, for one panel, an optional Axes) and return the Figure; axis
+labels carry units. Importing this module selects matplotlib's Agg backend.
+"""
 
 from __future__ import annotations
 
@@ -37,18 +38,8 @@ def _against_input_angle(tables: dict[str, object], values, ylabel: str, ax=None
 
 
 def speed_ratio(tables: dict[str, object], ax=None):
-    """omega_out / omega_in against the input angle.
-
-    Parameters
-    ----------
-    tables : dict of str to DataFrame
-        Label -> time table (``theta_in`` [rad], ``omega_in``, ``omega_out`` [rad/s]).
-    ax : matplotlib Axes, optional
-        Where to draw (default: a new figure).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+    """omega_out / omega_in against the input angle, one series per label of ``tables`` (time tables
+    with ``theta_in`` [rad], ``omega_in``, ``omega_out`` [rad/s]), on ``ax`` or a new figure.
     """
     return _against_input_angle(tables, lambda t: t["omega_out"] / t["omega_in"],
                                 "omega_out / omega_in [-]", ax)
@@ -56,25 +47,9 @@ def speed_ratio(tables: dict[str, object], ax=None):
 
 def data_limits(values, margin: float = 0.08, min_span: float = 2e-3,
                 clip: tuple[float, float] | None = None) -> tuple[float, float]:
-    """Axis limits that show the variation of ``values``: their finite range widened by
-    ``margin`` of its span on each side (a span of at least ``min_span``, centred, so that a
-    constant reads as one), then cut to ``clip`` when given. No finite value: ``clip`` or (0, 1).
-
-    Parameters
-    ----------
-    values : array_like
-        Every value the axis must show (NaN and infinities are ignored).
-    margin : float
-        Fraction of the span added below and above [-].
-    min_span : float
-        Smallest span of the limits, in the values' unit.
-    clip : tuple of float, optional
-        Limits never exceeded (for a quantity that is unbounded somewhere, eq. (18)).
-
-    Returns
-    -------
-    (float, float)
-        The lower and upper limit, in the values' unit.
+    """Axis limits (values' unit) showing the finite ``values``: their range widened by ``margin`` [-]
+    of its span each side, at least ``min_span`` wide (centred), then cut to ``clip``; none finite:
+    ``clip`` or (0, 1).
     """
     x = np.asarray(values, dtype=float).ravel()
     x = x[np.isfinite(x)]
@@ -101,24 +76,16 @@ def efficiency_against_input_angle(curves: dict[str, tuple], title: str = "", ax
                                    clip: tuple[float, float] = (-0.5, 1.05)):
     """Instantaneous efficiency of eq. (18) against the input angle (Figures 4, 6, 7 of the paper).
 
-    The y limits follow the data (:func:`data_limits`); eq. (18) is unbounded where the input
-    power changes sign, so they never leave ``clip``.
-
     Parameters
     ----------
     curves : dict of str to (array_like, array_like)
-        Label -> (input angle [deg], efficiency [-]), one revolution each, so that runs at
-        different speeds are comparable.
+        Label -> (input angle [deg], efficiency [-]), one revolution each.
     title : str
         Panel title (none when empty).
     ax : matplotlib Axes, optional
         Where to draw (default: a new figure).
     clip : tuple of float
-        Limits the y axis never leaves [-].
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+        Limits the y axis never leaves [-] (eq. (18) is unbounded where the input power changes sign).
     """
     fig, ax = _axes(ax)
     for label, (angle, eta) in curves.items():
@@ -137,21 +104,8 @@ def efficiency_against_input_angle(curves: dict[str, tuple], title: str = "", ax
 
 
 def pair_losses(angle, losses: dict[str, object], title: str = ""):
-    """Power loss of the spider pairs (left) and of the shaft-frame pairs (right) against the
-    input angle (the paper's Figure 5); each panel's y limits follow its data.
-
-    Parameters
-    ----------
-    angle : array_like
-        Input angle [deg].
-    losses : dict of str to array_like
-        Pair name -> power loss [W] at ``angle``.
-    title : str
-        Figure title (none when empty).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+    """Power loss [W] of the spider pairs (left) and shaft-frame pairs (right) against ``angle`` [deg]
+    (the paper's Figure 5); ``losses``: pair name -> loss at ``angle``; ``title``: none when empty.
     """
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
     for ax, pairs in zip(axes, (("input_spider", "spider_output"), ("frame_input", "output_frame")),
@@ -172,24 +126,18 @@ def pair_losses(angle, losses: dict[str, object], title: str = ""):
 
 
 def efficiency_against_paper(panels: dict[str, object], x: str, xlabel: str):
-    """Mean efficiency against the paper, one panel per parameter set, each with its own y limits
-    from its data (:func:`data_limits`): the set's two mean efficiencies as lines (``o-``: one
-    minus lost over input work; ``x:``: the time average of eq. (18), where defined) and the
-    paper's values as markers at the same abscissae (fitted cases filled, held-out ones open).
+    """Mean efficiency against the paper, one panel per parameter set.
+
+    Lines: the set's mean efficiency (``o-``) and time average of eq. (18) (``x:``); markers: the
+    paper's values (fitted cases filled, held-out open).
 
     Parameters
     ----------
     panels : dict of str to DataFrame
         Parameter set -> rows with ``x``, ``mean_efficiency``, ``mean_instantaneous_efficiency``,
         ``paper_mean_efficiency`` [-] and ``used_in_fit``.
-    x : str
-        The column on the abscissa.
-    xlabel : str
-        Its label, with its unit.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+    x, xlabel : str
+        The abscissa's column, and its label with unit.
     """
     fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 4), squeeze=False,
                              constrained_layout=True)
@@ -212,17 +160,7 @@ def efficiency_against_paper(panels: dict[str, object], x: str, xlabel: str):
 
 
 def save(fig, path, dpi: int = 130) -> None:
-    """Write ``fig`` to ``path`` and close it.
-
-    Parameters
-    ----------
-    fig : matplotlib.figure.Figure
-        The figure.
-    path : path-like
-        The file (its suffix sets the format).
-    dpi : int
-        Resolution of a raster format.
-    """
+    """Write ``fig`` to ``path`` (suffix sets the format; ``dpi`` for raster) and close it."""
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
 
@@ -238,8 +176,7 @@ CLASS_COLOURS = {"converged": "#4caf50", "drift": "#ff9800", "self_locking": "#5
 
 
 def _boundary(ax, locks: np.ndarray) -> None:
-    """Black lines on the edges between cells of different reference state (``locks``: the
-    reference self-locks, shape (angles, values))."""
+    """Black lines on the edges between cells of different reference state (``locks``, shape (angles, values))."""
     rows, cols = locks.shape
     for i in range(rows):
         for j in range(cols):
@@ -278,9 +215,10 @@ def _stability_panel(ax, sel, panel: dict, index: dict[str, int], cmap, classes)
 
 
 def stability_map(cells, panels: list[dict], classes):
-    """``cardan stress`` map: one panel per slice, shaft angle (rows) against the panel's
-    quantity (columns, one cell per value). Colour: Exudyn's class; hatching: the reference
-    self-locks; ``!``: the two disagree; black line: the reference's self-locking boundary.
+    """``cardan stress`` map: one panel per slice, shaft angle (rows) against the panel's quantity.
+
+    Colour: Exudyn's class; hatching: the reference self-locks; ``!``: the two disagree; black line:
+    the reference's self-locking boundary.
 
     Parameters
     ----------
@@ -290,11 +228,7 @@ def stability_map(cells, panels: list[dict], classes):
     panels : list of dict
         ``key``, ``title``, ``x_label``, ``x_values`` and ``angles`` [deg] of each panel.
     classes : sequence of str
-        The cell classes, in legend order (keys of :data:`CLASS_COLOURS`).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
+        The cell classes in legend order (keys of :data:`CLASS_COLOURS`).
     """
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
