@@ -1,5 +1,6 @@
 """``cardan reproduce``: the paper's results with friction under its three parameter sets, as a
-report folder (:func:`reproduce`; what the report holds: :mod:`.report`)."""
+report folder.
+"""
 
 from __future__ import annotations
 
@@ -33,25 +34,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def reproduce(out: str | os.PathLike, quick: bool = False, *, workers: int | None = None,
               restart: bool = False, retry_failed: bool = False,
               progress: bool | None = None) -> Reproduction:
-    """The whole of ``cardan reproduce`` without its printing: the runs, then the report folder.
-
-    Parameters
-    ----------
-    out : path
-        The report folder (replaced atomically; the sweep is kept in ``out/runs``).
-    quick, workers, restart, retry_failed, progress
-        As :func:`cardan_exudyn.studies.reproduce.compute.run_cases`.
-
-    Returns
-    -------
-    Reproduction
-        The runs and their records; the report (:func:`~cardan_exudyn.studies.reproduce.report.
-        write_reproduction`) covers the runs that ended ``ok`` and lists the others.
-
-    Raises
-    ------
-    SweepError
-        As :func:`~cardan_exudyn.studies.reproduce.compute.run_cases`.
+    """``cardan reproduce`` without its printing: :func:`~.compute.run_cases` (same arguments) into
+    ``out``, then the report folder, replaced atomically; returns the :class:`~.compute.Reproduction`.
     """
     # import cost: the runs load the engines, the report pandas and matplotlib; `cardan` imports
     # this module to register the command

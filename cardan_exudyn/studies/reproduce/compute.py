@@ -1,21 +1,8 @@
-"""The runs of ``cardan reproduce``: the paper's eleven cases under each parameter set of
-:data:`reference.paper.parameter_sets.PARAMETER_SETS`, as one sweep of :mod:`cardan_exudyn.sweep`.
+"""The runs of ``cardan reproduce``: the paper's eleven cases under each parameter set, as one sweep.
 
-The sweep's base scene is ``paper_scene(10 deg, 2000 rpm)`` of the ``physical`` set; each case's
-overrides are the leaves in which its own scene (:func:`reference.paper.scenes.paper_scene`, any
-parameter set) differs from the base, and :func:`paper_runs` checks that the runner rebuilds
-exactly that scene. Case ids read like ``matched-table2-35deg-2000rpm``. The sweep lives in
-``OUT/runs/``: a rerun runs only the cases without a record, a case that fails is recorded with its
-status and reason, and the cases can run in worker processes.
-
-Each case writes the engine's full summary (``summary.json``) and its time history
-(``history.npz``, the columns of :data:`HISTORY_COLUMNS`) into a folder of its own,
-``OUT/runs/files/<scene name>-<random token>/``, and names that folder in its record (``files``).
-Why files beside the records: the records stay a few scalars (a history is thousands of rows);
-the files are complete (written to a temporary name and renamed) before the record is, so a
-recorded case has its files; ``.npz`` keeps float64 exactly, so the figures are drawn from the
-engine's numbers; the folder reaches the case function as an argument (``function_args``), not as
-part of the scene, whose hash would change with the report folder's place.
+Each case writes its ``summary.json`` and ``history.npz`` into ``OUT/runs/files/<name>-<token>/``
+and names it in its record: records stay a few scalars, ``.npz`` keeps float64 exactly, and the
+folder is a ``function_args`` entry, not part of the scene (whose hash would then move with it).
 """
 
 from __future__ import annotations
@@ -58,15 +45,9 @@ BASE_SPEED_RPM = 2000.0
 
 
 def run_numbers(result: Result) -> dict[str, Any]:
-    """Status, reason and, for a run that is ``ok``, the numbers the report tabulates.
-
-    Works in J (``input_work_J``, ``loss_work_J``, ``energy_balance_residual_J``: input minus
-    output minus friction loss work minus the change of mechanical energy, trapezoidal over the
-    run), ``mean_torque_in`` and ``output_load_N_m`` (the scene's constant load) in N m,
-    ``dt_s`` (the step the run was made with), ``accuracy_target`` (the scene's
-    ``numerics.accuracy``) and ``wall_time_s`` in s, ``steps_per_revolution``
-    (at the mean input speed); ``engine`` and ``engine_version`` name what computed them;
-    efficiencies, loop gain and loss shares are dimensionless.
+    """Status, reason and, for an ``ok`` run, the numbers the report tabulates (works [J], torques
+    [N m], ``dt_s``, ``wall_time_s`` [s], ``accuracy_target``, ``steps_per_revolution``, engine and
+    version; efficiencies, loop gain and loss shares [-]).
     """
     s = result.summary
     out: dict[str, Any] = {"status": s.status, "reason": s.reason}
@@ -108,17 +89,9 @@ def energy_balance_residual(table) -> float:
 
 
 def paper_case_outputs(scene: Scene, engine: str, files: str | None = None) -> dict[str, Any]:
-    """Sweep case function: run ``scene`` and return :func:`run_numbers`.
-
-    Parameters
-    ----------
-    scene : Scene
-        The case's scene.
-    engine : str
-        Engine name.
-    files : str, optional
-        Folder under which the run's ``summary.json`` and ``history.npz`` go, into a folder of
-        their own whose name the outputs give as ``files``; nothing is written without it.
+    """Sweep case function: run ``scene`` with ``engine`` and return :func:`run_numbers`; with
+    ``files``, the run's ``summary.json`` and ``history.npz`` go into a new folder under it, named
+    in the outputs.
     """
     result = engines.run(scene, engine)
     out = run_numbers(result)
@@ -159,11 +132,8 @@ def base_scene() -> Scene:
 
 
 def paper_runs(quick: bool = False) -> list[PaperRun]:
-    """Every run in report order (parameter set, then the paper's case order).
-
-    A run's overrides are the leaves in which its scene differs from :func:`base_scene`; the
-    scene the sweep runner builds from them (with ``--quick``'s overrides) is checked to equal
-    ``paper_scene(angle, speed, parameters)`` (with the same overrides).
+    """Every run in report order (parameter set, then the paper's case order); each run's overrides
+    are checked to rebuild ``paper_scene(angle, speed, parameters)`` from :func:`base_scene`.
     """
     base = base_scene()
     fixed = QUICK_OVERRIDES if quick else {}
@@ -194,22 +164,8 @@ def _overrides(scene: Scene, base_leaves: dict[str, Any]) -> dict[str, Any]:
 
 def sweep_spec(runs: list[PaperRun], quick: bool = False,
                files: str | os.PathLike | None = None) -> SweepSpec:
-    """The explicit-case sweep of the runs.
-
-    Parameters
-    ----------
-    runs : list of PaperRun
-        The runs (:func:`paper_runs`), one case each.
-    quick : bool
-        ``--quick``'s overrides (:data:`QUICK_OVERRIDES`) on every case.
-    files : path, optional
-        The folder the case function :func:`paper_case_outputs` writes each run's files into
-        (none: it writes nothing).
-
-    Returns
-    -------
-    SweepSpec
-        Engine ``exudyn``, base scene :func:`base_scene`, case function :data:`CASE_FUNCTION`.
+    """The explicit-case :class:`SweepSpec` of ``runs`` (``--quick`` overrides when ``quick``), whose
+    case function writes each run's files under ``files`` (none: nothing written).
     """
     return SweepSpec(scene=base_scene(), engine="exudyn",
                      fixed=dict(QUICK_OVERRIDES) if quick else {},
@@ -262,8 +218,9 @@ def _load_history(path: Path) -> dict[str, np.ndarray]:
 
 def _collect(runs: list[PaperRun], records: dict[str, dict[str, Any]],
              files: Path) -> tuple[list[dict[str, Any]], dict[str, dict[str, Any]]]:
-    """The engine summary of every run (a stand-in naming the status for a run that raised) and
-    the time histories by parameter set and label, from the runs' files."""
+    """Every run's engine summary (a stand-in naming the status for a run that raised) and the time
+    histories by parameter set and label, from the runs' files.
+    """
     summaries: list[dict[str, Any]] = []
     histories: dict[str, dict[str, Any]] = {r.parameters: {} for r in runs}
     for run in runs:
@@ -283,27 +240,9 @@ def _collect(runs: list[PaperRun], records: dict[str, dict[str, Any]],
 
 @dataclass(frozen=True)
 class Reproduction:
-    """What :func:`reproduce` did.
-
-    Attributes
-    ----------
-    out : Path
-        The report folder.
-    runs : list of PaperRun
-        Every run, in report order.
-    records : dict
-        Case id -> sweep record (status, reason, the numbers of :func:`run_numbers`).
-    sweep : dict
-        The sweep's summary (``OUT/runs/sweep.json``): ``run_now``, ``wall_time_s`` [s],
-        ``executor``, ...
-    summaries : list of dict
-        The engine summary of every run, in report order (a stand-in naming the status and the
-        case for a run that raised).
-    histories : dict
-        Parameter set -> label (``10deg``, ``angle <a> deg``, ``speed <n> rpm``) -> time history
-        (the columns of :data:`HISTORY_COLUMNS`, SI units).
-    quick : bool
-        The runs are ``--quick``'s.
+    """What :func:`reproduce` did: folder ``out``, ``runs`` in report order, ``records`` (case id ->
+    sweep record), ``sweep`` (``sweep.json``), ``summaries`` (engine summary per run), ``histories``
+    (set -> label -> time history, SI units) and ``quick``.
     """
 
     out: Path
@@ -335,35 +274,10 @@ def run_cases(out: str | os.PathLike, quick: bool = False, *, workers: int | Non
               progress: bool | None = None) -> Reproduction:
     """Run (or resume) the cases in ``out/runs/`` and collect their records and files.
 
-    Parameters
-    ----------
-    out : path
-        The report folder; the sweep (plan, records, per-run files) lives in ``out/runs/`` and
-        is kept, so that a rerun of an interrupted invocation runs only the cases without a record.
-    quick : bool
-        Three cases per set (0 and 10 deg at 2000 rpm, 500 rpm), accuracy 1e-4, one revolution.
-    workers : int, optional
-        Local worker processes (default: the sweep runner's, every available core); 1 runs the
-        cases in this process.
-    restart, retry_failed : bool
-        Discard every earlier record; rerun the cases recorded with a status other than ``ok``.
-    progress : bool, optional
-        The sweep runner's progress bar on stderr; default when stderr is a terminal.
-
-    Returns
-    -------
-    Reproduction
-        Every run with its record, summary and history; ``success`` is False when a run failed.
-
-    Raises
-    ------
-    SweepError
-        ``out`` is not a folder, ``out/runs`` holds another plan (e.g. ``--quick`` then not)
-        or another invocation is running there (raised before anything runs); or, after the
-        runs, a recorded case's files are missing (the records are kept; ``restart`` helps).
-    cardan_exudyn.sweep.executors.SweepInterrupted
-        Ctrl-C or SIGTERM (a :class:`KeyboardInterrupt`): the runs finished before it are
-        recorded in ``out/runs``, none as failed; the same call runs only the missing runs.
+    ``quick``: three cases per set, accuracy 1e-4, one revolution; ``workers``, ``restart``,
+    ``retry_failed``, ``progress``: as :func:`cardan_exudyn.sweep.run_sweep`. Raises SweepError
+    (another plan or invocation in ``out/runs``; a recorded case's files missing) and
+    ``SweepInterrupted`` (the same call resumes).
     """
     out = Path(out)
     if out.exists() and not out.is_dir():

@@ -1,9 +1,6 @@
 """The report of ``cardan reproduce``: ``results.csv``, ``assumptions.csv``, the figures,
-``summaries.json`` and ``report.md``, from the runs' records and time histories
-(:mod:`cardan_exudyn.studies.reproduce.compute` makes them).
-
-Every number in the report is computed from ``reference/paper/data/paper.toml`` by the code in this
-repository; the only values copied from the paper are in the column ``paper_mean_efficiency``.
+``summaries.json`` and ``report.md``. Every number is computed from ``reference/paper/data/paper.toml``;
+only ``paper_mean_efficiency`` is copied from the paper.
 """
 
 from __future__ import annotations
@@ -75,23 +72,8 @@ def fit_case_keys(parameters: str) -> list[str]:
 
 
 def case_row(case: Mapping[str, Any], parameters: str, record: Mapping[str, Any]) -> dict[str, Any]:
-    """One row of the report's ``results.csv``.
-
-    Parameters
-    ----------
-    case : mapping
-        A paper case (``study``, ``shaft_angle_deg``, ``speed_rpm``, ``paper_mean_efficiency``).
-    parameters : str
-        The parameter set, one of :data:`reference.paper.parameter_sets.PARAMETER_SETS`.
-    record : mapping
-        The run's sweep record (:func:`cardan_exudyn.studies.reproduce.compute.run_numbers` and status).
-
-    Returns
-    -------
-    dict
-        The case, the paper's value, whether the set was fitted to it (``used_in_fit``) and, for
-        a run that is ``ok``, its numbers (works in J, torques in N m, step and wall time in s,
-        efficiencies and shares dimensionless).
+    """One row of ``results.csv``: paper ``case``, its value, whether set ``parameters`` was fitted to
+    it (``used_in_fit``) and, for an ``ok`` ``record``, its numbers (SI units).
     """
     used = in_fit(case, fit_case_keys(parameters))
     row: dict[str, Any] = {
@@ -123,26 +105,9 @@ def _value(record: Mapping[str, Any], key: str) -> Any:
 def write_report(folder: Path, rows: Sequence[Mapping[str, Any]] | pd.DataFrame,
                  histories: Mapping[str, Mapping[str, Any]], quick: bool, wall: float,
                  reused: int = 0, runs_dir: str = "runs") -> None:
-    """Write ``report.md``, ``results.csv``, ``assumptions.csv`` and the figures into ``folder``.
-
-    Parameters
-    ----------
-    folder : Path
-        An existing folder.
-    rows : sequence of dict or DataFrame
-        One :func:`case_row` per run, in report order.
-    histories : mapping
-        Parameter set -> label -> time history (columns ``t`` [s], ``theta_in`` [rad],
-        ``efficiency`` [-], ``power_in``, ``power_loss_<pair>`` [W]); labels ``10deg``,
-        ``angle <a> deg``, ``speed <n> rpm``.
-    quick : bool
-        The runs were ``--quick`` ones (said in the report's head).
-    wall : float
-        Wall time of the runs [s].
-    reused : int
-        Runs taken from an earlier invocation's records in ``runs_dir`` (said in the head).
-    runs_dir : str
-        Name of the folder of the sweep's records.
+    """Write ``report.md``, ``results.csv``, ``assumptions.csv`` and the figures into the existing
+    ``folder``, from ``rows`` (one :func:`case_row` per run) and ``histories`` (set -> label ->
+    time history); ``quick``, ``wall`` [s], ``reused`` and ``runs_dir`` go into the head.
     """
     rows = pd.DataFrame(rows)
     rows.to_csv(folder / "results.csv", index=False)
@@ -167,15 +132,8 @@ def write_reproduction(result: Reproduction) -> Path:
 
 
 def steady_revolution(history: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """The rows of a history the figures show: its last whole input revolution, without the
-    first :data:`START_UP_STEPS` steps of the run where they fall in it (a run of one revolution).
-
-    Returns
-    -------
-    angle : ndarray
-        Input angle of the selected rows within the revolution [deg], from 0 to 360.
-    rows : ndarray of bool
-        The selected rows.
+    """``(angle, rows)``: the history's last whole input revolution, without the first
+    :data:`START_UP_STEPS` steps; ``angle`` [deg] from 0 to 360, ``rows`` a boolean mask.
     """
     theta = np.asarray(history["theta_in"], dtype=float)
     start = theta[-1] - 2 * np.pi
@@ -186,9 +144,9 @@ def steady_revolution(history: Mapping[str, Any]) -> tuple[np.ndarray, np.ndarra
 
 
 def start_up_effect(history: Mapping[str, Any]) -> float | None:
-    """Mean efficiency of the run's first input revolution minus that of its last [-] (None with
-    fewer than two): at constant input speed the motion repeats every revolution, so this is the
-    start-up oscillation's whole effect on the first revolution's number."""
+    """Mean efficiency of the first input revolution minus that of the last [-] (None with fewer than
+    two): the whole effect of the start-up oscillation, the motion being periodic per revolution.
+    """
     theta = np.asarray(history["theta_in"], dtype=float)
     if theta[-1] < 4 * np.pi - 1e-9:
         return None
@@ -205,21 +163,8 @@ def start_up_effect(history: Mapping[str, Any]) -> float | None:
 
 def draw_figures(folder: Path, rows: pd.DataFrame,
                  histories: Mapping[str, Mapping[str, Any]]) -> list[tuple[str, str]]:
-    """Save every figure of the report into ``folder``.
-
-    Parameters
-    ----------
-    folder : Path
-        An existing folder.
-    rows : pandas.DataFrame
-        One :func:`case_row` per run.
-    histories : mapping
-        Parameter set -> label -> time history (as :func:`write_report`).
-
-    Returns
-    -------
-    list of (str, str)
-        File name and caption of each figure, in the report's order.
+    """Save every figure of the report into ``folder`` from ``rows`` and ``histories``; returns (file
+    name, caption) of each, in report order.
     """
     ok = rows[rows.status == Status.OK]
     figures = _mean_figures(folder, ok)
@@ -229,8 +174,7 @@ def draw_figures(folder: Path, rows: pd.DataFrame,
 
 
 def _mean_figures(folder: Path, ok: pd.DataFrame) -> list[tuple[str, str]]:
-    """Mean efficiency against the paper over Table 2's angles and over the speeds, one panel per
-    parameter set."""
+    """Mean efficiency against the paper over Table 2's angles and over the speeds, one panel per set."""
     figures = []
     for study, x, xlabel, name in MEAN_FIGURES:
         part = ok[ok.study == study]
@@ -246,8 +190,7 @@ def _mean_figures(folder: Path, ok: pd.DataFrame) -> list[tuple[str, str]]:
 
 
 def _history_figures(folder: Path, parameters: str, hist: Mapping[str, Any]) -> list[tuple[str, str]]:
-    """Figures 4 and 5 (10 deg, 2000 rpm), 6 (several angles) and 7 (several speeds), against the
-    input angle over one revolution (:func:`steady_revolution`)."""
+    """Figures 4 and 5 (10 deg, 2000 rpm), 6 (angles) and 7 (speeds) over one steady revolution."""
     figures = []
     window = (f"the run's last input revolution (the first {START_UP_STEPS} steps of the run, "
               "where they fall in it, left out: see 'The start-up oscillation' below)")
@@ -289,18 +232,8 @@ def _curves(histories: Mapping[str, Any]) -> dict[str, tuple[np.ndarray, np.ndar
 
 def report_text(rows: pd.DataFrame, register: pd.DataFrame, figures: Sequence[tuple[str, str]], *,
                 quick: bool, wall: float, reused: int, runs_dir: str) -> str:
-    """The markdown of ``report.md``.
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        One :func:`case_row` per run.
-    register : pandas.DataFrame
-        The assumption register.
-    figures : sequence of (str, str)
-        :func:`draw_figures`' file names and captions.
-    quick, wall, reused, runs_dir
-        As :func:`write_report`.
+    """The markdown of ``report.md`` from ``rows``, the assumption ``register`` and ``figures``
+    (:func:`draw_figures`); the rest as :func:`write_report`.
     """
     ok = rows[rows.status == Status.OK]
     md = (_head(rows, quick, wall, reused, runs_dir) + _parameter_sets() + _results(rows, ok)
@@ -310,9 +243,9 @@ def report_text(rows: pd.DataFrame, register: pd.DataFrame, figures: Sequence[tu
 
 def _table(frame: pd.DataFrame | Sequence[Mapping[str, Any]], columns: Sequence[str],
            spec: str = ".4f", formats: Mapping[str, str] | None = None) -> str:
-    """A markdown table of ``columns``: numbers in float columns with ``spec`` (angles and speeds
-    with ``g``) unless ``formats`` says otherwise, integers, booleans and text as they are, an
-    undefined number as an empty cell."""
+    """A markdown table of ``columns``: floats with ``spec`` (angles and speeds ``g``) unless
+    ``formats`` says otherwise, other values as they are, undefined numbers empty.
+    """
     frame = pd.DataFrame(frame)
     chosen = {c: "g" if c.endswith(("_deg", "_rpm")) else spec
               for c in columns if c in frame and frame[c].dtype.kind == "f"}
@@ -321,9 +254,7 @@ def _table(frame: pd.DataFrame | Sequence[Mapping[str, Any]], columns: Sequence[
 
 
 def _head(rows: pd.DataFrame, quick: bool, wall: float, reused: int, runs_dir: str) -> list[str]:
-    """The report's head: title, how it was generated, the parameter sets, how every number
-    was computed, the definitions.
-    """
+    """The report's head: title, how it was generated, the parameter sets, the definitions."""
     earlier = (f" ({reused} of the {len(rows)} runs from the records of an earlier invocation in "
                f"`{runs_dir}/`)" if reused else "")
     ok = rows[rows.status == Status.OK]
@@ -363,10 +294,10 @@ def _targets(ok: pd.DataFrame) -> str:
 
 
 def parameter_rows(parameters: str) -> list[dict[str, Any]]:
-    """A set's parameter table (:func:`reference.paper.parameter_sets.parameter_table`) for the report: the
-    plausible range as text and ``inside`` as ``yes``, ``**NO**`` (outside: not a plausible
-    dimension) or ``-`` (no range). A moment lever is checked as the dimension it stands for
-    (:data:`reference.paper.parameter_sets.LEVER_DIMENSIONS`), which its reason then names."""
+    """A set's parameter table for the report: the plausible range as text and ``inside`` as ``yes``,
+    ``**NO**`` or ``-``; a moment lever is checked as the dimension it stands for
+    (:data:`reference.paper.parameter_sets.LEVER_DIMENSIONS`).
+    """
     out = []
     for row in parameter_table(parameters):
         plausible = row["plausible"]
@@ -402,8 +333,9 @@ def _parameter_sets() -> list[str]:
 
 
 def error_summary(rows: pd.DataFrame) -> list[dict[str, Any]]:
-    """Per parameter set, the fitted and the held-out cases apart: the number of cases, the RMS
-    and the largest difference to the paper [-] (signed, with its case)."""
+    """Per parameter set, fitted and held-out cases apart: count, RMS and largest signed difference to
+    the paper [-] with its case.
+    """
     ok = rows[rows.status == Status.OK]
     out = []
     for parameters in PARAMETER_SETS:
@@ -423,8 +355,8 @@ def error_summary(rows: pd.DataFrame) -> list[dict[str, Any]]:
 
 
 def _results(rows: pd.DataFrame, ok: pd.DataFrame) -> list[str]:
-    """The mean efficiency of every set against the paper, the errors of the fitted and the
-    held-out cases, and the cases without a result.
+    """Mean efficiency of every set against the paper, the fitted and held-out errors, the cases
+    without a result.
     """
     md = ["\n## Mean efficiency against the paper\n"]
     for parameters in PARAMETER_SETS:
