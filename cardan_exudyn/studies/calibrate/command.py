@@ -1,7 +1,6 @@
-"""``cardan calibrate``: refit a parameter set's open values on its fit cases (:mod:`.fit`), or
-(``--envelope``) bound what the plausible box can give for each of the paper's numbers
-(:mod:`.envelope`); the reports: :mod:`.report`. ``tests/test_calibration.py`` (slow) re-runs both
-and checks the stored values."""
+"""``cardan calibrate``: refit a parameter set's open values on its fit cases, or (``--envelope``)
+bound what the plausible box can give for each of the paper's numbers.
+"""
 
 from __future__ import annotations
 

@@ -1,14 +1,7 @@
-"""The paper's numbers as bounds: for each of its eleven mean efficiencies, the lowest and highest
-value the model gives over the plausible box (``[plausible]`` of ``reference/paper/data/paper.toml``),
-``cardan calibrate --envelope``.
-
-Method: every combination of the box's discrete options, and the continuous box by its corners
-(all of them, each run once for every case); then, per case and direction, a bounded local
-optimisation (``scipy.optimize.minimize``, L-BFGS-B, finite-difference gradient) started from the
-best corner. It is a local search: an extreme inside the box that no corner leads to can be
-missed, so a stored ``lowest`` may be too high and a ``highest`` too low. For a number outside
-the envelope, the parameters at a bound of the box at the closest plausible point say what would
-have to change, with the slope of the efficiency against each of them there.
+"""``cardan calibrate --envelope``: the lowest and highest mean efficiency the model gives for each
+paper case over the plausible box. Method: every corner under every discrete combination, then a
+bounded L-BFGS-B from the best corner per case and direction; a local search, so a stored
+``lowest`` may be too high and ``highest`` too low.
 """
 
 from __future__ import annotations
@@ -34,24 +27,8 @@ __all__ = ["METHOD", "BOUND_TOL", "corner_scan", "refine", "at_bounds", "envelop
 
 def corner_scan(model: CaseModel, space: Space, combinations: list[dict[str, str]],
                 cases: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Every corner of ``space`` under every combination of discrete choices.
-
-    Parameters
-    ----------
-    model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
-    space : Space
-        The open numbers and their map to the unit box.
-    combinations : list of dict
-        The discrete choices to combine with each corner.
-    cases : list of dict
-        The paper cases.
-
-    Returns
-    -------
-    list of dict
-        Per point: ``u`` (unit box), ``choices`` and ``eta``, the mean efficiency of each case
-        [-] (NaN where the run failed).
+    """Every corner of ``space`` under every discrete combination, for ``cases``: per point ``u``,
+    ``choices`` and ``eta`` (each case's mean efficiency [-], NaN where the run failed).
     """
     points = []
     for choices in combinations:
@@ -64,25 +41,8 @@ def corner_scan(model: CaseModel, space: Space, combinations: list[dict[str, str
 
 def refine(model: CaseModel, space: Space, case: Mapping[str, Any], point: Mapping[str, Any],
            sign: float) -> tuple[float, np.ndarray]:
-    """Bounded local optimisation of ``sign * eta`` of ``case`` from a corner.
-
-    Parameters
-    ----------
-    model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
-    space : Space
-        The open numbers and their map to the unit box.
-    case : mapping
-        The paper case.
-    point : mapping
-        The corner (:func:`corner_scan`'s ``u`` and ``choices``).
-    sign : float
-        1 for the lowest efficiency, -1 for the highest.
-
-    Returns
-    -------
-    (float, ndarray)
-        The extreme efficiency [-] and its ``u``.
+    """``(eta, u)``: bounded local optimisation of ``sign * eta`` of ``case`` from corner ``point``
+    (``sign`` 1: lowest, -1: highest).
     """
     from scipy.optimize import minimize  # import cost: this module is behind a CLI command
 
@@ -105,27 +65,9 @@ def refine(model: CaseModel, space: Space, case: Mapping[str, Any], point: Mappi
 
 def at_bounds(model: CaseModel, space: Space, case: Mapping[str, Any], u: np.ndarray,
               choices: Mapping[str, str]) -> list[dict[str, Any]]:
-    """The parameters at a bound of the box at ``u``.
-
-    Parameters
-    ----------
-    model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
-    space : Space
-        The open numbers and their map to the unit box.
-    case : mapping
-        The paper case.
-    u : ndarray
-        The point in the unit box.
-    choices : mapping
-        The discrete choices there.
-
-    Returns
-    -------
-    list of dict
-        Per parameter at a bound: ``name``, ``bound`` (lower, upper), ``value`` [m] and the slope
-        of the efficiency moving outwards ``slope_outwards`` [1/m] (extrapolated from a step 1e-3
-        of the range inwards).
+    """The parameters at a bound of the box at ``u`` (with ``choices``): ``name``, ``bound``,
+    ``value`` [m] and ``slope_outwards`` [1/m] of ``case``'s efficiency (from a step 1e-3 of the
+    range inwards).
     """
     base = model.efficiency(case, {**choices, **space.values(u)})
     out = []
@@ -145,24 +87,11 @@ def at_bounds(model: CaseModel, space: Space, case: Mapping[str, Any], u: np.nda
 def envelope_study(engine: str = "reference", progress: Callable[[str], None] | None = None,
                    space: Space | None = None, combinations: list[dict[str, str]] | None = None,
                    cases: list[dict[str, Any]] | None = None) -> dict[str, Any]:
-    """The lowest and highest mean efficiency of each of the paper's cases over the plausible box.
+    """The lowest and highest mean efficiency of each paper case over the plausible box with ``engine``.
 
-    Parameters
-    ----------
-    engine : {"reference", "exudyn"}
-        Engine of every run.
-    progress : callable, optional
-        Called with a line of text as the study proceeds.
-    space, combinations, cases : optional
-        A smaller box, other choices or fewer cases than the data file's (for tests).
-
-    Returns
-    -------
-    dict
-        ``method``, ``engine``, ``cases`` (per case: ``case``, ``paper``, ``lowest``, ``highest``,
-        ``lowest_at``, ``highest_at`` (parameter values), ``reachable``, ``closest`` and, when not
-        reachable, ``limiting`` (:func:`at_bounds` at the closest point)), ``corners``, ``runs``,
-        ``failed_runs`` and ``wall_time_s`` [s].
+    ``space``, ``combinations``, ``cases``: a smaller study (tests). Returns ``method``, ``engine``,
+    ``cases`` (per case :func:`case_envelope`), ``corners``, ``runs``, ``failed_runs``,
+    ``wall_time_s`` [s].
     """
     start = time.perf_counter()
     model = CaseModel(engine, progress)
@@ -185,27 +114,9 @@ def envelope_study(engine: str = "reference", progress: Callable[[str], None] | 
 
 def case_envelope(model: CaseModel, space: Space, points: list[dict[str, Any]], k: int,
                   case: Mapping[str, Any]) -> dict[str, Any]:
-    """One case's envelope from the corner scan, refined.
-
-    Parameters
-    ----------
-    model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
-    space : Space
-        The open numbers and their map to the unit box.
-    points : list of dict
-        :func:`corner_scan`'s points.
-    k : int
-        The case's index in the points' ``eta``.
-    case : mapping
-        The paper case.
-
-    Returns
-    -------
-    dict
-        ``case``, ``paper``, ``lowest`` and ``highest`` [-] with where they are (``lowest_at``,
-        ``highest_at``), ``reachable``, ``closest`` [-] and, outside the envelope, ``limiting``
-        (:func:`at_bounds`).
+    """Case ``k``'s envelope from the corner scan ``points``, refined: ``case``, ``paper``, ``lowest``
+    and ``highest`` [-] with ``lowest_at``, ``highest_at``, ``reachable``, ``closest`` and, outside
+    the envelope, ``limiting`` (:func:`at_bounds`).
     """
     row: dict[str, Any] = {"case": case_key(case), "paper": case["paper_mean_efficiency"]}
     where = {}

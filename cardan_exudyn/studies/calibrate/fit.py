@@ -1,13 +1,7 @@
-"""The fit of ``cardan calibrate``: a parameter set's open values identified from a subset of
-the paper's own results (the set's ``fit_cases``), the others held out.
-
-``physical`` fits its ``fitted`` values (arm radius, support spacing, input eccentricity, spider
-centre-of-mass offset) inside the plausible box (``[plausible]`` of
-``reference/paper/data/paper.toml``) by bounded least squares (``scipy.optimize.least_squares``,
-trust-region reflective), once for every combination of the box's discrete options (gravity,
-reading of the 2 N m), and keeps the combination with the smallest RMS. ``matched`` refits its
-levers and eccentricity within wide bounds
-(:data:`cardan_exudyn.studies.calibrate.fitting.MATCHED_BOUNDS`, log scale), its choices held.
+"""The fit of ``cardan calibrate``: a parameter set's open values identified from its ``fit_cases``,
+the other paper cases held out. ``physical``: bounded least squares (trust-region reflective) in
+the plausible box, once per discrete combination, smallest RMS kept; ``matched``: levers and
+eccentricity within :data:`~cardan_exudyn.studies.calibrate.fitting.MATCHED_BOUNDS` (log scale).
 """
 
 from __future__ import annotations
@@ -33,17 +27,8 @@ XTOL = 1e-8
 
 
 def residuals(model: CaseModel, cases: Sequence[Mapping[str, Any]], values: Mapping[str, Any]) -> np.ndarray:
-    """Model minus paper mean efficiency [-] per case; a failed (self-locking) case counts as
-    efficiency 0: a large, finite residual.
-
-    Parameters
-    ----------
-    model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
-    cases : sequence of mapping
-        The paper cases.
-    values : mapping
-        Parameter values (numbers and choices).
+    """Model minus paper mean efficiency [-] per case of ``cases`` under ``values``; a failed
+    (self-locking) case counts as efficiency 0.
     """
     etas = [model.efficiency(c, values) for c in cases]
     return np.asarray([(e if math.isfinite(e) else 0.0) - c["paper_mean_efficiency"]
@@ -53,15 +38,12 @@ def residuals(model: CaseModel, cases: Sequence[Mapping[str, Any]], values: Mapp
 def fit(model: CaseModel, space: Space, combinations: Sequence[Mapping[str, Any]],
         start: Sequence[float], cases: Sequence[Mapping[str, Any]],
         progress: Callable[[str], None] | None = None) -> list[dict[str, Any]]:
-    """Bounded least-squares fit of ``space``'s numbers to ``cases``, once per combination of
-    discrete choices, from ``start`` (unit box).
+    """Bounded least-squares fit of ``space``'s numbers to ``cases``, once per discrete combination.
 
     Parameters
     ----------
     model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
     space : Space
-        The open numbers and their map to the unit box.
     combinations : sequence of mapping
         The discrete choices, one fit each.
     start : sequence of float
@@ -74,8 +56,7 @@ def fit(model: CaseModel, space: Space, combinations: Sequence[Mapping[str, Any]
     Returns
     -------
     list of dict
-        Per combination, best first: ``choices``, ``values`` (every parameter), ``rms`` [-]
-        (RMS residual on ``cases``), ``evaluations``, ``status`` (the optimiser's message).
+        Best first: ``choices``, ``values``, ``rms`` [-], ``evaluations``, ``status``.
     """
     from scipy.optimize import least_squares  # import cost: scipy for the fit only
 
@@ -113,7 +94,6 @@ def case_rows(model: CaseModel, values: Mapping[str, Any], fit_keys: Sequence[st
     Parameters
     ----------
     model : CaseModel
-        The cases' mean efficiencies under parameter values (cached).
     values : mapping
         Parameter values (numbers and choices).
     fit_keys : sequence of str
@@ -122,8 +102,8 @@ def case_rows(model: CaseModel, values: Mapping[str, Any], fit_keys: Sequence[st
     Returns
     -------
     list of dict
-        ``case``, ``used_in_fit`` (:func:`reference.paper.cases.in_fit`), ``paper`` and ``model``
-        mean efficiency [-], ``difference`` [-], ``status``, ``reason``.
+        ``case``, ``used_in_fit``, ``paper`` and ``model`` mean efficiency [-], ``difference`` [-],
+        ``status``, ``reason``.
     """
     rows = []
     for case in paper_cases():
@@ -147,24 +127,9 @@ def fit_statistics(rows: Sequence[Mapping[str, Any]]) -> dict[str, float]:
 
 def calibrate(name: str = "physical", engine: str = "reference",
               progress: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Refit parameter set ``name``'s fitted values on its fit cases; the errors on all eleven.
-
-    Parameters
-    ----------
-    name : {"physical", "matched"}
-        The set (``[sets.<name>]`` of the data file).
-    engine : {"reference", "exudyn"}
-        Engine of every run.
-    progress : callable, optional
-        Called with a line of text as the fit proceeds.
-
-    Returns
-    -------
-    dict
-        ``set``, ``engine``, ``fit_cases``, ``parameters`` (fitted name -> value [m]),
-        ``values`` (every value of the set), ``combinations`` (:func:`fit`, best first),
-        ``rows`` (:func:`case_rows`), the statistics of :func:`fit_statistics`, ``runs``,
-        ``method`` and ``wall_time_s`` [s].
+    """Refit set ``name``'s fitted values on its fit cases with ``engine``; returns ``set``, ``engine``,
+    ``fit_cases``, ``parameters`` [m], ``values``, ``combinations`` (:func:`fit`), ``rows``
+    (:func:`case_rows`), :func:`fit_statistics`, ``runs``, ``method``, ``wall_time_s`` [s].
     """
     if not isinstance(name, str) or name not in FIT_SETS:
         raise ValueError(f"`name` must be one of {list(FIT_SETS)}, got {name!r:.80}")

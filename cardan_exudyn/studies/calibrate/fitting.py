@@ -1,9 +1,6 @@
-"""The paper's eleven cases under given parameter values: the model's mean efficiencies, and the
-open values of a parameter set as an optimiser sees them (``cardan calibrate``).
-
-An optimiser works on ``u`` in the unit box ``[0, 1]^n``: each open number maps to it linearly
-(the plausible box of the physical set, where zero is a bound) or on a log scale (the matched
-set's wide bounds spanning decades), so that one step size and one tolerance fit every parameter.
+"""The paper's eleven cases under given parameter values, and a set's open values as an optimiser
+sees them: ``u`` in ``[0, 1]^n``, each number mapped linearly or (bounds spanning decades) on a
+log scale, so one step size and one tolerance fit every parameter.
 """
 
 from __future__ import annotations
@@ -50,16 +47,8 @@ def cases_named(keys: Sequence[str]) -> list[dict[str, Any]]:
 
 
 def case_scene(case: Mapping[str, Any], values: Mapping[str, Any]):
-    """The scene of ``case`` under parameter ``values`` (applied to the literal reading, as
-    :func:`reference.paper.scenes.paper_scene` does), one input revolution (the motion at constant speed
-    is periodic in one), no time series; the mean-input load solved on that scene.
-
-    Parameters
-    ----------
-    case : mapping
-        A paper case (``shaft_angle_deg``, ``speed_rpm``).
-    values : mapping
-        Parameter values (numbers and choices).
+    """The scene of paper ``case`` under ``values`` (as :func:`reference.paper.scenes.paper_scene`), one
+    input revolution (periodic at constant speed), no time series, mean-input load solved.
     """
     plain = {k: v for k, v in values.items() if k != "torque_reading"}
     scene = paper_scene(case["shaft_angle_deg"], case["speed_rpm"], parameters=plain)
@@ -78,7 +67,6 @@ class CaseModel:
     Parameters
     ----------
     engine : {"reference", "exudyn"}
-        Engine of every run (through :func:`cardan_exudyn.engines.run`).
     progress : callable, optional
         Called with a line of text every ``every`` runs.
     """
@@ -96,36 +84,18 @@ class CaseModel:
         self.start = time.perf_counter()
 
     def run_case(self, case: Mapping[str, Any], values: Mapping[str, Any]) -> tuple[float, str, str]:
-        """Mean efficiency [-] (NaN when the run failed), status and reason of ``case``.
-
-        Parameters
-        ----------
-        case : mapping
-            A paper case (``shaft_angle_deg``, ``speed_rpm``).
-        values : mapping
-            Parameter values (numbers and choices).
-        """
+        """Mean efficiency [-] (NaN when failed), status and reason of paper ``case`` under ``values``."""
         key = (case["shaft_angle_deg"], case["speed_rpm"], tuple(sorted(values.items())))
         if key not in self.cache:
             self.cache[key] = self._run(case, values)
         return self.cache[key]
 
     def efficiency(self, case: Mapping[str, Any], values: Mapping[str, Any]) -> float:
-        """Mean efficiency [-] of ``case`` under ``values``; NaN when the run failed.
-
-        Parameters
-        ----------
-        case : mapping
-            A paper case (``shaft_angle_deg``, ``speed_rpm``).
-        values : mapping
-            Parameter values (numbers and choices).
-        """
+        """Mean efficiency [-] of paper ``case`` under ``values``; NaN when the run failed."""
         return self.run_case(case, values)[0]
 
     def _run(self, case: Mapping[str, Any], values: Mapping[str, Any]) -> tuple[float, str, str]:
-        """One run of ``case`` under ``values``, counted; a scene whose mean-input load cannot
-        be found is a self-locking joint.
-        """
+        """One counted run of ``case`` under ``values``; no mean-input load means a self-locking joint."""
         self.runs += 1
         if self.progress and self.runs % self.every == 0:
             self.progress(f"{self.runs} runs, {time.perf_counter() - self.start:.0f} s")
@@ -140,10 +110,8 @@ class CaseModel:
 
 @dataclass(frozen=True)
 class Space:
-    """The open numbers of a fit and the map between their values and the unit box.
-
-    ``names`` [m]; ``lower``, ``upper`` bounds [m]; ``log`` whether a name is searched on a log
-    scale; ``held`` the values not searched (numbers and choices).
+    """The open numbers of a fit and their map to the unit box: ``names``, ``lower``, ``upper`` [m],
+    ``log`` (searched on a log scale) and ``held`` (values not searched).
     """
 
     names: tuple[str, ...]
@@ -176,8 +144,7 @@ class Space:
 
 
 def box_space(held: Mapping[str, Any] | None = None) -> tuple[Space, list[dict[str, str]]]:
-    """The plausible box (``[plausible]`` of the data file): its numbers as a linear
-    :class:`Space` and every combination of its discrete options."""
+    """The plausible box's numbers as a linear :class:`Space` and every combination of its discrete options."""
     box = plausible_box()
     numbers = [k for k, v in box.items() if "range" in v and k not in (held or {})]
     space = Space(tuple(numbers), tuple(box[k]["range"][0] for k in numbers),
@@ -193,14 +160,9 @@ def choice_combinations(options: Mapping[str, Sequence[str]]) -> list[dict[str, 
 
 
 def set_space(name: str) -> tuple[Space, list[dict[str, str]], list[float]]:
-    """The fit of parameter set ``name``: its fitted numbers as a :class:`Space` (the plausible
-    box, linear, for ``physical``; :data:`MATCHED_BOUNDS`, log, for ``matched``), the
-    combinations of discrete choices to try, and the start ``u``.
-
-    Raises
-    ------
-    ValueError
-        A set with nothing to fit.
+    """Set ``name``'s fit: its :class:`Space` (plausible box, linear, for ``physical``;
+    :data:`MATCHED_BOUNDS`, log, for ``matched``), the discrete combinations and the start ``u``;
+    ValueError for a set with nothing to fit.
     """
     entries = parameter_set(name)["values"]
     fitted = [k for k, e in entries.items() if e.get("fitted")]

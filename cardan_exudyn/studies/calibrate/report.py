@@ -1,6 +1,4 @@
-"""The reports of ``cardan calibrate``: the fit's (:func:`fit_text`, with what to paste into the
-data file) and the envelope's (:func:`envelope_text`), and the ``--out`` folder
-(:func:`write_result`)."""
+"""The reports of ``cardan calibrate`` (fit and envelope) and its ``--out`` folder."""
 
 from __future__ import annotations
 
@@ -24,19 +22,7 @@ ENVELOPE_FORMATS = {"paper": ".3f", "lowest": ".4f", "highest": ".4f", "closest"
 
 
 def write_result(out: str | Path, name: str, result: Mapping[str, Any], text: str) -> Path:
-    """The ``--out`` folder (replaced atomically).
-
-    Parameters
-    ----------
-    out : path
-        The folder.
-    name : str
-        The file of the ``result`` as JSON (``calibrate.json`` or ``envelope.json``).
-    result : mapping
-        The fit's or the envelope's result.
-    text : str
-        The report, written to ``report.md``.
-    """
+    """The ``--out`` folder ``out`` (replaced atomically): ``result`` as JSON file ``name``, ``text`` as ``report.md``."""
     with atomic_directory(out) as tmp:
         (tmp / name).write_text(dumps(result))
         (tmp / "report.md").write_text(text)
@@ -44,9 +30,9 @@ def write_result(out: str | Path, name: str, result: Mapping[str, Any], text: st
 
 
 def fit_text(result: Mapping[str, Any]) -> str:
-    """The report of :func:`~cardan_exudyn.studies.calibrate.fit.calibrate`'s ``result``: what
-    to paste into the data file, every combination's RMS, the table of the eleven cases and the
-    statistics."""
+    """The report of :func:`~cardan_exudyn.studies.calibrate.fit.calibrate`'s ``result``: what to paste
+    into the data file, every combination's RMS, the eleven cases, the statistics.
+    """
     stored = parameter_set(result["set"])["values"]
     lines = [f"parameter set {result['set']}, engine {result['engine']}; fit cases "
              f"{', '.join(result['fit_cases'])}", f"method: {result['method']}", "",
@@ -82,9 +68,9 @@ def _toml_raw(x: Any) -> str:
 
 
 def envelope_text(result: Mapping[str, Any]) -> str:
-    """The report of :func:`~cardan_exudyn.studies.calibrate.envelope.envelope_study`'s
-    ``result``: the table, what to paste into ``[envelope]`` of the data file, and what would
-    have to change for each number outside the envelope."""
+    """The report of :func:`~cardan_exudyn.studies.calibrate.envelope.envelope_study`'s ``result``: the
+    table, what to paste into ``[envelope]``, what would have to change for each number outside.
+    """
     rows = [{**r, "reachable": "yes" if r["reachable"] else "no",
              "limited by": "; ".join(map(_limit, r.get("limiting", []))) + _choices(r)}
             for r in result["cases"]]
@@ -112,8 +98,9 @@ def _limit(x: Mapping[str, Any]) -> str:
 
 
 def _choices(row: Mapping[str, Any]) -> str:
-    """`` [name = option, ...]``: the discrete choices at the bound nearest the paper's number
-    of a case outside the envelope; empty otherwise."""
+    """`` [name = option, ...]``: the discrete choices at the bound nearest the paper's number of a
+    case outside the envelope; empty otherwise.
+    """
     if row.get("reachable", True) or "limiting" not in row:
         return ""
     at = row["lowest_at"] if row["paper"] < row["lowest"] else row["highest_at"]
