@@ -1,6 +1,6 @@
-"""``cardan tolerance``: mounting-error studies, the paper's case (``paper``,
-:mod:`.paper_case`) and Monte Carlo (``montecarlo``, :mod:`.montecarlo`), each into a report
-folder (:mod:`.report`)."""
+"""``cardan tolerance``: mounting-error studies, the paper's case (``paper``) and Monte Carlo
+(``montecarlo``), each into a report folder.
+"""
 
 from __future__ import annotations
 
@@ -69,8 +69,9 @@ PAPER_ONLY = {"engines": "reference,exudyn"}
 
 
 def error_distribution(text: str) -> tuple[str, dict[str, Any]]:
-    """``PATH=uniform:LOW:HIGH`` or ``PATH=normal:MEAN:STD[:LOW:HIGH]`` of ``--error``: the scene
-    path and its distribution table."""
+    """The scene path and distribution table of an ``--error`` ``PATH=uniform:LOW:HIGH`` or
+    ``PATH=normal:MEAN:STD[:LOW:HIGH]``.
+    """
     path, spec = path_value("--error", text, "PATH=uniform:LOW:HIGH or PATH=normal:MEAN:STD[:LOW:HIGH]")
     kind, *numbers = spec.split(":")
     names = {"uniform": ("low", "high"), "normal": ("mean", "std", "low", "high")}.get(kind)
@@ -151,15 +152,7 @@ def monte_carlo_handler(args: argparse.Namespace) -> int:
 
 
 def monte_carlo_line(summary: Mapping[str, Any], out: str) -> str:
-    """Statuses, the ideal joint's efficiency and the 5/50/95 percentiles, in one line.
-
-    Parameters
-    ----------
-    summary : mapping
-        The study's summary (:func:`monte_carlo`).
-    out : str
-        The output folder.
-    """
+    """Statuses, the ideal joint's efficiency and the 5/50/95 percentiles of ``summary``, and folder ``out``, in one line."""
     m = summary["mean_efficiency"]
     ideal = (number(summary["ideal_mean_efficiency"], ".6f") if summary["ideal_status"] == Status.OK
              else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}")
@@ -173,20 +166,8 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
                 out: str | Path, method: str = "lhs", workers: int | None = None,
                 scheduler: Any = None, restart: bool = False,
                 progress: bool | None = None) -> dict[str, Any]:
-    """The whole of ``cardan tolerance montecarlo`` without its printing: the samples as a
-    sweep in ``out/cases``, then the study folder ``out/study``.
-
-    Parameters
-    ----------
-    scene, engine, samples, seed, distributions, method, workers, scheduler, restart, progress
-        As :func:`~cardan_exudyn.studies.tolerance.montecarlo.run_monte_carlo`.
-    out : path
-        The output folder.
-
-    Returns
-    -------
-    dict
-        The study's summary (:attr:`~cardan_exudyn.studies.tolerance.montecarlo.MonteCarlo.summary`).
+    """``cardan tolerance montecarlo`` without its printing: the samples as a sweep in ``out/cases``
+    (arguments as :func:`~.montecarlo.run_monte_carlo`), then ``out/study``; returns the summary.
     """
     # import cost: pandas, scipy and matplotlib for this study only
     from cardan_exudyn.studies.tolerance.montecarlo import run_monte_carlo
@@ -200,22 +181,8 @@ def monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
 
 def paper_report(out: str | Path, engines: tuple[str, ...] | list[str] = ("reference", "exudyn"),
                  progress: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
-    """The whole of ``cardan tolerance paper`` without its printing: the study, then its folder.
-
-    Parameters
-    ----------
-    out : path
-        The folder (replaced atomically).
-    engines : sequence of str
-        Keys of :data:`cardan_exudyn.engines.ENGINES`.
-    progress : callable, optional
-        Called with each row as it is computed.
-
-    Returns
-    -------
-    dict
-        What ``paper_case.json`` holds
-        (:func:`~cardan_exudyn.studies.tolerance.report.write_paper_case`).
+    """``cardan tolerance paper`` without its printing: the study with ``engines`` (``progress`` called
+    per row), then folder ``out``; returns what ``paper_case.json`` holds.
     """
     from cardan_exudyn.studies.tolerance.paper_case import paper_study  # import cost, as above
     from cardan_exudyn.studies.tolerance.report import write_paper_case

@@ -1,12 +1,7 @@
-"""Monte Carlo tolerance study: each mounting error drawn from a stated distribution
-(:class:`cardan_exudyn.sweep.Distribution`), N samples reproducible from a seed, run through the
-sweep runner (resumable, local cores or a Dask cluster).
-
-Output: the distribution of the mean efficiency and its percentiles, and per error three
-sensitivity measures: Spearman's rank correlation with the error and with its magnitude (an
-effect that depends on the size but not the sign of an offset shows only in the second), and the
-correlation ratio (share of the efficiency's variance explained by the error alone, from
-quantile-binned conditional means; it sees any monotone or even dependence).
+"""Monte Carlo tolerance study: mounting errors drawn from stated distributions, N samples from a
+seed, run as a sweep. Per error: Spearman's rho with the error and with its magnitude (an effect
+of size but not sign shows only there) and the correlation ratio (share of variance explained by
+the error alone).
 """
 
 from __future__ import annotations
@@ -40,9 +35,8 @@ LEVELS = (1, 5, 25, 50, 75, 95, 99)
 
 
 def default_distributions() -> dict[str, dict[str, Any]]:
-    """The paper's tolerances as symmetric uniform distributions (the paper states magnitudes).
-
-    ``a1..a3`` uniform in [-0.5, 0.5] mm, ``alpha1..alpha3`` uniform in [-6e-3, 6e-3] deg.
+    """The paper's tolerances (magnitudes) as symmetric uniforms: ``a1..a3`` in [-0.5, 0.5] mm,
+    ``alpha1..alpha3`` in [-6e-3, 6e-3] deg.
     """
     a = value("case.rig.offset_error") * 1e3
     alpha = value("case.rig.twist_error")
@@ -53,17 +47,9 @@ def default_distributions() -> dict[str, dict[str, Any]]:
 
 
 def correlation_ratio(x: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
-    """Share of ``var(y)`` explained by ``E[y | x]``, with ``x`` cut into quantile bins [-].
-
-    A first-order sensitivity index: 0 when ``y`` does not depend on ``x`` alone (up to the
-    sampling noise of about ``bins / n``), 1 when it is a function of ``x``.
-
-    Parameters
-    ----------
-    x, y : ndarray, shape (n,)
-        The input and the output samples.
-    bins : int
-        Quantile bins of ``x``; NaN with fewer than ``2 bins`` samples or a constant ``y``.
+    """Share [-] of ``var(y)`` explained by ``E[y | x]``, ``x`` cut into ``bins`` quantile bins: 0 when
+    ``y`` does not depend on ``x`` alone (noise about ``bins / n``), 1 when a function of it; NaN
+    with fewer than ``2 bins`` samples or a constant ``y``.
     """
     x = np.asarray(x, float)
     y = np.asarray(y, float)
@@ -77,21 +63,8 @@ def correlation_ratio(x: np.ndarray, y: np.ndarray, bins: int = 10) -> float:
 
 
 def sensitivities(table, parameters: Sequence[str], output: str = "mean_efficiency"):
-    """Per parameter: Spearman rho with the value and with its magnitude, correlation ratio [-].
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        The samples that ran ok: one column per parameter and ``output``.
-    parameters : sequence of str
-        The drawn parameters (scene paths).
-    output : str
-        The column whose sensitivity is measured.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Columns ``parameter``, ``spearman``, ``spearman_magnitude``, ``correlation_ratio``.
+    """Per drawn parameter (columns of ``table``): ``spearman``, ``spearman_magnitude`` and
+    ``correlation_ratio`` [-] of column ``output``, as a DataFrame.
     """
     import pandas as pd  # import cost: pandas and scipy for this study only
     from scipy.stats import spearmanr
@@ -108,20 +81,8 @@ def sensitivities(table, parameters: Sequence[str], output: str = "mean_efficien
 
 
 def efficiency_statistics(eta: np.ndarray, eta0: float) -> dict[str, dict[str, float]]:
-    """The distribution of the mean efficiency.
-
-    Parameters
-    ----------
-    eta : ndarray, shape (n,)
-        The samples' mean efficiencies [-].
-    eta0 : float
-        The ideal joint's [-] (NaN: no change reported).
-
-    Returns
-    -------
-    dict
-        ``mean_efficiency``: mean, std, min, max and percentiles of ``eta`` [-]; ``change``: the
-        percentiles of ``eta - eta0`` [-] (empty without samples, or without ``eta0``).
+    """``mean_efficiency``: mean, std, min, max and percentiles of ``eta`` [-]; ``change``: percentiles
+    of ``eta - eta0`` [-] (empty without samples or ``eta0``).
     """
     if not eta.size:
         return {"mean_efficiency": {}, "change": {}}
@@ -135,17 +96,9 @@ def efficiency_statistics(eta: np.ndarray, eta0: float) -> dict[str, dict[str, f
 
 @dataclass
 class MonteCarlo:
-    """A Monte Carlo study's outcome.
-
-    Attributes
-    ----------
-    table : pandas.DataFrame
-        The sweep's ``results.csv``: one row per sample, its drawn errors, status and numbers.
-    sensitivity : pandas.DataFrame
-        :func:`sensitivities` of the samples that ran ok (empty with fewer than three).
-    summary : dict
-        Counts per status, the ideal joint's efficiency, percentiles of the mean efficiency and
-        of its change (:func:`efficiency_statistics`), sensitivities, wall times.
+    """A Monte Carlo study's outcome: ``table`` (the sweep's ``results.csv``), ``sensitivity``
+    (:func:`sensitivities` of the ok samples, empty with fewer than three) and ``summary`` (counts,
+    ideal efficiency, :func:`efficiency_statistics`, sensitivities, wall times).
     """
 
     table: Any
@@ -163,24 +116,12 @@ def run_monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
                     out: str | Path, method: str = "lhs", workers: int | None = None,
                     scheduler: Any = None, restart: bool = False,
                     progress: bool | None = None) -> MonteCarlo:
-    """Monte Carlo tolerance study of ``scene``: the samples as a sweep in ``out/cases``
+    """Monte Carlo tolerance study of ``scene`` with ``engine``: the samples as a sweep in ``out/cases``
     (resumable), the ideal joint, the statistics.
 
-    Parameters
-    ----------
-    scene : Scene
-        The base scene; its own errors are replaced where a distribution is given.
-    engine : str
-        A key of :data:`cardan_exudyn.engines.ENGINES`.
-    samples, seed : int
-        N and the seed of the draws (same seed, same samples).
-    distributions : dict, optional
-        Scene path (e.g. ``joint.errors.a1_mm``) -> distribution table (``dist``, ``low``,
-        ``high``, ``mean``, ``std``); default :func:`default_distributions`.
-    out : path
-        Folder of the sweep, ``cases/``: one record per sample as it finishes.
-    method, workers, scheduler, restart, progress
-        Passed to :func:`cardan_exudyn.sweep.run_sweep` (``method``: ``lhs`` or ``random``).
+    ``samples``, ``seed``: N and the draws' seed; ``distributions``: scene path -> distribution table
+    (default :func:`default_distributions`), replacing the scene's own errors; ``method`` (``lhs``,
+    ``random``), ``workers``, ``scheduler``, ``restart``, ``progress``: to :func:`cardan_exudyn.sweep.run_sweep`.
     """
     import pandas as pd  # import cost: pandas for this study only
 

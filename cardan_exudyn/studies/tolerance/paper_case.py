@@ -1,12 +1,7 @@
 """The paper's tolerance case (sections 4.2 and 5): the rig scene (15 deg, 6 rad/s, f = 0.42,
-0.2 N m) without and with ``a_i = 0.5 mm`` and twist errors of 6e-3 deg (i = 1, 2, 3); the paper
-reports that such errors change the efficiency by about 0.15 %.
-
-:func:`paper_case` computes the change with every engine, parameter set, friction law
-(``friction.law``) and coupling: ``converged`` (friction fed back into the dynamics) or
-``uncoupled`` (eqs. (3), (5) on the frictionless reactions), with the per-pair breakdown and the
-sliding work of eq. (5); :func:`law_verdicts` says which combination matches the paper;
-:func:`sign_envelope` is the spread the errors' signs alone make.
+0.2 N m) without and with ``a_i = 0.5 mm`` and twist errors of 6e-3 deg; the paper reports an
+efficiency change of about 0.15 %. Computed per engine, parameter set, friction law and coupling
+(``converged``, or ``uncoupled``: eqs. (3), (5) on the frictionless reactions).
 """
 
 from __future__ import annotations
@@ -42,8 +37,7 @@ def _value(x: float | None) -> float:
 
 
 def case_numbers(summary: Summary) -> dict[str, float]:
-    """Mean efficiency and per-pair loss and sliding-loss shares of the input work [-] (NaN where
-    the run has no value)."""
+    """Mean efficiency and per-pair loss and sliding-loss shares of the input work [-] (NaN where missing)."""
     w_in = _value(summary.input_work)
     out = {"mean_efficiency": _value(summary.mean_efficiency)}
     for pair in PAIR_NAMES:
@@ -53,19 +47,8 @@ def case_numbers(summary: Summary) -> dict[str, float]:
 
 
 def paper_row(parameters: str, coupling: str, engine: str, law: str = "paper") -> dict[str, Any]:
-    """The rig case of one parameter set, friction law and coupling run by ``engine`` without and
-    with the stated errors: statuses, efficiencies [-], their change and per-pair loss changes [-].
-
-    Parameters
-    ----------
-    parameters : str
-        A parameter set of :func:`reference.paper.scenes.rig_scene`.
-    coupling : str
-        One of :data:`COUPLINGS`.
-    engine : str
-        A key of :data:`cardan_exudyn.engines.ENGINES`.
-    law : str
-        One of :data:`LAWS`.
+    """The rig case of set ``parameters``, ``law`` and ``coupling`` run by ``engine`` without and with
+    the stated errors: statuses, efficiencies, their change, per-pair loss changes [-].
     """
     ideal = replace(rig_scene(parameters=parameters), **{"friction.coupling": coupling, "friction.law": law})
     with_errors = replace(ideal, **paper_errors())
@@ -96,19 +79,17 @@ def paper_case(engines: Sequence[str] = ("reference", "exudyn"),
     Parameters
     ----------
     engines, parameter_sets, couplings, laws : sequence of str
-        Keys of :data:`cardan_exudyn.engines.ENGINES`, parameter sets of
-        :func:`reference.paper.scenes.rig_scene`, ``friction.coupling`` and ``friction.law`` values.
+        Keys of :data:`cardan_exudyn.engines.ENGINES`, sets of :func:`reference.paper.scenes.rig_scene`,
+        ``friction.coupling`` and ``friction.law`` values.
     progress : callable, optional
         Called with each row as it is computed.
 
     Returns
     -------
     pandas.DataFrame
-        One row per (parameters, law, coupling, engine): statuses, ``eta_ideal``, ``eta_errors``,
-        ``change`` (absolute) and ``relative_change``, ``sliding_share`` (sliding work over input
-        work, with errors) and per pair ``d_loss_<pair>``: the change of that pair's loss as a
-        share of the input work (they add up to minus the change of efficiency, up to the change
-        of the input work itself); all [-].
+        One row per (parameters, law, coupling, engine), all [-]: statuses, ``eta_ideal``,
+        ``eta_errors``, ``change``, ``relative_change``, ``sliding_share`` and per pair
+        ``d_loss_<pair>`` (that pair's loss change over the input work).
     """
     import pandas as pd  # import cost: pandas for this study only
 
@@ -121,23 +102,9 @@ def paper_case(engines: Sequence[str] = ("reference", "exudyn"),
 
 
 def law_verdicts(rows, paper: float) -> list[dict[str, Any]]:
-    """Per parameter set and engine of :func:`paper_case` rows: the relative change (or status) of
-    each (law, coupling), the closest to ``paper`` [-] in magnitude ratio, whether it is within
-    :data:`MATCH_FACTOR`.
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        :func:`paper_case`'s rows.
-    paper : float
-        The paper's relative change [-].
-
-    Returns
-    -------
-    list of dict
-        ``parameters``, ``engine``, ``cells`` (``"<law>/<coupling>"`` -> relative change [-], or
-        the status of a run that failed), ``closest`` (a cell key, None when nothing ran ok),
-        ``matches`` (bool, None without a closest).
+    """Per parameter set and engine of :func:`paper_case` ``rows``: ``cells`` (``"<law>/<coupling>"``
+    -> relative change [-] or failed status), ``closest`` to ``paper`` in magnitude ratio (None when
+    nothing ran ok), ``matches`` (within :data:`MATCH_FACTOR`).
     """
     out = []
     for (parameters, engine), group in rows.groupby(["parameters", "engine"], sort=False):
@@ -154,24 +121,9 @@ def law_verdicts(rows, paper: float) -> list[dict[str, Any]]:
 
 def sign_envelope(parameters: str = "matched", coupling: str = "converged",
                   engine: str = "reference") -> dict[str, Any]:
-    """Range of the efficiency change [-] over the 64 sign combinations of the stated errors.
-
-    The paper gives the tolerances as magnitudes; this is the spread their signs alone make.
-
-    Parameters
-    ----------
-    parameters : str
-        A parameter set of :func:`reference.paper.scenes.rig_scene`.
-    coupling : str
-        The scene's ``friction.coupling``.
-    engine : str
-        A key of :data:`cardan_exudyn.engines.ENGINES`.
-
-    Returns
-    -------
-    dict
-        The arguments, ``combinations``, ``ok`` (runs that ended ok), ``eta_ideal`` [-],
-        ``change_min`` and ``change_max`` [-] (NaN when none ran ok).
+    """Range of the efficiency change [-] over the 64 sign combinations of the stated errors (the paper
+    gives magnitudes): the arguments, ``combinations``, ``ok``, ``eta_ideal``, ``change_min``,
+    ``change_max`` (NaN when none ran ok).
     """
     ideal = replace(rig_scene(parameters=parameters), **{"friction.coupling": coupling})
     eta0 = _value(run(ideal, engine).mean_efficiency)
@@ -190,21 +142,8 @@ def sign_envelope(parameters: str = "matched", coupling: str = "converged",
 
 def paper_study(engines: Sequence[str] = ("reference", "exudyn"),
                 progress: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
-    """``cardan tolerance paper``'s numbers: :func:`paper_case` over every parameter set, law and
-    coupling, :func:`sign_envelope` per parameter set and coupling, :func:`law_verdicts`.
-
-    Parameters
-    ----------
-    engines : sequence of str
-        Keys of :data:`cardan_exudyn.engines.ENGINES`.
-    progress : callable, optional
-        Called with each row of :func:`paper_case` as it is computed.
-
-    Returns
-    -------
-    dict
-        ``paper_change`` (the paper's relative change [-]), ``rows`` (:func:`paper_case`'s
-        DataFrame), ``sign_envelope`` (list of dict) and ``verdicts`` (list of dict).
+    """``cardan tolerance paper``'s numbers with ``engines``: ``paper_change`` [-], ``rows``
+    (:func:`paper_case` over everything), ``sign_envelope`` and ``verdicts`` (:func:`law_verdicts`).
     """
     rows = paper_case(engines, progress=progress)
     envelope = [sign_envelope(p, c) for p in PARAMETER_SETS for c in COUPLINGS]

@@ -1,7 +1,4 @@
-"""The folders of ``cardan tolerance``: the Monte Carlo study's (``samples.csv``,
-``sensitivity.csv``, ``tolerance.json``, two plots, ``report.md``; :func:`write_monte_carlo`) and
-the paper case's (``paper_case.csv``, ``paper_case.json``, the breakdown plot, ``report.md``;
-:func:`write_paper_case`), each written atomically."""
+"""The folders of ``cardan tolerance`` (Monte Carlo study, paper case), each written atomically."""
 
 from __future__ import annotations
 
@@ -35,15 +32,8 @@ SENSITIVITY_FORMATS = {"Spearman rho": "+.3f", "rho with magnitude": "+.3f", "co
 
 
 def write_monte_carlo(study: MonteCarlo, folder: str | Path) -> Path:
-    """The study folder (replaced atomically): ``samples.csv``, ``sensitivity.csv``,
+    """The ``study``'s folder (replaced atomically): ``samples.csv``, ``sensitivity.csv``,
     ``tolerance.json``, the plots of :func:`monte_carlo_plots` and ``report.md``.
-
-    Parameters
-    ----------
-    study : MonteCarlo
-        The study (:func:`~cardan_exudyn.studies.tolerance.montecarlo.run_monte_carlo`).
-    folder : path
-        The folder.
     """
     summary = study.summary
     with atomic_directory(Path(folder)) as tmp:
@@ -57,19 +47,8 @@ def write_monte_carlo(study: MonteCarlo, folder: str | Path) -> Path:
 
 
 def monte_carlo_plots(folder: Path, table, params: Sequence[str], eta0: float) -> None:
-    """``efficiency_histogram.png`` (with the ideal joint and the 5/50/95 percentiles) and
-    ``efficiency_vs_errors.png`` (the efficiency against each error); nothing without a sample.
-
-    Parameters
-    ----------
-    folder : Path
-        An existing folder.
-    table : pandas.DataFrame
-        The samples that ran ok.
-    params : sequence of str
-        The drawn errors (scene paths).
-    eta0 : float
-        The ideal joint's mean efficiency [-].
+    """``efficiency_histogram.png`` and ``efficiency_vs_errors.png`` into ``folder`` from the ok samples
+    ``table``, errors ``params`` and ideal efficiency ``eta0`` [-]; nothing without a sample.
     """
     # import cost: matplotlib only when a study is written
     from cardan_exudyn.report.plots import plt, save
@@ -90,9 +69,7 @@ def monte_carlo_plots(folder: Path, table, params: Sequence[str], eta0: float) -
 
 
 def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: float) -> None:
-    """The mean efficiency ``eta`` of the samples against each error of ``params``, the
-    ideal joint's ``eta0`` dashed, into ``path``.
-    """
+    """Mean efficiency ``eta`` against each error of ``params``, ``eta0`` dashed, into ``path``."""
     from cardan_exudyn.report.plots import plt, save  # import cost, as above
 
     cols = min(3, len(params))
@@ -109,15 +86,7 @@ def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: fl
 
 
 def monte_carlo_markdown(summary: Mapping[str, Any], sens) -> str:
-    """``report.md`` of the Monte Carlo study: the draws, the percentiles, the sensitivities.
-
-    Parameters
-    ----------
-    summary : mapping
-        The study's summary.
-    sens : pandas.DataFrame
-        Its sensitivities (empty: none shown).
-    """
+    """``report.md`` of the Monte Carlo study from ``summary`` and sensitivities ``sens`` (empty: none shown)."""
     ideal = (f"{number(summary['ideal_mean_efficiency'], '.6f')}." if summary["ideal_status"] == Status.OK
              else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}.")
     parts = [f"# Monte Carlo tolerance study: {summary['scene']} ({summary['engine']})\n\n"
@@ -138,15 +107,8 @@ def monte_carlo_markdown(summary: Mapping[str, Any], sens) -> str:
 
 
 def percentile_table(m: Mapping[str, float], change: Mapping[str, float]) -> str:
-    """Percentiles of the mean efficiency and of its change from the ideal joint, mean and
-    std, as a markdown table.
-
-    Parameters
-    ----------
-    m : mapping
-        ``p<q>`` for each of :data:`LEVELS`, ``mean``, ``std`` [-].
-    change : mapping
-        ``p<q>`` of the change [-] (a missing one: empty).
+    """Markdown table of the percentiles, mean and std of the mean efficiency ``m`` and of its
+    ``change`` from the ideal joint [-].
     """
     rows = [{"statistic": f"p{q}", "mean efficiency": m[f"p{q}"], "change from ideal": change.get(f"p{q}")}
             for q in LEVELS]
@@ -157,15 +119,7 @@ def percentile_table(m: Mapping[str, float], change: Mapping[str, float]) -> str
 
 
 def verdict_line(v: Mapping[str, Any], paper: float) -> str:
-    """One sentence: which law/coupling of a parameter set and engine matches the paper's change.
-
-    Parameters
-    ----------
-    v : mapping
-        One of :func:`~cardan_exudyn.studies.tolerance.paper_case.law_verdicts`.
-    paper : float
-        The paper's relative change [-].
-    """
+    """One sentence: which law/coupling of verdict ``v`` matches the paper's relative change ``paper``."""
     if v["closest"] is None:
         return f"{v['parameters']}, {v['engine']}: no combination ran ok"
     said = "matches" if v["matches"] else f"is the closest, but outside a factor {MATCH_FACTOR:g} of"
@@ -175,21 +129,8 @@ def verdict_line(v: Mapping[str, Any], paper: float) -> str:
 
 
 def write_paper_case(study: Mapping[str, Any], out: str | Path) -> dict[str, Any]:
-    """The paper case's folder (replaced atomically): ``paper_case.csv``,
-    ``paper_case.json``, ``paper_case_breakdown.png``, ``report.md``.
-
-    Parameters
-    ----------
-    study : mapping
-        :func:`~cardan_exudyn.studies.tolerance.paper_case.paper_study`.
-    out : path
-        The folder.
-
-    Returns
-    -------
-    dict
-        What ``paper_case.json`` holds: ``paper_change`` [-], ``cases`` (the rows as records),
-        ``sign_envelope``, ``verdicts``.
+    """The paper case's folder ``out`` (replaced atomically) from ``study``: ``paper_case.csv``,
+    ``paper_case.json``, ``paper_case_breakdown.png``, ``report.md``; returns the JSON's content.
     """
     rows = study["rows"]
     summary = {"paper_change": study["paper_change"], "cases": rows.to_dict(orient="records"),
@@ -204,16 +145,7 @@ def write_paper_case(study: Mapping[str, Any], out: str | Path) -> dict[str, Any
 
 
 def breakdown_plot(path: Path, rows) -> None:
-    """Stacked bars of each pair's loss change per (parameters, law, coupling, engine) that ran
-    ok; nothing when none did.
-
-    Parameters
-    ----------
-    path : Path
-        The image file.
-    rows : pandas.DataFrame
-        :func:`~cardan_exudyn.studies.tolerance.paper_case.paper_case`'s rows.
-    """
+    """Stacked bars of each pair's loss change per ok row of ``rows`` into ``path``; nothing when none ran ok."""
     # import cost: matplotlib only when a report is written
     from cardan_exudyn.report.plots import plt, save
 
@@ -240,16 +172,7 @@ def breakdown_plot(path: Path, rows) -> None:
 
 
 def law_table(v: Mapping[str, Any], paper: float) -> str:
-    """One parameter set and engine: the table of relative changes (coupling x law) and the
-    verdict sentence.
-
-    Parameters
-    ----------
-    v : mapping
-        One of :func:`~cardan_exudyn.studies.tolerance.paper_case.law_verdicts`.
-    paper : float
-        The paper's relative change [-].
-    """
+    """Verdict ``v``'s table of relative changes (coupling x law) and its sentence against ``paper``."""
     rows = [{"coupling": c, **{law: v["cells"].get(f"{law}/{c}", "-") for law in LAWS}}
             for c in COUPLINGS]
     table = markdown_table(rows, ["coupling", *LAWS], {law: "+.3%" for law in LAWS})
@@ -257,8 +180,7 @@ def law_table(v: Mapping[str, Any], paper: float) -> str:
 
 
 def _case_rows(rows) -> list[dict[str, Any]]:
-    """The cases table's rows: a failed run has no numbers, its status stands in place of the
-    efficiency with errors."""
+    """The cases table's rows; a failed run's status stands in for the efficiency with errors."""
     cases = []
     for r in rows.to_dict(orient="records"):
         if r["status_errors"] != Status.OK or r["status_ideal"] != Status.OK:
@@ -270,19 +192,7 @@ def _case_rows(rows) -> list[dict[str, Any]]:
 
 def paper_markdown(rows, envelope: Sequence[Mapping[str, Any]], paper: float,
                    verdicts: Sequence[Mapping[str, Any]] = ()) -> str:
-    """``report.md`` of the paper's case: law x coupling tables, the cases, the sign envelope.
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        :func:`~cardan_exudyn.studies.tolerance.paper_case.paper_case`'s rows.
-    envelope : sequence of dict
-        :func:`~cardan_exudyn.studies.tolerance.paper_case.sign_envelope` per set and coupling.
-    paper : float
-        The paper's relative change [-].
-    verdicts : sequence of dict
-        :func:`~cardan_exudyn.studies.tolerance.paper_case.law_verdicts`.
-    """
+    """``report.md`` of the paper's case: law x coupling tables, the cases, the sign ``envelope``."""
     envelope_rows = [{"parameters": e["parameters"], "coupling": e["coupling"],
                       "combinations ok": f"{e['ok']}/{e['combinations']}",
                       "change min": e["change_min"], "change max": e["change_max"]} for e in envelope]
