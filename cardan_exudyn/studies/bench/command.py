@@ -1,23 +1,6 @@
-"""``cardan bench``: run time against error of every engine configuration on a scene.
-
-For each scene (the one of ``--scene`` or ``--name`` with the other scene options applied, or
-by default the fixed set of
-:data:`~cardan_exudyn.studies.bench.configs.SCENES`: frictionless and with the paper's friction,
-10 and 35 deg, and 10 deg with the paper's mounting tolerances so that pairs slide, at 2000 rpm)
-and each engine configuration (Exudyn's step size, Newton settings, node type, friction
-coupling, velocity projection and Richardson extrapolation; the reference engine's sampling and
-quadrature tolerance; MuJoCo with its recommended settings and a shorter constraint time
-constant, frictionless scenes only) the bench records the errors against the reference engine,
-the median wall time per simulated second and the engine's cost counters, and names the cheapest
-run of each configuration at the scene's ``numerics.accuracy``. ``docs/bench.md`` has the
-definitions. The modules, by concept:
-
-- :mod:`~cardan_exudyn.studies.bench.configs`: the default scenes and the engine configurations;
-- :mod:`~cardan_exudyn.studies.bench.ladders`: the runs, their errors and wall times;
-- :mod:`~cardan_exudyn.studies.bench.result`: the whole bench in one call, :func:`run_bench`, and
-  its reading at the scene's accuracy;
-- :mod:`~cardan_exudyn.studies.bench.report`: the results folder and ``report.md``;
-- this module: the command (:func:`register`, :func:`handler`).
+"""``cardan bench``: run time against error of every engine configuration on a scene (the one of
+``--scene``/``--name``, or the default :data:`~cardan_exudyn.studies.bench.configs.SCENES`);
+definitions in ``docs/bench.md``.
 """
 
 from __future__ import annotations
@@ -82,14 +65,8 @@ def given_scene_options(args: argparse.Namespace) -> list[str]:
 
 
 def scenes_from_args(args: argparse.Namespace) -> dict[str, Any] | None:
-    """The scene of ``--scene`` or ``--name`` with the other scene options applied
-    (``{name: scene}``), or None for the default set.
-
-    Raises
-    ------
-    BadInput
-        ``--scenes`` together with ``--scene`` or ``--name``, or another scene option without
-        either (the default scenes are fixed).
+    """``{name: scene}`` of ``--scene`` or ``--name`` with the other scene options, or None for the
+    default set; BadInput for ``--scenes`` with either, or a scene option without either.
     """
     options = given_scene_options(args)
     if args.scene is None and args.name is None:
@@ -126,8 +103,9 @@ def summary_lines(configurations: list[dict[str, Any]]) -> list[str]:
 
 
 def handler(args: argparse.Namespace) -> int:
-    """Run ``cardan bench``: the bench, its folder (``--out``) and the cheapest run of each
-    configuration at the scene's accuracy (or ``--json``)."""
+    """Run ``cardan bench``: the bench, its ``--out`` folder and the cheapest run of each configuration
+    at the scene's accuracy (or ``--json``).
+    """
     # The bench's modules load Exudyn, pandas and matplotlib; `cardan` imports every study's
     # `register` to build its parser, so they are imported when the command runs.
     from cardan_exudyn.studies.bench.configs import ENGINE_NAMES, BenchError, fixed_scenes

@@ -1,12 +1,6 @@
-"""What ``cardan bench`` runs: its default scenes (:func:`bench_scene`, :func:`fixed_scenes`)
-and every engine configuration on its ladder of steps per revolution (:func:`configurations`).
-
-Exudyn: the engine's defaults and the "tuned" Newton settings; with friction the three friction
-couplings (converged, extrapolated, and the paper's lagged one); without friction the velocity
-projection and the projection with Richardson extrapolation; the other node types (full bench).
-MuJoCo: RK4 at two constraint time constants (frictionless scenes without mounting errors, when
-the optional extra is installed); the reference engine: its quadrature tolerance and table
-samples. A configuration carries any scene changes it needs (:class:`Config`, ``changes``).
+"""What ``cardan bench`` runs: its default scenes and every engine configuration (Exudyn settings,
+couplings, projections, node types; MuJoCo on frictionless ideal scenes; the reference's
+tolerances and samples) on its ladder of steps per revolution.
 """
 
 from __future__ import annotations
@@ -85,13 +79,7 @@ class BenchError(ValueError):
 
 
 def bench_scene(key: str) -> Scene:
-    """The scene of the bench's scene key ``key`` (a key of :data:`SCENES`).
-
-    Raises
-    ------
-    BenchError
-        An unknown key.
-    """
+    """The scene of bench key ``key`` (of :data:`SCENES`); BenchError for an unknown key."""
     if key not in SCENES:
         raise BenchError(f"`scene` must be one of {list(SCENES)}, got {key!r}")
     scene = named_scene(SCENES[key])
@@ -102,12 +90,8 @@ def bench_scene(key: str) -> Scene:
 
 
 def fixed_scenes(keys: Iterable[str] | None = None) -> dict[str, Scene]:
-    """The default scenes named by ``keys`` (keys of :data:`SCENES`; None: all), in that order.
-
-    Raises
-    ------
-    BenchError
-        An unknown key.
+    """The default scenes named by ``keys`` (of :data:`SCENES`; None: all), in that order; BenchError
+    for an unknown key.
     """
     keys = list(SCENES) if keys is None else list(keys)
     unknown = [k for k in keys if k not in SCENES]
@@ -126,22 +110,10 @@ def frozen_changes(changes: Mapping[str, Any] | Iterable[tuple[str, Any]]) -> tu
 class Config:
     """One engine configuration at one resolution.
 
-    Attributes
-    ----------
-    engine : str
-        A key of :data:`cardan_exudyn.engines.ENGINES`.
-    label : str
-        The configuration's name in the tables and plots.
-    steps : int
-        Steps (Exudyn, MuJoCo) or table samples (reference) per input revolution [-].
-    options : engine options or None
-        Options of the engine's class; None takes the engine's defaults.
-    changes : mapping or tuple of (str, value) pairs
-        Scene changes as :func:`reference.scene.mapping.replace` takes them (``{"friction.coupling":
-        "lagged"}``, ``{"numerics.richardson": True}``); stored as a sorted tuple of pairs.
-    sets_step : bool
-        True: ``steps`` sets the scene's time step; False: the options hold the resolution (the
-        reference engine's table samples).
+    ``engine``, ``label`` (its name in tables and plots), ``steps`` (steps or, for the reference,
+    table samples per input revolution), ``options`` (None: the engine's defaults), ``changes``
+    (scene changes for :func:`reference.scene.mapping.replace`, stored as a sorted tuple of pairs)
+    and ``sets_step`` (``steps`` sets the scene's step; else the options hold the resolution).
     """
 
     engine: str
@@ -187,19 +159,9 @@ Setting = tuple[str, ExudynOptions, dict[str, Any]]
 
 
 def exudyn_settings(friction: bool, quick: bool) -> list[Setting]:
-    """``(label, options, scene changes)`` of the Exudyn configurations for a scene kind.
-
-    With friction the coupling is always given, so that a label means the same scheme whatever
-    the scene's default: ``default`` and ``tuned`` the converged one, ``tuned extrapolated`` the
-    one-solve scheme, ``tuned lagged`` the paper's. Without friction: the velocity projection,
-    and the projection with Richardson extrapolation of two runs (``numerics.richardson``).
-
-    Parameters
-    ----------
-    friction : bool
-        The scene has friction.
-    quick : bool
-        Leave out the other node types.
+    """``(label, options, scene changes)`` of the Exudyn configurations for a scene with or without
+    ``friction`` (``quick``: no other node types). With friction the coupling is always given, so a
+    label means one scheme whatever the scene's default.
     """
     converged = {"friction.coupling": "converged"} if friction else {}
     out: list[Setting] = [("exudyn default", EXUDYN_DEFAULT, converged),
@@ -218,15 +180,8 @@ def exudyn_settings(friction: bool, quick: bool) -> list[Setting]:
 
 
 def exudyn_configs(friction: bool, quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """Every Exudyn setting on the ladder.
-
-    Parameters
-    ----------
-    friction, quick : bool
-        As :func:`exudyn_settings`; ``quick`` also runs only :data:`QUICK_FULL_LADDER` on the whole
-        ladder, the others on its first two steps.
-    ladder : dict
-        Engine -> steps per revolution [-] (:data:`FULL_LADDER` or :data:`QUICK_LADDER`).
+    """Every Exudyn setting on ``ladder`` (engine -> steps per revolution); ``quick`` runs only
+    :data:`QUICK_FULL_LADDER` on the whole ladder, the others on its first two steps.
     """
     out = []
     for label, options, changes in exudyn_settings(friction, quick):
@@ -238,16 +193,8 @@ def exudyn_configs(friction: bool, quick: bool, ladder: dict[str, tuple[int, ...
 
 
 def mujoco_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """MuJoCo, RK4, constraint time constants of 10 and (not ``quick``) 20 steps, the
-    recommended one, on the ladder's MuJoCo steps (``ladder["mujoco"]`` per revolution); none without
-    the optional extra.
-
-    Parameters
-    ----------
-    quick : bool
-        The time constant of 10 steps only.
-    ladder : dict
-        Engine -> steps per revolution [-].
+    """MuJoCo, RK4, constraint time constants of 10 and (not ``quick``) 20 steps on ``ladder["mujoco"]``;
+    none without the optional extra.
     """
     out = []
     for tc in ((10.0,) if quick else (10.0, 20.0)):
@@ -261,16 +208,7 @@ def mujoco_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Conf
 
 
 def reference_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """The reference engine at quadrature tolerances 1e-9, 1e-6, 1e-4 (``quick``: 1e-6) and
-    the ladder's table samples per revolution (``ladder["reference"]``).
-
-    Parameters
-    ----------
-    quick : bool
-        One tolerance.
-    ladder : dict
-        Engine -> table samples per revolution [-].
-    """
+    """The reference at quadrature tolerances 1e-9, 1e-6, 1e-4 (``quick``: 1e-6) on ``ladder["reference"]``."""
     return [Config("reference", f"reference rtol {rtol:g}", n,
                    ReferenceOptions(samples_per_revolution=n, quadrature_rtol=rtol), sets_step=False)
             for rtol in ((1e-6,) if quick else (1e-9, 1e-6, 1e-4)) for n in ladder["reference"]]
@@ -278,20 +216,9 @@ def reference_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[C
 
 def configurations(scene: Scene, quick: bool = False,
                    engines: Iterable[str] = ENGINE_NAMES) -> list[Config]:
-    """Every configuration benchmarked on ``scene``: the friction configurations when it has
-    friction, the frictionless ones otherwise.
-
-    MuJoCo runs frictionless scenes without mounting errors only: it has no friction
-    proportional to the reactions, and its joints are the ideal joint's.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene benchmarked.
-    quick : bool
-        The short ladders (:data:`QUICK_LADDER`) and fewer settings.
-    engines : iterable of str
-        The engines to configure (of :data:`ENGINE_NAMES`).
+    """Every configuration benchmarked on ``scene`` for ``engines`` (``quick``: short ladders, fewer
+    settings). MuJoCo runs frictionless scenes without mounting errors only: its joints are ideal and
+    its friction not proportional to the reactions.
     """
     engines = set(engines)
     ladder = QUICK_LADDER if quick else FULL_LADDER

@@ -1,15 +1,7 @@
 """The work-precision runs of ``cardan bench``: every configuration of every scene, its errors
-against the reference engine and its wall time.
-
-The errors (:func:`run_errors`) are against the reference engine at its default (tightest)
-settings, which is exact for prescribed motion (to its ODE tolerance for a torque drive): largest
-error of ``omega_out / omega_in`` against the exact ratio, largest drive-torque error over the
-whole run and after the first revolution (the generalized-alpha start-up transient is in the
-first), the mean-efficiency error (with friction; without friction every engine reports exactly
-1) and the mean-input-torque error. The wall time is the median of ``repeats`` calls of
-the engine's run (model build, solve and the result table: what a caller pays), per simulated
-second; the repeats run in rounds over all configurations, so that a change in the machine's
-load hits every configuration alike.
+against the reference engine at its tightest defaults, and its median wall time per simulated
+second. The repeats run in rounds over all configurations, so a change in the machine's load hits
+every configuration alike.
 """
 
 from __future__ import annotations
@@ -59,13 +51,7 @@ class Yardstick:
 
 
 def yardstick(scene: Scene) -> Yardstick:
-    """Reference run of ``scene`` (summary only) at the engine's default (tightest) settings.
-
-    Raises
-    ------
-    BenchError
-        When the reference engine cannot solve the scene.
-    """
+    """Reference run of ``scene`` (summary only) at its tightest defaults; BenchError when it fails."""
     options = ReferenceOptions()
     result = engines.run(replace(scene, **{"record.timeseries": False}), "reference", options)
     if not result.success:
@@ -74,26 +60,12 @@ def yardstick(scene: Scene) -> Yardstick:
 
 
 def run_errors(scene: Scene, result: Result, yard: Yardstick) -> dict[str, float]:
-    """Error measures of one run against the reference (NaN when the run has no table/means).
+    """Errors [-] of run ``result`` of ``scene`` against ``yard`` (NaN without table or means).
 
-    Parameters
-    ----------
-    scene : Scene
-        The scene the run was made of.
-    result : Result
-        The run, with its time table.
-    yard : Yardstick
-        The reference's answer for ``scene`` (:func:`yardstick`).
-
-    Returns
-    -------
-    dict
-        ``speed_ratio_error``: max ``|omega_out/omega_in - Hooke(theta_in)|`` [-] (with mounting
-        errors the reference's exact ratio at the row's instant instead of Hooke's);
-        ``torque_in_error``: max ``|torque_in - reference|`` over the reference's largest
-        ``|torque_in|`` over all rows [-], ``torque_in_error_steady`` the same after the first
-        input revolution; ``mean_efficiency_error``: ``|eta - eta_ref|`` (friction scenes) [-];
-        ``mean_torque_in_error``: relative error of the mean input torque [-].
+    ``speed_ratio_error``: max ``|omega_out/omega_in - exact ratio|``; ``torque_in_error`` (all rows)
+    and ``torque_in_error_steady`` (after the first revolution): max ``|torque_in - reference|`` over
+    the reference's largest ``|torque_in|``; ``mean_efficiency_error`` (friction scenes);
+    ``mean_torque_in_error`` (relative).
     """
     out = dict.fromkeys(ERROR_KEYS, float("nan"))
     if not result.success or result.table is None:
@@ -109,9 +81,7 @@ def run_errors(scene: Scene, result: Result, yard: Yardstick) -> dict[str, float
 
 
 def _table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[str, float]:
-    """The speed-ratio and drive-torque errors of a run's time ``table`` of ``scene``
-    against the reference's ``yard`` (the first three keys of :func:`run_errors`).
-    """
+    """The speed-ratio and drive-torque errors of time ``table`` of ``scene`` against ``yard``."""
     t = table["t"].to_numpy()
     theta = table["theta_in"].to_numpy()
     ratio = table["omega_out"].to_numpy() / table["omega_in"].to_numpy()
@@ -131,8 +101,9 @@ def _table_errors(scene: Scene, table: pd.DataFrame, yard: Yardstick) -> dict[st
 
 
 def cost_counters(summary: Summary) -> dict[str, Any]:
-    """The engine's own cost counters, flattened: steps, Newton iterations, Jacobians, friction
-    evaluations per step (Exudyn with friction), quadrature panels (reference)."""
+    """The engine's cost counters, flattened: steps, Newton iterations, Jacobians, friction evaluations
+    per step, quadrature panels.
+    """
     friction = summary.friction
     quadrature = summary.extras.get("quadrature")
     return {"steps": summary.steps, "newton_iterations": summary.newton_iterations,
@@ -154,17 +125,7 @@ class Job:
 
 
 def bench_jobs(scenes: Mapping[str, Scene], quick: bool, engines: Iterable[str]) -> list[Job]:
-    """Every configuration of every scene, with the scene's yardstick.
-
-    Parameters
-    ----------
-    scenes : mapping of str to Scene
-        Key -> scene; the key is the rows' ``scene``.
-    quick : bool
-        The short ladders.
-    engines : iterable of str
-        The engines to run.
-    """
+    """Every configuration of every scene of ``scenes`` (key -> scene) for ``engines``, with the scene's yardstick."""
     jobs = []
     for key, base in scenes.items():
         yard = yardstick(base)
@@ -174,21 +135,7 @@ def bench_jobs(scenes: Mapping[str, Scene], quick: bool, engines: Iterable[str])
 
 
 def timed_run(config: Config, scene: Scene) -> tuple[Result | None, str, float]:
-    """One run of a configuration, timed.
-
-    Parameters
-    ----------
-    config : Config
-        The configuration.
-    scene : Scene
-        Its scene (``config.scene(base)``).
-
-    Returns
-    -------
-    (Result or None, str, float)
-        The result (None when the run raised), the error it raised (empty when none) and the wall
-        time [s].
-    """
+    """``(result or None, error raised or "", wall time [s])`` of one run of ``config`` on ``scene``."""
     start = time.perf_counter()
     result = None
     error = ""
@@ -200,8 +147,8 @@ def timed_run(config: Config, scene: Scene) -> tuple[Result | None, str, float]:
 
 
 def _first_record(job: Job, result: Result | None, error: str) -> dict[str, Any]:
-    """The row of ``job`` from its first run (``result``, None with the ``error`` it raised):
-    configuration, status, errors, cost counters, simulated time [s].
+    """The row of ``job`` from its first run (``result``, or None with ``error``): configuration,
+    status, errors, cost counters, simulated time [s].
     """
     record = {"scene": job.key, **job.config.describe()}
     # the coupling that ran (the scene's own where the configuration does not set one)
@@ -227,26 +174,9 @@ def _finished_row(job: Job) -> dict[str, Any]:
 def work_precision(scenes: Mapping[str, Scene], quick: bool, repeats: int,
                    engines: Iterable[str] = ENGINE_NAMES,
                    progress: Progress | None = None) -> pd.DataFrame:
-    """Run every configuration of every scene ``repeats`` times (in rounds); one row per config.
-
-    Parameters
-    ----------
-    scenes : mapping of str to Scene
-        The scenes by the key their rows carry in ``scene``.
-    quick : bool
-        The short ladders.
-    repeats : int
-        Timed runs per configuration; the wall time is their median.
-    engines : iterable of str
-        The engines to run.
-    progress : callable, optional
-        Called with one line per run.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per configuration: its description, status, errors (:func:`run_errors`), cost
-        counters, ``simulated_s`` [s], ``wall_s`` [s], ``wall_per_simulated_s`` [-].
+    """Run every configuration of every scene ``repeats`` times in rounds, the wall time their median;
+    one row per configuration: description, status, :func:`run_errors`, cost counters,
+    ``simulated_s``, ``wall_s`` [s], ``wall_per_simulated_s`` [-].
     """
     say = progress or quiet
     jobs = bench_jobs(scenes, quick, engines)

@@ -1,6 +1,6 @@
-"""The results folder of ``cardan bench``: ``bench.csv`` opening with an environment header,
-``bench.json``, ``report.md`` and the log-log work-precision plot ``work_precision.png`` (a panel
-per scene), written atomically."""
+"""The results folder of ``cardan bench``: ``bench.csv`` (environment header), ``bench.json``,
+``report.md`` and ``work_precision.png``, written atomically.
+"""
 
 from __future__ import annotations
 
@@ -35,15 +35,7 @@ MARKERS = {"exudyn": "o", "mujoco": "s", "reference": "^"}
 
 
 def header(env: Mapping[str, Any], title: str = "cardan bench") -> str:
-    """The ``#`` lines that open a results file.
-
-    Parameters
-    ----------
-    env : mapping
-        :func:`cardan_exudyn.report.environment.environment`'s date, commit, CPU, Python, packages.
-    title : str
-        The first line's title.
-    """
+    """The ``#`` lines that open a results file: ``title``, then ``env``'s date, commit, CPU, versions."""
     lines = [f"# {title}, {env['date']}", f"# commit {env['commit']}",
              f"# cpu {env['cpu']} ({env['cpu_count']} logical), {env['platform']}",
              f"# python {env['python']}, " + ", ".join(f"{k} {v}" for k, v in env["packages"].items())]
@@ -51,17 +43,7 @@ def header(env: Mapping[str, Any], title: str = "cardan bench") -> str:
 
 
 def table(frame: pd.DataFrame, columns: Sequence[str], formats: Mapping[str, str] | None = None) -> str:
-    """A markdown table.
-
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        The rows.
-    columns : sequence of str
-        The columns shown.
-    formats : mapping, optional
-        Column -> format spec; float columns default to three significant digits.
-    """
+    """A markdown table of ``columns`` of ``frame``; ``formats``: column -> spec (floats: 3 significant digits)."""
     floats = {c: ".3g" for c in columns if c in frame and frame[c].dtype.kind == "f"}
     return markdown_table(frame, columns, {**floats, **(formats or {})})
 
@@ -84,17 +66,7 @@ def bench_command(settings: Mapping[str, Any]) -> str:
 
 
 def intro(result: BenchResult, title: str = "cardan bench", command: str | None = None) -> str:
-    """Title, environment and how to read the numbers.
-
-    Parameters
-    ----------
-    result : BenchResult
-        The bench.
-    title : str
-        The heading.
-    command : str, optional
-        The command line that ran the bench (none: not said).
-    """
+    """Title, environment, the ``command`` that ran ``result`` (if given) and how to read the numbers."""
     env = result.environment
     return (f"# {title}{' (quick)' if result.settings.get('quick') else ''}\n"
             f"{env['date']}, commit `{env['commit']}`, {env['cpu']} ({env['cpu_count']} logical "
@@ -132,8 +104,7 @@ def rows_section(rows: pd.DataFrame) -> str:
 
 
 def report_markdown(result: BenchResult) -> str:
-    """``report.md``: environment, the cheapest run at the accuracy, the work-precision table and
-    plot."""
+    """``report.md``: environment, the cheapest run at the accuracy, the work-precision table and plot."""
     return (intro(result, command=bench_command(result.settings)) + accuracy_section(result)
             + rows_section(result.rows))
 
@@ -154,17 +125,8 @@ def _panel(ax: Any, sel: pd.DataFrame, key: str, label: str) -> None:
 
 
 def work_precision_figure(rows: pd.DataFrame, panels: Mapping[str, tuple[str, float]]) -> Any:
-    """Error against wall time per simulated second, log-log, one column per scene.
-
-    Top row: the scene's measure with its level dashed; bottom row: the drive-torque error after
-    the first revolution. One line per configuration, points along its step ladder.
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        Work-precision rows.
-    panels : mapping of str to (str, float)
-        Scene key -> (error column of the top row, its level [-]), in the order of the columns.
+    """Error against wall time per simulated second, log-log, one column per scene of ``panels`` (key ->
+    top row's error column and level [-]); bottom row: drive-torque error after the first revolution.
     """
     from cardan_exudyn.report.plots import plt  # import cost: matplotlib only when a plot is drawn
 
@@ -180,20 +142,7 @@ def work_precision_figure(rows: pd.DataFrame, panels: Mapping[str, tuple[str, fl
 
 
 def write_bench(result: BenchResult, out: str | os.PathLike) -> Path:
-    """Write the results folder of a bench (replaced as a whole, atomically).
-
-    Parameters
-    ----------
-    result : BenchResult
-        The bench.
-    out : path
-        The folder: ``bench.csv``, ``bench.json``, ``report.md``, ``work_precision.png``.
-
-    Returns
-    -------
-    Path
-        ``out``.
-    """
+    """Write ``result``'s folder ``out`` (replaced atomically); returns ``out``."""
     from cardan_exudyn.report.plots import close  # import cost, as above
 
     panels = {key: (accuracy_measure(scene), scene.numerics.accuracy)

@@ -1,6 +1,6 @@
-"""The whole of ``cardan bench`` in one call (:func:`run_bench`), what it returns
-(:class:`BenchResult`), and its reading: the cheapest run of each configuration at the scene's
-accuracy (:func:`cheapest`, :func:`at_accuracy`)."""
+"""The whole of ``cardan bench`` in one call (:func:`run_bench`), its :class:`BenchResult`, and the
+cheapest run of each configuration at the scene's accuracy.
+"""
 
 from __future__ import annotations
 
@@ -22,22 +22,15 @@ __all__ = ["BenchResult", "accuracy_measure", "cheapest", "at_accuracy", "check_
 
 
 def accuracy_measure(scene: Scene) -> str:
-    """The error column that ``numerics.accuracy`` bounds for ``scene``: the mean-efficiency
-    error with friction, the speed-ratio error without (every engine reports an efficiency of
-    exactly 1 there)."""
+    """The error column ``numerics.accuracy`` bounds for ``scene``: mean-efficiency error with friction,
+    speed-ratio error without (every engine reports exactly 1 there).
+    """
     return "mean_efficiency_error" if scene.has_friction else "speed_ratio_error"
 
 
 def cheapest(rows: pd.DataFrame, levels: Mapping[str, float]) -> pd.Series | None:
-    """The ok row with the least wall time per simulated second whose every error column of
-    ``levels`` is at most its level (a NaN error never is); None when no row qualifies.
-
-    Parameters
-    ----------
-    rows : pandas.DataFrame
-        Work-precision rows (:func:`~cardan_exudyn.studies.bench.ladders.work_precision`).
-    levels : mapping of str to float
-        Error column -> largest acceptable value [-].
+    """The ok row of ``rows`` with the least wall time per simulated second whose every error column of
+    ``levels`` is at most its level [-] (NaN never is); None when none qualifies.
     """
     ok = (rows["status"] == Status.OK) & rows["wall_per_simulated_s"].notna()
     for column, level in levels.items():
@@ -50,21 +43,9 @@ def cheapest(rows: pd.DataFrame, levels: Mapping[str, float]) -> pd.Series | Non
 
 @dataclass
 class BenchResult:
-    """Everything one bench run measured.
-
-    Attributes
-    ----------
-    rows : pandas.DataFrame
-        The work-precision rows, one per configuration and step.
-    scenes : dict of str to Scene
-        The scenes benchmarked, by the key their rows carry in ``scene``.
-    environment : dict
-        Versions, CPU, date and commit.
-    settings : dict
-        ``quick``, ``repeats``, ``scenes`` (the keys), ``engines``, and ``scene_options`` (the
-        scene options given on the command line, empty for the default scenes).
-    wall_s : float
-        Wall time of the whole bench [s].
+    """Everything one bench run measured: ``rows`` (one per configuration and step), ``scenes`` (by
+    key), ``environment``, ``settings`` (``quick``, ``repeats``, ``scenes``, ``engines``,
+    ``scene_options``) and ``wall_s`` [s].
     """
 
     rows: pd.DataFrame
@@ -74,9 +55,7 @@ class BenchResult:
     wall_s: float = 0.0
 
     def summary(self) -> dict[str, Any]:
-        """What ``--json`` prints: environment, settings, wall time, and per scene and
-        configuration the runs, how many ended ok, the fastest and the cheapest at the scene's
-        accuracy (:func:`at_accuracy`)."""
+        """What ``--json`` prints: environment, settings, wall time, and :func:`at_accuracy`'s entries."""
         return {"environment": self.environment, "settings": self.settings, "wall_s": self.wall_s,
                 "configurations": at_accuracy(self)}
 
@@ -98,16 +77,9 @@ def _best_record(scene: str, config: str, sel: pd.DataFrame, measure: str,
 
 
 def at_accuracy(result: BenchResult) -> list[dict[str, Any]]:
-    """Per scene and configuration, the cheapest step whose error on the scene's measure
-    (:func:`accuracy_measure`) is within the scene's ``numerics.accuracy``.
-
-    Returns
-    -------
-    list of dict
-        ``scene``, ``config``, ``runs``, ``ok``, ``fastest_wall_per_simulated_s`` [-] (any ok
-        run, None without one), ``measure``, ``accuracy`` [-], and of the cheapest run at the
-        accuracy ``steps_per_revolution``, ``error`` [-] and ``wall_per_simulated_s`` [-] (None
-        when no step of the ladder reaches it).
+    """Per scene and configuration: ``runs``, ``ok``, ``fastest_wall_per_simulated_s``, ``measure``,
+    ``accuracy`` and the cheapest step within it (``steps_per_revolution``, ``error``,
+    ``wall_per_simulated_s``; None when no step reaches it).
     """
     out = []
     if result.rows.empty:
@@ -119,21 +91,8 @@ def at_accuracy(result: BenchResult) -> list[dict[str, Any]]:
 
 
 def check_inputs(engines: Iterable[str], repeats: int | None, quick: bool) -> tuple[list[str], int]:
-    """The engines and repeats of a bench run (default repeats filled in).
-
-    Parameters
-    ----------
-    engines : iterable of str
-        Of :data:`~cardan_exudyn.studies.bench.configs.ENGINE_NAMES`.
-    repeats : int or None
-        Timed runs per configuration (None: 3, quick 1).
-    quick : bool
-        The quick bench.
-
-    Raises
-    ------
-    BenchError
-        For an unknown engine, or repeats that are not a positive integer.
+    """``engines`` and ``repeats`` (None: 3, ``quick`` 1) checked; BenchError for an unknown engine or
+    repeats not a positive integer.
     """
     engines = list(engines)
     bad = [e for e in engines if e not in ENGINE_NAMES]
@@ -149,29 +108,9 @@ def run_bench(scenes: Mapping[str, Scene] | None = None, quick: bool = False,
               repeats: int | None = None, engines: Iterable[str] = ENGINE_NAMES,
               progress: Progress | None = None,
               scene_options: Iterable[str] = ()) -> BenchResult:
-    """Every engine configuration on every scene, errors against the reference engine and wall
-    times (:func:`~cardan_exudyn.studies.bench.ladders.work_precision`).
-
-    Parameters
-    ----------
-    scenes : mapping of str to Scene, optional
-        The scenes by key (default: the default set,
-        :func:`~cardan_exudyn.studies.bench.configs.fixed_scenes`).
-    quick : bool
-        Short ladders, one repeat by default.
-    repeats : int, optional
-        Timed runs per configuration (default 3, quick 1).
-    engines : iterable of str
-        Engines to run (of :data:`~cardan_exudyn.studies.bench.configs.ENGINE_NAMES`).
-    progress : callable, optional
-        Called with one line of text per finished run.
-    scene_options : iterable of str
-        The command-line scene options the scenes came from, recorded in the settings.
-
-    Raises
-    ------
-    BenchError
-        Bad engines or repeats, or a scene the reference engine cannot solve.
+    """Every engine configuration on every scene (default :func:`~.configs.fixed_scenes`): errors
+    against the reference and wall times; ``scene_options`` is recorded in the settings. BenchError
+    for bad engines or repeats, or a scene the reference cannot solve.
     """
     engines, repeats = check_inputs(engines, repeats, quick)
     scenes = dict(fixed_scenes() if scenes is None else scenes)
