@@ -23,7 +23,7 @@ def is_number(value: Any) -> bool:
 
 
 def number(value: Any, spec: str = ".4g", missing: str = "-") -> str:
-    """``value`` formatted with format spec ``spec`` (``".4f"``), or ``missing`` when it is not a finite number."""
+    """``value`` formatted with format spec ``spec`` (``".4f"``), or ``missing`` if not a finite number."""
     return format(value, spec) if is_number(value) else missing
 
 

@@ -176,7 +176,7 @@ CLASS_COLOURS = {"converged": "#4caf50", "drift": "#ff9800", "self_locking": "#5
 
 
 def _boundary(ax, locks: np.ndarray) -> None:
-    """Black lines on the edges between cells of different reference state (``locks``, shape (angles, values))."""
+    """Black lines between cells of different reference state (``locks``, shape (angles, values))."""
     rows, cols = locks.shape
     for i in range(rows):
         for j in range(cols):

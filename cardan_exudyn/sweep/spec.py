@@ -120,7 +120,7 @@ def _check_disjoint(spec: SweepSpec) -> None:
 
 
 def grid_values(path: str, spec: Any) -> tuple:
-    """The values of grid parameter ``path`` from ``spec``: a list or ``{linspace|geomspace = [start, stop, num]}``."""
+    """Values of grid parameter ``path``: ``spec`` a list or ``{linspace|geomspace = [start, stop, num]}``."""
     where = f"`grid.\"{path}\"`"
     if isinstance(spec, Mapping):
         return _spaced_values(where, spec)

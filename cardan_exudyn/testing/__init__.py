@@ -1,15 +1,7 @@
-"""The harness inside a user's own pytest suite.
-
-Installing cardan-exudyn registers the pytest plugin :mod:`cardan_exudyn.testing.plugin`
-(entry point ``pytest11``): the fixtures ``cardan_scene`` and ``cardan_run``, the marker
-``cardan_slow`` and the ``--cardan-*`` options. The assertions work with or without pytest::
-
-    from cardan_exudyn.testing import assert_efficiency, assert_engines_agree
-
-See ``docs/pytest.md``.
-
-Names are imported on first use (PEP 562): pytest imports the plugin at every start, and the
-comparison behind :func:`assert_engines_agree` pulls in pandas and scipy.
+"""The harness inside a user's own pytest suite: the plugin :mod:`cardan_exudyn.testing.plugin`
+(fixtures ``cardan_scene``, ``cardan_run``) and assertions that work with or without pytest.
+See ``docs/pytest.md``. Names load on first use (PEP 562): pytest imports the plugin at every
+start, and :func:`assert_engines_agree` pulls in pandas and scipy.
 """
 
 from __future__ import annotations

@@ -90,7 +90,7 @@ class CachingRunner:
         return scene, engine, options
 
     def error_estimate(self, result: Result) -> ErrorEstimate | None:
-        """:func:`cardan_exudyn.model.error_estimate.error_estimate` with this runner for the half-step rerun."""
+        """:func:`cardan_exudyn.model.error_estimate.error_estimate`, this runner doing the half-step rerun."""
         return error_estimate(result, run=self)
 
     @property

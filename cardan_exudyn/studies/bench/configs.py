@@ -208,7 +208,7 @@ def mujoco_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Conf
 
 
 def reference_configs(quick: bool, ladder: dict[str, tuple[int, ...]]) -> list[Config]:
-    """The reference at quadrature tolerances 1e-9, 1e-6, 1e-4 (``quick``: 1e-6) on ``ladder["reference"]``."""
+    """The reference at quadrature tolerances 1e-9, 1e-6, 1e-4 (``quick``: 1e-6), ``ladder["reference"]``."""
     return [Config("reference", f"reference rtol {rtol:g}", n,
                    ReferenceOptions(samples_per_revolution=n, quadrature_rtol=rtol), sets_step=False)
             for rtol in ((1e-6,) if quick else (1e-9, 1e-6, 1e-4)) for n in ladder["reference"]]

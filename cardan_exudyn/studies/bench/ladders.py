@@ -125,7 +125,7 @@ class Job:
 
 
 def bench_jobs(scenes: Mapping[str, Scene], quick: bool, engines: Iterable[str]) -> list[Job]:
-    """Every configuration of every scene of ``scenes`` (key -> scene) for ``engines``, with the scene's yardstick."""
+    """Every configuration of each of ``scenes`` (key -> scene) for ``engines``, with its yardstick."""
     jobs = []
     for key, base in scenes.items():
         yard = yardstick(base)

@@ -43,7 +43,7 @@ def header(env: Mapping[str, Any], title: str = "cardan bench") -> str:
 
 
 def table(frame: pd.DataFrame, columns: Sequence[str], formats: Mapping[str, str] | None = None) -> str:
-    """A markdown table of ``columns`` of ``frame``; ``formats``: column -> spec (floats: 3 significant digits)."""
+    """Markdown table of ``columns`` of ``frame``; ``formats``: column -> spec (floats: 3 digits)."""
     floats = {c: ".3g" for c in columns if c in frame and frame[c].dtype.kind == "f"}
     return markdown_table(frame, columns, {**floats, **(formats or {})})
 

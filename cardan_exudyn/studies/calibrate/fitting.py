@@ -144,7 +144,7 @@ class Space:
 
 
 def box_space(held: Mapping[str, Any] | None = None) -> tuple[Space, list[dict[str, str]]]:
-    """The plausible box's numbers as a linear :class:`Space` and every combination of its discrete options."""
+    """The plausible box as a linear :class:`Space` and every combination of its discrete options."""
     box = plausible_box()
     numbers = [k for k, v in box.items() if "range" in v and k not in (held or {})]
     space = Space(tuple(numbers), tuple(box[k]["range"][0] for k in numbers),

@@ -1,5 +1,4 @@
-"""``cardan compare``: several engines on one scene (the library's
-:func:`cardan_exudyn.comparison.compare`) and its report folder (:mod:`.report`)."""
+"""``cardan compare``: engines on one scene (:func:`cardan_exudyn.comparison.compare`), a report folder."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
-"""The report folder of ``cardan compare``: ``comparison.json``, ``report.md``, one
-``<engine>.csv`` table per engine and ``overlay_<group>.png``, from a
-:class:`cardan_exudyn.comparison.Comparison`."""
+"""The report folder of ``cardan compare``: ``comparison.json``, ``report.md``, ``<engine>.csv``
+and ``overlay_<group>.png``, from a :class:`cardan_exudyn.comparison.Comparison`.
+"""
 
 from __future__ import annotations
 
@@ -38,8 +38,9 @@ def report_markdown(comparison: Comparison) -> str:
 
 
 def engines_table(comparison: Comparison) -> str:
-    """One row per engine: version, status and reason, mean efficiency and work ratio (only for
-    a run that ended ok), step [s], steps, wall time [s]."""
+    """One row per engine: version, status, reason, mean efficiency and work ratio (ok runs), step [s],
+    steps, wall time [s].
+    """
     rows = []
     for name in comparison.results:
         r = comparison.engine_record(name)
@@ -53,14 +54,8 @@ def engines_table(comparison: Comparison) -> str:
 
 
 def difference_section(d: EngineDifference, skip_revolutions: float) -> str:
-    """The mean-value differences and the per-column statistics of one engine against the base.
-
-    Parameters
-    ----------
-    d : EngineDifference
-        The engine's differences (:class:`cardan_exudyn.comparison.EngineDifference`).
-    skip_revolutions : float
-        Revolutions left out of the steady statistics [-].
+    """Mean-value differences and per-column statistics of engine difference ``d`` against the base
+    (``skip_revolutions`` left out of the steady statistics).
     """
     means = [{"mean value": key, "difference": value} for key, value in d.means.items()]
     columns = []
@@ -91,20 +86,8 @@ def overlay_groups() -> dict[str, list[tuple[str, Callable[[Any], Any]]]]:
 
 
 def overlay_plots(comparison: Comparison, folder: Path) -> list[str]:
-    """Overlay plots of the engines against the input angle, one file per group of
-    :func:`overlay_groups`.
-
-    Parameters
-    ----------
-    comparison : Comparison
-        The comparison; engines without a time table are left out.
-    folder : Path
-        An existing folder.
-
-    Returns
-    -------
-    list of str
-        The file names (``overlay_<group>.png``).
+    """Overlay plots of ``comparison``'s engines with a time table against the input angle, one file
+    per :func:`overlay_groups` group in ``folder``; returns the file names.
     """
     tables = {name: r.table for name, r in comparison.results.items() if r.table is not None}
     names = []
@@ -117,18 +100,8 @@ def overlay_plots(comparison: Comparison, folder: Path) -> list[str]:
 
 def overlay_figure(title: str, tables: dict[str, Any],
                    panels: list[tuple[str, Callable[[Any], Any]]], path: Path) -> None:
-    """One figure, one panel per ``(label, values)``, one line per engine (the base solid).
-
-    Parameters
-    ----------
-    title : str
-        The figure's title (the scene's name).
-    tables : dict
-        Engine -> time table, the base first.
-    panels : list of (str, callable)
-        Label and the values of a table to draw, against the input angle [deg].
-    path : Path
-        The image file.
+    """One figure ``title`` into ``path``: a panel per (label, values) of ``panels`` against the input
+    angle [deg], a line per engine of ``tables`` (the base first, solid).
     """
     # import cost: matplotlib only when a report is written (report.plots selects the Agg backend
     # before any figure exists)
@@ -154,22 +127,8 @@ def overlay_figure(title: str, tables: dict[str, Any],
 
 
 def write_report(comparison: Comparison, out: str | Path) -> Path:
-    """The report folder: ``comparison.json``, ``report.md``, ``<engine>.csv`` tables,
-    overlay plots.
-
-    Written into a temporary folder renamed into place, so a failure leaves nothing half-written.
-
-    Parameters
-    ----------
-    comparison : Comparison
-        The comparison.
-    out : path
-        The folder (replaced as a whole).
-
-    Returns
-    -------
-    Path
-        ``out``.
+    """``comparison``'s folder ``out`` (replaced atomically): ``comparison.json``, ``report.md``,
+    ``<engine>.csv``, overlay plots; returns ``out``.
     """
     with atomic_directory(out) as folder:
         (folder / "comparison.json").write_text(dumps(comparison.to_dict()))

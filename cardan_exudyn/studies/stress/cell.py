@@ -1,7 +1,5 @@
-"""One cell of ``cardan stress``'s map measured: the reference engine's verdict, and Exudyn at
-the cell's step ``h`` and (when it is ok with friction) at ``h / 2``, all through
-:func:`cardan_exudyn.engines.run` (:func:`measure_cell`; :func:`cell` is the sweep's case
-function). The measurements are flat scalars; :mod:`.classify` reads them.
+"""One cell of ``cardan stress``'s map measured: the reference's verdict, and Exudyn at the cell's
+step ``h`` and (ok with friction) at ``h / 2``, as flat scalars for :mod:`.classify`.
 """
 
 from __future__ import annotations
@@ -48,23 +46,8 @@ def exudyn_measures(s: Summary) -> dict[str, Any]:
 
 
 def exact_ratio(scene: Scene, t: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """The exact ``omega_out / omega_in`` of ``scene`` at some instants: Hooke's closed form
-    for the ideal joint, the reference engine's RCCC kinematics with mounting errors (where Hooke's
-    law does not hold).
-
-    Parameters
-    ----------
-    scene : Scene
-        The cell's scene (a prescribed input motion).
-    t : ndarray, shape (n,)
-        Instants [s].
-    theta : ndarray, shape (n,)
-        Input angles at ``t`` [rad].
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The ratio [-].
+    """Exact ``omega_out / omega_in`` [-] of ``scene`` at instants ``t`` [s] and input angles ``theta``
+    [rad]: Hooke's closed form for the ideal joint, the reference's RCCC kinematics with mounting errors.
     """
     if not scene.joint.errors.any:
         return speed_ratio(theta, scene.joint.geometry.shaft_angle)
@@ -73,20 +56,8 @@ def exact_ratio(scene: Scene, t: np.ndarray, theta: np.ndarray) -> np.ndarray:
 
 
 def ratio_error(table: pd.DataFrame, scene: Scene) -> float | None:
-    """Largest error of ``omega_out / omega_in`` of a run against the exact ratio
-    (:func:`exact_ratio`).
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        The run's time table (``t``, ``theta_in``, ``omega_in``, ``omega_out``).
-    scene : Scene
-        The scene it was made of.
-
-    Returns
-    -------
-    float or None
-        The error [-]; None when it is not finite.
+    """Largest error [-] of ``omega_out / omega_in`` of time ``table`` against :func:`exact_ratio` of
+    ``scene``; None when not finite.
     """
     ratio = table["omega_out"].to_numpy() / table["omega_in"].to_numpy()
     err = np.abs(ratio - exact_ratio(scene, table["t"].to_numpy(), table["theta_in"].to_numpy()))
@@ -94,23 +65,9 @@ def ratio_error(table: pd.DataFrame, scene: Scene) -> float | None:
 
 
 def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
-    """Run the reference and Exudyn (at ``h`` and, when it is ok with friction, ``h / 2``)
-    on one cell's scene.
-
-    Parameters
-    ----------
-    scene : Scene
-        The cell's scene (:meth:`~cardan_exudyn.studies.stress.panels.Panel.overrides` on the base).
-    node_type : str
-        Exudyn's node type of the spider and the output.
-
-    Returns
-    -------
-    dict
-        Flat scalars: the reference's and Exudyn's statuses, reasons, mean efficiencies [-] and
-        friction loop gains [-]; Exudyn's steps, Newton iterations, wall time [s] and constraint
-        violations [m], [rad]; ``ratio_error`` and its promise ``ratio_promise`` [-]; with friction
-        the efficiency at ``h / 2`` and its status.
+    """Run the reference and Exudyn (``node_type``; at ``h`` and, ok with friction, ``h / 2``) on a
+    cell's ``scene``: statuses, reasons, efficiencies and loop gains [-], Exudyn's cost, wall time
+    [s] and constraint violations [m], [rad], ``ratio_error`` and ``ratio_promise`` [-], as flat scalars.
     """
     out = reference_measures(scene)
     result = run(scene, ENGINE, node_type=node_type)
@@ -128,17 +85,7 @@ def measure_cell(scene: Scene, node_type: str) -> dict[str, Any]:
 
 
 def cell(scene: Scene, engine: str, node_type: str) -> dict[str, Any]:
-    """Sweep case function: one map cell (:func:`measure_cell`'s record).
-
-    Parameters
-    ----------
-    scene : Scene
-        The cell's scene.
-    engine : str
-        The sweep's engine: Exudyn, the one the map tests.
-    node_type : str
-        Exudyn's node type (a ``function_args`` value).
-    """
+    """Sweep case function: :func:`measure_cell` of ``scene`` (``engine``: Exudyn) at ``node_type``."""
     if engine != ENGINE:
         raise ValueError(f"stress cells compare {ENGINE} with the {REFERENCE}; engine {engine!r}")
     return measure_cell(scene, node_type)

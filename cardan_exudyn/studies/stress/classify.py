@@ -1,28 +1,12 @@
 """A cell of ``cardan stress``'s map classified from its measurements alone (:func:`classify`).
 
-``converged``
-    Exudyn's status is ok and its answer is within what the step promises: the largest error of
-    ``omega_out / omega_in`` against the exact ratio is at most ``SAFETY * K(beta) h^2 +
-    RATIO_FLOOR`` (the a-priori error model of :mod:`cardan_exudyn.model.stepsize`), the mean
-    efficiency is within ``SAFETY * 2^p / (2^p - 1) |eta_h - eta_h/2| + EFFICIENCY_FLOOR`` of the
-    reference's (the step-halving estimate of an error of order ``p``: :data:`ORDER`), it lies in
-    [0, 1], and the pair constraints hold to ``CONSTRAINT_LIMIT``.
-``drift``
-    Exudyn's status is ok but one of those checks fails: an answer that looks valid and is not.
-``self_locking``
-    Exudyn stopped the run because its friction fixed point does not converge (the engine's
-    detection, :mod:`cardan_exudyn.model.coupling`).
-``integration_failure``
-    Newton or the integrator failed (or the run diverged, ended early, or its means came out
-    impossible: status ``unphysical``, e.g. a mean efficiency outside [0, 1] at too coarse a step).
-``error``
-    The harness raised (a bug; the record keeps the traceback).
-
-The reference's verdict is physical: ``self_locking`` when its friction fixed point has no
-solution at some instant of the revolution (loop gain >= 1, :mod:`reference.engine.dynamics`), else
-ok. Exudyn's failure boundary (self_locking or integration_failure) is compared with it cell by
-cell; :func:`classify` names the category of every disagreement, and ``docs/stress.md`` explains
-them.
+``converged``: Exudyn ok, ratio error <= ``SAFETY * K(beta) h^2 + RATIO_FLOOR``
+(:mod:`cardan_exudyn.model.stepsize`), ``|eta - eta_ref| <= SAFETY * 2^p / (2^p - 1)
+|eta_h - eta_h/2| + EFFICIENCY_FLOOR`` (step-halving estimate, order ``p``), eta in [0, 1], pair
+constraints within ``CONSTRAINT_LIMIT``. ``drift``: ok but a check fails. ``self_locking``:
+Exudyn's friction fixed point does not converge. ``integration_failure``: Newton or integrator
+failed, or ``unphysical``. ``error``: the harness raised. The reference self-locks when its loop
+gain reaches 1 at some instant; disagreements are categorised (``docs/stress.md``).
 """
 
 from __future__ import annotations
@@ -75,8 +59,9 @@ def efficiency_promise(record: dict[str, Any]) -> float:
 
 
 def broken_promises(record: dict[str, Any]) -> list[str]:
-    """The checks an Exudyn run with status ok fails (empty: converged): speed ratio within the
-    step's promise, efficiency in [0, 1] and within its promise of the reference's, constraints."""
+    """The checks an ok Exudyn run fails (empty: converged): speed ratio and efficiency within their
+    promises, efficiency in [0, 1], constraints.
+    """
     reasons = []
     ratio_err = as_float(record.get("ratio_error"))
     promise = as_float(record.get("ratio_promise"))
@@ -150,8 +135,9 @@ def _where_reference_locks(record: dict[str, Any], cls: str, reasons: list[str])
 
 
 def classify(record: dict[str, Any]) -> dict[str, Any]:
-    """Class, agreement with the reference's physics, category and a one-line explanation of
-    one cell from its measurements (a record of :func:`measure_cell`, or a harness error)."""
+    """Class, agreement with the reference, category and a one-line explanation of a cell from its
+    ``record`` (:func:`measure_cell`'s, or a harness error).
+    """
     if record.get("status", "ok") != Status.OK:  # the case function raised
         return _verdict("error", "unknown", False, "harness error", str(record.get("reason"))[:200])
     cls, reasons = cell_class(record)

@@ -1,9 +1,5 @@
-"""``cardan stress``: the stability map of a joint's Exudyn model against the reference engine.
-
-The map (:mod:`.map`: panels :mod:`.panels`, one cell measured :mod:`.cell`, classified
-:mod:`.classify`) covers shaft angle against friction coefficient (per coupling and node type),
-input speed and step, for the joint the scene options describe (as ``cardan run`` takes them; by
-default the paper's); :mod:`.report` writes the folder. Details: ``docs/stress.md``.
+"""``cardan stress``: the stability map of a joint's Exudyn model against the reference engine,
+for the joint the scene options describe (default: the paper's). Details: ``docs/stress.md``.
 """
 
 from __future__ import annotations
@@ -52,15 +48,7 @@ def _say(text: str) -> None:
 
 
 def summary_lines(counts: dict[str, Any], out: str | os.PathLike) -> list[str]:
-    """What ``cardan stress`` prints when it is done.
-
-    Parameters
-    ----------
-    counts : dict
-        :meth:`~cardan_exudyn.studies.stress.map.StressMap.counts`.
-    out : path
-        The report folder.
-    """
+    """What ``cardan stress`` prints at the end: ``counts`` (:meth:`~.map.StressMap.counts`), ``out``."""
     return ["map: " + ", ".join(f"{v} {k}" for k, v in counts["classes"].items())
             + f"; {counts['disagreements']} of {counts['cells']} cells disagree with the reference",
             f"report: {out}/report.md"]

@@ -1,10 +1,5 @@
-"""The stability map of ``cardan stress``: where the Exudyn model of a joint stops giving the
-right answer, and why.
-
-Every cell of the panels (:mod:`.panels`) is measured (:mod:`.cell`) and classified from its
-measurements alone (:mod:`.classify`). The cells run as sweeps (:mod:`cardan_exudyn.sweep`, one
-sweep per node type in ``OUT/runs/``), so an interrupted map resumes where it stopped
-(:func:`run_map`).
+"""The stability map of ``cardan stress``: every cell of the panels measured and classified, run as
+one sweep per node type in ``OUT/runs/`` so an interrupted map resumes.
 """
 
 from __future__ import annotations
@@ -30,21 +25,9 @@ CELL_FUNCTION = "cardan_exudyn.studies.stress.cell:cell"
 
 @dataclass
 class StressMap:
-    """The classified cells (one row each) and how they were obtained.
-
-    Attributes
-    ----------
-    cells : pandas.DataFrame
-        One row per cell: panel, node type, coupling, the cell's settings, measurements
-        (:func:`~cardan_exudyn.studies.stress.classify.measured`) and classification.
-    panels : list of Panel
-        The panels, in the order of the report.
-    quick : bool
-        The coarse map.
-    sweeps : dict
-        Per node type the sweep's ``run_now``, ``wall_time_s`` [s] and ``executor``.
-    scene : str
-        The base scene's name.
+    """The classified cells and how they were obtained: ``cells`` (one row each: panel, node type,
+    coupling, settings, measurements, classification), ``panels``, ``quick``, ``sweeps`` (per node
+    type ``run_now``, ``wall_time_s``, ``executor``) and ``scene`` (the base scene's name).
     """
 
     cells: pd.DataFrame
@@ -66,15 +49,8 @@ class StressMap:
 
 
 def sweep_specs(quick: bool = False, scene: Scene | None = None) -> dict[str, SweepSpec]:
-    """One explicit-case sweep spec per node type (the map's panels grouped by node type).
-
-    Parameters
-    ----------
-    quick : bool
-        The coarse map.
-    scene : Scene, optional
-        The joint (default :data:`~cardan_exudyn.studies.stress.panels.BASE_SCENE`); the base scene
-        is :func:`~cardan_exudyn.studies.stress.panels.base_scene` of it.
+    """One explicit-case sweep spec per node type (``quick``: coarse map) for joint ``scene``
+    (default :data:`~.panels.BASE_SCENE`).
     """
     groups: dict[str, list[dict[str, Any]]] = {}
     for panel in panels(quick):
@@ -89,14 +65,8 @@ def sweep_specs(quick: bool = False, scene: Scene | None = None) -> dict[str, Sw
 
 
 def classified_cells(chosen: list[Panel], records: dict[str, dict[str, Any]]) -> pd.DataFrame:
-    """One row per cell of the panels: its settings, measurements and classification.
-
-    Parameters
-    ----------
-    chosen : list of Panel
-        The panels.
-    records : dict
-        Cell id (:func:`~cardan_exudyn.studies.stress.panels.cell_id`) -> sweep record.
+    """One row per cell of panels ``chosen``: settings, measurements and classification from ``records``
+    (cell id -> sweep record).
     """
     rows = []
     for panel in chosen:
@@ -114,21 +84,9 @@ def run_map(runs: str | os.PathLike, quick: bool = False, *, scene: Scene | None
             progress: bool | None = None) -> StressMap:
     """Run (or resume) the map's sweeps into ``runs/<node type>/`` and classify every cell.
 
-    Parameters
-    ----------
-    runs : path
-        Folder of the sweeps (one per node type); kept between invocations.
-    quick : bool
-        The coarse map of :func:`~cardan_exudyn.studies.stress.panels.panels`.
-    scene : Scene, optional
-        The joint to map (default :data:`~cardan_exudyn.studies.stress.panels.BASE_SCENE`).
-    workers, restart, progress
-        As :func:`cardan_exudyn.sweep.run_sweep`; cells that raised are always rerun.
-
-    Raises
-    ------
-    cardan_exudyn.sweep.SweepError
-        ``runs`` holds the sweeps of another map (another scene, or ``quick`` then not).
+    ``quick``: the coarse map; ``scene``: the joint (default :data:`~.panels.BASE_SCENE`); ``workers``,
+    ``restart``, ``progress``: as :func:`cardan_exudyn.sweep.run_sweep` (cells that raised always
+    rerun). SweepError when ``runs`` holds another map's sweeps.
     """
     runs = Path(runs)
     records: dict[str, dict[str, Any]] = {}

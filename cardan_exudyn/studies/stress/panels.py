@@ -1,8 +1,6 @@
-"""The panels of ``cardan stress``'s map: 2-D slices over shaft angle (0 to 80 deg) against one
-more quantity each: the friction coefficient (0 to 1, the same in all four pairs) for each
-coupling scheme and node type, the input speed (10 to 10,000 rpm) and the step (steps per input
-revolution). Every cell is one revolution of the base scene (:func:`base_scene`: the user's joint,
-by default the paper's) from the assembled start at constant input speed.
+"""The panels of ``cardan stress``'s map: shaft angle (0 to 80 deg) against friction coefficient (per
+coupling and node type), input speed or step; each cell one revolution of :func:`base_scene` at
+constant input speed.
 """
 
 from __future__ import annotations
@@ -55,15 +53,8 @@ class Panel:
     steps: int = DEFAULT_STEPS
 
     def cell(self, angle: float, x: float) -> dict[str, Any]:
-        """The settings of one cell: shaft angle [deg], friction coefficient, rpm, steps per
-        revolution.
-
-        Parameters
-        ----------
-        angle : float
-            Shaft angle [deg], the row.
-        x : float
-            The panel's quantity (friction coefficient [-], rpm or steps per revolution), the column.
+        """The settings of the cell at row ``angle`` [deg] and column ``x`` (friction coefficient [-], rpm
+        or steps per revolution).
         """
         values = {"angle_deg": angle, "friction": self.friction, "rpm": self.rpm,
                   "steps": self.steps}
@@ -72,15 +63,8 @@ class Panel:
         return values
 
     def overrides(self, angle: float, x: float) -> dict[str, Any]:
-        """Scene overrides (dotted paths) of one cell: shaft angle, a constant-speed drive, the
-        step, the coupling, every pair's friction coefficient.
-
-        Parameters
-        ----------
-        angle : float
-            Shaft angle [deg], the row.
-        x : float
-            The panel's quantity (friction coefficient [-], rpm or steps per revolution), the column.
+        """Scene overrides of the cell at ``angle`` [deg], ``x``: shaft angle, constant-speed drive, step,
+        coupling, every pair's friction coefficient.
         """
         c = self.cell(angle, x)
         speed = c["rpm"] * RPM
@@ -101,8 +85,7 @@ def panels(quick: bool = False) -> list[Panel]:
 
 
 def quick_panels() -> list[Panel]:
-    """A few cells on each side of the boundaries, one of them where the lagged coupling runs on
-    through a self-lock."""
+    """A few cells each side of the boundaries, one where the lagged coupling runs through a self-lock."""
     angles = (0.0, 10.0, 40.0, 80.0)
     few = (0.0, 40.0, 80.0)
     friction = (0.0, 0.2, 0.6)
@@ -139,23 +122,13 @@ def full_panels() -> list[Panel]:
 
 
 def base_scene(scene: Scene | None = None) -> Scene:
-    """The map's base scene: ``scene`` (default :data:`BASE_SCENE`) for :data:`REVOLUTIONS`
-    revolution, every revolution averaged; each cell overrides its shaft angle, drive, step,
-    coupling and friction coefficients (:meth:`Panel.overrides`)."""
+    """The map's base scene: ``scene`` (default :data:`BASE_SCENE`) for :data:`REVOLUTIONS` revolution,
+    every revolution averaged.
+    """
     scene = named_scene(BASE_SCENE) if scene is None else scene
     return replace(scene, **{"revolutions": REVOLUTIONS, "record.skip_revolutions": 0.0})
 
 
 def cell_id(panel: Panel, angle: float, x: float) -> str:
-    """The cell's case id in the sweeps, e.g. ``friction/10deg/friction=0.2``.
-
-    Parameters
-    ----------
-    panel : Panel
-        The cell's panel.
-    angle : float
-        Shaft angle [deg], the row.
-    x : float
-        The panel's quantity (friction coefficient [-], rpm or steps per revolution), the column.
-    """
+    """The case id of ``panel``'s cell at ``angle`` [deg], ``x``, e.g. ``friction/10deg/friction=0.2``."""
     return f"{panel.key}/{angle:g}deg/{panel.x}={x:g}"

@@ -1,6 +1,6 @@
-"""The report folder of ``cardan stress``: ``report.md``, ``map_cells.csv`` (every cell with its
-measurements, class, category and explanation), ``stability_map.png`` and ``stress.json``,
-written atomically with the map's sweeps (``runs/``) moved into it (:func:`write_stress`)."""
+"""The report folder of ``cardan stress`` (``report.md``, ``map_cells.csv``, ``stability_map.png``,
+``stress.json``), written atomically with the map's sweeps moved in.
+"""
 
 from __future__ import annotations
 
@@ -36,20 +36,8 @@ def problems(stress: StressMap) -> list[str]:
 
 
 def summary(stress: StressMap, wall_s: float) -> dict[str, Any]:
-    """The content of ``stress.json`` (without the environment).
-
-    Parameters
-    ----------
-    stress : StressMap
-        The map.
-    wall_s : float
-        Its wall time [s].
-
-    Returns
-    -------
-    dict
-        ``wall_s`` (``{"map": seconds}``), ``problems``, and ``map``: the counts of
-        :meth:`StressMap.counts`, the scene, ``quick`` and the sweeps.
+    """``stress.json`` without the environment: ``wall_s`` (``{"map": wall_s}``), ``problems`` and
+    ``map`` (:meth:`StressMap.counts`, scene, ``quick``, sweeps).
     """
     return {"wall_s": {"map": wall_s}, "problems": problems(stress),
             "map": {**stress.counts(), "scene": stress.scene, "quick": stress.quick,
@@ -57,17 +45,7 @@ def summary(stress: StressMap, wall_s: float) -> dict[str, Any]:
 
 
 def write_stress(stress: StressMap, out: str | os.PathLike, wall_s: float) -> Path:
-    """The report folder (replaced atomically), with the sweeps of ``out/runs`` moved in.
-
-    Parameters
-    ----------
-    stress : StressMap
-        The map.
-    out : path
-        The folder: ``report.md``, ``map_cells.csv``, ``stability_map.png``, ``stress.json``.
-    wall_s : float
-        The map's wall time [s].
-    """
+    """``stress``'s folder ``out`` (replaced atomically; ``wall_s`` [s]), with ``out/runs`` moved in."""
     out = Path(out)
     env = environment()
     found = problems(stress)
@@ -108,17 +86,7 @@ def error_mark(r: pd.Series) -> str:
 
 
 def panel_table(cells: pd.DataFrame, panel: Panel, mark: Callable[[pd.Series], str] = class_mark) -> str:
-    """Markdown grid of one panel, one mark per cell.
-
-    Parameters
-    ----------
-    cells : pandas.DataFrame
-        The map's cells.
-    panel : Panel
-        The panel shown.
-    mark : callable
-        Row -> text of its cell (default :func:`class_mark`).
-    """
+    """Markdown grid of ``panel`` over ``cells``, each cell's text ``mark(row)`` (default :func:`class_mark`)."""
     sel = cells[cells["panel"] == panel.key]
     columns = ["angle", *(f"{x:g}" for x in panel.x_values)]
     rows = []
@@ -186,8 +154,9 @@ def map_markdown(stress: StressMap) -> str:
 
 
 def plot_map(stress: StressMap) -> Any:
-    """One image per panel: cell colour = class, hatched = reference self-locks, ``!`` =
-    disagreement; the reference's self-locking boundary drawn as a black line."""
+    """One image per panel: colour = class, hatched = reference self-locks, ``!`` = disagreement, black
+    line = the reference's self-locking boundary.
+    """
     return plots.stability_map(stress.cells, [
         {"key": p.key, "title": p.title, "x": p.x, "x_label": X_LABELS[p.x],
          "x_values": p.x_values, "angles": p.angles} for p in stress.panels], CLASSES)

@@ -152,7 +152,7 @@ def monte_carlo_handler(args: argparse.Namespace) -> int:
 
 
 def monte_carlo_line(summary: Mapping[str, Any], out: str) -> str:
-    """Statuses, the ideal joint's efficiency and the 5/50/95 percentiles of ``summary``, and folder ``out``, in one line."""
+    """Statuses, ideal efficiency and 5/50/95 percentiles of ``summary``, and folder ``out``, in one line."""
     m = summary["mean_efficiency"]
     ideal = (number(summary["ideal_mean_efficiency"], ".6f") if summary["ideal_status"] == Status.OK
              else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}")

@@ -121,7 +121,8 @@ def run_monte_carlo(scene: Scene, engine: str, samples: int, seed: int,
 
     ``samples``, ``seed``: N and the draws' seed; ``distributions``: scene path -> distribution table
     (default :func:`default_distributions`), replacing the scene's own errors; ``method`` (``lhs``,
-    ``random``), ``workers``, ``scheduler``, ``restart``, ``progress``: to :func:`cardan_exudyn.sweep.run_sweep`.
+    ``random``), ``workers``, ``scheduler``, ``restart``, ``progress``: to
+    :func:`cardan_exudyn.sweep.run_sweep`.
     """
     import pandas as pd  # import cost: pandas for this study only
 

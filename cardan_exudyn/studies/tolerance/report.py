@@ -86,7 +86,7 @@ def _scatter(path: Path, table, params: Sequence[str], eta: np.ndarray, eta0: fl
 
 
 def monte_carlo_markdown(summary: Mapping[str, Any], sens) -> str:
-    """``report.md`` of the Monte Carlo study from ``summary`` and sensitivities ``sens`` (empty: none shown)."""
+    """``report.md`` of the Monte Carlo study: ``summary`` and sensitivities ``sens`` (empty: none)."""
     ideal = (f"{number(summary['ideal_mean_efficiency'], '.6f')}." if summary["ideal_status"] == Status.OK
              else f"{summary['ideal_status']}: {summary.get('ideal_reason', '')}.")
     parts = [f"# Monte Carlo tolerance study: {summary['scene']} ({summary['engine']})\n\n"
@@ -145,7 +145,7 @@ def write_paper_case(study: Mapping[str, Any], out: str | Path) -> dict[str, Any
 
 
 def breakdown_plot(path: Path, rows) -> None:
-    """Stacked bars of each pair's loss change per ok row of ``rows`` into ``path``; nothing when none ran ok."""
+    """Stacked bars of each pair's loss change per ok row of ``rows`` into ``path`` (none ok: nothing)."""
     # import cost: matplotlib only when a report is written
     from cardan_exudyn.report.plots import plt, save
 
