@@ -90,7 +90,7 @@ class CachingRunner:
         return scene, engine, options
 
     def error_estimate(self, result: Result) -> ErrorEstimate | None:
-        """:func:`cardan_exudyn.model.error_estimate.error_estimate`, this runner doing the half-step rerun."""
+        """:func:`cardan_exudyn.model.error_estimate.error_estimate`, this runner running the half step."""
         return error_estimate(result, run=self)
 
     @property

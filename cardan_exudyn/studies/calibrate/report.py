@@ -22,7 +22,7 @@ ENVELOPE_FORMATS = {"paper": ".3f", "lowest": ".4f", "highest": ".4f", "closest"
 
 
 def write_result(out: str | Path, name: str, result: Mapping[str, Any], text: str) -> Path:
-    """The ``--out`` folder ``out``, replaced atomically: ``result`` as JSON ``name``, ``text`` as ``report.md``."""
+    """Folder ``out``, replaced atomically: ``result`` as JSON file ``name``, ``text`` as ``report.md``."""
     with atomic_directory(out) as tmp:
         (tmp / name).write_text(dumps(result))
         (tmp / "report.md").write_text(text)

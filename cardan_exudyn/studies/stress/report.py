@@ -86,7 +86,7 @@ def error_mark(r: pd.Series) -> str:
 
 
 def panel_table(cells: pd.DataFrame, panel: Panel, mark: Callable[[pd.Series], str] = class_mark) -> str:
-    """Markdown grid of ``panel`` over ``cells``, each cell's text ``mark(row)`` (default :func:`class_mark`)."""
+    """Markdown grid of ``panel`` over ``cells``, a cell's text ``mark(row)`` (default :func:`class_mark`)."""
     sel = cells[cells["panel"] == panel.key]
     columns = ["angle", *(f"{x:g}" for x in panel.x_values)]
     rows = []
