@@ -1,12 +1,9 @@
-"""What every ``cardan`` subcommand (the CLI's, the studies' and ``rigdata``'s) shares on its
-command line: exit statuses, one-line bad input, number and count parsers, output-folder checks.
-The scene options and the scene they describe: :mod:`cardan_exudyn.scene_options`.
+"""What every ``cardan`` subcommand shares on its command line: exit statuses, one-line bad input,
+number and count parsers, output-folder checks.
 
-Exit status of every command: 0 success; 2 bad input (one line on stderr naming the argument, no
-traceback); 3 the simulation failed or is physically meaningless (the reason is in the summary
-``status``); 4 (``cardan sweep``) the sweep stopped before every case ran (rerun to resume); 5
-(``cardan run``) the run ended ok but its estimated mean-efficiency error exceeds the target
-``--accuracy`` (summary ``accuracy_met`` false; ``docs/accuracy.md``); 130 interrupted.
+Exit status: 0 success; 2 bad input (one line on stderr, no traceback); 3 the run failed (summary
+``status``); 4 a sweep stopped early (rerun to resume); 5 ``cardan run`` ended ok but missed
+``--accuracy`` (``docs/accuracy.md``); 130 interrupted.
 """
 
 from __future__ import annotations
@@ -41,23 +38,8 @@ class BadInput(Exception):
 
 
 def out_folder(path: str | None, option: str = "--out", replace: bool = True) -> None:
-    """Refuse an output folder that cannot be one, before anything runs.
-
-    Parameters
-    ----------
-    path : str or None
-        The option's value; None: not given (nothing to check).
-    option : str
-        The option's name, for the message.
-    replace : bool
-        The command replaces the folder as a whole (not a sweep, which writes into it):
-        :func:`cardan_exudyn.outputs.check_output_folder` refuses more.
-
-    Raises
-    ------
-    BadInput
-        An empty value, or a folder that cannot be written as asked.
-    """
+    """Refuse output folder ``path`` of ``option`` (None: not given) before anything runs: :class:`BadInput`
+    when empty or not writable as asked (``replace``: the command replaces it as a whole)."""
     if path is not None and not path.strip():
         raise BadInput(f"{option} is empty: give a folder")
     if path:
@@ -69,22 +51,8 @@ def out_folder(path: str | None, option: str = "--out", replace: bool = True) ->
 
 def number(kind: str, *, positive: bool = False, non_negative: bool = False,
            maximum: float | None = None) -> Callable[[str], float]:
-    """An argparse ``type`` for a finite number.
-
-    Parameters
-    ----------
-    kind : str
-        The option's unit (or name), shown in the messages.
-    positive, non_negative : bool
-        Refuse values <= 0, or < 0.
-    maximum : float, optional
-        Refuse values above it.
-
-    Returns
-    -------
-    callable
-        ``parse(text) -> float``; ``argparse.ArgumentTypeError`` naming the rule broken.
-    """
+    """An argparse ``type`` for a finite number (``kind``: unit shown in messages), optionally
+    ``positive``, ``non_negative`` or at most ``maximum``."""
     def parse(text: str) -> float:
         try:
             value = float(text)
@@ -105,32 +73,15 @@ def number(kind: str, *, positive: bool = False, non_negative: bool = False,
 
 COUNT_LIMITS = {"--samples": 100_000, "--workers": 1024, "--repeats": 1000, "--mc": 100_000,
                 "--pulses-per-rev": 1_000_000, "--cells": 1_000_000, "--seed": 2**63 - 1}
-"""Largest value of each count option: a value above it would exhaust memory or run for weeks
-(100 000 Monte Carlo samples or draws already pin a 95 % interval to about 1e-3 of its width;
-no machine here has 1024 cores). Options not listed take at most :data:`MAX_COUNT`."""
+"""Largest value of each count option (beyond it: memory or weeks; 1e5 Monte Carlo samples already
+pin a 95 % interval to about 1e-3 of its width). Others take at most :data:`MAX_COUNT`."""
 MAX_COUNT = 1_000_000
 """Largest value of a count option without a :data:`COUNT_LIMITS` entry."""
 
 
 def count(name: str, minimum: int = 1, maximum: int | None = None) -> Callable[[str], int]:
-    """An argparse ``type`` for an integer option in [``minimum``, ``maximum``]; ``1e3`` is read
-    as 1000.
-
-    Parameters
-    ----------
-    name : str
-        The option (``"--workers"``), shown in the messages and looked up in :data:`COUNT_LIMITS`.
-    minimum : int
-        Smallest value allowed.
-    maximum : int, optional
-        Largest value allowed (default: the option's :data:`COUNT_LIMITS` entry, else
-        :data:`MAX_COUNT`).
-
-    Returns
-    -------
-    callable
-        ``parse(text) -> int``; ``argparse.ArgumentTypeError`` naming the rule broken.
-    """
+    """An argparse ``type`` for integer option ``name`` in [``minimum``, ``maximum``] (default
+    :data:`COUNT_LIMITS` or :data:`MAX_COUNT`); ``1e3`` reads as 1000."""
     top = maximum if maximum is not None else COUNT_LIMITS.get(name, MAX_COUNT)
 
     def parse(text: str) -> int:
@@ -162,29 +113,8 @@ def cli_value(text: str) -> Any:
 
 
 def path_value(option: str, text: str, form: str) -> tuple[str, str]:
-    """``PATH=VALUE`` split at the first ``=``.
-
-    Parameters
-    ----------
-    option : str
-        The option (``"--set"``), for the message.
-    text : str
-        What was given.
-    form : str
-        The expected form (``"PATH=VALUE"``), for the message.
-
-    Returns
-    -------
-    path : str
-        Stripped of blanks.
-    value : str
-        As given.
-
-    Raises
-    ------
-    BadInput
-        No ``=``, or an empty path or value.
-    """
+    """``(path, value)`` of ``option``'s ``text`` ``PATH=VALUE`` split at the first ``=``, path
+    stripped; :class:`BadInput` (showing ``form``) for no ``=`` or an empty side."""
     path, sep, value = text.partition("=")
     if not sep or not path.strip() or not value.strip():
         raise BadInput(f"{option} must look like {form}, got {text!r}")
@@ -192,22 +122,8 @@ def path_value(option: str, text: str, form: str) -> tuple[str, str]:
 
 
 def refuse_options(args: argparse.Namespace, dests: tuple[str, ...] | list[str], why: str) -> None:
-    """Refuse options the command would otherwise silently ignore.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        The parsed command line.
-    dests : sequence of str
-        Destinations of the options that do not apply.
-    why : str
-        Ends the message (``"to a Monte Carlo study"``).
-
-    Raises
-    ------
-    BadInput
-        Naming the first of ``dests`` that was given (not None, not False).
-    """
+    """:class:`BadInput` naming the first of ``dests`` given in ``args`` (not None/False): those options
+    do not apply ``why``."""
     for dest in dests:
         value = getattr(args, dest, None)
         if value is not None and value is not False:

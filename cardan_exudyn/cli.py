@@ -1,15 +1,10 @@
-"""The ``cardan`` command line: the core commands (``run``, ``sweep``, ``scene``), the commands
-the study modules register (:data:`cardan_exudyn.studies.COMMANDS`) and those other packages
-register under the ``cardan.commands`` entry-point group (``cardan rig``).
+"""The ``cardan`` command line: the core commands (``run``, ``sweep``, ``scene``), the study modules'
+(:data:`cardan_exudyn.studies.COMMANDS`) and those of the ``cardan.commands`` entry points.
 
-Exit status: 0 success; 2 bad input (one line on stderr naming the argument, no traceback), an
-output another command is writing, or a disk that refuses the output (full, read-only; the
-previous output is kept); 3 the simulation failed or is physically meaningless (the reason is in
-the summary ``status``); 4 (``cardan sweep``) the sweep stopped before every case ran (rerun the
-command to resume); 5 (``cardan run``) the run ended ok but its estimated mean-efficiency error
-exceeds ``--accuracy``; 130 interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing recorded as
-failed, the previous output kept, rerunning resumes a sweep; 141 the reader of the output went
-away (``cardan run --json | head -1``).
+Exit status: 0 success; 2 bad input (one line on stderr), an output another command is writing, or
+a disk that refuses the output; 3 the run failed (summary ``status``); 4 a sweep stopped early
+(rerun to resume); 5 ``cardan run`` ended ok but missed ``--accuracy``; 130 Ctrl-C, 143 SIGTERM
+(previous output kept); 141 the output's reader went away.
 """
 
 from __future__ import annotations
@@ -73,8 +68,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """``cardan run``: exit 0 when the run ended ok, 3 when it did not, 5 when it ended ok but its
-    estimated mean-efficiency error exceeds ``--accuracy`` (``accuracy_met`` false, a warning)."""
+    """``cardan run``: exit 0 ok, 3 failed, 5 ok but the estimated error exceeds ``--accuracy``."""
     if args.engine not in ENGINES:
         raise BadInput(f"`--engine` must be one of {sorted(ENGINES)}, got {args.engine!r}")
     options = None
@@ -101,9 +95,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def _warn_given_step(scene: Scene) -> None:
-    """Before a run at a given ``--dt``: a warning on stderr when the a-priori error models of the
-    time-stepping engine (Exudyn) predict more than the target accuracy, naming the quantity
-    (speed ratio; mean efficiency at the largest loss, which the run then measures)."""
+    """Warn on stderr when Exudyn's a-priori error models predict more than the accuracy at ``--dt``."""
     if scene.numerics.dt is None:
         return
     from cardan_exudyn.model.stepsize import predicted_errors  # the Exudyn engine's step model
@@ -116,8 +108,7 @@ def _warn_given_step(scene: Scene) -> None:
 
 
 def _no_work(s: Summary) -> str:
-    """What a run with status ok prints for an efficiency that is undefined (no work transmitted
-    or lost, e.g. a joint spinning free), instead of 'nan'; the warnings say why."""
+    """The text for an ok run's undefined efficiency (no work transmitted or lost), instead of 'nan'."""
     return f"undefined (input work {number(s.input_work, '.3g')} J)"
 
 
@@ -137,8 +128,7 @@ def _error_text(s: Summary) -> str:
 
 
 def _set_text(s: Summary) -> str:
-    """`` (physical parameter set)`` after the scene name: which of the paper's parameter sets
-    the numbers come from (nothing for a scene that is not the paper's)."""
+    """`` (physical parameter set)`` after the scene name; empty for a scene not the paper's."""
     label = s.scene.get("parameter_set", "")
     if not label:
         return ""
@@ -146,8 +136,8 @@ def _set_text(s: Summary) -> str:
 
 
 def _print_summary(s: Summary, out: str | None, files: list[str]) -> None:
-    """``cardan run``'s report: one line on stdout for a run that ended ok (then its warnings on
-    stderr and the files written to ``out``), else the status and reason on stderr."""
+    """``cardan run``'s report: one line on stdout (warnings and files written on stderr/stdout), or the
+    status and reason on stderr for a failed run."""
     if s.status != Status.OK:
         print(f"status: {s.status}: {s.reason}", file=sys.stderr)
         return
@@ -172,15 +162,8 @@ def cmd_scene(args: argparse.Namespace) -> int:
 
 
 def sweep_spec_from_args(args: argparse.Namespace) -> SweepSpec:
-    """The sweep spec of ``cardan sweep``: the SPEC file, with the command-line options applied.
-
-    Raises
-    ------
-    SweepError
-        An unreadable or invalid spec (the message names the file).
-    BadInput
-        A ``--grid`` or ``--set`` not of the form ``PATH=VALUE``.
-    """
+    """The sweep spec of ``cardan sweep``: the SPEC file with the command-line options applied;
+    ``SweepError`` for a bad spec, :class:`BadInput` for a ``--grid``/``--set`` not ``PATH=VALUE``."""
     # import cost: the sweep package (process pools, Dask hooks) loads for `cardan sweep` only
     from cardan_exudyn.sweep import SweepError, looks_like_path, read_spec_file, spec_from_mapping
 
@@ -313,8 +296,7 @@ def _add_study_commands(sub: argparse._SubParsersAction) -> None:
 
 
 def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:
-    """Commands other packages register under the ``cardan.commands`` entry-point group (``cardan
-    rig`` from ``rigdata``): imports keep pointing one way, this package never imports them."""
+    """Commands of the ``cardan.commands`` entry points (``cardan rig``); this package never imports them."""
     from importlib.metadata import entry_points  # import cost: ~30 ms, for these commands only
 
     for entry in sorted(entry_points(group="cardan.commands"), key=lambda e: e.name):
@@ -323,19 +305,15 @@ def _add_plugin_commands(sub: argparse._SubParsersAction) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the ``cardan`` command ``argv`` (default: the process's arguments); the exit status.
-
-    SIGTERM raises :class:`cardan_exudyn.interrupts.Terminated` while the command runs, so it
-    stops as Ctrl-C does (cleanup, previous output kept, exit 143 instead of 130)."""
+    SIGTERM raises :class:`cardan_exudyn.interrupts.Terminated` (exit 143), so it stops as Ctrl-C does."""
     args = parse_args(argv)
     with terminate_raises():
         return _run_command(args)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    """The parsed ``cardan`` command line ``argv`` (default: the process's arguments), as
-    :func:`main` runs it. A core command (``cardan run``) is parsed without importing the study
-    modules or looking up entry points (import cost); anything else (``cardan --help``, a study,
-    a mistyped command) gets the whole parser."""
+    """The parsed command line ``argv``; a core command is parsed without the study modules and entry
+    points (import cost)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     return build_parser(core_only=bool(argv) and argv[0] in CORE_COMMANDS).parse_args(argv)
 
@@ -367,9 +345,8 @@ def _run_command(args: argparse.Namespace) -> int:
 
 @contextlib.contextmanager
 def _holding_output(args: argparse.Namespace) -> Iterator[None]:
-    """Hold the command's ``--out`` (:func:`cardan_exudyn.outputs.output_lock`) from its start, so a
-    second command writing there is refused at once; when the output's folder does not exist yet,
-    the writer locks it when it makes it. A path the command will refuse is left to it."""
+    """Hold the command's ``--out`` lock from its start, so a second writer is refused at once (a folder
+    not made yet is locked by its writer; a path the command refuses is left to it)."""
     out = getattr(args, "out", None)
     if not isinstance(out, str) or not out.strip() or Path(out).name in ("", ".", "..") \
             or not Path(out).parent.is_dir():
@@ -380,8 +357,8 @@ def _holding_output(args: argparse.Namespace) -> Iterator[None]:
 
 
 def _discard_stdout() -> None:
-    """Point stdout at the null device, so that the interpreter's last flush of what the closed
-    pipe did not take raises no second BrokenPipeError (the recipe of Python's ``signal`` docs)."""
+    """Point stdout at the null device so the last flush after a closed pipe raises no second
+    BrokenPipeError (the recipe of Python's ``signal`` docs)."""
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, sys.stdout.fileno())
     os.close(devnull)

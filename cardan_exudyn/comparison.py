@@ -1,28 +1,8 @@
-"""Cross-engine comparison: one scene, several engines, differences per column.
+"""Cross-engine comparison: one scene, several engines, per-column differences from the first (base).
 
-:func:`compare` runs each engine on the same scene, joins the time tables on the input angle and
-returns a :class:`Comparison`: per later engine, the maximum and RMS difference from the first
-engine (the *base*) of every shared column, with the scale of the column, and the differences of
-the mean values. Fixed-step engines choose their step from the scene; the reference engine is
-then asked for rows at the base engine's step (``numerics.dt``), which only sets where its exact
-solution is sampled, so for constant-speed scenes the rows coincide and no interpolation enters
-the differences. Otherwise the other engine's columns are interpolated onto the base's input
-angles with a cubic spline, and the comparison says so.
-
-The first ``skip_revolutions`` (default 0) can be left out of the per-column statistics, e.g. to
-keep an integrator's start-up transient apart from its steady-state error; the comparison gives
-both.
-
-Example::
-
-    import cardan_exudyn
-    from reference import named_scene
-
-    comparison = cardan_exudyn.compare(named_scene("paper-10deg"), ("exudyn", "reference"))
-    print(comparison.differences_table(rtol=1e-3))
-
-The module is not named ``compare``: a submodule of that name would replace the package's
-function ``cardan_exudyn.compare`` as soon as anything imported it.
+Tables are joined on the input angle: the same rows when the angles match (the reference engine
+is sampled at the base's step), else a cubic spline of the other engine's columns.
+Not named ``compare``: such a submodule would shadow the function ``cardan_exudyn.compare``.
 """
 
 from __future__ import annotations
@@ -74,17 +54,14 @@ class EngineDifference:
     Attributes
     ----------
     engine, against : str
-        The engine compared, and the base engine it is compared with.
+        The engine compared, and the base engine.
     join : str
-        How the rows were matched: ``"same rows"`` or a cubic spline in the input angle.
+        ``"same rows"`` or ``"cubic spline in the input angle"``.
     means : dict[str, float]
-        ``engine - against`` of the :data:`SUMMARY_KEYS` (units of each key), only when both
-        runs ended ``ok`` and both values are finite.
+        ``engine - against`` of the :data:`SUMMARY_KEYS`, when both runs ended ``ok`` and are finite.
     overall, steady : pandas.DataFrame
-        Per column (the index, named ``column``): ``max_abs`` and ``rms`` of the difference, the
-        base column's largest magnitude ``scale`` (units of the column), ``max_rel`` =
-        ``max_abs / scale`` [-] and the number of ``rows``; over all rows, and after the
-        comparison's ``skip_revolutions``.
+        Per ``column``: ``max_abs``, ``rms``, the base column's largest magnitude ``scale``,
+        ``max_rel = max_abs / scale`` [-] and ``rows``; over all rows, and after ``skip_revolutions``.
     """
 
     engine: str
@@ -113,9 +90,9 @@ class Comparison:
     results : dict[str, Result]
         Per engine, in the order asked for; the first is the base.
     wall_time_s : dict[str, float]
-        Per engine, the wall time of its run [s].
+        Per engine [s].
     differences : dict[str, EngineDifference]
-        Per later engine that produced a table (none when the base produced none).
+        Per later engine that produced a table.
     """
 
     scene: Scene
@@ -135,9 +112,8 @@ class Comparison:
         return all(result.success for result in self.results.values())
 
     def engine_record(self, engine: str) -> dict[str, Any]:
-        """What the report says about one engine's run: status, reason, version, wall time [s],
-        step [s], steps, the direction of the power flow, and the :data:`SUMMARY_KEYS` the run
-        has a value for."""
+        """The report's record of ``engine``'s run: status, reason, version, wall time [s], step [s],
+        steps, power flow and its :data:`SUMMARY_KEYS`."""
         s = self.results[engine].summary
         return {"status": s.status.value, "reason": s.reason, "engine_version": s.engine_version,
                 "wall_time_s": self.wall_time_s[engine], "dt": s.dt, "steps": s.steps,
@@ -150,23 +126,9 @@ class Comparison:
                 "differences": {engine: d.to_dict() for engine, d in self.differences.items()}}
 
     def differing(self, rtol: float = 0.0, atol: float = 0.0, steady: bool = True) -> pd.DataFrame:
-        """The columns that differ by more than ``atol + rtol * scale``.
-
-        Parameters
-        ----------
-        rtol : float
-            Tolerance relative to the base column's largest magnitude [-].
-        atol : float
-            Absolute tolerance, in the units of each column.
-        steady : bool
-            Judge the rows after ``skip_revolutions`` (default) or all rows.
-
-        Returns
-        -------
-        pandas.DataFrame
-            One row per (engine, column) over the limit: ``engine``, ``column`` and the
-            statistics of :class:`EngineDifference`.
-        """
+        """The (``engine``, ``column``, statistics) rows whose ``max_abs`` exceeds ``atol + rtol * scale``
+        (``atol`` in the column's units, ``rtol`` of the base's largest magnitude [-]); ``steady``: judge
+        the rows after ``skip_revolutions``, else all rows."""
         frames = []
         for engine, d in self.differences.items():
             stats = (d.steady if steady else d.overall).reset_index()
@@ -178,18 +140,7 @@ class Comparison:
         return pd.concat(frames, ignore_index=True)[columns]
 
     def differences_table(self, rtol: float = 0.0, atol: float = 0.0, steady: bool = True) -> str:
-        """:meth:`differing` as a markdown table, for an assertion message or a terminal.
-
-        Parameters
-        ----------
-        rtol, atol, steady
-            As for :meth:`differing`.
-
-        Returns
-        -------
-        str
-            Columns engine, column, max |difference|, RMS, scale, max |difference| / scale.
-        """
+        """:meth:`differing` as a markdown table, for an assertion message or a terminal."""
         columns = ["engine", "column", "max_abs", "rms", "scale", "max_rel"]
         formats = {c: ".3e" for c in columns[2:]}
         return markdown_table(self.differing(rtol, atol, steady), columns, formats)
@@ -203,33 +154,14 @@ def summary_values(summary: Summary) -> dict[str, float]:
 
 
 def statistics_dict(stats: pd.DataFrame) -> dict[str, dict[str, float]]:
-    """Per-column statistics as the JSON report writes them: column -> :data:`SERIALISED` key ->
-    value (``rows`` an integer)."""
+    """Per-column statistics as the JSON report writes them: column -> :data:`SERIALISED` key -> value."""
     return {column: {key: int(row[key]) if key == "rows" else float(row[key]) for key in SERIALISED}
             for column, row in stats.iterrows()}
 
 
 def join_on_input_angle(base: pd.DataFrame, other: pd.DataFrame) -> tuple[dict[str, np.ndarray], str]:
-    """``other``'s columns at ``base``'s input angles, and how they were obtained.
-
-    Rows are taken as they are when both tables have the same input angles (to 1e-9 rad);
-    otherwise each column is interpolated by a cubic spline in the input angle, over the span
-    both tables cover (base rows outside it are NaN).
-
-    Parameters
-    ----------
-    base : pandas.DataFrame
-        The base engine's time table (``theta_in`` [rad] and the :data:`COMPARED` columns).
-    other : pandas.DataFrame
-        Another engine's time table of the same scene.
-
-    Returns
-    -------
-    columns : dict of str to ndarray
-        Each :data:`COMPARED` column ``other`` has, at ``base``'s rows (units of the column).
-    join : str
-        ``"same rows"`` or ``"cubic spline in the input angle"``.
-    """
+    """``(columns, join)``: ``other``'s :data:`COMPARED` columns at ``base``'s input angles, taken as
+    they are when the angles match to 1e-9 rad, else by cubic spline (NaN outside the shared span)."""
     theta_b = base["theta_in"].to_numpy(float)
     theta_o = other["theta_in"].to_numpy(float)
     if theta_b.shape == theta_o.shape and np.max(np.abs(theta_b - theta_o)) <= 1e-9:
@@ -251,25 +183,8 @@ def join_on_input_angle(base: pd.DataFrame, other: pd.DataFrame) -> tuple[dict[s
 
 def column_differences(base: pd.DataFrame, joined: Mapping[str, np.ndarray],
                        mask: np.ndarray) -> pd.DataFrame:
-    """Statistics of ``joined - base`` over the rows in ``mask``, per column.
-
-    Parameters
-    ----------
-    base : pandas.DataFrame
-        The base engine's time table.
-    joined : mapping of str to ndarray
-        The other engine's columns at the base's rows (:func:`join_on_input_angle`).
-    mask : ndarray of bool
-        The base rows to take.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Index ``column``; ``max_abs`` and ``rms`` of the difference and ``scale``, the base
-        column's largest magnitude (units of the column), ``max_rel = max_abs / scale`` [-] (NaN
-        for a column that is zero in the base) and ``rows`` (rows where both are finite).
-        Columns without such a row are left out.
-    """
+    """Per column (index ``column``), :data:`STATISTICS` of ``joined - base`` over the rows in ``mask``
+    (``max_rel`` NaN for a column zero in the base; columns with no finite row left out)."""
     records = {}
     for c, values in joined.items():
         b = base[c].to_numpy(float)[mask]
@@ -299,32 +214,25 @@ def compare(scene: Scene, engines: Sequence[str] = ("exudyn", "reference"),
     Parameters
     ----------
     scene : Scene
-        Run with every step recorded (``record.timeseries``, ``record.every = 1``).
+        Run with every step recorded.
     engines : sequence of str
         At least two distinct keys of :data:`cardan_exudyn.engines.ENGINES`; the first is the base.
     options : mapping, optional
-        Engine name -> options object of that engine (``ExudynOptions``, ...); engines not in
-        it run with their defaults.
+        Engine name -> options object of that engine; others run with their defaults.
     skip_revolutions : float
         Input revolutions [-] left out of the ``steady`` per-column statistics.
     progress : callable, optional
         Called with one line of text before each engine runs.
 
-    Returns
-    -------
-    Comparison
-
     Raises
     ------
     TypeError
-        ``scene`` not a Scene, ``engines`` a string or holding something else than names,
-        ``options`` not a mapping, ``skip_revolutions`` not a number, ``progress`` not callable.
+        An argument of the wrong type (``engines`` a single string).
     ValueError
         Fewer than two engines, an engine twice, a negative ``skip_revolutions`` or one that
         leaves none of the scene's revolutions.
     EngineUnavailable
-        An engine that is unknown, not installed, or cannot run the scene (before any engine
-        runs, except for the last reason).
+        An engine unknown, not installed (before any engine runs), or unable to run the scene.
     OptionsError
         Options for an engine not compared, or of another engine's class.
     """
@@ -347,9 +255,7 @@ def compare(scene: Scene, engines: Sequence[str] = ("exudyn", "reference"),
 
 
 def engine_list(engines: Any) -> list[str]:
-    """``engines`` as a list of engine names; ``TypeError`` naming the argument for a single
-    string (``"exudyn,reference"`` is one name, not two) or anything that is not a sequence of
-    strings."""
+    """``engines`` as a list of names; ``TypeError`` for one string or anything else than strings."""
     if isinstance(engines, (str, bytes)):
         raise TypeError(f"`engines` must be a sequence of engine names such as ['exudyn', 'reference'], "
                         f"not one string: got {engines!r:.80}")
@@ -363,22 +269,7 @@ def engine_list(engines: Any) -> list[str]:
 
 
 def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutions: float) -> None:
-    """Refuse a comparison that cannot be made, before any engine runs.
-
-    Parameters
-    ----------
-    engines : list of str
-        The engines, the base first.
-    options : mapping
-        Engine name -> options of that engine.
-    skip_revolutions : float
-        Input revolutions left out of the steady statistics [-].
-
-    Raises
-    ------
-    TypeError, ValueError, EngineUnavailable, OptionsError
-        As :func:`compare` describes.
-    """
+    """Refuse a comparison that cannot be made (as :func:`compare` describes), before any engine runs."""
     engines = engine_list(engines)
     if isinstance(skip_revolutions, bool) or not isinstance(skip_revolutions, (int, float, np.integer,
                                                                                np.floating)):
@@ -400,30 +291,8 @@ def check_request(engines: list[str], options: Mapping[str, Any], skip_revolutio
 def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any],
                 progress: Callable[[str], None] | None = None,
                 runner: Callable[..., Result] = run) -> tuple[dict[str, Result], dict[str, float]]:
-    """Run each engine on ``scene`` with every step recorded; engines in :data:`SAMPLED_ENGINES`
-    are sampled at the step of the first engine that reports one, unless the scene sets it.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene.
-    engines : sequence of str
-        The engines, in order.
-    options : mapping
-        Engine name -> options; engines not in it run with their defaults.
-    progress : callable, optional
-        Called with one line of text before each engine runs.
-    runner : callable
-        ``runner(scene, engine, options) -> Result``: :func:`cardan_exudyn.engines.run`, or a
-        caching wrapper of it (the pytest plugin's).
-
-    Returns
-    -------
-    results : dict of str to Result
-        Per engine, in order.
-    walls : dict of str to float
-        Per engine, the wall time of its run [s].
-    """
+    """``(results, walls [s])`` per engine of running ``scene`` with every step recorded through
+    ``runner(scene, engine, options)``; :data:`SAMPLED_ENGINES` sample at the first reported step."""
     scene = replace(scene, **{"record.timeseries": True, "record.every": 1})
     results: dict[str, Result] = {}
     walls: dict[str, float] = {}
@@ -443,20 +312,8 @@ def run_engines(scene: Scene, engines: Sequence[str], options: Mapping[str, Any]
 
 
 def differences(results: Mapping[str, Result], skip_revolutions: float) -> dict[str, EngineDifference]:
-    """Every later engine that produced a table against the first (none without a base table).
-
-    Parameters
-    ----------
-    results : mapping of str to Result
-        Per engine, the base first.
-    skip_revolutions : float
-        Input revolutions left out of the steady statistics [-].
-
-    Returns
-    -------
-    dict of str to EngineDifference
-        Per later engine with a table.
-    """
+    """Per later engine with a table, its :class:`EngineDifference` from the first (none without a
+    base table)."""
     base_name, *others = results
     base = results[base_name].table
     if base is None:
@@ -468,22 +325,8 @@ def differences(results: Mapping[str, Result], skip_revolutions: float) -> dict[
 
 def difference(base: Result, other: Result, base_name: str, engine: str,
                steady: np.ndarray) -> EngineDifference:
-    """``other`` against ``base``: the join, the mean-value and the per-column differences.
-
-    Parameters
-    ----------
-    base, other : Result
-        The two runs, each with a table.
-    base_name, engine : str
-        Their engines.
-    steady : ndarray of bool
-        The base rows after the skipped revolutions.
-
-    Returns
-    -------
-    EngineDifference
-        Mean-value differences only when both runs ended ``ok``.
-    """
+    """``other`` against ``base`` (engines ``engine``, ``base_name``); ``steady`` marks the base rows
+    after the skipped revolutions."""
     joined, how = join_on_input_angle(base.table, other.table)
     means = {}
     if base.success and other.success:

@@ -1,13 +1,7 @@
-"""The one engine dispatch: every engine takes a :class:`reference.scene.scene.Scene` and options, and
-returns a :class:`reference.results.result.Result` with the same columns and summary fields.
+"""The one engine dispatch: every engine runs a :class:`reference.scene.scene.Scene` with its options
+into a :class:`reference.results.result.Result` of the same columns and summary fields.
 
-Like scipy's ``solve_ivp(method=...)`` over its ``METHODS`` table: callers name an engine (or
-pass options of an engine's class) and never import an engine module themselves. Engines are
-imported on first use, so a missing optional engine (MuJoCo) costs nothing until asked for.
-
-Many scenes at once: :func:`run_batch`. An engine with a batched pass (the reference engine's
-:mod:`reference.engine.batch.solve`) runs the scenes of equal :func:`batch_key` together; the
-others, and scenes whose key is None, run one at a time as :func:`run` would.
+Engines import on first use, so a missing optional engine (MuJoCo) costs nothing until asked for.
 """
 
 from __future__ import annotations
@@ -26,22 +20,8 @@ from reference.scene.validation import require_scene
 
 @dataclass(frozen=True)
 class Engine:
-    """An entry of :data:`ENGINES`.
-
-    Attributes
-    ----------
-    name : str
-        The key in :data:`ENGINES`.
-    module : str
-        The module whose ``run(scene, options) -> Result`` runs a scene (imported on first use).
-    options : str
-        Its options class, as ``"module:Class"``.
-    description : str
-        One line for listings.
-    batch : str
-        Module with ``check_scenes``, ``batch_key(scene)`` and ``run_batch(scenes, options)``;
-        "": no batched pass.
-    """
+    """An entry of :data:`ENGINES`: ``module`` has ``run(scene, options) -> Result``, ``options`` is
+    ``"module:Class"``, ``batch`` a module with ``check_scenes``, ``batch_key``, ``run_batch`` ("": none)."""
 
     name: str
     module: str
@@ -98,13 +78,8 @@ def _import(name: str, module: str) -> Any:
 
 
 def options_class(engine: str) -> type:
-    """The options class of ``engine`` (a frozen dataclass validated on construction).
-
-    Raises
-    ------
-    EngineUnavailable
-        An unknown engine, or one whose options module does not import.
-    """
+    """The options class of ``engine`` (a frozen dataclass validated on construction);
+    :class:`EngineUnavailable` for an unknown engine or one whose options module does not import."""
     module, _, cls = _entry(engine).options.partition(":")
     return getattr(_import(engine, module), cls)
 
@@ -118,11 +93,6 @@ def make_options(engine: str, **values: Any) -> Any:
         A key of :data:`ENGINES`.
     **values
         Fields of its options class.
-
-    Returns
-    -------
-    object
-        An instance of :func:`options_class` ``(engine)``.
 
     Raises
     ------
@@ -140,25 +110,13 @@ def make_options(engine: str, **values: Any) -> Any:
 
 
 def get_engine(name: str) -> Callable[..., Result]:
-    """The run function ``run(scene, options=None) -> Result`` of the named engine.
-
-    Raises
-    ------
-    EngineUnavailable
-        An unknown engine, or one that is not installed.
-    """
+    """The function ``run(scene, options=None) -> Result`` of engine ``name``."""
     return _import(name, _entry(name).module).run
 
 
 def engine_of(options: Any) -> str:
-    """The engine whose options class ``options`` is an instance of (matched by class name, so
-    that the engine's module need not be imported).
-
-    Raises
-    ------
-    OptionsError
-        ``options`` of no engine's class.
-    """
+    """The engine whose options class ``options`` is an instance of (matched by class name, so the
+    engine's module need not import); :class:`OptionsError` if none."""
     for name, entry in ENGINES.items():
         if type(options).__name__ == entry.options_name:
             return name
@@ -171,31 +129,7 @@ DEFAULT_ENGINE = "exudyn"
 
 
 def resolve(engine: str | None = None, options: Any = None, **option_values: Any) -> tuple[str, Any]:
-    """The engine and an instance of its options from what a caller gave (see :func:`run`).
-
-    Parameters
-    ----------
-    engine : str, optional
-        A key of :data:`ENGINES`; by default the engine of ``options``, else :data:`DEFAULT_ENGINE`.
-    options : optional
-        An instance of the engine's options class.
-    **option_values
-        Or the fields of the options, as keywords.
-
-    Returns
-    -------
-    engine : str
-    options : object
-        An instance of the engine's options class.
-
-    Raises
-    ------
-    EngineUnavailable
-        An unknown or uninstalled engine.
-    OptionsError
-        Both ``options`` and option keywords, unknown or out-of-range keywords, or options of
-        another engine's class.
-    """
+    """``(engine, options)`` from what a caller gave to :func:`run` (``options`` or their keywords)."""
     if options is not None and option_values:
         raise OptionsError("give `options` or option keywords, not both")
     if engine is None:
@@ -214,26 +148,21 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
     Parameters
     ----------
     scene : Scene
-        The scene to run.
     engine : str, optional
         A key of :data:`ENGINES`; by default the engine of ``options``, else ``"exudyn"``.
     options : optional
         An instance of the engine's options class (``ExudynOptions``, ``ReferenceOptions``,
         ``MujocoOptions``); or give its fields as keywords (``node_type="EP"``).
-    **option_values
-        The options' fields, when ``options`` is not given.
 
     Returns
     -------
     Result
-        The time table (built when first read) and the summary; a run that failed returns a
-        result with its status and reason, it does not raise.
+        A failed run returns a result with its status and reason; it does not raise.
 
     Raises
     ------
     TypeError
-        ``scene`` is not a Scene (:class:`reference.scene.validation.SceneTypeError`), or ``engine``
-        not a string.
+        ``scene`` is not a Scene, or ``engine`` not a string.
     EngineUnavailable
         Unknown or uninstalled engine, or a scene the engine cannot express.
     OptionsError
@@ -249,33 +178,12 @@ def run(scene: Scene, engine: str | None = None, options: Any = None, **option_v
 
 
 def has_batch(engine: str) -> bool:
-    """Whether ``engine`` has a batched pass (:func:`run_batch` then runs scenes together)."""
+    """Whether ``engine`` has a batched pass."""
     return bool(_entry(engine).batch)
 
 
 def batch_key(scene: Scene, engine: str | None = None) -> Hashable | None:
-    """The key that groups scenes in :func:`run_batch`.
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene.
-    engine : str, optional
-        A key of :data:`ENGINES` (default :data:`DEFAULT_ENGINE`).
-
-    Returns
-    -------
-    hashable or None
-        Scenes of one engine with equal keys run together; None: the scene runs on its own
-        (always None for an engine without a batched pass).
-
-    Raises
-    ------
-    TypeError
-        ``scene`` is not a Scene, or ``engine`` not a string.
-    EngineUnavailable
-        Unknown or uninstalled engine.
-    """
+    """The key grouping ``scene`` in :func:`run_batch` for ``engine``; None: the scene runs on its own."""
     require_scene(scene)
     engine = DEFAULT_ENGINE if engine is None else engine
     entry = _entry(engine)
@@ -285,24 +193,16 @@ def batch_key(scene: Scene, engine: str | None = None) -> Hashable | None:
 def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any = None,
               **option_values: Any) -> list[Result]:
     """Run many scenes with one engine: one :class:`Result` per scene, in order, each equal to
-    ``run(scene, engine, options)`` (to rounding, or to the quadrature tolerance where the batched
-    pass adapts differently: :mod:`reference.engine.batch.solve`).
+    ``run(scene, engine, options)`` to rounding or to the quadrature tolerance.
 
-    Scenes of equal :func:`batch_key` run in one pass of the engine's batched evaluation (a scene
-    that locks or fails gets its own failed Result); the others, and every scene of an engine
-    without a batched pass, run one at a time.
+    Scenes of equal :func:`batch_key` run in one pass of the engine's batched evaluation; the others
+    run one at a time.
 
     Parameters
     ----------
     scenes : sequence of Scene
-        The scenes, in the order of the results.
     engine, options, option_values
         As in :func:`run`.
-
-    Returns
-    -------
-    list of Result
-        One per scene, in order.
 
     Raises
     ------
@@ -311,8 +211,8 @@ def run_batch(scenes: Sequence[Scene], engine: str | None = None, options: Any =
     EngineUnavailable, OptionsError
         As in :func:`run`; raised before any scene runs.
     SceneError
-        A scene the engine's batched pass refuses before running (a table beyond the step
-        limit), named by its index in ``scenes``; raised before any scene runs.
+        A scene the batched pass refuses (a table beyond the step limit), named by its index;
+        raised before any scene runs.
     """
     if isinstance(scenes, (Scene, str, bytes)) or not isinstance(scenes, Sequence):
         raise TypeError(f"`scenes` must be a sequence of Scene, got {type(scenes).__name__} {scenes!r:.80}")

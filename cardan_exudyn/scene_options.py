@@ -82,24 +82,9 @@ LEAVE_OUT = ("angle", "rpm", "load_torque", "friction_spider", "friction_frame",
 
 def add_scene_options(p: argparse.ArgumentParser, *, default: str | None = None,
                       leave_out: tuple[str, ...] = ()) -> None:
-    """Add the scene options (destinations :data:`SCENE_OPTIONS`) to a command's parser.
-
-    Parameters
-    ----------
-    p : argparse.ArgumentParser
-        The command's parser.
-    default : str, optional
-        What ``--name`` says the command takes without a scene (default: :data:`DEFAULT_SCENE`,
-        physical set, as ``cardan run``).
-    leave_out : tuple of str
-        Destinations of :data:`LEAVE_OUT` the command sets itself: not offered (argparse refuses
-        them), None in the parsed arguments, so that :func:`scene_from_args` works.
-
-    Raises
-    ------
-    ValueError
-        ``leave_out`` names an option no command may set itself.
-    """
+    """Add the scene options (:data:`SCENE_OPTIONS`) to parser ``p``; ``default`` is what ``--name``
+    says the command takes without one; ``leave_out`` (of :data:`LEAVE_OUT`, else ``ValueError``)
+    the options the command sets itself, not offered and None when parsed."""
     if not set(leave_out) <= set(LEAVE_OUT):
         raise ValueError(f"`leave_out` must name options of {list(LEAVE_OUT)}, got {leave_out!r}")
     offered = set(SCENE_OPTIONS) - set(leave_out)
@@ -134,15 +119,8 @@ def _add_numerics_options(p: argparse.ArgumentParser, offered: set[str]) -> None
 
 
 def scene_from_args(args: argparse.Namespace) -> Scene:
-    """The scene named or loaded by the options, with the command-line overrides applied and
-    named after them (:func:`override_name`): ``--angle 45`` on ``paper-10deg-2000rpm`` is
-    ``paper-45deg-2000rpm``, ``--load-torque 3`` adds ``+load=3Nm``.
-
-    Raises
-    ------
-    SceneError
-        An unknown name, an unreadable or invalid file, or an override the scene refuses.
-    """
+    """The scene named or loaded by the options with the overrides applied and named after them
+    (``--angle 45`` on ``paper-10deg-2000rpm`` is ``paper-45deg-2000rpm``); ``SceneError`` if refused."""
     changes, labels = _overrides(args)
     if args.scene is not None:
         scene = load_scene(args.scene)
@@ -163,10 +141,8 @@ def scene_from_args(args: argparse.Namespace) -> Scene:
 
 
 def _named(name: str, labels: list[tuple[str, str]]) -> Scene:
-    """The named scene, built at the ``--angle`` and ``--rpm`` asked for (their ``labels``) when it
-    is one of the paper's (so that its parameter set's choices, such as the load that gives the
-    case's mean input torque, are made for that angle and speed; the override then changes
-    nothing)."""
+    """The named scene built at the ``--angle``/``--rpm`` ``labels`` when it is one of the paper's, so its
+    parameter set's choices (the load giving the case's mean input torque) fit that angle and speed."""
     scene = named_scene(name)
     tokens = [(k, text) for k, text in labels if k in ("angle", "rpm") and not text.startswith("-")]
     if not scene.parameter_set or not tokens:
@@ -193,8 +169,7 @@ def _drive_overrides(args: argparse.Namespace, changes: dict[str, Any],
 
 
 def _overrides(args: argparse.Namespace) -> tuple[dict[str, Any], list[tuple[str, str]]]:
-    """The scene changes the options ask for (dotted path -> value), and their labels (key,
-    value text) for the name."""
+    """The scene changes (dotted path -> value) and their labels (key, value text) for the name."""
     changes: dict[str, Any] = {}
     labels: list[tuple[str, str]] = []
     _drive_overrides(args, changes, labels)
@@ -215,9 +190,8 @@ def _overrides(args: argparse.Namespace) -> tuple[dict[str, Any], list[tuple[str
 
 
 def _friction_labels(scene: Scene) -> list[tuple[str, str]]:
-    """The friction coefficients of the spider and frame pairs after an override (both, so that
-    the name says what the other group has): ``f_spider=0.42``, or ``0.1/0.2`` when the two
-    pairs of a group differ."""
+    """Both groups' friction labels after an override: ``f_spider=0.42``, or ``0.1/0.2`` when the pairs
+    of a group differ."""
     pairs = dict(scene.joint.pairs.items())
     out = []
     for label, names in (("f_spider", SPIDER_PAIRS), ("f_frame", FRAME_PAIRS)):
@@ -227,25 +201,9 @@ def _friction_labels(scene: Scene) -> list[tuple[str, str]]:
 
 
 def override_name(name: str, labels: list[tuple[str, str]], frictionless: bool | None = None) -> str:
-    """A scene name that says what was overridden: a shaft angle (``angle``) or speed (``rpm``)
-    replaces the one part of ``name`` that gives it (``paper-10deg-2000rpm`` -> ``paper-45deg-
-    2000rpm``); a ``frictionless`` part goes when the scene has friction after all
-    (``frictionless`` False); every other label is appended as ``+key=value`` (``+load=3Nm``,
-    ``+f_spider=0.42``, ``+no_gravity``).
-
-    Parameters
-    ----------
-    name : str
-        The base scene's name.
-    labels : list of (str, str)
-        Override key and its value with unit (empty for a flag), in order.
-    frictionless : bool, optional
-        Whether the scene is frictionless after the overrides (None: not changed).
-
-    Returns
-    -------
-    str
-    """
+    """``name`` with the overrides ``labels`` ((key, value text) pairs): an ``angle``/``rpm`` replaces
+    its part (``paper-10deg-2000rpm`` -> ``paper-45deg-2000rpm``), ``frictionless`` False drops a
+    ``frictionless`` part, other labels append as ``+key=value`` (``+load=3Nm``, ``+no_gravity``)."""
     parts = name.split("-")
     extra = []
     for key, text in labels:
