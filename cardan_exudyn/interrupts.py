@@ -1,14 +1,8 @@
 """Interruptions (Ctrl-C, SIGTERM) as exceptions that no layer mistakes for a failure.
 
-Ctrl-C raises :class:`KeyboardInterrupt`, and the ``cardan`` command makes SIGTERM raise
-:class:`Terminated`, a subclass: every ``except Exception`` lets both through, every cleanup
-written for one serves both, and the command exits ``128 + signal`` (130, 143).
-
-Exudyn calls Python user functions (friction, stop test) inside its solver and turns any
-exception they raise into a failed solve ("Python ... UserFunction failed"); an interruption
-between two of them can also come back as a ``SystemError``. :func:`watch_signals` records a
-signal arriving while foreign code runs, so the caller raises the interruption whatever that
-code made of it.
+SIGTERM raises :class:`Terminated`, a :class:`KeyboardInterrupt`: ``except Exception`` lets both
+through and the command exits ``128 + signal`` (130, 143). Exudyn turns an exception in a Python
+user function into a failed solve, so :func:`watch_signals` re-raises a signal foreign code swallowed.
 """
 
 from __future__ import annotations
@@ -54,8 +48,7 @@ def _raise_terminated(signum: int, frame: FrameType | None) -> None:
 
 @contextlib.contextmanager
 def terminate_raises() -> Iterator[None]:
-    """Within the block SIGTERM raises :class:`Terminated` (in the main thread; a SIGTERM that
-    the process was told to ignore stays ignored)."""
+    """Within the block SIGTERM raises :class:`Terminated` (main thread only; an ignored SIGTERM stays ignored)."""
     if not _main_thread() or signal.getsignal(signal.SIGTERM) == signal.SIG_IGN:
         yield
         return
@@ -84,13 +77,8 @@ class SignalWatch:
 
 @contextlib.contextmanager
 def watch_signals() -> Iterator[SignalWatch]:
-    """Record SIGINT and SIGTERM arriving within the block; on leaving it after one arrived,
-    raise the interruption (:func:`interruption`), whatever the block raised or returned.
-
-    Only signals with a Python handler are watched (an ignored or default signal is left alone)
-    and only in the main thread, where Python runs handlers; the handler still runs, so an
-    interruption also stops the block as it would without the watch.
-    """
+    """Record SIGINT and SIGTERM within the block and raise the interruption on leaving it, whatever the
+    block raised or returned. Only Python-handled signals in the main thread; the handler still runs."""
     watch = SignalWatch()
     previous = {}
     if _main_thread():
@@ -113,10 +101,8 @@ def watch_signals() -> Iterator[SignalWatch]:
 
 @contextlib.contextmanager
 def deferred_signals() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back within the block (a few lines that must not be cut in half,
-    such as one record's append and its bookkeeping); one that arrived meanwhile is handled when
-    the block ends. (A handler that only notes the signal, not a blocked signal mask: Python runs
-    handlers in the main thread, whichever thread the signal reached.)"""
+    """Hold SIGINT and SIGTERM back within the block (lines that must not be cut in half); one that
+    arrived is handled at its end. A noting handler, not a signal mask: Python handles in the main thread."""
     if not _main_thread():
         yield
         return

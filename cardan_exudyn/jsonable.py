@@ -15,9 +15,8 @@ __all__ = ["to_jsonable", "dumps"]
 
 
 def to_jsonable(value: Any) -> Any:
-    """``value`` as plain JSON data: a :class:`~reference.results.summary.Summary` as its
-    ``to_dict()``, an enum as its value, mappings (keys as strings), sequences and arrays as
-    lists, numpy scalars as Python numbers, non-finite floats as None; anything else unchanged."""
+    """``value`` as plain JSON data: Summary as ``to_dict()``, enums as values, string keys, sequences and
+    arrays as lists, numpy scalars as Python numbers, non-finite floats as None."""
     if isinstance(value, Summary):
         return to_jsonable(value.to_dict())
     if isinstance(value, Enum):

@@ -1,11 +1,8 @@
 """A command's output: folders and files written atomically, one writer at a time, and a run's
 result folder (CSV time table, JSON summary).
 
-A command writes into a new hidden sibling of its output folder and exchanges it with the
-previous one in one step when it is complete (:func:`atomic_directory`), so a command killed at
-any instant leaves the complete previous output or the complete new one; the next command
-removes what a killed one left. While a command runs, a second one writing to the same output
-is refused (:func:`output_lock`). The guarantees and their limits: ``docs/outputs.md``.
+A killed command leaves the complete previous output or the complete new one (:func:`atomic_directory`);
+a second writer is refused (:func:`output_lock`). Guarantees and limits: ``docs/outputs.md``.
 """
 
 from __future__ import annotations
@@ -32,31 +29,14 @@ __all__ = ["OutputError", "WRITE_ERRORS", "write_error", "check_output_folder", 
 
 
 class OutputError(ValueError):
-    """An output path cannot be written as asked: it exists and is not a folder, it may not be
-    replaced, its parent cannot hold it or another command is writing it (raised before anything
-    is written), or the disk is full (the previous output is kept). The CLI prints it, exit
-    status 2."""
+    """An output path cannot be written as asked (not a folder, not replaceable, parent unusable, another
+    writer; raised before writing), or the disk refused it (previous output kept). CLI exit status 2."""
 
 
 @contextlib.contextmanager
 def atomic_open(path: str | os.PathLike, mode: str = "wb", **kwargs: Any) -> Iterator[IO]:
-    """Open a temporary sibling of ``path``; on success flush, fsync and rename it onto ``path``.
-
-    Parameters
-    ----------
-    path : path-like
-        Target file; its folder must exist.
-    mode : {"wb", "w"}
-        Binary or text.
-    **kwargs
-        Passed to :func:`open` (``encoding``, ``newline``).
-
-    Yields
-    ------
-    file object
-        Write to it; on an exception (an interruption included) the temporary file is removed
-        and the target is untouched.
-    """
+    """Open a temporary sibling of ``path`` (its folder must exist) with ``mode`` ``"wb"``/``"w"`` and
+    ``open`` ``kwargs``; on success flush, fsync and rename it onto ``path``, on an exception remove it."""
     target = Path(path)
     tmp = target.with_name(f".{target.name}.{os.urandom(8).hex()}.tmp")
     # os.open applies the umask to 0o666, as open() would; mkstemp would leave the file 0o600
@@ -74,44 +54,15 @@ def atomic_open(path: str | os.PathLike, mode: str = "wb", **kwargs: Any) -> Ite
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[IO], Any]) -> None:
-    """Write one binary file atomically and durably (:func:`atomic_open`).
-
-    Parameters
-    ----------
-    path : path-like
-        Target file; its folder must exist.
-    write : callable
-        ``write(f)`` fills the binary file object ``f``.
-    """
+    """Write binary file ``path`` atomically and durably: ``write(f)`` fills ``f``."""
     with atomic_open(path, "wb") as f:
         write(f)
 
 
 def check_output_folder(target: str | os.PathLike, replace: bool = True) -> Path:
-    """``target`` as a folder a command may create (and, with ``replace``, replace as a whole).
-
-    A folder that is replaced as a whole must be one of its own: not the current folder, the home
-    folder, the root or a folder above one of them (however it is spelt: ``.``, ``$(pwd)``,
-    ``~/..``), and not a folder holding a ``.git`` repository.
-
-    Parameters
-    ----------
-    target : path-like
-        The output folder.
-    replace : bool
-        The command replaces the folder as a whole (False: it writes into it, as a sweep does).
-
-    Returns
-    -------
-    Path
-        ``target``.
-
-    Raises
-    ------
-    OutputError
-        ``target`` exists and is not a folder, its nearest existing parent is not a folder, or
-        (with ``replace``) it is not a folder of its own.
-    """
+    """``target`` as a folder a command may create; with ``replace`` (replaced as a whole) it must be one
+    of its own: not the current or home folder, the root or above them, nor a ``.git`` holder.
+    :class:`OutputError` otherwise, or when ``target`` or its nearest existing parent is not a folder."""
     target = Path(target)
     if replace and target.name in ("", ".", ".."):  # "", ".", "/", "..": a folder above the output's own
         raise OutputError(f"{str(target)!r} names no folder of its own (the current folder, a parent "
@@ -143,27 +94,13 @@ def _check_replaceable(folder: Path) -> None:
 
 
 WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS})
-"""Errors of a write the disk refuses (full, over quota, over the file size limit, read-only):
-reported in one line (:func:`write_error`), exit status 2."""
+"""Errors of a write the disk refuses (full, quota, file size limit, read-only): one line, exit 2."""
 _LEFTOVER = re.compile(r"\.(?P<name>.+)\.cardan-(?P<kind>new|old)-(?P<pid>\d+)-[0-9a-f]+")
 _held: dict[str, int] = {}  # lock files this process holds -> nesting depth (the lock is re-entrant)
 
 
 def write_error(exc: OSError, target: str | os.PathLike) -> OutputError:
-    """A write failure (full disk, quota, file size limit, read-only) as one line.
-
-    Parameters
-    ----------
-    exc : OSError
-        The failure.
-    target : path-like
-        The output it was writing.
-
-    Returns
-    -------
-    OutputError
-        To raise; names the target, the reason and the file.
-    """
+    """Write failure ``exc`` of output ``target`` as a one-line :class:`OutputError` (to raise)."""
     return OutputError(f"cannot write {str(target)!r}: {exc.strerror or exc}"
                        + (f" ({exc.filename})" if exc.filename else ""))
 
@@ -176,12 +113,9 @@ def lock_path(target: str | os.PathLike) -> Path:
 
 @contextlib.contextmanager
 def output_lock(target: str | os.PathLike) -> Iterator[None]:
-    """Hold ``target`` (an output folder or file) for this process: a second command writing to
-    it meanwhile gets :class:`OutputError` naming this one. Re-entrant within a process.
-
-    The lock is an advisory ``flock`` on ``.NAME.lock`` next to the target, removed on release;
-    its folder must exist. Without ``fcntl`` (Windows), or where the lock file cannot be created
-    (a read-only folder, which no command can write into anyway), nothing is locked."""
+    """Hold output ``target`` for this process (re-entrant): a second writer gets :class:`OutputError`
+    naming this one. An advisory ``flock`` on ``.NAME.lock`` next to it, removed on release; nothing
+    locked without ``fcntl`` (Windows) or where the lock file cannot be made (read-only folder)."""
     path = lock_path(target)
     key = str(path)
     if key in _held:
@@ -246,11 +180,8 @@ def _alive(pid: int) -> bool:
 
 
 def clean_leftovers(target: str | os.PathLike) -> list[Path]:
-    """Remove the temporary siblings ``.NAME.cardan-new-PID-*`` and ``.NAME.cardan-old-PID-*`` of
-    ``target`` left by killed commands (their process is gone); when ``target`` itself is
-    missing and a killed swap left the previous output aside (``old``), put it back first.
-
-    Returns the leftovers found (restored or removed)."""
+    """Remove the siblings ``.NAME.cardan-{new,old}-PID-*`` of ``target`` whose process is gone, first
+    restoring an ``old`` one when ``target`` is missing; the leftovers found."""
     target = Path(target)
     if not target.parent.is_dir():
         return []
@@ -283,8 +214,7 @@ def _sibling(target: Path, kind: str) -> Path:
 
 @functools.cache
 def _renameat2():
-    """libc's ``renameat2`` (Linux >= 3.15, glibc >= 2.28), or ``None``; looked up on first use,
-    not at import."""
+    """libc's ``renameat2`` (Linux >= 3.15, glibc >= 2.28) or None, looked up on first use."""
     if not sys.platform.startswith("linux"):
         return None
     try:
@@ -301,24 +231,8 @@ _RENAME_EXCHANGE = 2  # renameat2's flag: swap the two paths
 
 
 def exchange(a: str | os.PathLike, b: str | os.PathLike) -> bool:
-    """Swap two existing paths in one atomic step (Linux ``renameat2(RENAME_EXCHANGE)``).
-
-    Parameters
-    ----------
-    a, b : path-like
-        The two paths.
-
-    Returns
-    -------
-    bool
-        True when swapped; False where the system or the file system cannot (the caller falls
-        back to two renames).
-
-    Raises
-    ------
-    OSError
-        Any other failure.
-    """
+    """Swap existing paths ``a`` and ``b`` in one atomic step (Linux ``renameat2(RENAME_EXCHANGE)``).
+    False where the system or file system cannot (the caller then renames twice); ``OSError`` otherwise."""
     renameat2 = _renameat2()
     if renameat2 is None:
         return False
@@ -331,8 +245,8 @@ def exchange(a: str | os.PathLike, b: str | os.PathLike) -> bool:
 
 
 def _swap(new: Path, target: Path) -> None:
-    """Put the complete folder ``new`` at ``target``; the previous one is removed after. Ctrl-C
-    and SIGTERM wait for the renames (:func:`cardan_exudyn.interrupts.deferred_signals`)."""
+    """Put complete folder ``new`` at ``target`` and remove the previous one; Ctrl-C and SIGTERM wait
+    for the renames."""
     with deferred_signals():
         if not os.path.lexists(target):
             os.rename(new, target)
@@ -352,8 +266,7 @@ def _swap(new: Path, target: Path) -> None:
 
 
 def _fsync_tree(folder: Path) -> None:
-    """Files and folders under ``folder`` on disk before the swap (a power cut then finds the new
-    output complete, not files of zero length)."""
+    """Fsync everything under ``folder`` before the swap (a power cut finds no zero-length files)."""
     for root, _, files in os.walk(folder):
         for name in [*files, "."]:
             fd = os.open(os.path.join(root, name), os.O_RDONLY)
@@ -373,22 +286,12 @@ def _make_parents(target: Path) -> None:
 
 @contextlib.contextmanager
 def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
-    """Yield a new empty folder that replaces ``target`` only when the block succeeds.
+    """Yield a new empty sibling folder that replaces ``target`` only when the block succeeds.
 
-    The folder is ``.NAME.cardan-new-PID-*`` next to ``target``, made with the permissions the
-    umask gives. When the block ends, its files are fsync'ed and it takes the place of
-    ``target`` in one atomic exchange (where the file system cannot exchange: two renames, see
-    :func:`clean_leftovers`); on an exception (an interruption included) it is removed and
-    ``target`` is untouched. The command holds :func:`output_lock` throughout and first removes
-    the leftovers of killed commands.
-
-    Raises
-    ------
-    OutputError
-        Before the block runs: ``target`` exists and is not a folder (a file is never replaced
-        by a folder), may not be replaced (:func:`check_output_folder`), its parent cannot be
-        made, or another command is writing it. After: the disk is full or the output cannot
-        be written (:data:`WRITE_ERRORS`); the previous output is kept.
+    On success its files are fsync'ed and it is exchanged with ``target`` atomically (else two renames,
+    :func:`clean_leftovers`); on an exception it is removed. Holds :func:`output_lock` throughout.
+    :class:`OutputError` before the block (as :func:`check_output_folder`, or another writer) or after
+    (:data:`WRITE_ERRORS`; previous output kept).
     """
     target = check_output_folder(target)
     _make_parents(target)
@@ -414,46 +317,20 @@ def atomic_directory(target: str | os.PathLike) -> Iterator[Path]:
 
 
 def result_files(result: Result) -> list[str]:
-    """The files :func:`write_result_files` writes for ``result``: ``timeseries.csv`` only when a
-    table was recorded (``record.timeseries``), then ``summary.json``."""
+    """The files :func:`write_result_files` writes: ``timeseries.csv`` when recorded, ``summary.json``."""
     return (["timeseries.csv"] if result.has_table else []) + ["summary.json"]
 
 
 def write_result_files(result: Result, folder: Path) -> None:
-    """Write ``timeseries.csv`` (when recorded) and ``summary.json`` into an existing folder.
-
-    Parameters
-    ----------
-    result : Result
-        The run; its table is built here (the one place a run's table is read to be written).
-    folder : Path
-        The folder.
-    """
+    """Write ``result``'s ``timeseries.csv`` (when recorded; its table is built here) and ``summary.json``
+    into existing ``folder``."""
     if result.table is not None:
         result.table.to_csv(folder / "timeseries.csv", index=False, float_format="%.12g")
     (folder / "summary.json").write_text(dumps(result.summary) + "\n", encoding="utf-8")
 
 
 def write_result(result: Result, out: str | os.PathLike) -> Path:
-    """Write a run's result folder atomically (:func:`atomic_directory`).
-
-    Parameters
-    ----------
-    result : Result
-        The run.
-    out : path-like
-        The folder, replaced as a whole.
-
-    Returns
-    -------
-    Path
-        ``out``.
-
-    Raises
-    ------
-    OutputError
-        As :func:`atomic_directory`.
-    """
+    """Write ``result``'s folder ``out`` atomically (:func:`atomic_directory`); ``Path(out)``."""
     with atomic_directory(out) as tmp:
         write_result_files(result, tmp)
     return Path(out)
