@@ -48,7 +48,8 @@ def _raise_terminated(signum: int, frame: FrameType | None) -> None:
 
 @contextlib.contextmanager
 def terminate_raises() -> Iterator[None]:
-    """Within the block SIGTERM raises :class:`Terminated` (main thread only; an ignored SIGTERM stays ignored)."""
+    """Within the block SIGTERM raises :class:`Terminated` (main thread only; an ignored SIGTERM stays
+    ignored)."""
     if not _main_thread() or signal.getsignal(signal.SIGTERM) == signal.SIG_IGN:
         yield
         return
@@ -77,8 +78,8 @@ class SignalWatch:
 
 @contextlib.contextmanager
 def watch_signals() -> Iterator[SignalWatch]:
-    """Record SIGINT and SIGTERM within the block and raise the interruption on leaving it, whatever the
-    block raised or returned. Only Python-handled signals in the main thread; the handler still runs."""
+    """Record SIGINT and SIGTERM within the block and raise the interruption on leaving it, whatever
+    the block raised or returned. Only Python-handled signals in the main thread; the handler still runs."""
     watch = SignalWatch()
     previous = {}
     if _main_thread():

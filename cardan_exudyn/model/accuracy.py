@@ -1,13 +1,10 @@
-"""A run's accuracy: the Exudyn runs a scene takes to meet ``numerics.accuracy`` and the estimate
-of their mean-efficiency error (``docs/accuracy.md``). :func:`run` is the engine's entry.
+"""The Exudyn runs a scene takes to meet ``numerics.accuracy``, and their mean-efficiency error
+estimate (``docs/accuracy.md``). With friction a companion at H = 2..3 times the main step h gives
 
-With friction the main run has a companion at 2 to 3 times its step, and the error estimate is
-Richardson's from the two, ``|eta_h - eta_H| / ((H / h)^p - 1)`` with ``p`` the order of
-:func:`cardan_exudyn.model.stepsize.convergence_order`, never below a share of the a-priori model
-where the error is irregular in the step. An automatic step is planned by a pilot run, whose
-losses set the steps (:func:`cardan_exudyn.model.stepsize.plan_steps`); when the estimate misses
-the target, or the companion failed, the step is refined once. Without friction the mean
-efficiency is 1 exactly and nothing else runs.
+    err = |eta_h - eta_H| / ((H / h)^p - 1),
+
+never below a share of the a-priori model where the error is irregular in the step. An automatic
+step is planned by a pilot run and refined once if the estimate misses the target.
 """
 
 from __future__ import annotations
@@ -44,9 +41,8 @@ __all__ = ["EXTRAPOLATION_GAIN_CAP", "MAX_COMPANION_RATIO", "MODEL_FLOOR", "run"
            "Verdict", "pilot_plan", "pilot_gain", "assess", "publish", "failed", "loss_fraction"]
 
 EXTRAPOLATION_GAIN_CAP = 0.95
-"""The loop gain at which the extrapolated coupling escalates to the converged one
-(:data:`cardan_exudyn.model.extrapolated.ESCALATE_GAIN`): a plan without an estimate takes its error
-amplification as at most ``1 / (1 - 0.95)``."""
+"""The loop gain at which the extrapolated coupling escalates to the converged one: a plan without an
+estimate takes its error amplification as at most ``1 / (1 - 0.95)``."""
 MAX_COMPANION_RATIO = 3.0
 """The pilot is the companion when the main step is at most this many times finer; else a
 companion at exactly twice the main step runs. Measured: docs/accuracy.md#accuracy-constants."""
@@ -57,32 +53,28 @@ Measured: docs/accuracy.md#accuracy-constants."""
 
 
 def run(scene: Scene, options: ExudynOptions | None = None) -> Result:
-    """Simulate ``scene`` with Exudyn: its time table and summary, with the estimated error of
-    its mean efficiency.
+    """Simulate ``scene`` with Exudyn, with the estimated error of its mean efficiency.
 
-    A given ``numerics.dt`` runs with a companion at twice the step; an automatic step is planned
-    by a pilot (:func:`pilot_plan`). ``numerics.richardson`` (frictionless scenes only): the
-    Richardson combination of the scene at its step and at half of it
-    (:func:`cardan_exudyn.model.richardson.run_combined`).
+    A given ``numerics.dt`` runs with a companion at twice the step; an automatic step is planned by
+    a pilot. ``numerics.richardson`` (frictionless only): the Richardson combination of the step and
+    its half.
 
     Parameters
     ----------
     scene : Scene
     options : ExudynOptions, optional
-        The solver settings; ``error_estimate=False``: no companion and no estimate (an
-        automatic step is still planned by the pilot).
+        ``error_estimate=False``: no companion and no estimate.
 
     Returns
     -------
     Result
-        The main run: ``summary.efficiency_error_estimate`` and ``accuracy_met`` (None without an
-        estimate), how in ``summary.accuracy``; ``wall_time_s`` of every run it took.
+        The main run: ``summary.efficiency_error_estimate``, ``accuracy_met`` (None without an
+        estimate), ``accuracy``; ``wall_time_s`` of every run it took.
 
     Raises
     ------
     SceneError
-        ``numerics.accuracy`` needs more steps than allowed (the message gives the predicted
-        steps per revolution and run time); ``numerics.richardson`` with friction.
+        ``numerics.accuracy`` needs more steps than allowed; ``numerics.richardson`` with friction.
     """
     options = options or ExudynOptions()
     wall_start = time.perf_counter()
@@ -117,9 +109,8 @@ def _given_step_runs(scene: Scene, options: ExudynOptions) -> Result:
 
 
 def _speed_ratio_warning(main: Result, scene: Scene, options: ExudynOptions) -> None:
-    """At a given step (not combined by Richardson), a warning in ``main``'s summary when the
-    speed-ratio model predicts more than the target: the estimate and ``accuracy_met`` cover the
-    mean efficiency only."""
+    """Warn in ``main``'s summary when the speed-ratio model predicts more than the target at a given
+    step (the estimate covers the mean efficiency only)."""
     predicted = None if scene.numerics.richardson else predicted_errors(scene, options.node_type)
     target = scene.numerics.accuracy
     if predicted is not None and predicted["speed-ratio"] > target:
@@ -130,19 +121,8 @@ def _speed_ratio_warning(main: Result, scene: Scene, options: ExudynOptions) -> 
 
 @dataclass(frozen=True)
 class PilotPlan:
-    """The pilot run of an automatic step and the steps per revolution its losses plan.
-
-    Attributes
-    ----------
-    pilot : Result
-        The pilot run (no time table).
-    pilot_steps : int
-        Its steps per input revolution at the drive's top speed.
-    steps : int
-        The main run's steps per revolution (even, at least twice the pilot's).
-    why : str
-        How the steps were chosen, for ``summary.dt_choice``.
-    """
+    """The pilot run (no table) of an automatic step, its ``pilot_steps`` and the main run's ``steps``
+    per revolution (even, at least twice the pilot's), and ``why`` for ``summary.dt_choice``."""
 
     pilot: Result
     pilot_steps: int
@@ -159,23 +139,8 @@ class Verdict(NamedTuple):
 
 
 def pilot_plan(scene: Scene, options: ExudynOptions) -> PilotPlan:
-    """Run the pilot of an automatic step and plan the main run's steps from its loss fraction.
-
-    The pilot runs at half the speed-ratio step, at least
-    :data:`~cardan_exudyn.model.stepsize.MIN_COMPANION_STEPS` per revolution, without a table; a
-    pilot that failed counts as losing everything (loss fraction 1).
-
-    Parameters
-    ----------
-    scene : Scene
-        With an automatic step (``numerics.dt`` None).
-    options : ExudynOptions
-
-    Raises
-    ------
-    SceneError
-        The speed ratio or the plan needs more steps than allowed.
-    """
+    """Run the pilot of an automatic step (half the speed-ratio step, at least ``MIN_COMPANION_STEPS``
+    per revolution; a failed pilot loses everything) and plan the main run's steps from its losses."""
     period = revolution_period(scene)
     pilot_steps = max(MIN_COMPANION_STEPS, math.ceil(0.5 * _kinematic_steps(scene, options)))
     pilot = run_once(_companion(scene, period / pilot_steps), options)
@@ -188,11 +153,9 @@ def pilot_plan(scene: Scene, options: ExudynOptions) -> PilotPlan:
 
 
 def _planned_run(scene: Scene, options: ExudynOptions) -> Result:
-    """An automatic step without the estimate: the pilot plans the steps for the mean efficiency
-    as in :func:`_automatic_runs`, the main run is the only other run. With the extrapolated
-    coupling the steps grow by ``sqrt(1 / (1 - g))`` for the pilot's loop gain ``g``
-    (:func:`pilot_gain`): no estimate will catch the extrapolation's error, which grows as
-    ``1 / (1 - g)`` (:mod:`cardan_exudyn.model.extrapolated`) and which the model leaves out."""
+    """An automatic step without the estimate: pilot and main run; with the extrapolated coupling the
+    steps grow by ``sqrt(1 / (1 - g))`` (pilot loop gain ``g``), as its error ``~ 1 / (1 - g)`` is
+    left out of the model."""
     plan = pilot_plan(scene, options)
     steps = plan.steps
     why = plan.why
@@ -211,9 +174,8 @@ def _planned_run(scene: Scene, options: ExudynOptions) -> Result:
 
 
 def pilot_gain(pilot: Result) -> tuple[float, str]:
-    """The loop gain a plan without an estimate allows for, in [0, :data:`EXTRAPOLATION_GAIN_CAP`],
-    and how it was found: the pilot's largest probe; 0 where its probes saw the friction not move
-    (no feedback to amplify); the cap where no probe finished or the pilot failed."""
+    """The loop gain a plan without an estimate allows for, in [0, :data:`EXTRAPOLATION_GAIN_CAP`], and
+    its text: the pilot's largest probe; 0 when probes saw the friction not move; else the cap."""
     gain = pilot.summary.max_friction_loop_gain
     if pilot.success and gain is not None and math.isfinite(gain):
         return min(max(gain, 0.0), EXTRAPOLATION_GAIN_CAP), f"loop gain {gain:.2f}"
@@ -226,13 +188,9 @@ def pilot_gain(pilot: Result) -> tuple[float, str]:
 
 
 def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
-    """The runs of an automatic step, the main run returned with its estimate.
-
-    The pilot plans ``n`` steps per revolution (:func:`pilot_plan`) and is the companion when
-    ``n`` is at most :data:`MAX_COMPANION_RATIO` times its steps, else a companion at ``n / 2``
-    runs. When the estimate exceeds the target, or the companion failed while the main run did
-    not, the main run becomes the companion of one more at ``2 n`` (where the error changes
-    order two levels can both read high)."""
+    """The runs of an automatic step: pilot plans ``n`` steps (the pilot is the companion when ``n`` is at
+    most :data:`MAX_COMPANION_RATIO` times its steps, else one at ``n / 2`` runs); refined once to
+    ``2 n`` when the estimate misses the target or the companion alone failed."""
     period = revolution_period(scene)
     plan = pilot_plan(scene, options)
     steps = plan.steps
@@ -260,8 +218,7 @@ def _automatic_runs(scene: Scene, options: ExudynOptions) -> Result:
 
 
 def _refine(verdict: Verdict | None, main: Result, coarse: Result, scene: Scene) -> bool:
-    """Whether an automatic step is refined once: its estimate exceeds the target, or there is
-    none because the companion failed (not because the main run has no efficiency)."""
+    """Whether an automatic step is refined: the estimate exceeds the target, or the companion failed."""
     if verdict is None:
         return False
     estimate = verdict.estimate
@@ -303,20 +260,8 @@ def loss_fraction(result: Result) -> float:
 
 
 def publish(main: Result, record: RunAccuracy, estimate: float | None) -> None:
-    """Write a run's accuracy into its summary, each field once.
-
-    Parameters
-    ----------
-    main : Result
-        The run (its summary is changed).
-    record : RunAccuracy
-        Becomes ``summary.accuracy``. Without a target (a plan without an estimate) nothing else
-        is written.
-    estimate : float or None
-        Estimated absolute error of the mean efficiency [-]: ``efficiency_error_estimate``, and
-        ``accuracy_met`` against the target; a warning when it exceeds the target, or when there
-        is none.
-    """
+    """Write ``record`` as ``main``'s ``summary.accuracy`` and, against its target, ``estimate`` [-] as
+    ``efficiency_error_estimate`` and ``accuracy_met`` (a warning when over or missing)."""
     s = main.summary
     s.accuracy = record
     target = record.target
@@ -335,32 +280,11 @@ def publish(main: Result, record: RunAccuracy, estimate: float | None) -> None:
 
 def assess(main: Result, coarse: Result, scene: Scene,
            options: ExudynOptions) -> Verdict | None:
-    """The estimate of ``main``'s mean-efficiency error and how it was made.
-
-    Richardson at the order of :func:`~cardan_exudyn.model.stepsize.convergence_order`; at first
-    order and wherever friction reverses at least :data:`MODEL_FLOOR` times the a-priori model;
-    at least the model when the companion has fewer than
-    :data:`~cardan_exudyn.model.stepsize.MIN_COMPANION_STEPS` steps per revolution (outside the
-    asymptotic range). A failed companion gives no estimate: the run it should check is then
-    close to what fails at the coarser step (a friction loop near self-locking), where the
-    a-priori model does not hold.
-
-    Parameters
-    ----------
-    main : Result
-        The run whose error is estimated.
-    coarse : Result
-        Its companion at a coarser step.
-    scene : Scene
-        The scene as asked for (its ``numerics.accuracy`` is the target).
-    options : ExudynOptions
-
-    Returns
-    -------
-    Verdict or None
-        The record and the estimate (None when the companion failed); None when ``main`` has no
-        usable mean efficiency.
-    """
+    """``main``'s mean-efficiency error estimate against companion ``coarse``: Richardson at
+    ``convergence_order``, at least :data:`MODEL_FLOOR` x the a-priori model at first order or
+    where friction reverses, at least the model when the companion is under ``MIN_COMPANION_STEPS``.
+    Estimate None when the companion failed (near self-locking the model does not hold); None
+    without a usable ``main``."""
     if failed(main):
         return None
     s = main.summary
