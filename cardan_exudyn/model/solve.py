@@ -1,7 +1,5 @@
-"""One Exudyn solve of a scene: the model built, the solver set up (step, settings, friction
-coupling, stop function) and run, and its columns and summary. The runs a scene takes to meet
-its accuracy are :mod:`cardan_exudyn.model.accuracy`'s.
-"""
+"""One Exudyn solve of a scene: the model built, the solver set up (step, settings, friction coupling,
+stop function) and run, and its columns and summary."""
 
 from __future__ import annotations
 
@@ -42,16 +40,8 @@ def engine_version() -> str:
 
 
 def end_time(scene: Scene, start: float) -> float:
-    """Time [s] at which the input has turned ``scene.revolutions`` revolutions in a run starting at
-    ``start`` [s] (a torque drive: the time it is allowed).
-
-    Parameters
-    ----------
-    scene : Scene
-        On the model's clock (:func:`reference.scene.histories.run_clock`).
-    start : float
-        The run's start time [s].
-    """
+    """Time [s] at which the input has turned ``scene.revolutions`` (model clock) from ``start`` [s]; a
+    torque drive: the time it is allowed."""
     drive = scene.drive
     target = 2.0 * math.pi * scene.revolutions
     if drive.kind == "speed":
@@ -62,40 +52,15 @@ def end_time(scene: Scene, start: float) -> float:
 
 
 def steps_for_span(span: float, dt: float) -> int:
-    """Fewest whole steps of at most ``dt`` (to rounding) that cover ``span``.
-
-    Not the nearest count: it would stop short of the span by up to half a step, and a span of
-    exactly ``1 + skip`` revolutions would then average less than one revolution.
-
-    Parameters
-    ----------
-    span : float
-        Time to cover [s].
-    dt : float
-        Largest step [s].
-
-    Returns
-    -------
-    int
-        At least 1.
-    """
+    """Fewest whole steps of at most ``dt`` [s] covering ``span`` [s], at least 1 (the nearest count could
+    stop half a step short, averaging less than the revolutions asked for)."""
     return max(1, math.ceil(span / dt - 1e-9))
 
 
 def simulation_settings(dt: float, t_start: float, t_end: float,
                         options: ExudynOptions) -> Any:
-    """Exudyn's simulation settings of one run: fixed step, no solution file, sensors stored at
-    every step.
-
-    Parameters
-    ----------
-    dt : float
-        The step [s].
-    t_start, t_end : float
-        The span [s]; it ends at ``t_end`` or up to one step later (:func:`steps_for_span`).
-    options : ExudynOptions
-        Spectral radius and Newton settings.
-    """
+    """Exudyn's simulation settings of one run at step ``dt`` [s] over ``t_start``..``t_end`` [s] (whole
+    steps, :func:`steps_for_span`): fixed step, no solution file, sensors stored every step."""
     s = exu.SimulationSettings()
     ti = s.timeIntegration
     n = steps_for_span(t_end - t_start, dt)
@@ -119,24 +84,8 @@ def simulation_settings(dt: float, t_start: float, t_end: float,
 
 @dataclass
 class Solved:
-    """A finished (or failed) Exudyn solve of a scene.
-
-    Attributes
-    ----------
-    model : ExudynModel
-        The model, its sensors holding every step.
-    solver : exudyn.MainSolverImplicitSecondOrder
-        The solver, with its counters (``solver.it``).
-    status : Status
-    reason : str
-        Why the solve did not end ``ok`` (empty when it did).
-    dt : float
-        The step used [s] (whole steps over the span).
-    dt_reason : str
-        How the step was chosen.
-    wall_time_s : float
-        Wall time of build and solve [s].
-    """
+    """A finished (or failed) Exudyn solve: ``model`` (sensors holding every step), ``solver`` (counters
+    ``solver.it``), ``status``, ``reason`` (empty when ok), step ``dt`` [s] and ``dt_reason``, ``wall_time_s``."""
 
     model: ExudynModel
     solver: Any
@@ -150,8 +99,8 @@ class Solved:
 def solve(scene: Scene, options: ExudynOptions, reactions: bool,
           tweak: Callable[[ExudynModel, Any], None] | None = None,
           model: ExudynModel | None = None) -> Solved:
-    """Build the model of ``scene`` and integrate it: the step choice, solver settings, friction
-    set-up and stop function of every Exudyn run (:func:`run_once`, the long runs, the benchmark).
+    """Build the model of ``scene`` and integrate it: the step, solver settings, friction set-up and
+    stop function of every Exudyn run.
 
     Parameters
     ----------
@@ -160,14 +109,10 @@ def solve(scene: Scene, options: ExudynOptions, reactions: bool,
     reactions : bool
         Record the pair reactions (sensors) for the table.
     tweak : callable, optional
-        ``tweak(model, settings)``, called once the model and its simulation settings are made
-        and before the solver starts (the benchmark's skip audit adds or removes one thing).
+        ``tweak(model, settings)``, called before the solver starts (the benchmark's skip audit).
     model : ExudynModel, optional
-        Integrate this model again instead of building one: a model :func:`reusable` for the
-        same scene up to ``numerics.dt``, whose earlier results have been read. Exudyn starts
-        every solve from the model's initial coordinates and clears the sensors' stored data, so
-        the run is the one a fresh build gives, bit for bit (``tests/test_fixed_costs.py``);
-        only the whole revolutions the post-step hook took out of the input angle are reset.
+        A :func:`reusable` model of the same scene up to ``numerics.dt``, integrated again instead of
+        a new build; bit for bit the fresh build's run (``tests/test_fixed_costs.py``).
 
     Raises
     ------
@@ -207,14 +152,9 @@ def _model(scene: Scene, options: ExudynOptions, reactions: bool,
 
 
 def _integrate(model: ExudynModel, solver: Any, settings: Any) -> tuple[Status, str]:
-    """Run the solver over ``settings``' span: the status and reason of the solve.
-
-    With friction the coupling's initial friction is made consistent first; a self-locking
-    coupling's status wins over the solver's, and a Python error inside its user function is
-    raised here. Ctrl-C / SIGTERM inside the solver come back from Exudyn as a failed solve or a
-    SystemError: :func:`cardan_exudyn.interrupts.watch_signals` raises the interruption instead,
-    so it is never recorded as an integration failure.
-    """
+    """``(status, reason)`` of running the solver over ``settings``' span; with friction the coupling is
+    initialised first and its status wins. An interruption inside the solver is raised as itself
+    (:func:`~cardan_exudyn.interrupts.watch_signals`), never recorded as an integration failure."""
     friction = model.friction
     status = Status.OK
     reason = ""
@@ -241,8 +181,8 @@ def _integrate(model: ExudynModel, solver: Any, settings: Any) -> tuple[Status, 
 
 
 def torque_step_hint(scene: Scene) -> str:
-    """What to add to an integration failure at an automatic step of a torque drive (the step
-    was sized for its initial speed), else ``""``."""
+    """The note for an integration failure at a torque drive's automatic step (sized for its initial
+    speed), else ``""``."""
     if scene.drive.kind != "torque":
         return ""
     return (f" (the step was sized for the torque drive's initial speed, "
@@ -251,60 +191,20 @@ def torque_step_hint(scene: Scene) -> str:
 
 
 def reusable(model: ExudynModel, reactions: bool) -> bool:
-    """Whether :func:`solve` can integrate a model again.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        A model solved before.
-    reactions : bool
-        Whether the next run records the reactions.
-
-    Returns
-    -------
-    bool
-        True with no friction coupling (its state belongs to one run) and the reaction sensors
-        when ``reactions`` asks for them.
-    """
+    """Whether :func:`solve` can integrate ``model`` again: no friction coupling (its state is one run's)
+    and reaction sensors when ``reactions`` asks for them."""
     recorded = f"{PAIR_NAMES[0]}_force" in model.sensors
     return model.friction is None and (recorded or not reactions)
 
 
 def run_once(scene: Scene, options: ExudynOptions) -> Result:
-    """One Exudyn run of a scene at its own step.
-
-    Parameters
-    ----------
-    scene : Scene
-        Its ``numerics.dt``, or :func:`~cardan_exudyn.model.stepsize.choose_step`'s step.
-    options : ExudynOptions
-
-    Returns
-    -------
-    Result
-        The table (when the scene records one) and the summary, means included.
-    """
+    """One Exudyn run of ``scene`` at its own step: the table (when recorded) and summary with means."""
     summary, columns, origin = run_columns(scene, options)
     return result_of(scene, summary, columns, origin)
 
 
 def run_columns(scene: Scene, options: ExudynOptions) -> tuple[Summary, dict[str, np.ndarray] | None, float]:
-    """One run as :func:`run_once` does it, before the table.
-
-    Parameters
-    ----------
-    scene : Scene
-    options : ExudynOptions
-
-    Returns
-    -------
-    summary : Summary
-        Means included.
-    columns : dict of str to ndarray or None
-        On the model's clock; None when nothing usable was recorded.
-    origin : float
-        The scene's time at the model's ``t = 0`` [s].
-    """
+    """:func:`run_once` before the table: ``(summary, columns on the model's clock or None, origin [s])``."""
     summary, columns, origin, _ = run_model(scene, options)
     return summary, columns, origin
 
@@ -312,24 +212,8 @@ def run_columns(scene: Scene, options: ExudynOptions) -> tuple[Summary, dict[str
 def run_model(scene: Scene, options: ExudynOptions, model: ExudynModel | None = None,
               means: bool = True) -> tuple[Summary, dict[str, np.ndarray] | None, float,
                                            ExudynModel | None]:
-    """:func:`run_columns` and the model it solved (None when the loop did not close).
-
-    Parameters
-    ----------
-    scene : Scene
-    options : ExudynOptions
-    model : ExudynModel, optional
-        Solved again instead of a new build (:func:`solve`).
-    means : bool
-        False: the summary's means are left out (a caller that takes them from other columns).
-
-    Returns
-    -------
-    summary, columns, origin
-        As :func:`run_columns`.
-    model : ExudynModel or None
-        The solved model; None when the loop did not close.
-    """
+    """:func:`run_columns` and the model it solved (None when the loop did not close); ``model``: solve
+    it again (:func:`solve`); ``means`` False leaves the summary's means out."""
     wall_start = time.perf_counter()
     summary = Summary(Status.OK, engine=ENGINE_NAME, engine_version=engine_version(),
                       scene=scene_to_dict(scene),
@@ -370,19 +254,8 @@ def _record_solve(summary: Summary, solved: Solved) -> None:
 
 def result_of(scene: Scene, summary: Summary, columns: dict[str, np.ndarray] | None,
               origin: float) -> Result:
-    """The result of a run's columns.
-
-    Parameters
-    ----------
-    scene : Scene
-        Says whether and how often the table is recorded.
-    summary : Summary
-        The run's, its means taken before.
-    columns : dict of str to ndarray or None
-        On the model's clock; time is shifted by ``origin`` to the scene's own (in place).
-    origin : float
-        The scene's time at the model's ``t = 0`` [s].
-    """
+    """The result of a run's ``columns`` (time shifted in place by ``origin`` [s] to the scene's clock),
+    the table recorded as ``scene.record`` says."""
     if columns is None:
         return Result(None, summary)
     columns["t"] = columns["t"] + origin
@@ -392,8 +265,7 @@ def result_of(scene: Scene, summary: Summary, columns: dict[str, np.ndarray] | N
 
 def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarray],
                    summary: Summary, options: ExudynOptions, means: bool = True) -> None:
-    """Constraint violations, finiteness, the torque drive's turn, and the means into ``summary``
-    (unless ``means`` is False)."""
+    """Constraint violations, finiteness, the torque drive's turn and (``means``) the means into ``summary``."""
     violation = constraint_violation(model.pair_kinematics)
     summary.max_constraint_violation_m = violation["max_constraint_violation_m"]
     summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
@@ -417,8 +289,7 @@ def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarr
 
 
 def _set_pre_step(model: ExudynModel, target: float | None) -> None:
-    """Stop the run after ``target`` [rad] of the input (torque drive) or when the friction
-    coupling's status is no longer ``ok``."""
+    """Stop the run after ``target`` [rad] of input (torque drive) or when the friction coupling fails."""
     node = model.nodes["input"]
     friction = model.friction
     if target is None and friction is None:

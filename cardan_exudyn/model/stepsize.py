@@ -1,15 +1,11 @@
 """The a-priori error model of an Exudyn run and the time step it asks for.
 
-``numerics.accuracy`` is the target absolute error of the mean efficiency and the target relative
-error of the speed ratio ``omega_out / omega_in``. With ``h = omega dt`` the input angle per step
-[rad] and ``beta`` the shaft angle:
+With ``h = omega dt`` [rad] per step, ``beta`` the shaft angle and ``1 - eta`` the loss fraction:
 
-- speed ratio: error ``K(beta) h^2`` with ``K = c + f * ERROR_CONSTANT tan(beta)^2 / cos(beta)^2``,
-  ``(c, f)`` of :data:`NODE_ERROR` for the node type of spider and output (the ratio peaks at
-  ``1 / cos(beta)`` with a width proportional to ``cos(beta)``, and the step must resolve it);
-- mean efficiency (:func:`efficiency_error`): ``(C2 + K) h^2 (1 - eta)``, plus ``C1 h (1 - eta)``
-  with the ``lagged`` coupling (friction one step late: first order), ``1 - eta`` the run's loss
-  fraction (from a pilot run, :mod:`cardan_exudyn.model.accuracy`).
+- speed ratio (relative): ``K h^2``, ``K = c + f * ERROR_CONSTANT tan(beta)^2 / cos(beta)^2``,
+  ``(c, f)`` of :data:`NODE_ERROR`;
+- mean efficiency (absolute): ``(C2 + K) h^2 (1 - eta)``, plus ``C1 h (1 - eta)`` with the
+  ``lagged`` coupling (first order).
 
 The constants bound the measurements from above: docs/accuracy.md#step-model-constants.
 """
@@ -40,72 +36,21 @@ NODE_ERROR = {"Rxyz": (0.0, 1.0), "RotVecLG": (0.0, 2.0), "EP": (0.045, 2.2)}
 
 
 def error_coefficient(shaft_angle: float, node_type: str = "Rxyz") -> float:
-    """``K`` of the speed-ratio error ``K h^2``.
-
-    Parameters
-    ----------
-    shaft_angle : float
-        [rad].
-    node_type : str
-        Node type of spider and output (:data:`NODE_ERROR`).
-
-    Returns
-    -------
-    float
-        ``K`` [1/rad^2].
-    """
+    """``K`` [1/rad^2] of the speed-ratio error ``K h^2`` at ``shaft_angle`` [rad] for ``node_type``."""
     constant, factor = NODE_ERROR[node_type]
     t = math.tan(shaft_angle)
     return constant + factor * ERROR_CONSTANT * t * t / math.cos(shaft_angle) ** 2
 
 
 def steps_per_revolution(shaft_angle: float, accuracy: float, node_type: str = "Rxyz") -> int:
-    """Steps per input revolution that meet ``accuracy`` on the speed ratio, at least
-    :data:`MIN_STEPS_PER_REVOLUTION`; not capped (the caller refuses beyond
-    :data:`MAX_STEPS_PER_REVOLUTION`, :func:`refuse`): a capped step would miss the accuracy.
-
-    Parameters
-    ----------
-    shaft_angle : float
-        [rad].
-    accuracy : float
-        Target relative error of the speed ratio [-].
-    node_type : str
-        Node type of spider and output (:data:`NODE_ERROR`).
-
-    Returns
-    -------
-    int
-    """
+    """Steps per input revolution meeting ``accuracy`` [-] on the speed ratio at ``shaft_angle`` [rad],
+    at least :data:`MIN_STEPS_PER_REVOLUTION`; not capped (a capped step would miss the accuracy)."""
     return int(max(kinematic_steps(shaft_angle, accuracy, node_type), MIN_STEPS_PER_REVOLUTION))
 
 
 def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
-    """Time step of a single run: the given ``numerics.dt``, else the speed ratio's
-    (:func:`steps_per_revolution`) at the drive's top speed.
-
-    With a constant-speed drive the step divides one revolution exactly, so that averages over
-    whole revolutions need no interpolation at the window ends.
-
-    Parameters
-    ----------
-    scene : Scene
-    node_type : str
-        Node type of spider and output (:data:`NODE_ERROR`).
-
-    Returns
-    -------
-    dt : float
-        Time step [s].
-    why : str
-        How it was chosen, for ``summary.dt_choice``.
-
-    Raises
-    ------
-    SceneError
-        (:func:`refuse`, before anything runs) when no step is given and ``numerics.accuracy`` on
-        the speed ratio needs more than :data:`MAX_STEPS_PER_REVOLUTION`.
-    """
+    """``(dt [s], why)`` of a single run: the given ``numerics.dt``, else the speed ratio's step at the
+    drive's top speed (dividing a revolution exactly); ``SceneError`` beyond the step limit."""
     if scene.numerics.dt is not None:
         return scene.numerics.dt, "given"
     beta = scene.joint.geometry.shaft_angle
@@ -122,37 +67,29 @@ def choose_step(scene: Scene, node_type: str = "Rxyz") -> tuple[float, str]:
 
 
 EFFICIENCY_FIRST_ORDER = 0.6
-"""``C1`` [1/rad] of the mean-efficiency model's first-order term ``C1 h r`` (``r`` the loss
-fraction), the ``lagged`` coupling's (:func:`convergence_order`); ``python tests/benchmarks
-accuracy --fit`` refits it."""
+"""``C1`` [1/rad] of the first-order term ``C1 h (1 - eta)`` (``lagged`` coupling);
+``python tests/benchmarks accuracy --fit`` refits it."""
 EFFICIENCY_FIRST_ORDER_ERRORS = 3.5
-"""``C1`` with mounting errors: their sliding reverses too, and its sign changes cost far more
-than its small loss."""
+"""``C1`` with mounting errors (their sliding reverses too, and sign changes cost more than the loss)."""
 EFFICIENCY_SECOND_ORDER = 3.0
 """``C2`` [1/rad^2] of the smooth part, ``(C2 + K) (1 - eta) h^2``."""
 SECONDS_PER_STEP = 3e-3
-"""Wall time of one Exudyn step with friction [s] on one core, for the predicted run time of a
-refused request before anything ran."""
+"""Wall time of one Exudyn step with friction [s] on one core, for a refusal's predicted run time."""
 SECONDS_PER_FRICTIONLESS_STEP = 1e-4
-"""Wall time of one Exudyn step without friction [s] on one core, for the predicted run time of a
-refused request."""
+"""Wall time of one frictionless Exudyn step [s] on one core, for a refusal's predicted run time."""
 MIN_COMPANION_STEPS = 50
-"""Fewest steps per revolution of a pilot or companion run (half
-:data:`MIN_STEPS_PER_REVOLUTION`); below it the estimate is at least the a-priori model."""
+"""Fewest steps per revolution of a pilot or companion run; below it the estimate is at least the model."""
 
 
 def revolution_period(scene: Scene) -> float:
-    """Time of one input revolution at the drive's highest speed [s]: steps per revolution are
-    counted against it."""
+    """Time of one input revolution at the drive's highest speed [s]."""
     return 2.0 * math.pi / scene.drive.max_speed()
 
 
 def reversing_parts(scene: Scene) -> list[tuple[str, str]]:
-    """The ``(pair, "rotation" | "sliding")`` motions with friction that may reverse: the spider
-    pairs' rotation at a shaft angle or with mounting errors, every pair's sliding with mounting
-    errors, the frame pairs' rotation under a drive that may turn back (an angle history that is
-    not monotonic; a torque drive, conservatively). Their friction changes sign inside steps: the
-    error is first order until the ramps are resolved."""
+    """The ``(pair, "rotation" | "sliding")`` motions with friction that may reverse (spider rotation
+    at a shaft angle or with mounting errors, all sliding with mounting errors, frame rotation under
+    a drive that may turn back): the error is first order there until the ramps are resolved."""
     pairs = dict(scene.joint.pairs.items())
     errors = has_errors(scene)
     drive = scene.drive
@@ -181,28 +118,14 @@ def _monotonic(values: tuple) -> bool:
 
 
 def convergence_order(scene: Scene) -> int:
-    """Order of convergence of the mean efficiency in the step: 1 with the ``lagged`` coupling
-    (friction one step late), else 2: friction's sign jumps are integrated across, each side on
-    its own (:mod:`reference.results.quadrature`; measured in docs/accuracy.md)."""
+    """Order of the mean efficiency's error in the step: 1 with the ``lagged`` coupling, else 2
+    (friction's sign jumps are integrated across each side on its own)."""
     return 1 if scene.has_friction and scene.friction.coupling == "lagged" else 2
 
 
 def efficiency_error(scene: Scene, steps: float, loss_fraction: float, node_type: str = "Rxyz") -> float:
-    """A-priori error [-] of the mean efficiency: ``(C2 + K) h^2 (1 - eta)``, plus ``C1 h (1 - eta)``
-    with the ``lagged`` coupling (first order, :func:`convergence_order`), ``C1`` larger with
-    mounting errors; ``K`` the speed-ratio coefficient (:func:`error_coefficient`); 0 without
-    friction.
-
-    Parameters
-    ----------
-    scene : Scene
-    steps : float
-        Steps per input revolution; ``h = 2 pi / steps`` [rad].
-    loss_fraction : float
-        ``1 - eta``, the share of the input work the run loses [-].
-    node_type : str
-        Node type of spider and output.
-    """
+    """A-priori mean-efficiency error [-] at ``steps`` per revolution and ``loss_fraction`` [-]
+    (module formula); 0 without friction."""
     if not scene.has_friction:
         return 0.0
     h = 2.0 * math.pi / steps
@@ -216,19 +139,8 @@ def efficiency_error(scene: Scene, steps: float, loss_fraction: float, node_type
 
 
 def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_type: str = "Rxyz") -> int:
-    """Fewest steps per revolution whose :func:`efficiency_error` meets ``accuracy`` [-] for a run
-    losing ``loss_fraction`` [-] (may exceed :data:`MAX_STEPS_PER_REVOLUTION`: the caller refuses).
-
-    Parameters
-    ----------
-    scene : Scene
-    accuracy : float
-        Target absolute error of the mean efficiency [-].
-    loss_fraction : float
-        ``1 - eta`` [-].
-    node_type : str
-        Node type of spider and output.
-    """
+    """Fewest steps per revolution whose :func:`efficiency_error` meets ``accuracy`` [-] at
+    ``loss_fraction`` [-]; not capped."""
 
     def meets(n: int) -> bool:
         return efficiency_error(scene, n, loss_fraction, node_type) <= accuracy
@@ -245,53 +157,16 @@ def efficiency_steps(scene: Scene, accuracy: float, loss_fraction: float, node_t
 
 
 def refuse(scene: Scene, steps: float, why: str, seconds_per_step: float = SECONDS_PER_STEP) -> None:
-    """Raise :class:`SceneError` when ``steps`` per revolution exceed
-    :data:`MAX_STEPS_PER_REVOLUTION`, with the predicted steps and run time in one line
-    (:func:`reference.scene.validation.refuse_steps_per_revolution`).
-
-    Parameters
-    ----------
-    scene : Scene
-        A torque drive counts as 4 times its revolutions (the time it is allowed).
-    steps : float
-        Steps per input revolution asked for.
-    why : str
-        What asks for them (the message's subject).
-    seconds_per_step : float
-        Wall time of one step [s], for the predicted run time.
-    """
+    """``SceneError`` when ``steps`` per revolution asked for by ``why`` exceed the limit, with the
+    predicted run time at ``seconds_per_step`` [s] (a torque drive counts 4 times its revolutions)."""
     revolutions = scene.revolutions * (4.0 if scene.drive.kind == "torque" else 1.0)
     refuse_steps_per_revolution(steps, revolutions, seconds_per_step, why)
 
 
 def plan_steps(scene: Scene, loss_fraction: float, node_type: str = "Rxyz",
                seconds_per_step: float = SECONDS_PER_STEP) -> tuple[int, str]:
-    """Steps per revolution meeting ``numerics.accuracy`` on the speed ratio and on the mean
-    efficiency of a run losing ``loss_fraction`` of its input work (:func:`efficiency_error`), and
-    why.
-
-    Parameters
-    ----------
-    scene : Scene
-    loss_fraction : float
-        ``1 - eta`` of the run [-] (a pilot's).
-    node_type : str
-        Node type of spider and output.
-    seconds_per_step : float
-        Wall time of one step [s], for the message of a refusal.
-
-    Returns
-    -------
-    steps : int
-        Even (the companion at twice the step), at least :data:`MIN_STEPS_PER_REVOLUTION`.
-    why : str
-        For ``summary.dt_choice``.
-
-    Raises
-    ------
-    SceneError
-        Beyond :data:`MAX_STEPS_PER_REVOLUTION` (:func:`refuse`).
-    """
+    """``(steps, why)``: even steps per revolution meeting ``numerics.accuracy`` on the speed ratio and
+    on the mean efficiency at ``loss_fraction`` [-]; ``SceneError`` beyond the limit."""
     accuracy = scene.numerics.accuracy
     beta = scene.joint.geometry.shaft_angle
     kinematic = kinematic_steps(beta, accuracy, node_type)
@@ -309,22 +184,8 @@ def plan_steps(scene: Scene, loss_fraction: float, node_type: str = "Rxyz",
 
 
 def kinematic_steps(shaft_angle: float, accuracy: float, node_type: str = "Rxyz") -> float:
-    """Steps per revolution for a relative speed-ratio error, not capped (may be huge).
-
-    Parameters
-    ----------
-    shaft_angle : float
-        [rad].
-    accuracy : float
-        Target relative error of the speed ratio [-].
-    node_type : str
-        Node type of spider and output (:data:`NODE_ERROR`).
-
-    Returns
-    -------
-    float
-        Steps per input revolution; :data:`MIN_STEPS_PER_REVOLUTION` where ``K`` is 0.
-    """
+    """Steps per revolution for relative speed-ratio error ``accuracy`` at ``shaft_angle`` [rad], not
+    capped; :data:`MIN_STEPS_PER_REVOLUTION` where ``K`` is 0."""
     k = error_coefficient(shaft_angle, node_type)
     if k == 0.0:
         return MIN_STEPS_PER_REVOLUTION
@@ -332,44 +193,14 @@ def kinematic_steps(shaft_angle: float, accuracy: float, node_type: str = "Rxyz"
 
 
 def richardson(fine: float, coarse: float, ratio: float, order: int) -> float:
-    """Richardson estimate of the error of ``fine``: ``|fine - coarse| / (ratio**order - 1)``.
-
-    Parameters
-    ----------
-    fine, coarse : float
-        The value at the fine and at the coarse step (any unit).
-    ratio : float
-        Step ratio coarse / fine [-].
-    order : int
-        Order of the error in the step.
-
-    Returns
-    -------
-    float
-        The error estimate (the unit of ``fine``).
-    """
+    """Richardson estimate of ``fine``'s error: ``|fine - coarse| / (ratio**order - 1)``, ``ratio`` the
+    coarse / fine step."""
     return abs(fine - coarse) / (ratio ** order - 1.0)
 
 
 def predicted_errors(scene: Scene, node_type: str = "Rxyz") -> dict[str, float] | None:
-    """A-priori errors of a run at the scene's given ``numerics.dt``, before anything runs.
-
-    Named apart because a run's error estimate covers the mean efficiency only: a frictionless
-    run is exact there at any step.
-
-    Parameters
-    ----------
-    scene : Scene
-    node_type : str
-        Node type of spider and output (:data:`NODE_ERROR`).
-
-    Returns
-    -------
-    dict or None
-        ``{"speed-ratio": ..., "mean-efficiency": ...}`` [-]: the speed-ratio model and the
-        mean-efficiency model at the largest loss fraction (1; 0 without friction, where nothing
-        is lost); None without a given step.
-    """
+    """A-priori ``{"speed-ratio", "mean-efficiency"}`` errors [-] at the given ``numerics.dt`` (the latter
+    at loss fraction 1), before anything runs; None without a given step."""
     if scene.numerics.dt is None:
         return None
     steps = revolution_period(scene) / scene.numerics.dt
