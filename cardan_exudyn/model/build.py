@@ -1,34 +1,9 @@
 """The RCCC Cardan joint as an Exudyn model, built from a scene with only the items it needs.
 
-Modelling choices
------------------
-- Three ``NodeRigidBodyRxyz`` nodes, each at its body's centre of mass, with node axes equal to the
-  global axes in the reference configuration (input angle 0). The input rotates about global x,
-  so its first Tait-Bryan angle is the shaft angle (the drive acts on it directly). The spider's
-  orientation is ``Rx(theta) Ry(gamma)`` with ``|gamma| <= beta``, and the output's second angle
-  stays below ``beta`` too: the parametrisation is regular for every shaft angle below 90 deg.
-  ``build_model(node_type=...)`` gives the spider and the output Euler-parameter
-  (``NodeRigidBodyEP``) or rotation-vector (``NodeRigidBodyRotVecLG``) nodes instead, for
-  comparing node types; the input keeps its Rxyz node (the drive acts on its first angle).
-  Readers of node coordinates go through ``ExudynModel.rotations`` (:mod:`cardan_exudyn.model.rotations`).
-- Four ``ObjectJointGeneric`` pairs (revolute ``[1,1,1,1,1,0]``, cylindrical ``[1,1,0,1,1,0]``,
-  z the pair axis): 17 constraints on 18 coordinates, mobility one, no redundancy.
-- Constant speed: ``ObjectConnectorCoordinate`` at velocity level on the input angle (no Python
-  user function). Prescribed angle: the same connector at position level with an offset user
-  function evaluating a cubic spline. Torque drive: ``LoadTorqueVector``. A load history: a
-  ``LoadTorqueVector`` with a user function. Both user functions find the sample interval by
-  bisection and evaluate one piece in plain floats (:mod:`reference.scene.histories`): O(log n) per
-  call, so a long measured history costs what a short one does. The model's clock starts at 0
-  whatever time the histories start at (``ExudynModel.time_origin``).
-- Gravity loads and the output load only when they are non-zero; friction loads and their user
-  function only for pairs with a non-zero coefficient (``cardan_exudyn.model.coupling``).
-- Mounting errors (``scene.joint.errors``): each pair's marker frames are displaced and rotated
-  to the joint's Denavit-Hartenberg geometry (the pair axes do not meet at one point, so the
-  cylindrical pairs slide). The marker frames and the initial assembled state are taken from
-  :mod:`reference.physics.rccc` at the start; from there on the motion is Exudyn's own (its constraints
-  keep the loop closed; the tests compare it with the reference engine). The ideal joint keeps
-  the closed form below, written independently of ``reference``. In both cases the reference
-  configuration (node axes = global axes) is the assembled joint at input angle 0.
+Three rigid-body nodes at the centres of mass (node axes = global axes at input angle 0; the input
+always ``NodeRigidBodyRxyz``, its first angle the input angle); four ``ObjectJointGeneric`` pairs
+(revolute ``[1,1,1,1,1,0]``, cylindrical ``[1,1,0,1,1,0]``, z the pair axis): 17 constraints on 18
+coordinates, mobility one. Mounting errors place the markers by :mod:`reference.physics.rccc`.
 """
 
 from __future__ import annotations
@@ -58,12 +33,11 @@ CONSTRAINED_AXES = {"revolute": [1, 1, 1, 1, 1, 0], "cylindrical": [1, 1, 0, 1, 
 COUPLINGS = {"extrapolated": ExtrapolatedCoupling, "converged": ConvergedCoupling,
              "lagged": LaggedCoupling}
 """The friction coupling scheme of each ``scene.friction.coupling`` but ``uncoupled`` (friction
-evaluated after the run, :mod:`cardan_exudyn.model.postprocess`)."""
+evaluated after the run)."""
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` of two 3-vectors: ``np.cross``'s products and differences, without its axis
-    handling (which costs more than the product; a build takes ten)."""
+    """``a x b`` of two 3-vectors without ``np.cross``'s axis handling (costlier than the product)."""
     a0, a1, a2 = (float(x) for x in a)
     b0, b1, b2 = (float(x) for x in b)
     return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
@@ -80,7 +54,7 @@ def _rot_x(angle: float) -> np.ndarray:
 
 
 def _loop_motion(scene: Scene, theta: float, omega: float) -> dict[str, rccc.BodyMotion]:
-    """Body motions of the joint with mounting errors at one input state (reference.physics.rccc)."""
+    """Body motions of the joint with mounting errors at input angle ``theta`` [rad], speed ``omega`` [rad/s]."""
     params = rccc.DHParameters.of_joint(scene.joint)
     positions, rates = rccc.solve_motion(params, np.array([theta]), omega, 0.0)
     return {name: rccc.BodyMotion(*(np.asarray(v)[0] for v in (m.rotation, m.origin, m.omega,
@@ -117,32 +91,11 @@ def pair_geometry(scene: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
 
 def assembled_state(scene: Scene, theta: float, omega: float) -> dict[str, dict[str, np.ndarray]]:
-    """Orientation, angular velocity, frame origin and its velocity of each body at an input state.
+    """Per moving body at input angle ``theta`` [rad] and speed ``omega`` [rad/s]: ``A`` (node to global),
+    ``omega`` [rad/s], frame ``origin`` [m] and ``velocity`` [m/s] (zero for the ideal joint).
 
-    Parameters
-    ----------
-    scene : Scene
-        The joint.
-    theta : float
-        Input shaft angle [rad].
-    omega : float
-        Input shaft speed [rad/s].
-
-    Returns
-    -------
-    dict
-        Per moving body: ``A``, shape (3, 3), rotating node coordinates to global ones;
-        ``omega``, shape (3,), angular velocity [rad/s]; ``origin``, shape (3,), the body's
-        canonical-frame origin [m] and ``velocity`` its velocity [m/s] (both zero for the ideal
-        joint, whose bodies turn about the joint centre).
-
-    Notes
-    -----
-    Ideal joint: closed-form vector geometry (written here independently of
-    ``reference.physics.kinematics``): the output yoke axis is normal to the output shaft axis and the
-    input yoke axis; the relative rates follow from the velocity loop
-    ``omega e_x + gamma_t u1 = theta2_t a2 + phi_t u2``. With mounting errors:
-    :mod:`reference.physics.rccc`.
+    Ideal joint, closed form independent of ``reference``: the velocity loop
+    ``omega e_x + gamma_t u1 = theta2_t a2 + phi_t u2``. Mounting errors: :mod:`reference.physics.rccc`.
     """
     axes = node_axes_in_canonical(scene)
     if scene.joint.errors.any:
@@ -203,36 +156,10 @@ class ExudynModel:
 
 def build_model(scene: Scene, sensors: bool = True, reactions: bool = True,
                 node_type: str = "Rxyz") -> ExudynModel:
-    """Assemble the Exudyn system for ``scene`` (no solving), with recording sensors.
-
-    Parameters
-    ----------
-    scene : Scene
-    sensors : bool
-        Add the recording sensors (:func:`add_sensors`).
-    reactions : bool
-        Record the eight pair reactions too (the table needs them; the summary does not:
-        friction reads the reactions itself).
-    node_type : str
-        The rigid-body node of the spider and the output: ``"Rxyz"`` (``NodeRigidBodyRxyz``,
-        Tait-Bryan angles), ``"EP"`` (``NodeRigidBodyEP``, Euler parameters with their
-        normalisation constraint: one more coordinate and one algebraic equation per body) or
-        ``"RotVecLG"`` (``NodeRigidBodyRotVecLG``, rotation vector updated by Exudyn's Lie-group
-        generalized-alpha; its velocity coordinates are the local angular velocity; it needs a
-        spectral radius of 0.8 or less, docs/engines.md#exudyn-model-measurements). The input
-        keeps ``NodeRigidBodyRxyz`` under every value: the drive (a coordinate connector) and the
-        input angle of the results use its raw first angle (coordinate 3), which no other node
-        type has; that coordinate is kept within ``[-pi, pi]`` between steps and
-        ``ExudynModel.input_turns`` gives back the continuous input angle. Every node's reference
-        rotation is the identity (node axes = global axes at input angle 0); rotation vectors are
-        kept within ``|nu| <= pi`` between steps (:func:`_wrap_rotations`).
-
-    Returns
-    -------
-    ExudynModel
-        The assembled model on a clock starting at 0 (``time_origin``: the scene's time there),
-        its friction coupling prepared when the scene has friction.
-    """
+    """Assemble (not solve) the Exudyn system of ``scene`` on a clock starting at 0 (``time_origin``:
+    the scene's time there), with recording ``sensors`` (``reactions``: the eight pair reactions too).
+    ``node_type`` of spider and output: ``"Rxyz"``, ``"EP"`` or ``"RotVecLG"`` (needs spectral radius
+    <= 0.8: docs/engines.md#exudyn-model-measurements); the input stays Rxyz (the drive uses its angle)."""
     if node_type not in ROTATION_COORDINATES:
         raise ValueError(f"node_type must be one of {list(ROTATION_COORDINATES)}, got {node_type!r}")
     # the model runs on a clock that starts at 0 (histories starting at t = 1e9 s included):
@@ -283,10 +210,8 @@ def _add_bodies(model: ExudynModel) -> None:
 
 def _add_body(model: ExudynModel, name: str, state: dict[str, np.ndarray], com: np.ndarray,
               p0: np.ndarray) -> None:
-    """The node and rigid body of body ``name`` (its mass, inertia, reference position and
-    rotation coordinates already in ``model``) in its initial ``state`` (``A``, ``origin``,
-    ``velocity``, ``omega``), ``com`` its centre of mass from its frame origin [m] and ``p0`` its
-    initial rotation coordinates."""
+    """The node and rigid body of body ``name`` in its initial ``state``; ``com`` its centre of mass from
+    its frame origin [m], ``p0`` its initial rotation coordinates."""
     rot = model.rotations[name]
     inertia = model.inertia[name]
     w = state["omega"]
@@ -332,32 +257,12 @@ def _add_pairs(model: ExudynModel, ground: int) -> None:
 
 
 def _wrap_rotations(model: ExudynModel) -> None:
-    """After every step, keep the input's angle coordinate and the other Rxyz angles within
-    ``[-pi, pi]``, and the rotation vectors of ``NodeRigidBodyRotVecLG`` nodes within ``|nu| <= pi``.
+    """After every step keep the Rxyz angles within ``[-pi, pi]`` (the input's whole turns recorded in
+    ``ExudynModel.input_turns``) and ``RotVecLG`` vectors within ``|nu| <= pi`` (``nu (1 - 2 pi / |nu|)``).
 
-    Input angle: the input's first Rxyz angle is the input angle. Unbounded, its update rounds at
-    the spacing of doubles at the angle and the angle wanders from ``omega t`` (the velocity-level
-    drive holds the speed, nothing holds the angle); with ``"RotVecLG"`` nodes the pair
-    input-spider then ends misaligned where the spider passes the identity. The hook removes whole
-    revolutions (exact in floating point: ``q - 2 pi`` for ``pi < q < 4 pi``;
-    ``ExudynModel.input_turns`` records them). Nothing else depends on the choice: ``Rx`` is
-    periodic, the speed drive acts on the velocity, an angle drive's offset and a torque drive's
-    stop subtract the same revolutions, the friction coupling reads relative angles of rotation
-    matrices, and the results' ``theta_in`` adds them back
-    (:func:`cardan_exudyn.model.postprocess.body_states`). The spider's and output's Rxyz angles
-    are wrapped the same way, unrecorded: the spider's first angle is the input angle too, and
-    their roundings cancel in the pair input-spider only when both are wrapped.
-
-    Rotation vectors: Exudyn's Lie-group update lets a body that turns whole revolutions reach
-    ``|nu| = 2 pi`` once every two revolutions, where the exponential map is singular. A vector
-    with ``|nu| > pi`` is replaced by the same rotation ``nu (1 - 2 pi / |nu|)``; the velocity
-    coordinates (local angular velocity) and the integrator's accelerations do not depend on the
-    choice. The nodes start at the identity (Exudyn computes wrong initial multipliers for a
-    non-zero initial rotation vector), which holds for a drive starting at input angle 0; an angle
-    drive starting elsewhere gets that start-up error with ``RotVecLG``.
-
-    The hook runs before Exudyn stores the step's sensor values, and the next step starts from
-    the state it leaves. Measured: docs/engines.md#exudyn-model-measurements.
+    Why: an unbounded input angle rounds at the spacing of doubles and wanders from ``omega t``, and a
+    rotation vector reaches the singular ``|nu| = 2 pi`` every two revolutions. The hook runs before
+    the step's sensors are stored. Measured: docs/engines.md#exudyn-model-measurements.
     """
     mbs = model.mbs
     angle, angles, vectors = _rotation_indices(model)
@@ -389,8 +294,8 @@ def _wrap_rotations(model: ExudynModel) -> None:
 
 
 def _rotation_indices(model: ExudynModel) -> tuple[int, list[int], list[int]]:
-    """Indices in the ODE2 coordinates of the input angle, of the other Rxyz nodes' three angles
-    and of the first component of each ``RotVecLG`` node's rotation vector."""
+    """ODE2 indices of the input angle, of the other Rxyz nodes' angles and of each ``RotVecLG`` vector's
+    first component."""
     mbs = model.mbs
     angle = mbs.GetNodeODE2Index(model.nodes["input"]) + 3
     angles = [mbs.GetNodeODE2Index(node) + 3 + k for name, node in model.nodes.items()
@@ -413,9 +318,8 @@ def _initial_drive_state(scene: Scene) -> tuple[float, float, float]:
 
 
 def _add_drive(model: ExudynModel, ground) -> None:
-    """The drive of the input: a torque load, or a coordinate constraint on the input angle
-    (velocity level for a constant speed, position level with a spline offset for an angle
-    history) against ``ground``."""
+    """The input's drive against ``ground``: a torque load, or a coordinate constraint on its angle
+    (velocity level for a constant speed, position level with a spline offset for a history)."""
     mbs = model.mbs
     drive = model.scene.drive
     if drive.kind == "torque":
@@ -470,18 +374,8 @@ def _add_loads(model: ExudynModel) -> None:
 
 
 def add_sensors(model: ExudynModel, reactions: bool = True) -> None:
-    """Internal (in-memory) sensors for node states, pair reactions and the drive force.
-
-    Every sensor is stored at every step and costs time: the eight reaction sensors are most of
-    the recording cost of a frictionless run.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The model being built; its ``sensors`` are filled.
-    reactions : bool
-        Whether the pair reactions are recorded (else their table columns are NaN).
-    """
+    """In-memory sensors of node states, drive force and (``reactions``, most of a frictionless run's
+    recording cost) the pair reactions, stored every step into ``model.sensors``."""
     out = exu.OutputVariableType
 
     def sensor(key: str, item: Any, variable: Any, node: bool = False) -> None:

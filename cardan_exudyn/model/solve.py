@@ -84,8 +84,9 @@ def simulation_settings(dt: float, t_start: float, t_end: float,
 
 @dataclass
 class Solved:
-    """A finished (or failed) Exudyn solve: ``model`` (sensors holding every step), ``solver`` (counters
-    ``solver.it``), ``status``, ``reason`` (empty when ok), step ``dt`` [s] and ``dt_reason``, ``wall_time_s``."""
+    """A finished (or failed) Exudyn solve: ``model`` (sensors holding every step), ``solver``
+    (counters ``solver.it``), ``status``, ``reason`` (empty when ok), step ``dt`` [s] and its
+    ``dt_reason``, ``wall_time_s``."""
 
     model: ExudynModel
     solver: Any
@@ -265,7 +266,8 @@ def result_of(scene: Scene, summary: Summary, columns: dict[str, np.ndarray] | N
 
 def _check_columns(scene: Scene, model: ExudynModel, columns: dict[str, np.ndarray],
                    summary: Summary, options: ExudynOptions, means: bool = True) -> None:
-    """Constraint violations, finiteness, the torque drive's turn and (``means``) the means into ``summary``."""
+    """Constraint violations, finiteness, the torque drive's turn and (``means``) the means into
+    ``summary``."""
     violation = constraint_violation(model.pair_kinematics)
     summary.max_constraint_violation_m = violation["max_constraint_violation_m"]
     summary.max_constraint_violation_rad = violation["max_constraint_violation_rad"]
