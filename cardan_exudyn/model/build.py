@@ -54,7 +54,8 @@ def _rot_x(angle: float) -> np.ndarray:
 
 
 def _loop_motion(scene: Scene, theta: float, omega: float) -> dict[str, rccc.BodyMotion]:
-    """Body motions of the joint with mounting errors at input angle ``theta`` [rad], speed ``omega`` [rad/s]."""
+    """Body motions of the joint with mounting errors at input angle ``theta`` [rad], speed ``omega``
+    [rad/s]."""
     params = rccc.DHParameters.of_joint(scene.joint)
     positions, rates = rccc.solve_motion(params, np.array([theta]), omega, 0.0)
     return {name: rccc.BodyMotion(*(np.asarray(v)[0] for v in (m.rotation, m.origin, m.omega,

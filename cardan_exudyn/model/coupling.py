@@ -1,39 +1,10 @@
-"""Friction of eqs. (1)-(5) in the Exudyn model, computed from the pairs' reaction outputs: what
-every coupling scheme shares (:class:`FrictionCoupling`).
+"""Friction of eqs. (1)-(5) in the Exudyn model from the pairs' reactions: what every coupling scheme
+shares (:class:`FrictionCoupling`).
 
-What is added to the model
---------------------------
-For each pair with a non-zero friction coefficient (and only for those) a friction torque about
-the pair axis, and for cylindrical pairs of a joint with mounting errors an axial force, on each
-moving body of the pair: merged per body into one body-fixed torque vector, and a force vector
-only where a pair slides (:class:`cardan_exudyn.model.friction_io.BodyLoads`). Body ``b``
-receives the friction (torque ``M_z``, force ``F_z``), body ``a`` the opposite. The ideal
-joint's cylindrical pairs cannot slide: their axial friction is 0 (as the reference engine
-computes it), so that the solver's noise in their slide (at the Newton tolerance) is never
-turned into force by the sign ramp.
-
-How the friction is updated
----------------------------
-One Python post-Newton user function (``mbs.SetPostNewtonUserFunction``) reads, after each Newton
-solve, the law's inputs -- per pair the magnitudes of the reaction force normal to the axis and of
-the bending moment (from the Lagrange multipliers), and the relative angular and sliding speeds
-(BDF2 of the joint's own angle and slide outputs) -- computes the friction and sets the loads
-(:mod:`cardan_exudyn.model.friction_io`, :class:`cardan_exudyn.model.friction_law.LawTable`). The
-friction is carried as one flat tuple ``(M_z, F_z)`` per pair. Before the first step it is
-iterated to consistency with the initial state (:meth:`FrictionCoupling.initialise`), so no
-scheme starts frictionless. The schemes (``scene.friction.coupling``) differ in what the function
-does after a solve: :mod:`~cardan_exudyn.model.extrapolated` (the default, one solve per step),
-:mod:`~cardan_exudyn.model.converged` (a fixed point per step), :mod:`~cardan_exudyn.model.lagged`
-(the paper's: the friction one step late).
-
-Self-locking
-------------
-The friction feedback (friction -> reactions -> friction) has a loop gain; at a gain of 1 or more
-there is no consistent friction. A scheme that iterates a step to its fixed point sees this as a
-stalled iteration; a scheme with one solve per step as geometric growth of the friction from
-step to step, and growth by more than :data:`LAGGED_GROWTH_LIMIT` over consecutive growing steps
-is handled by the scheme (:meth:`FrictionCoupling.grown`). Either way the run ends with
-status ``self_locking``.
+Per pair with friction, a torque ``M_z`` about the pair axis (and an axial force ``F_z`` where a
+cylindrical pair slides, i.e. with mounting errors) on body b, the opposite on body a, set by a
+post-Newton user function from the reactions and relative speeds (BDF2). Loop gain >= 1 (friction
+-> reactions -> friction) ends the run ``self_locking``.
 """
 
 from __future__ import annotations
@@ -56,31 +27,15 @@ LAGGED_GROWTH_LIMIT = 1e3
 """Geometric growth of the friction over consecutive growing steps (schemes with one solve per
 step) taken as a loop gain of 1 or more."""
 REST_FLOOR = 1e-6
-"""The fixed-point tolerance is relative to the largest friction load, but at least to this share
-of the largest load the pairs would carry sliding: when every rubbing pair is at rest (inside its
-sign ramp, e.g. the spider pairs at 0 deg) the loads are rounding noise of the relative speeds,
-and a tolerance relative to the noise itself is never met."""
+"""Floor of the fixed-point tolerance, as a share of the largest sliding load: with every pair at
+rest the loads are rounding noise, and a tolerance relative to the noise is never met."""
 
 
 @dataclass
 class PairData:
-    """A pair with friction as the coupling sees it.
-
-    Attributes
-    ----------
-    name : str
-        One of :data:`reference.scene.joint.PAIR_NAMES`.
-    law : PairLaw
-        Its friction law.
-    joint : int
-        Its Exudyn ``ObjectJointGeneric``.
-    bands : (float, float, float)
-        Half-widths of its sign ramps [m/s]: rotation, sliding, resultant.
-    slides : bool
-        Whether it carries an axial force (cylindrical, with mounting errors).
-    weight : float
-        The lever that makes a force count as a torque, ``d / 2`` [m].
-    """
+    """A pair with friction as the coupling sees it: ``name``, friction ``law``, Exudyn ``joint``, sign
+    ramp half-widths ``bands`` (rotation, sliding, resultant) [m/s], whether it ``slides``, and the
+    ``weight`` ``d / 2`` [m] that makes a force count as a torque."""
 
     name: str
     law: PairLaw
@@ -92,8 +47,8 @@ class PairData:
 
 @dataclass
 class FrictionLog:
-    """Per accepted step: its time [s], the friction in effect in its final solve (flat
-    ``(M_z, F_z)`` per pair [N m, N]) and the evaluations it took."""
+    """Per accepted step: time [s], the friction in effect in its final solve (flat ``(M_z, F_z)`` per
+    pair [N m, N]) and its evaluations."""
 
     t: list = field(default_factory=list)
     applied: list = field(default_factory=list)
@@ -101,19 +56,9 @@ class FrictionLog:
 
 
 class FrictionCoupling:
-    """Friction loads of a model, their bookkeeping and the services every coupling scheme uses.
-
-    A scheme (a subclass: :class:`~cardan_exudyn.model.lagged.LaggedCoupling`,
-    :class:`~cardan_exudyn.model.converged.ConvergedCoupling`,
-    :class:`~cardan_exudyn.model.extrapolated.ExtrapolatedCoupling`) adds ``initialise(solver,
-    settings)`` and ``post_newton(mbs, t)``, Exudyn's user function, and calls down into these;
-    nothing here calls a scheme's methods, so each scheme reads from the top down.
-
-    Parameters
-    ----------
-    model : cardan_exudyn.model.build.ExudynModel
-        The model being built, its bodies, joints, markers and pair frames added.
-    """
+    """Friction loads of ``model`` (being built, joints and markers added), their bookkeeping and the
+    services every scheme uses. A scheme adds ``initialise(solver, settings)`` and
+    ``post_newton(mbs, t)`` and calls down into these; nothing here calls a scheme."""
 
     iterates = True
     """Whether Exudyn's discontinuous iteration may repeat a step's solve (:meth:`configure`)."""
@@ -172,8 +117,8 @@ class FrictionCoupling:
         self.model.user_functions.append(self.post_newton)
 
     def configure(self, settings: Any) -> None:
-        """Exudyn's discontinuous-iteration settings: a scheme that :attr:`iterates` repeats a
-        step's solve while the friction changes by more than the tolerance."""
+        """Exudyn's discontinuous-iteration settings: a scheme that :attr:`iterates` repeats a step's solve
+        while the friction changes by more than the tolerance."""
         d = settings.timeIntegration.discontinuous
         d.iterationTolerance = self.settings.tolerance if self.iterates else 1.0
         d.maxIterations = self.settings.max_iterations + 1 if self.iterates else 1
@@ -181,8 +126,8 @@ class FrictionCoupling:
         d.useRecommendedStepSize = False
 
     def _read_inputs(self, t: float | None) -> list[tuple[float, float, float, float]]:
-        """Per pair the law's inputs ``(|F|, |M|, omega_rel, slide_rel)`` at the current state
-        (``t`` None: the initial state, with velocity-level speeds)."""
+        """Per pair the law's inputs ``(|F|, |M|, omega_rel, slide_rel)`` now (``t`` None: the initial
+        state, velocity-level speeds)."""
         self._last_inputs = self.reader.read(t)
         return self._last_inputs
 
@@ -193,34 +138,14 @@ class FrictionCoupling:
         return friction
 
     def evaluate(self, t: float | None) -> tuple[float, ...]:
-        """Friction at the current state, flat ``(M_z, F_z)`` on body b of each pair [N m, N]
-        (``t`` None: the initial state, with velocity-level speeds)."""
+        """Friction now, flat ``(M_z, F_z)`` on body b of each pair [N m, N] (``t`` None: initial state)."""
         return self._law(self._read_inputs(t))
 
     def consistent_start(self, solver: Any, settings: Any,
                          max_iterations: int = 60) -> tuple[np.ndarray, list] | None:
-        """Friction consistent with the initial reactions, before the first step.
-
-        Exudyn computes the initial accelerations and reactions from the initial state and the
-        loads in place; the friction loads are iterated with them (Broyden) until consistent,
-        so that the first recorded row and the first step include friction.
-
-        Parameters
-        ----------
-        solver : exudyn.MainSolverImplicitSecondOrder
-            Initialised (``solver.InitializeSolver`` called).
-        settings : exudyn.SimulationSettings
-            The run's settings.
-        max_iterations : int
-            Broyden iterations before the start is declared self-locking.
-
-        Returns
-        -------
-        (friction, inputs) or None
-            The friction in effect, shape (n, 2) [N m, N], and the law's inputs read there
-            (:meth:`_read_inputs`); None, with :attr:`status` ``self_locking``, when the
-            iteration does not converge in ``max_iterations``.
-        """
+        """``(friction (n, 2) [N m, N], inputs)`` consistent with the initial reactions, by Broyden
+        iteration of the loads before the first step (so the first row and step include friction); None,
+        status ``self_locking``, without convergence in ``max_iterations``."""
         b = None
         x_prev = None
         r_prev = None
@@ -250,36 +175,23 @@ class FrictionCoupling:
         return None
 
     def apply(self, friction: Any, size: float | None = None) -> None:
-        """Set every friction load.
-
-        Parameters
-        ----------
-        friction : tuple or ndarray
-            Flat ``(M_z, F_z)`` per pair [N m, N], or an array of shape (n, 2).
-        size : float, optional
-            Its largest magnitude, when known.
-        """
+        """Set every friction load from ``friction`` (flat ``(M_z, F_z)`` per pair or shape (n, 2)); ``size``
+        its largest magnitude when known."""
         values = tuple(friction.ravel().tolist()) if isinstance(friction, np.ndarray) else friction
         self.loads.apply(values)
         self.applied = values
         self._applied_size = max(map(abs, values)) if size is None else size
 
     def failed(self, exc: Exception) -> list[float]:
-        """What a scheme's post-Newton function returns when its update raised ``exc``.
-
-        Exudyn reports any Python exception raised in a user function as a solver failure; the
-        exception is kept in :attr:`error` instead (the pre-step function then stops the run) so
-        that :func:`cardan_exudyn.model.solve.solve` re-raises it: a bug is not a physical
-        outcome.
-        """
+        """Keep ``exc`` raised in a scheme's update in :attr:`error` (the pre-step function stops the run
+        and ``solve`` re-raises it: a bug is not a physical outcome); the post-Newton return value."""
         self.error = exc
         self.status = Status.INTEGRATION_FAILURE
         self.reason = f"friction update raised {exc!r}"
         return [0.0, -1.0]
 
     def new_step(self, t: float) -> bool:
-        """Bookkeeping at each evaluation; True at the first evaluation of a step (the one before
-        was then accepted: its coordinates join the BDF2 history)."""
+        """Bookkeeping at each evaluation; True at a step's first evaluation (the one before was accepted)."""
         log = self.log
         if t == self._step_t:
             self._step_iter += 1
@@ -296,26 +208,14 @@ class FrictionCoupling:
         return True
 
     def change(self, friction: tuple, before: tuple) -> float:
-        """Largest change between two friction states, forces weighted by ``d / 2``.
-
-        Parameters
-        ----------
-        friction, before : tuple of float
-            Flat ``(M_z, F_z)`` per pair [N m, N].
-
-        Returns
-        -------
-        float
-            The largest weighted change [N m].
-        """
+        """Largest change [N m] between flat friction states ``friction`` and ``before``, forces weighted
+        by ``d / 2``."""
         return max((w * abs(a - b) for w, a, b in zip(self._flat_weight, friction, before, strict=True)),
                    default=0.0)
 
     def grown(self, size: float) -> bool:
-        """Self-locking watch of a scheme with one solve per step: whether the friction about to
-        be applied (largest magnitude ``size``) has grown by more than
-        :data:`LAGGED_GROWTH_LIMIT` over consecutive growing steps. Growth out of rounding noise
-        (pairs at rest) is no locking: it counts from :attr:`scale_floor` at least."""
+        """Whether friction of largest magnitude ``size`` has grown over :data:`LAGGED_GROWTH_LIMIT` times
+        over consecutive growing steps (counted from :attr:`scale_floor` at least: noise is no locking)."""
         before = self._applied_size
         if not (before > 0.0 and size > before):
             self._growth_steps = 0
@@ -340,8 +240,7 @@ class FrictionCoupling:
                 "the direction of friction in pairs that do not move; use a positive band)")
 
     def diagnostics(self) -> FrictionDiagnostics:
-        """The run's counters and loop-gain estimates (median and largest; the median is robust
-        to the start-up steps)."""
+        """The run's counters and loop-gain estimates (median, robust to the start-up steps, and largest)."""
         iterations = np.asarray(self.log.iterations, dtype=float)
         return FrictionDiagnostics(
             coupling=self.settings.coupling,
@@ -359,8 +258,8 @@ class FrictionCoupling:
         )
 
     def columns(self, times: np.ndarray) -> dict[str, np.ndarray]:
-        """Friction applied in the step ending at each recorded time ``times`` [s], per pair
-        (``<pair>_friction_torque`` [N m], ``<pair>_friction_force`` [N]; zeros elsewhere)."""
+        """Friction applied in the step ending at each of ``times`` [s], per pair ``<pair>_friction_torque``
+        [N m] and ``<pair>_friction_force`` [N] (zeros elsewhere)."""
         n = len(times)
         out = {f"{name}_{kind}": np.zeros(n) for name in PAIR_NAMES
                for kind in ("friction_torque", "friction_force")}
@@ -385,19 +284,7 @@ class FrictionCoupling:
 
 
 def friction_pairs(model: Any, bands: dict[str, Any]) -> list[PairData]:
-    """The pairs of ``model``'s scene with a non-zero friction coefficient, in order.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The model being built (its joints added).
-    bands : dict of str to (float, float, float)
-        Each pair's sign ramps [m/s] (:func:`reference.physics.bands.sign_bands`).
-
-    Returns
-    -------
-    list of PairData
-    """
+    """The :class:`PairData` of ``model``'s pairs with friction, in order; ``bands`` per pair [m/s]."""
     scene = model.scene
     out = []
     for name, pair in scene.joint.friction_pairs():
@@ -410,21 +297,7 @@ def friction_pairs(model: Any, bands: dict[str, Any]) -> list[PairData]:
 
 
 def body_contributions(model: Any, name: str) -> list[tuple[int, Any, int]]:
-    """The moving bodies of a pair that carry its friction.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The model being built (bodies and markers added).
-    name : str
-        One of :data:`reference.scene.joint.PAIR_NAMES`.
-
-    Returns
-    -------
-    list of (int, ndarray, int)
-        Per moving body its body number, the marker position in the body [m], shape (3,), and
-        -1 for body ``a``, +1 for body ``b``.
-    """
+    """Per moving body of pair ``name``: body number, marker position in the body [m], -1 (a) or +1 (b)."""
     return [(model.bodies[body], local, role) for role, body, local in
             zip((-1, 1), PAIR_BODIES[name], model.marker_local[name], strict=True) if body != "ground"]
 
