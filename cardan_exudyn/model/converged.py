@@ -1,18 +1,10 @@
 """The ``converged`` friction coupling: every step iterated to its fixed point.
 
-After each Newton solve the post-Newton function returns the relative change of the friction as
-the error of Exudyn's *discontinuous iteration*; Exudyn repeats the solve of the same step with
-the updated friction until the change is below ``friction.tolerance``. The friction applied in a
-step is then that of the step's own reactions. The iteration is Broyden's quasi-Newton method on
-``r(x) = Phi(x) - x`` (``Phi``: friction -> reactions -> friction), its secant matrix kept across
-steps; an accepted step's friction is extrapolated quadratically over the last three steps as
-the next step's first guess. Cost: measured in docs/engines.md#friction-coupling-measurements.
-
-Self-locking: the plain map contracts with the loop gain of the friction feedback (the spectral
-radius of the secant estimate of ``dPhi/dx``, ``loop_gain_estimate``). A step whose residual
-shrank by less than :data:`STALL_RATIO` after ``friction.max_iterations`` has no consistent
-friction state and stops the run (``self_locking``); one that still converges, slowly, is
-counted in ``unconverged_steps`` and the run goes on.
+The post-Newton function returns the friction's relative change as the error of Exudyn's
+discontinuous iteration, which repeats the step until it is below ``friction.tolerance``. The
+iteration is Broyden's on ``r(x) = Phi(x) - x`` (``Phi``: friction -> reactions -> friction), its
+secant matrix kept across steps. A step stalled after ``friction.max_iterations`` (residual shrunk
+less than :data:`STALL_RATIO`) is ``self_locking``. Cost: docs/engines.md#friction-coupling-measurements.
 """
 
 from __future__ import annotations
@@ -31,8 +23,7 @@ STALL_RATIO = 0.1
 """A step whose fixed-point residual shrank less than this after ``friction.max_iterations`` is
 taken as self-locking (no consistent friction state)."""
 GAIN_EVERY = 4
-"""The loop-gain estimate (the secant matrix's eigenvalues, as costly as a friction evaluation) is
-taken every this many accepted steps."""
+"""The loop-gain estimate (eigenvalues, costly as a friction evaluation) every this many accepted steps."""
 
 
 class ConvergedCoupling(FrictionCoupling):
@@ -48,73 +39,31 @@ class ConvergedCoupling(FrictionCoupling):
         self._accepted: list[tuple] = []  # the last accepted steps' friction (flat)
 
     def initialise(self, solver: Any, settings: Any) -> tuple[np.ndarray, list] | None:
-        """Friction consistent with the initial state, the first accepted state.
-
-        Parameters
-        ----------
-        solver : exudyn.MainSolverImplicitSecondOrder
-            Initialised (``solver.InitializeSolver`` called).
-        settings : exudyn.SimulationSettings
-            The run's settings.
-
-        Returns
-        -------
-        (friction, inputs) or None
-            :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
-        """
+        """Friction consistent with the initial state, the first accepted state."""
         start = self.consistent_start(solver, settings)
         if start is not None:
             self._accepted = [tuple(start[0].ravel().tolist())]
         return start
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
-        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
-
-        Parameters
-        ----------
-        mbs : exudyn MainSystem
-            The system just solved.
-        t : float
-            Time of the solve [s].
-
-        Returns
-        -------
-        list of float
-            Exudyn's ``[error, -1]``: a positive error repeats the step's solve.
-        """
+        """Exudyn's post-Newton user function at ``t`` [s]: :meth:`update`'s ``[error, -1]``, an
+        exception kept."""
         try:
             return self.update(t)
         except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it
             return self.failed(exc)
 
     def update(self, t: float) -> list[float]:
-        """One evaluation of the step at ``t`` [s] (:meth:`iterate`), the step :meth:`accept`-ed
-        when it is done."""
+        """One evaluation of the step at ``t`` [s], the step accepted when done."""
         error, done = self.iterate(t)
         if done is not None:
             self.accept(done)
         return error
 
     def iterate(self, t: float, counted: bool = False) -> tuple[list[float], tuple | None]:
-        """One evaluation of the fixed point of a step.
-
-        Parameters
-        ----------
-        t : float
-            Time of the step [s].
-        counted : bool
-            Whether :meth:`new_step` was already called for this evaluation.
-
-        Returns
-        -------
-        error : list of float
-            Exudyn's ``[error, -1]``: the relative change, above the tolerance while the step is
-            solved again with the next Broyden iterate (applied here), 0 when it is done.
-        done : tuple or None
-            The step's friction (flat) when it is done: within the tolerance, or at
-            ``friction.max_iterations`` (self-locking when stalled); None while it iterates.
-        """
+        """One evaluation of a step's fixed point at ``t`` [s] (``counted``: :meth:`new_step` already called):
+        ``(error, done)``, Exudyn's ``[relative change, -1]`` (next Broyden iterate applied while above
+        the tolerance, 0 when done) and the step's flat friction when done (else None)."""
         if not counted:
             self.new_step(t)
         friction = self.evaluate(t)
@@ -130,9 +79,8 @@ class ConvergedCoupling(FrictionCoupling):
         return [error, -1.0], None
 
     def _relative_change(self, friction: tuple, applied: tuple) -> float:
-        """The change from ``applied`` to ``friction`` relative to the larger of the friction and
-        :attr:`scale_floor`; forces enter as the torque they make at the journal radius, so one
-        relative measure covers both kinds of load."""
+        """Change from ``applied`` to ``friction`` relative to the larger of the friction and
+        :attr:`scale_floor`; forces count as their torque at the journal radius."""
         weights = self._flat_weight
         scale = max(max([w * abs(f) for w, f in zip(weights, friction, strict=True)]), self.scale_floor)
         change = max([w * abs(f - a) for w, f, a in zip(weights, friction, applied, strict=True)])
@@ -158,8 +106,7 @@ class ConvergedCoupling(FrictionCoupling):
                 self._step_gain = r1 / r0
 
     def _give_up(self, t: float) -> None:
-        """The step reached ``friction.max_iterations``: counted, and self-locking when the
-        residual stalled (:data:`STALL_RATIO`)."""
+        """At ``friction.max_iterations``: counted, and self-locking when the residual stalled."""
         rs = self._rs
         self.unconverged_steps += 1
         shrink = math.sqrt(rs[-1] @ rs[-1]) / max(math.sqrt(rs[0] @ rs[0]), 1e-300)
@@ -172,13 +119,8 @@ class ConvergedCoupling(FrictionCoupling):
                            "is >= 1" + self.band_hint())
 
     def _broyden(self) -> tuple[float, ...]:
-        """Next friction guess (flat): Broyden's quasi-Newton method on ``r(x) = Phi(x) - x``.
-
-        The map is nearly linear within a step (signs fixed) and changes slowly from step to
-        step, so the secant approximation ``B`` of ``dr/dx`` is kept across steps (it starts as
-        ``-I``, a plain fixed-point update, and is updated with every pair of iterates of the same
-        step). Works on the loads that can be non-zero; the others stay 0.
-        """
+        """Next flat friction guess by Broyden on ``r(x) = Phi(x) - x``; the secant ``B`` (from ``-I``) is
+        kept across steps since the map changes slowly. Only loads that can be non-zero move."""
         xs = self._xs
         rs = self._rs
         x = xs[-1]
@@ -202,14 +144,8 @@ class ConvergedCoupling(FrictionCoupling):
         return tuple(out)
 
     def accept(self, friction: tuple) -> None:
-        """The step is accepted with ``friction`` (flat): record the loop gain, and apply the
-        quadratic extrapolation of the last three steps as the next step's first guess.
-
-        Loop gain: the spectral radius of ``B + I``, the secant estimate of d(friction out) /
-        d(friction in): the contraction of the plain map at this step (exact for the directions
-        the iterations have explored). The extrapolation (error O(h^3)) only sets the starting
-        guess.
-        """
+        """Accept the step with flat ``friction``: record the loop gain (spectral radius of ``B + I``) and
+        apply the quadratic extrapolation of the last three steps as the next first guess."""
         self._accepted_steps += 1
         if self._broyden_b is not None and self._accepted_steps % GAIN_EVERY == 1:
             g = self._broyden_b + np.eye(self._broyden_b.shape[0])

@@ -1,25 +1,10 @@
-"""The ``extrapolated`` friction coupling (the default): one Newton solve per step, the law
-evaluated on the inputs extrapolated to the end of the next step.
+"""The ``extrapolated`` friction coupling (the default): one Newton solve per step, the law evaluated
+on the inputs extrapolated to the end of the next step, ``x_{n+1} ~ 1.5 x_n - 0.5 x_{n-2}``.
 
-At the end of step ``n`` the law's inputs ``x`` (reaction magnitudes, relative speeds) are
-extrapolated to the end of step ``n + 1`` as ``1.5 x_n - 0.5 x_{n-2}`` (linear through steps
-``n - 2`` and ``n``) and the law, sign ramps included, is evaluated on them: the friction acting in
-step ``n + 1`` is that of its own (predicted) state, so the mean efficiency converges at the
-integrator's order (second) where friction is smooth. The linear map of the friction feedback
-(loop gain ``g``: reactions -> friction -> reactions) then iterates as ``z^3 = g (1.5 z^2 - 0.5)``,
-whose roots lie inside the unit circle for every real ``g`` in (-1, 1)
-(``tests/test_coupling_lean.py`` checks the roots and runs at gains near -1 and +1). The first two
-steps extrapolate with what exists (constant, then linear through two steps).
-
-A step where a pair's motion crosses its sign ramp within a few steps (a reversal: the friction
-jumps, and the reactions with it) is solved to its fixed point by the converged scheme's
-iteration. Every :data:`PROBE_EVERY`-th step that is not a reversal step (more often at coarse
-steps, :data:`PROBES_PER_REVOLUTION`) is solved twice, the second time with the friction of the
-first solve's state: the ratio of the two friction changes estimates the loop gain. A probe
-above :data:`ESCALATE_GAIN`, or growth of the friction by more than
-:data:`~cardan_exudyn.model.coupling.LAGGED_GROWTH_LIMIT`, switches the run to the converged
-scheme: near self-locking the extrapolation amplifies its error by ``1 / (1 - g)``, and only the
-fixed-point iteration tells a joint that locks.
+Second order where friction is smooth; the feedback map ``z^3 = g (1.5 z^2 - 0.5)`` is stable for
+loop gains ``g`` in (-1, 1). Reversal steps are iterated to their fixed point; a probed gain above
+:data:`ESCALATE_GAIN` or runaway growth switches the run to the converged scheme (near locking the
+extrapolation's error grows as ``1 / (1 - g)``).
 """
 
 from __future__ import annotations
@@ -34,8 +19,8 @@ __all__ = ["PROBE_EVERY", "PROBES_PER_REVOLUTION", "ESCALATE_GAIN", "RAMP_STEPS"
            "ExtrapolatedCoupling"]
 
 PROBE_EVERY = 25
-"""Every this many steps one step is solved twice to estimate the loop gain (a reversal step is
-solved to its fixed point instead). Measured: docs/engines.md#friction-coupling-measurements."""
+"""Every this many steps one step is solved twice to estimate the loop gain. Measured:
+docs/engines.md#friction-coupling-measurements."""
 PROBES_PER_REVOLUTION = 8
 """Probes per input revolution at least: the gain varies over a revolution. Measured:
 docs/engines.md#friction-coupling-measurements."""
@@ -44,8 +29,7 @@ ESCALATE_GAIN = 0.95
 RAMP_STEPS = 4
 """A sign ramp crossed in fewer steps than this counts as a jump (a reversal step)."""
 PROBE_NOISE = 1e-9
-"""A probe whose first friction change is below this share of the largest friction load is
-rounding noise and estimates nothing."""
+"""A probe whose first friction change is below this share of the largest load estimates nothing."""
 
 
 class ExtrapolatedCoupling(ConvergedCoupling):
@@ -62,24 +46,8 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         self._predicted_regime: tuple = ()  # the regime the step was solved with
 
     def initialise(self, solver: Any, settings: Any) -> tuple[Any, list] | None:
-        """The probe interval, then the consistent initial friction.
-
-        The interval gives at least :data:`PROBES_PER_REVOLUTION` probes per revolution at the
-        drive's top speed, at most every :data:`PROBE_EVERY`-th step; the initial friction's
-        inputs and regime start the extrapolation.
-
-        Parameters
-        ----------
-        solver : exudyn.MainSolverImplicitSecondOrder
-            Initialised (``solver.InitializeSolver`` called).
-        settings : exudyn.SimulationSettings
-            The run's settings.
-
-        Returns
-        -------
-        (friction, inputs) or None
-            :meth:`~cardan_exudyn.model.coupling.FrictionCoupling.consistent_start`'s.
-        """
+        """The probe interval (at least :data:`PROBES_PER_REVOLUTION` per revolution, at most every
+        :data:`PROBE_EVERY`-th step), then the consistent initial friction that starts the extrapolation."""
         ti = settings.timeIntegration
         speed = self.model.scene.drive.max_speed()
         duration = ti.endTime - ti.startTime
@@ -94,21 +62,8 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return start
 
     def post_newton(self, mbs: Any, t: float) -> list[float]:
-        """Exudyn's post-Newton user function: :meth:`update`, an exception kept
-        (:meth:`~cardan_exudyn.model.coupling.FrictionCoupling.failed`).
-
-        Parameters
-        ----------
-        mbs : exudyn MainSystem
-            The system just solved.
-        t : float
-            Time of the solve [s].
-
-        Returns
-        -------
-        list of float
-            Exudyn's ``[error, -1]``: a positive error repeats the step's solve.
-        """
+        """Exudyn's post-Newton user function at ``t`` [s]: :meth:`update`'s ``[error, -1]``, an
+        exception kept."""
         try:
             return self.update(t)
         except Exception as exc:  # process boundary with Exudyn's C++ loop: re-raised after it
@@ -122,10 +77,8 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return self._one_solve(t)
 
     def _iterated(self, t: float, counted: bool) -> list[float]:
-        """One evaluation of a step solved to its fixed point
-        (:meth:`~cardan_exudyn.model.converged.ConvergedCoupling.iterate`); when it is done, a
-        reversal step goes back to one solve per step, an escalated run accepts it as the
-        converged scheme does."""
+        """One evaluation of a step solved to its fixed point; when done, a reversal step returns to one
+        solve per step and an escalated run accepts it."""
         error, done = self.iterate(t, counted)
         if done is None:
             return error
@@ -137,8 +90,8 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return error
 
     def _one_solve(self, t: float) -> list[float]:
-        """After a step's solve: the friction for the next step from the law on extrapolated
-        inputs; a probe step is solved twice, a reversal step to its fixed point."""
+        """After a step's solve: the next step's friction from the extrapolated inputs; a probe step is
+        solved twice, a reversal step to its fixed point."""
         first = self.new_step(t)
         if self._iterating:
             return self._iterated(t, counted=True)
@@ -163,12 +116,9 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return [0.0, -1.0]
 
     def _reversed(self, inputs: list, regime: tuple) -> bool:
-        """Whether a pair's motion crossed its sign ramp in fewer than :data:`RAMP_STEPS` steps
-        (from one side to the other or into it) between ``inputs`` (of ``regime``) and the steps
-        the extrapolation through them would use, or against the prediction this step was solved
-        with: its friction then jumps, and so do the reactions, which a line through the jump
-        would carry into the next steps as an error of order one. A ramp the step resolves is
-        crossed smoothly and needs nothing."""
+        """Whether a pair's motion crossed its sign ramp in fewer than :data:`RAMP_STEPS` steps between
+        ``inputs`` (of ``regime``) and the extrapolation's steps or prediction: friction and reactions
+        jump, and a line through the jump would carry an O(1) error."""
         others = (self._predicted_regime, *self._regimes)
         if all(other == regime for other in others):
             return False
@@ -182,8 +132,8 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         return False
 
     def _predict(self, inputs: list, regime: tuple) -> None:
-        """Accept the step's ``inputs`` (of ``regime``) and apply the friction of the law on the
-        inputs extrapolated to the end of the next step (``1.5 x_n - 0.5 x_{n-2}``)."""
+        """Accept the step's ``inputs`` (of ``regime``) and apply the law on the inputs extrapolated to the
+        next step's end."""
         hist = self._inputs
         regimes = self._regimes
         hist.append(inputs)
@@ -203,8 +153,8 @@ class ExtrapolatedCoupling(ConvergedCoupling):
         self.apply(friction, size)
 
     def _finish_probe(self, t: float, friction: tuple) -> None:
-        """Second solve of a probe step at ``t`` [s]: the loop gain from the two friction
-        changes; escalation above :data:`ESCALATE_GAIN`."""
+        """Second solve of a probe step at ``t`` [s]: the loop gain from the two friction changes;
+        escalation above :data:`ESCALATE_GAIN`."""
         first, change0 = self._probe
         self._probe = None
         self.probes += 1
