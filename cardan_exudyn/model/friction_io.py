@@ -1,40 +1,11 @@
-"""What a friction evaluation reads from Exudyn and the loads it sets, in plain floats.
+"""What a friction evaluation reads from Exudyn and the loads it sets, in plain floats (numpy on
+3-vectors costs more than the law; measured: docs/engines.md#friction-coupling-measurements).
 
-The friction coupling (:mod:`cardan_exudyn.model.coupling`) evaluates the law after every Newton
-solve; on this model numpy on three-vectors costs more than the law itself, so everything here is
-float arithmetic on values read once per evaluation.
-The coupling's hot path reads through :class:`PairReader` (one pass over the pairs; the
-functions below are the same reads one quantity at a time, for the initial state and the tests).
-About half of an evaluation is Exudyn's ``GetObjectOutput`` and ``SetLoadParameter`` calls
-(measured: docs/engines.md#friction-coupling-measurements).
-
-Reactions
----------
-All Lagrange multipliers are read with one ``GetAECoordinates`` call. Each ``ObjectJointGeneric``
-owns six of them (``GetObjectLTGAE``): force then torque. For a joint between two bodies they
-equal its ``ForceLocal`` and ``TorqueLocal`` outputs (components in the joint frame, z the pair
-axis; ``TorqueLocal``'s in-plane components are rotated by 90 deg, which the magnitude ignores).
-For a joint whose first marker is on the ground, the force part is in global components and the
-constant rows of the ground marker's frame give the pair components (measured on Exudyn 1.13.6 and
-pinned by ``tests/test_coupling_lean.py`` against ``ForceLocal`` / ``TorqueLocal``).
-
-Relative motion
----------------
-The pair angle and slide are the joint's own ``Rotation`` z and ``DisplacementLocal`` z outputs
-(the relative rotation of body b about the axis and the axial offset of its pair point, in the
-frame of body a); the relative speeds are their second-order backward differences, as in
-:func:`cardan_exudyn.model.postprocess.relative_speeds`, because the integrator's velocities miss
-the velocity constraints by ``O(h^2)`` (about 1e-3 m/s of spurious slide). At the initial,
-consistent state the joint's ``AngularVelocityLocal`` z and ``VelocityLocal`` z are used.
-
-Loads
------
-One body-fixed ``LoadTorqueVector`` per moving body with friction, and a body-fixed
-``LoadForceVector`` at its centre of mass (the node) only where a pair slides: a pair's axial
-force ``F`` at its point ``p`` (node frame) is the force ``F`` at the node plus the torque
-``p x F``, exact for a rigid body. Body ``b`` of a pair receives the friction, body ``a`` its
-opposite; the pair axis is fixed in both bodies, so every contribution is a constant vector
-times one number.
+Reactions: a generic joint's six Lagrange multipliers (force, torque; pair frame, or global force
+components when its first marker is on the ground). Relative speeds: BDF2 of the joint's
+``Rotation`` z and ``DisplacementLocal`` z (the integrator's velocities miss the constraints by
+``O(h^2)``). Loads: per moving body one body-fixed torque, plus a force at the node where a pair
+slides (axial ``F`` at point ``p`` = ``F`` at the node + ``p x F``); body b gets the friction.
 """
 
 from __future__ import annotations
@@ -63,20 +34,9 @@ _TWO_PI = 2.0 * math.pi
 
 @dataclass(frozen=True)
 class PairChannel:
-    """Where one pair's law inputs are read.
-
-    Attributes
-    ----------
-    joint : int
-        The pair's ``ObjectJointGeneric``.
-    ae : int
-        Index of its first Lagrange multiplier in the system's algebraic coordinates.
-    force_rows : tuple or None
-        None: the force multipliers are pair components; else the two rows (3-tuples) that turn
-        global components into the pair's x and y (a joint whose first marker is on the ground).
-    slides : bool
-        Whether the pair's slide is read (a cylindrical pair of a joint with mounting errors).
-    """
+    """Where one pair's law inputs are read: its ``joint``, index ``ae`` of its first multiplier,
+    ``force_rows`` turning global force components into the pair's x, y (None: already pair
+    components) and whether it ``slides``."""
 
     joint: int
     ae: int
@@ -85,25 +45,8 @@ class PairChannel:
 
 
 def pair_channel(mbs: Any, joint: int, ground_first: bool, frame: np.ndarray, slides: bool) -> PairChannel:
-    """The channel of one pair's joint.
-
-    Parameters
-    ----------
-    mbs : exudyn MainSystem
-        Assembled (``mbs.Assemble`` called).
-    joint : int
-        The pair's ``ObjectJointGeneric``.
-    ground_first : bool
-        Whether the joint's first marker is on the ground.
-    frame : ndarray, shape (3, 3)
-        The pair frame's columns in global axes (used when ``ground_first``).
-    slides : bool
-        Whether the pair's slide is read.
-
-    Returns
-    -------
-    PairChannel
-    """
+    """The :class:`PairChannel` of an assembled ``joint``; ``frame`` (3, 3) the pair frame's columns,
+    used when ``ground_first``."""
     rows = None
     if ground_first:
         rows = (tuple(float(c) for c in frame[:, 0]), tuple(float(c) for c in frame[:, 1]))
@@ -111,22 +54,8 @@ def pair_channel(mbs: Any, joint: int, ground_first: bool, frame: np.ndarray, sl
 
 
 def read_reactions(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, float, float, float]]:
-    """Per pair the reaction in the pair frame, from one read of all multipliers.
-
-    Parameters
-    ----------
-    mbs : exudyn MainSystem
-        At the current state.
-    channels : list of PairChannel
-        One per pair.
-
-    Returns
-    -------
-    list of (fx, fy, mx, my)
-        Per pair the force components normal to the axis [N] and the bending moment's two
-        components [N m], as ``TorqueLocal`` gives them (rotated by 90 deg about the axis, which
-        magnitudes ignore).
-    """
+    """Per pair ``(fx, fy, mx, my)``: force normal to the axis [N] and bending moment [N m] (as
+    ``TorqueLocal``, rotated 90 deg about the axis), from one read of all multipliers."""
     ae = mbs.systemData.GetAECoordinates(exu.ConfigurationType.Current).tolist()
     out = []
     for c in channels:
@@ -143,20 +72,7 @@ def read_reactions(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, f
 
 
 def pair_coordinates(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, float]]:
-    """Per pair the relative rotation angle and the slide.
-
-    Parameters
-    ----------
-    mbs : exudyn MainSystem
-        At the current state.
-    channels : list of PairChannel
-        One per pair.
-
-    Returns
-    -------
-    list of (angle, slide)
-        Angle [rad] in ``(-pi, pi]`` and slide [m] (0 for a pair whose slide is not read).
-    """
+    """Per pair ``(angle [rad] in (-pi, pi], slide [m])`` (slide 0 when not read)."""
     get = mbs.GetObjectOutput
     return [(float(get(c.joint, _ROTATION)[2]), float(get(c.joint, _DISPLACEMENT)[2]) if c.slides else 0.0)
             for c in channels]
@@ -164,26 +80,8 @@ def pair_coordinates(mbs: Any, channels: list[PairChannel]) -> list[tuple[float,
 
 def bdf2_speeds(coords: list, h1: float, previous: list, h2: float | None = None,
                 before: list | None = None) -> list[tuple[float, float]]:
-    """Relative angular and sliding speeds: BDF2 of the pair coordinates (BDF1 without ``before``).
-
-    Parameters
-    ----------
-    coords : list of (angle, slide)
-        Per pair at the current step [rad, m] (:func:`pair_coordinates`).
-    h1 : float
-        Step from ``previous`` to ``coords`` [s].
-    previous : list of (angle, slide)
-        At the step before.
-    h2 : float, optional
-        Step from ``before`` to ``previous`` [s].
-    before : list of (angle, slide), optional
-        Two steps back.
-
-    Returns
-    -------
-    list of (omega_rel, slide_rel)
-        Per pair [rad/s, m/s]; angle differences are unwrapped.
-    """
+    """Per pair ``(omega_rel [rad/s], slide_rel [m/s])``: BDF2 of ``coords``, ``previous`` and ``before``
+    over steps ``h1``, ``h2`` [s] (BDF1 without ``before``), angles unwrapped."""
     out = []
     if before is None:
         for (a, s), (a1, s1) in zip(coords, previous, strict=True):
@@ -200,47 +98,18 @@ def bdf2_speeds(coords: list, h1: float, previous: list, h2: float | None = None
 
 
 def initial_speeds(mbs: Any, channels: list[PairChannel]) -> list[tuple[float, float]]:
-    """Per pair the relative speeds from the joint's velocity outputs.
-
-    For the consistent initial state, where no history exists.
-
-    Parameters
-    ----------
-    mbs : exudyn MainSystem
-        At the current state.
-    channels : list of PairChannel
-        One per pair.
-
-    Returns
-    -------
-    list of (omega_rel, slide_rel)
-        Per pair [rad/s, m/s] (0 for a slide that is not read).
-    """
+    """Per pair ``(omega_rel [rad/s], slide_rel [m/s])`` from the joint's velocity outputs (the initial
+    state, no history)."""
     get = mbs.GetObjectOutput
     return [(float(get(c.joint, _ANGULAR_VELOCITY)[2]),
              float(get(c.joint, _VELOCITY)[2]) if c.slides else 0.0) for c in channels]
 
 
 class PairReader:
-    """The law's inputs of every pair after a Newton solve, in one pass (the coupling's hot path).
-
-    Gives what :func:`read_reactions`, :func:`pair_coordinates` and :func:`bdf2_speeds` (or
-    :func:`initial_speeds`) give together, to the last bit, and keeps the coordinates of the last
-    two accepted steps for the backward differences. In the same pass it sets :attr:`regime`, the
-    side of its sign ramps each pair's motion is on (as
-    :meth:`cardan_exudyn.model.friction_law.LawTable.loads` gives it for the inputs it evaluates).
-
-    Parameters
-    ----------
-    mbs : exudyn MainSystem
-        Assembled.
-    channels : list of PairChannel
-    start_time : float
-        Time of the initial state, whose coordinates start the history [s].
-    sides : list of (float, float, float)
-        Per pair the journal radius [m] and the widths of the rotation's and the sliding's sign
-        ramps [m/s].
-    """
+    """The law's inputs of every pair after a Newton solve in one pass (the hot path), bit-identical to
+    :func:`read_reactions`, :func:`pair_coordinates` and :func:`bdf2_speeds`; keeps the last two
+    accepted steps and sets :attr:`regime` (each pair's side of its sign ramps). ``sides``: per pair
+    journal radius [m] and rotation, sliding ramp widths [m/s]; ``start_time`` [s]."""
 
     def __init__(self, mbs: Any, channels: list[PairChannel], start_time: float,
                  sides: list[tuple[float, float, float]]) -> None:
@@ -268,22 +137,8 @@ class PairReader:
                       for (a1, s1), (a2, s2) in zip(self._c1, self._c2, strict=True)]
 
     def read(self, t: float | None) -> list[tuple[float, float, float, float]]:
-        """The law's inputs of every pair at the current state; sets :attr:`regime`.
-
-        One loop on purpose: this runs after every Newton solve, and a pass per quantity costs
-        more than the law.
-
-        Parameters
-        ----------
-        t : float or None
-            Time of the state [s]: speeds by BDF2 over the accepted steps, the coordinates kept
-            as :attr:`coords`; None: the initial state, with velocity-level speeds.
-
-        Returns
-        -------
-        list of (float, float, float, float)
-            Per pair ``|F|`` [N], ``|M|`` [N m], ``omega_rel`` [rad/s], ``slide_rel`` [m/s].
-        """
+        """Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])`` now, setting :attr:`regime`;
+        ``t`` [s] for BDF2 over the accepted steps, None for the initial state (velocity-level speeds)."""
         if t is None or self._back is None:
             return self._read_plain(t)
         h1 = t - self._t1
@@ -341,20 +196,9 @@ class PairReader:
 
 
 class BodyLoads:
-    """The merged friction loads of the moving bodies (see the module doc).
-
-    Parameters
-    ----------
-    mbs : exudyn MainSystem
-        The loads are added to it.
-    contributions : list of list of (int, ndarray, int)
-        Per pair, for each moving body of the pair: its body number, the pair point in its node
-        frame [m], shape (3,), and +1 for body b, -1 for body a.
-    axes : list of ndarray, shape (3,)
-        Per pair the unit axis in node frames.
-    slides : list of bool
-        Per pair whether it carries an axial force.
-    """
+    """The merged friction loads of the moving bodies. ``contributions``: per pair, per moving body
+    (body number, pair point in its node frame [m], +1 body b / -1 body a); ``axes`` per pair the unit
+    axis in node frames; ``slides`` per pair whether it carries an axial force."""
 
     def __init__(self, mbs: Any, contributions: list[list[tuple[int, np.ndarray, int]]],
                  axes: list[np.ndarray], slides: list[bool]) -> None:
@@ -379,8 +223,7 @@ class BodyLoads:
                     self.kinds.append(kind)
 
     def apply(self, friction: tuple) -> None:
-        """Set every load from ``friction``, flat ``(torque_0, force_0, torque_1, ...)`` on body b
-        of each pair [N m, N]."""
+        """Set every load from flat ``friction`` ``(torque_0, force_0, torque_1, ...)`` on body b [N m, N]."""
         set_load = self.mbs.SetLoadParameter
         for load, terms in self._loads:
             x = y = z = 0.0

@@ -1,35 +1,16 @@
-"""The friction law of the Exudyn model as pure functions: floats in, floats out, no Exudyn.
+"""The friction law of the Exudyn model as pure float functions, no Exudyn; written apart from
+:mod:`reference.physics.friction` on purpose (the reference catches mistakes here).
 
-Written separately from :mod:`reference.physics.friction` on purpose (the reference exists to catch
-mistakes here; neither calls the other). Plain ``float`` arithmetic, because the coupling calls
-it once per pair after every Newton solve and numpy on scalars costs more than the law itself.
+Pair with coefficient ``f``, journal diameter ``d``, moment lever ``L``, reaction magnitudes
+``|F|`` (normal to the axis) and ``|M|`` (bending), eqs. (1)-(5):
 
-A pair with friction coefficient ``f``, journal diameter ``d`` and moment lever ``L`` carries a
-reaction with the magnitudes ``|F|`` (force normal to its axis) and ``|M|`` (bending moment).
-The bending moment acts as a couple of normal forces ``|M| / L`` (eq. (1)); each rubs at the
-journal radius, so the friction torque magnitude is (eqs. (2)-(4))
+    T = f d |M| / L + f (d / 2) |F|,      A = f (|F| + 2 |M| / L)  (cylindrical pairs).
 
-    T = f d |M| / L + f (d / 2) |F|
+Paper law: body b receives ``-s(omega_rel d / 2) T`` about the axis and ``-s(v_slide) A`` along
+it (body a the opposite), ``s`` the sign regularised by a linear ramp of width ``band``
+(``slide_band``) [m/s]. Resultant law: ``-(d / 2) A v_c / m`` and ``-A v_a / m``,
+``(v_c, v_a) = (omega_rel d / 2, v_slide)``, ``m = max(|(v_c, v_a)|, resultant_band)``.
 
-and a cylindrical pair also resists sliding with the axial force magnitude (eq. (5))
-
-    A = f (|F| + 2 |M| / L).
-
-Body ``b`` of the pair receives ``-s(v_rot) T`` about the axis and ``-s(v_slide) A`` along it,
-body ``a`` the opposite, where ``s`` is the sign of the relative surface speed of ``b`` with
-respect to ``a``, regularised by a linear ramp of width ``band`` [m/s] (the rotation's; the
-sliding has its own, ``slide_band``); for the rotation the surface speed is ``omega_rel d / 2``.
-The widths are scene data, the same for every engine (:func:`reference.physics.bands.sign_bands`).
-
-That is the paper's law (``FrictionSettings.law = "paper"``). Since ``T = (d / 2) A``, both are
-one Coulomb force ``A`` at the journal surface; the resultant-slip law (``"resultant"``) lets that
-one force oppose the contact's slip velocity ``(v_c, v_a) = (omega_rel d / 2, v_slide)`` instead of
-acting in full in each direction: body ``b`` receives ``-(d / 2) A v_c / m`` about the axis and
-``-A v_a / m`` along it, ``m = max(sqrt(v_c^2 + v_a^2), resultant_band)`` (the unit slip direction
-outside the band, linear inside). A revolute pair has ``v_a = 0``.
-
-References
-----------
 Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
 experimental validation": eqs. (1)-(5).
 """
@@ -46,22 +27,8 @@ __all__ = ["PairLaw", "FrictionLoads", "ramp_sign", "pair_loads", "magnitude_loa
 
 @dataclass(frozen=True)
 class PairLaw:
-    """The constants of one pair's law.
-
-    Attributes
-    ----------
-    cylindrical : bool
-        True for a cylindrical pair (axial friction too), False for a revolute.
-    f : float
-        Friction coefficient [-].
-    d : float
-        Journal diameter [m].
-    lever : float
-        Moment lever ``L`` of eqs. (1)-(2) [m].
-    resultant : bool
-        True: one Coulomb force against the resultant slip (``FrictionSettings.law ==
-        "resultant"``); False: the paper's eqs. (3), (5), one sign per direction.
-    """
+    """The constants of one pair's law: ``cylindrical`` (axial friction too), coefficient ``f`` [-],
+    journal diameter ``d`` [m], moment ``lever`` L [m], ``resultant`` (the resultant-slip law)."""
 
     cylindrical: bool
     f: float
@@ -71,21 +38,8 @@ class PairLaw:
 
     @classmethod
     def of(cls, kind: str, pair: Any, law: str = "paper") -> PairLaw:
-        """The law of a scene's pair.
-
-        Parameters
-        ----------
-        kind : {"revolute", "cylindrical"}
-            The pair's kind.
-        pair : reference.scene.joint.Pair
-            Its ``moment_lever`` resolved to a number [m].
-        law : {"paper", "resultant"}
-            ``FrictionSettings.law``.
-
-        Returns
-        -------
-        PairLaw
-        """
+        """The law of a scene's ``pair`` of ``kind`` ``"revolute"``/``"cylindrical"`` under ``law``
+        ``"paper"``/``"resultant"``."""
         if law not in ("paper", "resultant"):
             raise ValueError(f"`law` must be 'paper' or 'resultant', got {law!r}")
         return cls(kind == "cylindrical", pair.friction_coefficient, pair.journal_diameter,
@@ -93,19 +47,9 @@ class PairLaw:
 
 
 class FrictionLoads(NamedTuple):
-    """Friction on body ``b`` of a pair (a NamedTuple: built once per pair after every Newton
-    solve, where a frozen dataclass costs a third of the law).
-
-    Attributes
-    ----------
-    torque : float
-        About the pair axis [N m].
-    force : float
-        Along the pair axis [N] (0 for a revolute pair).
-    sliding_scale : float
-        The largest load the pair would carry sliding, axial force counted as the torque it makes
-        at the journal radius [N m]: the scale of the coupling's convergence tests.
-    """
+    """Friction on body b of a pair: ``torque`` [N m] about and ``force`` [N] along the axis, and
+    ``sliding_scale`` [N m], the largest load it would carry sliding (the convergence tests' scale).
+    A NamedTuple: a frozen dataclass costs a third of the law."""
 
     torque: float
     force: float
@@ -113,20 +57,7 @@ class FrictionLoads(NamedTuple):
 
 
 def ramp_sign(speed: float, band: float) -> float:
-    """Sign of a speed, regularised by a linear ramp.
-
-    Parameters
-    ----------
-    speed : float
-        Relative surface or sliding speed [m/s].
-    band : float
-        Width of the ramp [m/s]; 0: the exact sign.
-
-    Returns
-    -------
-    float
-        In ``[-1, 1]`` [-].
-    """
+    """Sign of ``speed`` [m/s] regularised by a linear ramp of width ``band`` [m/s] (0: exact), in [-1, 1]."""
     if band <= 0.0:
         return float(speed > 0.0) - float(speed < 0.0)
     return max(-1.0, min(1.0, speed / band))
@@ -136,31 +67,9 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
                omega_rel: float, slide_rel: float, band: float,
                slide_band: float | None = None,
                resultant_band: float | None = None) -> FrictionLoads:
-    """Friction of one pair from its reaction and relative motion (eqs. (1)-(5)).
-
-    Parameters
-    ----------
-    law : PairLaw
-    force_x, force_y : float
-        Reaction force components normal to the pair axis, in any frame whose z is the axis [N].
-    moment_x, moment_y : float
-        Bending moment components in such a frame [N m].
-    omega_rel : float
-        Angular speed of body ``b`` relative to ``a`` about the axis [rad/s].
-    slide_rel : float
-        Sliding speed of ``b`` relative to ``a`` along the axis [m/s] (ignored for a revolute).
-    band : float
-        Width of the rotation's sign ramp, in relative surface speed [m/s] (0: the exact sign).
-    slide_band : float or None
-        Width of the sliding's sign ramp [m/s]; None: ``band``.
-    resultant_band : float or None
-        Resultant-slip law: width of the ramp of the slip speed ``hypot(omega_rel d / 2,
-        slide_rel)`` [m/s]; None: ``band``.
-
-    Returns
-    -------
-    FrictionLoads
-    """
+    """Friction of one pair (eqs. (1)-(5)) from reaction components normal to the axis ``force_x, y``
+    [N], ``moment_x, y`` [N m], relative ``omega_rel`` [rad/s] and ``slide_rel`` [m/s], and the ramp
+    widths [m/s] (``slide_band``, ``resultant_band`` default ``band``)."""
     return FrictionLoads(*magnitude_loads(law, math.hypot(force_x, force_y), math.hypot(moment_x, moment_y),
                                           omega_rel, slide_rel, band, slide_band, resultant_band))
 
@@ -168,23 +77,8 @@ def pair_loads(law: PairLaw, force_x: float, force_y: float, moment_x: float, mo
 def magnitude_loads(law: PairLaw, force_n: float, moment_n: float, omega_rel: float, slide_rel: float,
                     band: float, slide_band: float | None = None,
                     resultant_band: float | None = None) -> tuple[float, float, float]:
-    """:func:`pair_loads` from the reaction's magnitudes, as a plain tuple (the coupling's hot path).
-
-    Parameters
-    ----------
-    law : PairLaw
-    force_n : float
-        Magnitude of the reaction force normal to the axis [N].
-    moment_n : float
-        Magnitude of the bending moment [N m].
-    omega_rel, slide_rel, band, slide_band, resultant_band : float
-        As for :func:`pair_loads` [rad/s, m/s, m/s, m/s, m/s].
-
-    Returns
-    -------
-    torque, force, sliding_scale : float
-        The fields of :class:`FrictionLoads` [N m, N, N m]; ``force`` is 0 for a revolute pair.
-    """
+    """:func:`pair_loads` from the magnitudes ``force_n`` [N], ``moment_n`` [N m], as a plain tuple
+    ``(torque, force, sliding_scale)`` (the hot path)."""
     radius = 0.5 * law.d
     torque = law.f * law.d * moment_n / law.lever + law.f * radius * force_n
     magnitude = law.f * (force_n + 2.0 * moment_n / law.lever)
@@ -204,40 +98,16 @@ def magnitude_loads(law: PairLaw, force_n: float, moment_n: float, omega_rel: fl
 
 
 def bdf2_weights(h1: float, h2: float) -> tuple[float, float]:
-    """Weights of the second-order backward difference on a non-uniform grid.
-
-    With ``d1 = c_n - c_{n-1}`` over the last step ``h1`` and ``d2 = c_{n-1} - c_{n-2}`` over the
-    one before, ``h2``, the derivative at ``t_n`` is ``(w1 d1 - w2 d2) / h1`` (exact for
-    quadratics).
-
-    Parameters
-    ----------
-    h1, h2 : float or ndarray
-        The last step and the one before [s].
-
-    Returns
-    -------
-    w1, w2 : float or ndarray
-        The weights [-].
-    """
+    """Weights ``(w1, w2)`` of BDF2 on a non-uniform grid: ``dc/dt(t_n) = (w1 d1 - w2 d2) / h1`` with
+    ``d1``, ``d2`` the last two differences over steps ``h1``, ``h2`` [s] (exact for quadratics)."""
     w = h1 / h2
     return (1.0 + 2.0 * w) / (1.0 + w), w * w / (1.0 + w)
 
 
 class LawTable:
-    """The laws of a coupling's pairs, evaluated together on the law's inputs (the hot path).
-
-    Gives, to the last bit, what :func:`magnitude_loads` gives pair by pair (the same operations in
-    the same order), and in the same pass each pair's regime and the largest loads.
-
-    Parameters
-    ----------
-    laws : list of PairLaw
-    bands : list of (float, float, float)
-        Per pair the widths of the sign ramps: rotation, sliding, resultant [m/s].
-    slides : list of bool
-        Per pair whether its axial force acts (else it is 0, whatever the law gives).
-    """
+    """The ``laws`` of a coupling's pairs evaluated together (the hot path), bit-identical to
+    :func:`magnitude_loads` pair by pair. ``bands`` per pair: rotation, sliding, resultant ramp widths
+    [m/s]; ``slides`` per pair: whether its axial force acts."""
 
     def __init__(self, laws: list[PairLaw], bands: list[tuple[float, float, float]],
                  slides: list[bool]) -> None:
@@ -252,30 +122,10 @@ class LawTable:
 
     def loads(self, inputs: list, older: list | None = None, a: float = 1.0,
               b: float = 0.0) -> tuple[tuple[float, ...], tuple[int, ...], float, float]:
-        """The friction on the law's ``inputs`` or, with ``older``, on ``a x - b x_older``.
-
-        One loop with the law inlined on purpose: it runs after every Newton solve, where a call
-        per pair costs more than the law.
-
-        Parameters
-        ----------
-        inputs, older : list of (float, float, float, float)
-            Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])``.
-        a, b : float
-            Weights of the extrapolation through ``inputs`` and ``older`` [-].
-
-        Returns
-        -------
-        friction : tuple of float
-            Flat ``(M_z_0, F_z_0, M_z_1, ...)`` on body b of each pair [N m, N].
-        regime : tuple of int
-            Per pair the side of its two sign ramps the motion the law was evaluated on is on
-            (-1, 0 inside, +1), flat: ``(rotation_0, sliding_0, rotation_1, ...)``.
-        sliding : float
-            The largest ``sliding_scale`` of the pairs [N m].
-        size : float
-            The largest ``|M_z|`` or ``|F_z|`` [N m or N].
-        """
+        """``(friction, regime, sliding, size)`` on the ``inputs`` ``(|F|, |M|, omega_rel, slide_rel)`` per
+        pair, or on ``a x - b x_older``: flat ``(M_z, F_z)`` per pair on body b [N m, N], flat per-pair
+        ramp sides (-1, 0 inside, +1) of rotation and sliding, the largest ``sliding_scale`` [N m], the
+        largest load magnitude. One loop with the law inlined: a call per pair costs more than the law."""
         friction: list[float] = []
         regime: list[int] = []
         sliding = size = 0.0
