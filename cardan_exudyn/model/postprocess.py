@@ -1,15 +1,9 @@
 """The result schema's columns from an Exudyn run's recorded sensors.
 
-Reaction conventions (pinned by ``tests/test_reactions.py``)
-------------------------------------------------------------
-Exudyn 1.13.6 reports for ``ObjectJointGeneric`` in dynamic runs ``ForceLocal`` = minus the force
-that body ``a`` (marker 0) exerts on body ``b``, in the joint frame fixed to body ``a``; and
-``TorqueLocal`` with its in-plane components rotated by 90 degrees, the same sign flip, and
-its components in the joint frame attached to body ``b`` (marker 1): the moment of body ``a`` on
-body ``b`` in the pair frame of body ``b`` is ``(-TL_y, TL_x, -TL_z)``; it is rotated into the
-pair frame of body ``a`` with the pair's relative rotation (they differ by the free rotation about
-the pair axis, e.g. the whole shaft angle for ``frame_input``).
-The drive torque on the input shaft is minus the ``Force`` of the coordinate connector.
+Reaction conventions of ``ObjectJointGeneric`` (Exudyn 1.13.6, pinned by ``tests/test_reactions.py``):
+``ForceLocal`` is minus the force of body a on body b in a's joint frame; the moment of a on b in
+b's pair frame is ``(-TL_y, TL_x, -TL_z)`` of ``TorqueLocal``. The drive torque is minus the
+coordinate connector's ``Force``.
 """
 
 from __future__ import annotations
@@ -40,25 +34,8 @@ def first_non_finite(columns: dict[str, np.ndarray]) -> str | None:
 
 
 def stored(model: ExudynModel, key: str) -> np.ndarray:
-    """The stored data of one sensor.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The solved model.
-    key : str
-        Sensor name in ``model.sensors``.
-
-    Returns
-    -------
-    ndarray, shape (n, 1 + k)
-        Time [s] in column 0, then the sensor's ``k`` values (SI units).
-
-    Raises
-    ------
-    ValueError
-        When the sensor recorded nothing (e.g. a failure in the first step).
-    """
+    """The stored data of sensor ``key``, shape (n, 1 + k): time [s], then its values;
+    ``ValueError`` when it recorded nothing."""
     data = np.asarray(model.mbs.GetSensorStoredData(model.sensors[key]))
     if data.ndim != 2:  # nothing recorded, e.g. a failure in the first step
         raise ValueError(f"sensor `{key}` recorded no data")
@@ -66,13 +43,8 @@ def stored(model: ExudynModel, key: str) -> np.ndarray:
 
 
 def body_states(model: ExudynModel) -> dict[str, dict[str, np.ndarray]]:
-    """Per body: time, CoM position, velocity, rotation matrices (node axes) and angular velocity.
-
-    ``psi`` holds the node's total rotation coordinates (reference included): the Rxyz angles
-    for the input (every node type; the first is the continuous shaft angle, the recorded
-    coordinate plus the whole revolutions ``model.input_turns`` took out of it), else those of
-    ``model.rotations[name]``.
-    """
+    """Per body: time, CoM position, velocity, rotation matrices (node axes), angular velocity and
+    ``psi``, the node's total rotation coordinates (the input's first the continuous shaft angle)."""
     states = {}
     for name in model.nodes:
         q = stored(model, f"{name}_q")
@@ -103,28 +75,9 @@ Kinematics = dict[str, dict[str, np.ndarray]]
 
 def pair_kinematics(model: ExudynModel, states: dict, n: int,
                     positions: Kinematics | None = None) -> Kinematics:
-    """Pair axes, marker points and their velocities (global) for both bodies of each pair.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The solved model (marker points and pair frames).
-    states : dict
-        :func:`body_states`, per body.
-    n : int
-        Rows to use.
-    positions : dict, optional
-        A result of this function for the same positions (e.g. the one a velocity projection
-        started from, which keeps them): its position-level entries are taken over and only the
-        velocities computed.
-
-    Returns
-    -------
-    dict
-        Per pair: ``frame_a``, ``frame_b`` (n, 3, 3) pair frames, ``pa``, ``pb`` (n, 3) marker
-        points [m], ``va``, ``vb`` (n, 3) their velocities [m/s], ``omega_a``, ``omega_b`` (n, 3)
-        angular velocities [rad/s], and ``relative`` (n, 3, 3), ``frame_a^T frame_b``.
-    """
+    """Per pair, global, first ``n`` rows: ``frame_a``, ``frame_b`` (n, 3, 3), marker points ``pa``,
+    ``pb`` [m], their velocities ``va``, ``vb`` [m/s], ``omega_a``, ``omega_b`` [rad/s] and
+    ``relative = frame_a^T frame_b``; ``positions``: reuse its position-level entries."""
     out = {}
     for name in PAIR_NAMES:
         body_a, body_b = PAIR_BODIES[name]
@@ -166,27 +119,9 @@ def _marker_velocity(s: dict | None, p: np.ndarray, n: int) -> tuple[np.ndarray,
 
 
 def postprocess(model: ExudynModel, project: bool = False) -> dict[str, np.ndarray]:
-    """Columns of the result schema from the recorded sensors.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The solved model; its ``pair_kinematics`` (and, when projecting, its
-        ``velocity_correction``) are set.
-    project : bool
-        Replace the recorded velocities by their projection onto the velocity constraints
-        (:mod:`cardan_exudyn.model.projection`).
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        The result schema's columns (SI units).
-
-    Raises
-    ------
-    ValueError
-        When fewer than two steps are recorded.
-    """
+    """The result schema's columns (SI, shape (n,)) from the solved ``model``'s sensors, setting its
+    ``pair_kinematics``; ``project``: velocities projected onto the velocity constraints.
+    ``ValueError`` for fewer than two recorded steps."""
     states = body_states(model)
     n = min(len(s["t"]) for s in states.values())
     if n < 2:
@@ -255,11 +190,8 @@ def _pair_columns(model: ExudynModel, name: str, k: dict[str, np.ndarray], t: np
 
 def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
                       n: int) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Friction torque and force on body b of each pair at the recorded times.
-
-    Coupled runs: what the coupling applied. ``uncoupled``: the law evaluated on the frictionless
-    reactions, row by row (the scalar law of :mod:`cardan_exudyn.model.friction_law`).
-    """
+    """Friction torque and force on body b of each pair at the recorded times: what the coupling applied,
+    or (``uncoupled``) the law on the frictionless reactions row by row."""
     scene = model.scene
     if model.friction is not None:
         applied = model.friction.columns(cols["t"])
@@ -282,24 +214,8 @@ def _friction_columns(model: ExudynModel, cols: dict[str, np.ndarray],
 
 
 def projected_states(model: ExudynModel, states: dict, n: int, kin: dict | None = None) -> dict:
-    """``states`` with velocities projected onto the joint's velocity constraints.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        The solved model; the largest correction [m/s] is left in ``model.velocity_correction``.
-    states : dict
-        :func:`body_states`.
-    n : int
-        Rows to use.
-    kin : dict, optional
-        :func:`pair_kinematics` of ``states``, computed when not given.
-
-    Returns
-    -------
-    dict
-        Per body, as ``states`` (first ``n`` rows), velocities ``v`` and ``omega`` projected.
-    """
+    """The first ``n`` rows of ``states`` with ``v`` and ``omega`` projected onto the velocity
+    constraints; the largest correction [m/s] left in ``model.velocity_correction``."""
     drive = model.scene.drive
     if isinstance(drive, AngleDrive):
         spline = drive.spline()
@@ -327,32 +243,11 @@ def relative_angle(k: dict[str, np.ndarray]) -> np.ndarray:
 
 def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
                     cylindrical: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Relative angular and sliding speed of body b w.r.t. body a of a pair.
+    """``(omega_rel [rad/s], slide_rel [m/s])`` of body b w.r.t. a of one pair (``k``), at times ``t``.
 
-    Parameters
-    ----------
-    t : ndarray, shape (n,)
-        Times [s].
-    k : dict
-        One pair's entry of :func:`pair_kinematics`.
-    cylindrical : bool
-        Whether the pair can slide (else the sliding speed is zero).
-
-    Returns
-    -------
-    omega_rel : ndarray, shape (n,)
-        Relative angular speed about the pair axis [rad/s].
-    slide_rel : ndarray, shape (n,)
-        Relative sliding speed along the pair axis [m/s].
-
-    Notes
-    -----
-    Index-3 integration keeps positions on the constraint manifold to the Newton tolerance but
-    leaves O(h^2) residuals in the velocity constraints (sliding speeds of ~1e-3 m/s in pairs
-    that cannot slide). The relative speeds are therefore the second-order backward difference
-    (BDF2, BDF1 for the first step) of the pair's relative coordinates: the rotation angle of
-    b's pair frame about the axis and the axial offset of b's pair point. The initial row uses the
-    (consistent) initial velocities. The friction law uses the same definition in the step loop.
+    BDF2 (BDF1 for the first step) of the relative angle and axial offset, the initial row at
+    velocity level: index-3 integration leaves O(h^2) residuals in the velocity constraints (~1e-3
+    m/s of spurious slide). The friction law uses the same definition in the step loop.
     """
     axis = k["frame_a"][:, :, 2]
     angle = relative_angle(k)
@@ -379,22 +274,7 @@ def relative_speeds(t: np.ndarray, k: dict[str, np.ndarray],
 
 
 def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and gravitational potential energy of the three bodies.
-
-    Parameters
-    ----------
-    model : ExudynModel
-        Masses, inertias and the scene's gravity.
-    states : dict
-        :func:`body_states`.
-    n : int
-        Rows to use.
-
-    Returns
-    -------
-    kinetic, potential : ndarray, shape (n,)
-        Energies [J].
-    """
+    """Kinetic and gravitational potential energy [J] of the three bodies, first ``n`` rows."""
     kinetic = np.zeros(n)
     potential = np.zeros(n)
     g = np.asarray(model.scene.gravity)
@@ -409,12 +289,8 @@ def mechanical_energy(model: ExudynModel, states: dict, n: int) -> tuple[np.ndar
 
 
 def constraint_violation(pair_kinematics: dict[str, dict[str, np.ndarray]]) -> dict[str, float]:
-    """Largest violation of the pair constraints over the run.
-
-    Position [m]: distance of the two marker points (revolute) or of marker b from the axis of
-    marker a (cylindrical). Angle [rad]: misalignment of the two pair axes, and for the revolute
-    the twist is free so only the axis counts.
-    """
+    """Largest pair-constraint violation over the run: position [m] (marker points, or b from a's axis
+    for cylindrical pairs) and axis misalignment [rad]."""
     pos = 0.0
     ang = 0.0
     for name, k in pair_kinematics.items():

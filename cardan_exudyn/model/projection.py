@@ -1,29 +1,11 @@
-"""Velocity projection of recorded Exudyn states onto the joint's velocity constraints.
+"""Velocity projection of recorded Exudyn states onto the joint's velocity constraints (post-processing:
+nothing feeds back into the integration).
 
-Generalized-alpha with index-3 constraints keeps the *positions* on the constraint manifold to
-the Newton tolerance, but its velocities come from the Newmark update and miss the velocity
-constraints by ``O(h^2)``: that is the whole of Exudyn's error in ``omega_out / omega_in``
-(measured: docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not). Projecting the
-recorded velocities onto the velocity constraints at the recorded positions removes that part:
-
-- with a prescribed input (constant speed or angle history) the joint has no degree of freedom
-  left, the 17 pair constraints and the drive fix all 18 velocity components, and the projection
-  is the exact velocity *of the computed positions*: its error is then the position error, which
-  index-3 keeps at the Newton tolerance;
-- with a torque drive one degree of freedom remains and the projection is the closest
-  consistent velocity in the kinetic-energy metric (the usual velocity projection of index-3
-  integrators).
-
-It is post-processing: the projected velocities do not feed back into the integration, so the
-drive torque, the reactions and the friction keep the integrator's ``O(h^2)`` error.
-
-The constraint rows are the time derivatives of the pair constraints of
-``ObjectJointGeneric`` (relative displacement normal to the axis, or all of it for the revolute;
-relative rotation about the two axes normal to the pair axis), written here from the pair
-geometry: for a pair with body ``a`` (frame ``x_j`` columns, point ``p_a``) and body ``b``
-(point ``p_b``), ``x_j . (v_b(p_b) - v_a(p_b)) = 0`` (the velocity of ``p_b`` relative to body
-``a``; this includes the rotation of ``x_j`` when a cylindrical pair's points are apart along the
-axis) and ``(omega_b - omega_a) . x_j = 0`` for ``j = x, y``.
+Index-3 generalized-alpha keeps positions on the constraints but velocities miss them by
+``O(h^2)``, the whole of Exudyn's speed-ratio error (docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not).
+Per pair (a's frame columns ``x_j``, points ``p_a``, ``p_b``): ``x_j . (v_b(p_b) - v_a(p_b)) = 0``
+and ``(omega_b - omega_a) . x_j = 0`` for ``j = x, y``. A prescribed input fixes all 18 velocities;
+a torque drive gets the closest consistent velocity in the kinetic-energy metric.
 """
 
 from __future__ import annotations
@@ -40,19 +22,7 @@ BODIES = ("input", "spider", "output")
 
 
 def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` row by row: ``np.cross`` without its axis handling, which costs more than the
-    product on short runs.
-
-    Parameters
-    ----------
-    a, b : ndarray, shape (n, 3) or (3,)
-        Vectors (any unit); a ``(3,)`` vector broadcasts against the rows of the other.
-
-    Returns
-    -------
-    ndarray, shape (n, 3) or (3,)
-        The cross products (unit of ``a`` times unit of ``b``).
-    """
+    """``a x b`` row by row, shapes (n, 3) or (3,) broadcasting: ``np.cross`` without its axis handling."""
     a = np.asarray(a, float)
     b = np.asarray(b, float)
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -71,23 +41,9 @@ def _skew_rows(rho: np.ndarray, axis: np.ndarray) -> np.ndarray:
 
 def constraint_jacobian(states: dict[str, dict[str, np.ndarray]],
                         pairs: dict[str, dict[str, np.ndarray]]) -> np.ndarray:
-    """Velocity-constraint Jacobian of the four pairs at every recorded row.
-
-    Parameters
-    ----------
-    states : dict
-        Per body ``r``, shape (n, 3): centre-of-mass position [m].
-    pairs : dict
-        Per pair ``frame_a``, shape (n, 3, 3) (columns the pair axes of body a), and ``pa``,
-        ``pb``, shape (n, 3): marker points [m].
-
-    Returns
-    -------
-    ndarray, shape (n, 17, 18)
-        ``J``; the unknowns per body (in :data:`BODIES` order) are the centre-of-mass velocity
-        (3) then the angular velocity (3), global components. Rows are dimensionless (velocity
-        rows) or in m (the lever of an angular velocity in a velocity row).
-    """
+    """The (n, 17, 18) velocity-constraint Jacobian of the four pairs, from body CoMs ``states[b]["r"]``
+    [m] and pair ``frame_a``, ``pa``, ``pb``; unknowns per body in :data:`BODIES` order: CoM velocity,
+    then angular velocity (global)."""
     n = next(iter(pairs.values()))["pa"].shape[0]
     jac = np.zeros((n, 17, 18))
     row = 0
@@ -116,28 +72,9 @@ def project_velocities(states: dict[str, dict[str, np.ndarray]],
                        mass: dict[str, float], inertia_node: dict[str, np.ndarray],
                        input_axis: np.ndarray,
                        input_speed: Callable[[np.ndarray], np.ndarray] | None) -> dict:
-    """Replace ``v`` and ``omega`` of every body by their projection (see the module docstring).
-
-    Parameters
-    ----------
-    states : dict
-        Per body ``t, r, v, A, omega`` (n rows), as :func:`cardan_exudyn.model.postprocess.body_states`.
-    pairs : dict
-        Per pair the geometry of :func:`constraint_jacobian`.
-    mass, inertia_node : dict
-        Per body the mass [kg] and inertia about the centre of mass in node coordinates [kg m^2]
-        (the metric of a torque-driven projection).
-    input_axis : ndarray
-        Unit vector of the input shaft axis (global).
-    input_speed : callable or None
-        ``t -> omega_in`` of a prescribed input (the 18th row), None for a torque drive.
-
-    Returns
-    -------
-    dict
-        ``states`` with ``v`` and ``omega`` replaced (new arrays), and the largest velocity
-        correction ``|u - u_recorded|`` in ``"max_velocity_correction"`` (rad/s or m/s, mixed).
-    """
+    """``states`` with every body's ``v`` and ``omega`` projected, plus ``"max_velocity_correction"``.
+    ``mass`` [kg], ``inertia_node`` [kg m^2] the torque drive's metric; ``input_axis`` the input's unit
+    axis; ``input_speed(t)`` the prescribed input speed [rad/s] (None: torque drive)."""
     n = next(iter(pairs.values()))["pa"].shape[0]
     jac = constraint_jacobian(states, pairs)
     u_rec = np.concatenate([np.concatenate([states[b]["v"][:n], states[b]["omega"][:n]], axis=1)

@@ -1,12 +1,9 @@
-"""Rotation coordinates of Exudyn's rigid-body nodes, vectorised over time.
+"""Rotation coordinates of Exudyn's rigid-body nodes, vectorised over time, without Exudyn (checked
+against its node outputs by ``tests/test_node_types.py``).
 
-Exudyn's ``NodeRigidBodyRxyz`` uses ``A = Rx(psi0) Ry(psi1) Rz(psi2)`` (body to global) and
-angular velocity ``omega = G(psi) psi_t`` with ``G = [e_x, Rx e_y, Rx Ry e_z]`` (global
-components). ``NodeRigidBodyEP`` (Euler parameters) and ``NodeRigidBodyRotVecLG`` (rotation
-vector, local angular velocity as velocity coordinates) are below; ``ROTATION_COORDINATES`` maps
-each node type to its functions (``RotationCoordinates``). These helpers post-process node
-coordinates without calling Exudyn; ``tests/test_node_types.py`` checks them against Exudyn's
-node outputs.
+Rxyz: ``A = Rx(psi0) Ry(psi1) Rz(psi2)``, ``omega = G(psi) psi_t``, ``G = [e_x, Rx e_y, Rx Ry e_z]``
+(global). EP: Euler parameters ``(e0, e1, e2, e3)``. RotVecLG: ``A = exp(skew(nu))``, velocity
+coordinates the local angular velocity, ``omega = A p_t``.
 """
 
 from __future__ import annotations
@@ -43,20 +40,8 @@ def rxyz_matrix(psi: np.ndarray) -> np.ndarray:
 
 
 def rxyz_angular_velocity(psi: np.ndarray, psi_t: np.ndarray) -> np.ndarray:
-    """Global angular velocity ``G(psi) psi_t`` of Rxyz coordinates.
-
-    Parameters
-    ----------
-    psi : ndarray, shape (n, 3) or (3,)
-        Rxyz angles [rad].
-    psi_t : ndarray, shape (n, 3) or (3,)
-        Their rates [rad/s].
-
-    Returns
-    -------
-    ndarray, shape (n, 3)
-        Global angular velocity [rad/s].
-    """
+    """Global angular velocity ``G(psi) psi_t`` [rad/s], shape (n, 3), of Rxyz angles ``psi`` [rad] and
+    rates ``psi_t`` [rad/s]."""
     psi = np.atleast_2d(psi)
     psi_t = np.atleast_2d(psi_t)
     c0 = np.cos(psi[:, 0])
@@ -80,20 +65,7 @@ def rxyz_from_matrix(a: np.ndarray) -> np.ndarray:
 
 
 def rxyz_rates(psi: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Angle rates ``psi_t`` with ``G(psi) psi_t = omega``.
-
-    Parameters
-    ----------
-    psi : ndarray, shape (3,)
-        Rxyz angles [rad].
-    omega : ndarray, shape (3,)
-        Global angular velocity [rad/s].
-
-    Returns
-    -------
-    ndarray, shape (3,)
-        Angle rates [rad/s].
-    """
+    """Angle rates ``psi_t`` [rad/s] with ``G(psi) psi_t = omega`` (global [rad/s])."""
     c0 = np.cos(psi[0])
     c1 = np.cos(psi[1])
     s0 = np.sin(psi[0])
@@ -103,40 +75,13 @@ def rxyz_rates(psi: np.ndarray, omega: np.ndarray) -> np.ndarray:
 
 
 def rxyz_frame(psi: np.ndarray, psi_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrices and global angular velocities of Rxyz coordinates.
-
-    Parameters
-    ----------
-    psi : ndarray, shape (n, 3)
-        Rxyz angles [rad].
-    psi_t : ndarray, shape (n, 3)
-        Their rates [rad/s].
-
-    Returns
-    -------
-    a : ndarray, shape (n, 3, 3)
-        Rotation matrices, body to global.
-    omega : ndarray, shape (n, 3)
-        Global angular velocities [rad/s].
-    """
+    """Rotation matrices (n, 3, 3), body to global, and global angular velocities [rad/s] of Rxyz
+    angles ``psi`` [rad] and rates ``psi_t``."""
     return rxyz_matrix(psi), rxyz_angular_velocity(psi, psi_t)
 
 
 def rxyz_frame_one(psi, psi_t) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`rxyz_frame` of one state with scalar math (for the per-Newton-solve friction update).
-
-    Parameters
-    ----------
-    psi, psi_t : sequence of float, length 3
-        Rxyz angles [rad] and their rates [rad/s].
-
-    Returns
-    -------
-    a : ndarray, shape (3, 3)
-        Rotation matrix, body to global.
-    omega : ndarray, shape (3,)
-        Global angular velocity [rad/s].
-    """
+    """:func:`rxyz_frame` of one state with scalar math (the per-Newton-solve friction update)."""
     c0, c1, c2 = math.cos(psi[0]), math.cos(psi[1]), math.cos(psi[2])
     s0, s1, s2 = math.sin(psi[0]), math.sin(psi[1]), math.sin(psi[2])
     a = np.array([
@@ -156,22 +101,8 @@ def rxyz_frame_one(psi, psi_t) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ep_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrices and global angular velocities of Euler parameters.
-
-    Parameters
-    ----------
-    p : ndarray, shape (n, 4)
-        Euler parameters ``(e0, e1, e2, e3)``, ``e0`` the scalar part [-].
-    p_t : ndarray, shape (n, 4)
-        Their rates [1/s].
-
-    Returns
-    -------
-    a : ndarray, shape (n, 3, 3)
-        Rotation matrices, body to global.
-    omega : ndarray, shape (n, 3)
-        Global angular velocities [rad/s].
-    """
+    """Rotation matrices (n, 3, 3) and global angular velocities [rad/s] of Euler parameters ``p``
+    (n, 4) and rates ``p_t`` [1/s]."""
     p = np.atleast_2d(p)
     p_t = np.atleast_2d(p_t)
     e0, e1, e2, e3 = p.T
@@ -193,20 +124,7 @@ def ep_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ep_frame_one(p, p_t) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`ep_frame` of one state with scalar math.
-
-    Parameters
-    ----------
-    p, p_t : sequence of float, length 4
-        Euler parameters [-] and their rates [1/s].
-
-    Returns
-    -------
-    a : ndarray, shape (3, 3)
-        Rotation matrix, body to global.
-    omega : ndarray, shape (3,)
-        Global angular velocity [rad/s].
-    """
+    """:func:`ep_frame` of one state with scalar math."""
     e0, e1, e2, e3 = float(p[0]), float(p[1]), float(p[2]), float(p[3])
     d0, d1, d2, d3 = float(p_t[0]), float(p_t[1]), float(p_t[2]), float(p_t[3])
     a = np.array([
@@ -243,20 +161,7 @@ def ep_from_matrix(a: np.ndarray) -> np.ndarray:
 
 
 def ep_rates(p: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Rates ``p_t`` with ``G(p) p_t = omega`` and ``p . p_t = 0`` (unit p): ``G^T omega / 4``.
-
-    Parameters
-    ----------
-    p : ndarray, shape (4,)
-        Unit Euler parameters [-].
-    omega : ndarray, shape (3,)
-        Global angular velocity [rad/s].
-
-    Returns
-    -------
-    ndarray, shape (4,)
-        Euler parameter rates [1/s].
-    """
+    """Rates ``p_t`` [1/s] of unit ``p`` with ``G(p) p_t = omega`` and ``p . p_t = 0``: ``G^T omega / 4``."""
     e0, e1, e2, e3 = p
     g = 2.0 * np.array([[-e1, e0, -e3, e2], [-e2, e3, e0, -e1], [-e3, -e2, e1, e0]])
     return 0.25 * g.T @ np.asarray(omega, dtype=float)
@@ -276,22 +181,8 @@ def _rotvec_coefficients(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def rotvec_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotation matrices and global angular velocities of rotation vectors.
-
-    Parameters
-    ----------
-    p : ndarray, shape (n, 3)
-        Rotation vectors [rad].
-    p_t : ndarray, shape (n, 3)
-        Local angular velocities [rad/s] (the RotVecLG node's velocity coordinates).
-
-    Returns
-    -------
-    a : ndarray, shape (n, 3, 3)
-        Rotation matrices, body to global.
-    omega : ndarray, shape (n, 3)
-        Global angular velocities [rad/s].
-    """
+    """Rotation matrices (n, 3, 3) and global angular velocities [rad/s] of rotation vectors ``p``
+    [rad] and local angular velocities ``p_t`` [rad/s]."""
     p = np.atleast_2d(p)
     p_t = np.atleast_2d(p_t)
     x, y, z = p.T
@@ -310,20 +201,7 @@ def rotvec_frame(p: np.ndarray, p_t: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 
 def rotvec_frame_one(p, p_t) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`rotvec_frame` of one state with scalar math.
-
-    Parameters
-    ----------
-    p, p_t : sequence of float, length 3
-        Rotation vector [rad] and local angular velocity [rad/s].
-
-    Returns
-    -------
-    a : ndarray, shape (3, 3)
-        Rotation matrix, body to global.
-    omega : ndarray, shape (3,)
-        Global angular velocity [rad/s].
-    """
+    """:func:`rotvec_frame` of one state with scalar math."""
     x, y, z = float(p[0]), float(p[1]), float(p[2])
     phi = math.sqrt(x * x + y * y + z * z)
     if phi == 0.0:
@@ -351,34 +229,16 @@ def rotvec_from_matrix(a: np.ndarray) -> np.ndarray:
 
 
 def rotvec_rates(p: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """Rates of a RotVecLG node: the local angular velocity ``A(nu)^T omega``.
-
-    Parameters
-    ----------
-    p : ndarray, shape (3,)
-        Rotation vector ``nu`` [rad].
-    omega : ndarray, shape (3,)
-        Global angular velocity [rad/s].
-
-    Returns
-    -------
-    ndarray, shape (3,)
-        Local angular velocity [rad/s].
-    """
+    """Velocity coordinates of a RotVecLG node: the local angular velocity ``A(nu)^T omega`` [rad/s]."""
     a, _ = rotvec_frame_one(p, np.zeros(3))
     return a.T @ np.asarray(omega, dtype=float)
 
 
 @dataclass(frozen=True)
 class RotationCoordinates:
-    """How a rigid-body node type stores its rotation, and how to read it.
-
-    ``reference`` is the node's reference rotation coordinates (the identity rotation); the node
-    coordinates are relative to it. ``frame`` maps total rotation coordinates and their rates,
-    shapes (n, size), to rotation matrices (n, 3, 3) and global angular velocities (n, 3);
-    ``frame_one`` does the same for one state with scalar math; ``from_matrix`` and ``rates``
-    give the total coordinates of a rotation matrix and the rates of a global angular velocity.
-    """
+    """How a node type stores its rotation: ``reference`` coordinates (the identity), ``frame`` /
+    ``frame_one`` (coordinates, rates) -> (matrices, global angular velocities), ``from_matrix`` and
+    ``rates`` the inverse maps."""
 
     name: str
     node_class: str
@@ -399,21 +259,9 @@ TWO_PI = 2.0 * math.pi
 
 @dataclass
 class WholeTurns:
-    """Whole revolutions taken out of an unbounded angle coordinate, and when.
-
-    The input's first Rxyz angle is the input angle, unbounded; a post-step hook keeps the
-    coordinate within ``[-pi, pi]`` by :meth:`remove`, which records each change so that
-    :meth:`angle` gives back the continuous angle of every recorded state.
-
-    Attributes
-    ----------
-    start : int
-        Whole revolutions in the initial angle (the coordinate starts within ``[-pi, pi]``).
-    times : list of float
-        Times [s] of the states at which revolutions were removed.
-    counts : list of int
-        Whole revolutions removed in total at each of those times, ``start`` included.
-    """
+    """Whole revolutions taken out of the input's unbounded angle coordinate (kept within ``[-pi, pi]``
+    by :meth:`remove`): ``start`` in the initial angle, and the ``times`` [s] and total ``counts``
+    of each removal, so :meth:`angle` gives back the continuous angle."""
 
     start: int = 0
     times: list[float] = field(default_factory=list)
@@ -425,25 +273,12 @@ class WholeTurns:
         return self.counts[-1] if self.counts else self.start
 
     def reset(self) -> None:
-        """Forget the revolutions removed (the model is about to be solved again from its start)."""
+        """Forget the revolutions removed (the model is solved again from its start)."""
         self.times.clear()
         self.counts.clear()
 
     def remove(self, coordinate: float, t: float) -> float:
-        """``coordinate`` less its nearest whole revolutions, recording the change.
-
-        Parameters
-        ----------
-        coordinate : float
-            Angle coordinate [rad].
-        t : float
-            Time of the state [s].
-
-        Returns
-        -------
-        float
-            The coordinate within ``[-pi, pi]`` [rad].
-        """
+        """``coordinate`` [rad] less its nearest whole revolutions at time ``t`` [s], recording the change."""
         k = round(coordinate / TWO_PI)
         if k == 0:
             return coordinate
@@ -457,20 +292,7 @@ class WholeTurns:
         return counts[np.searchsorted(np.asarray(self.times, dtype=float), t, side="right")]
 
     def angle(self, t: np.ndarray, coordinate: np.ndarray) -> np.ndarray:
-        """The continuous angle of recorded states.
-
-        Parameters
-        ----------
-        t : ndarray, shape (n,)
-            Times of the states [s].
-        coordinate : ndarray, shape (n,)
-            Their angle coordinates [rad].
-
-        Returns
-        -------
-        ndarray, shape (n,)
-            Continuous angle [rad].
-        """
+        """The continuous angle [rad] of recorded states at times ``t`` [s] with angle ``coordinate`` [rad]."""
         return coordinate + TWO_PI * self.at(t)
 
 
