@@ -2,9 +2,10 @@
 nothing feeds back into the integration).
 
 Index-3 generalized-alpha keeps positions on the constraints but velocities miss them by
-``O(h^2)``, the whole of Exudyn's speed-ratio error (docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not).
-Per pair (a's frame columns ``x_j``, points ``p_a``, ``p_b``): ``x_j . (v_b(p_b) - v_a(p_b)) = 0``
-and ``(omega_b - omega_a) . x_j = 0`` for ``j = x, y``. A prescribed input fixes all 18 velocities;
+``O(h^2)``, the whole of Exudyn's speed-ratio error (measured:
+docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not). Per pair (a's frame columns
+``x_j``, points ``p_a``, ``p_b``): ``x_j . (v_b(p_b) - v_a(p_b)) = 0`` and
+``(omega_b - omega_a) . x_j = 0`` for ``j = x, y``. A prescribed input fixes all 18 velocities;
 a torque drive gets the closest consistent velocity in the kinetic-energy metric.
 """
 
