@@ -1,20 +1,9 @@
-"""The error of a finished run's mean values and time-table columns, as the pytest plugin's
-checks use it (:func:`error_estimate`), from what the run knows about itself.
+"""The error of a finished run's mean values and time-table columns, for the pytest plugin's checks.
 
-- Reference engine: its quadrature's error estimates of the input and lost work
-  (``summary.extras["quadrature"]``); works without an estimate of their own (output work,
-  per-pair losses) get the quadrature's acceptance bound, ``rtol`` times the input work, the
-  ratios (mean efficiency, work ratio) the propagated error. Its table rows are exact for a
-  prescribed input motion; a torque-driven scene adds the ODE's relative tolerance.
-- Exudyn (:data:`STEP_ORDERS`): step halving. The same scene and options run again at half the
-  step; the change of every mean value and column times ``2**p / (2**p - 1)``, ``p`` the order
-  of :func:`cardan_exudyn.model.stepsize.convergence_order`, estimates the error at the full step.
-  For the mean efficiency the larger of that and the run's own estimate
-  (``summary.efficiency_error_estimate``, :mod:`cardan_exudyn.model.accuracy`) is taken, and
-  every mean is scaled alike: where friction reverses, step halving at order 2 under-reads.
-- Other engines (MuJoCo): no estimate (None).
-
-Measured: docs/pytest.md#what-the-default-tolerance-means.
+Reference engine: its quadrature's estimates (plus the ODE ``rtol`` for a torque drive). Exudyn:
+step halving, ``2**p / (2**p - 1)`` times the change at half the step, ``p`` the convergence
+order; the mean efficiency at least the run's own estimate, every mean scaled alike. Others
+(MuJoCo): None. Measured: docs/pytest.md#what-the-default-tolerance-means.
 """
 
 from __future__ import annotations
@@ -65,13 +54,11 @@ class ErrorEstimate:
     method : str
         ``"quadrature"`` or ``"step halving"``.
     means : mapping
-        Mean-value name (:data:`ESTIMATED_MEANS`, ``loss_work_<pair>``) -> estimated error, in
-        the units of the value.
+        Mean-value name (:data:`ESTIMATED_MEANS`, ``loss_work_<pair>``) -> error, in its units.
     columns : mapping
-        Time-table column -> estimated largest error over the rows, in the units of the column
-        (empty when the run has no table).
+        Time-table column -> largest error over the rows, in its units (empty without a table).
     detail : str
-        How the estimate was made (steps, order, tolerances), for messages.
+        How the estimate was made, for messages.
     """
 
     engine: str
@@ -81,13 +68,12 @@ class ErrorEstimate:
     detail: str = ""
 
     def of(self, name: str) -> float | None:
-        """The estimated error of a mean value or column, None when there is none."""
+        """The estimated error of mean value or column ``name``, None when there is none."""
         return self.means.get(name, self.columns.get(name))
 
 
 def mean_values(summary: Summary) -> dict[str, float]:
-    """The summary's finite mean values by name: :data:`ESTIMATED_MEANS` and the per-pair losses
-    (``loss_work_<pair>``, ``loss_work_<pair>_sliding``) as :meth:`Summary.to_dict` names them."""
+    """The summary's finite mean values by name: :data:`ESTIMATED_MEANS` and ``loss_work_<pair>*``."""
     return {key: float(value) for key, value in summary.to_dict().items()
             if (key in ESTIMATED_MEANS or key.startswith("loss_work_")) and is_number(value)}
 
@@ -113,12 +99,10 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
     result : Result
         A run that ended ``ok``.
     run : callable, optional
-        ``run(scene, engine, options) -> Result`` for the half-step rerun of a fixed-step engine:
-        :func:`cardan_exudyn.engines.run` by default; a caching runner (the pytest plugin's
-        ``cardan_run``) makes repeated estimates free.
+        ``run(scene, engine, options) -> Result`` for a half-step rerun (default
+        :func:`cardan_exudyn.engines.run`; a caching runner makes repeated estimates free).
     skip_revolutions : float
-        Input revolutions [-] at the start left out of the columns' estimates (e.g. an
-        integrator's start-up transient); the means are over the scene's own window.
+        Input revolutions [-] at the start left out of the columns' estimates.
 
     Returns
     -------
@@ -158,20 +142,8 @@ def error_estimate(result: Result, run: Callable[..., Result] | None = None,
 
 def ratio_error(numerator: float, denominator: float, numerator_error: float,
                 denominator_error: float) -> float:
-    """First-order error of ``numerator / denominator`` (and of one minus it).
-
-    Parameters
-    ----------
-    numerator, denominator : float
-        The two values (same unit, e.g. J).
-    numerator_error, denominator_error : float
-        Their absolute errors (same unit).
-
-    Returns
-    -------
-    float
-        The ratio's absolute error [-].
-    """
+    """First-order absolute error [-] of ``numerator / denominator`` (and of one minus it) from their
+    absolute errors."""
     d = abs(denominator)
     return numerator_error / d + abs(numerator) * denominator_error / d ** 2
 
@@ -207,21 +179,7 @@ def quadrature_estimate(result: Result) -> ErrorEstimate:
 
 
 def half_step_scene(scene: Scene, dt: float, table: bool) -> Scene:
-    """A scene at half a run's step, its table rows at the run's.
-
-    Parameters
-    ----------
-    scene : Scene
-        The run's scene.
-    dt : float
-        The run's step [s].
-    table : bool
-        Whether a table is recorded (every second step, the rows at ``dt``).
-
-    Returns
-    -------
-    Scene
-    """
+    """``scene`` at half the step ``dt`` [s], its table (when ``table``) recorded at the rows of ``dt``."""
     every = 2 * scene.record.every if table else 1
     return replace(scene, **{"numerics.dt": 0.5 * dt, "record.every": every,
                              "record.timeseries": table})
@@ -229,32 +187,9 @@ def half_step_scene(scene: Scene, dt: float, table: bool) -> Scene:
 
 def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int,
                           run: Callable[..., Result], skip_revolutions: float = 0.0) -> ErrorEstimate:
-    """Estimate by a rerun at half the step: ``2**order / (2**order - 1)`` times the changes.
-
-    Parameters
-    ----------
-    result : Result
-        The run at the full step (``ok``).
-    scene : Scene
-        Its scene.
-    options : engine options
-        Its options (a companion run is switched off for the rerun).
-    order : int
-        Order of convergence in the step.
-    run : callable
-        ``run(scene, engine, options) -> Result`` for the rerun.
-    skip_revolutions : float
-        Input revolutions [-] left out of the columns' changes.
-
-    Returns
-    -------
-    ErrorEstimate
-
-    Raises
-    ------
-    AccuracyError
-        No step to halve, the rerun refused (too many steps) or failed.
-    """
+    """Estimate by a rerun at half the step through ``run``: ``2**order / (2**order - 1)`` times the
+    changes (columns after ``skip_revolutions``); :class:`AccuracyError` without a step or when the
+    rerun is refused or fails."""
     s = result.summary
     if not is_number(s.dt) or s.dt <= 0:
         raise AccuracyError(f"the {s.engine} run reports no time step to halve")
@@ -281,23 +216,8 @@ def step_halving_estimate(result: Result, scene: Scene, options: Any, order: int
 
 
 def row_changes(coarse: Any, fine: Any, dt: float, skip_revolutions: float = 0.0) -> dict[str, float]:
-    """Largest change of each column between two tables with the same rows.
-
-    Parameters
-    ----------
-    coarse, fine : pandas.DataFrame
-        The tables (result schema columns, ``t`` and ``theta_in`` among them).
-    dt : float
-        The coarse step [s]: the rows' times must agree to a millionth of it.
-    skip_revolutions : float
-        Input revolutions [-] left out at the start.
-
-    Returns
-    -------
-    dict of str to float
-        Per column (``t`` aside) the largest absolute change (column units); empty when the
-        times differ.
-    """
+    """Per column (``t`` aside) the largest absolute change between two tables with the same rows (times
+    agreeing to 1e-6 ``dt`` [s], else empty), after ``skip_revolutions``."""
     n = min(len(coarse), len(fine))
     t_coarse = coarse["t"].to_numpy(float)[:n]
     t_fine = fine["t"].to_numpy(float)[:n]

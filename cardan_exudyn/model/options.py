@@ -23,29 +23,22 @@ class ExudynOptions:
     spectral_radius : float
         Generalized-alpha spectral radius at infinity, in [0, 1); lower damps more.
     modified_newton : bool
-        Use modified Newton (Jacobian reused) instead of full Newton.
+        Modified Newton (Jacobian reused) instead of full Newton.
     jacobian_every_step : bool
-        With modified Newton: compute the Jacobian once at the start of every step (Exudyn's
-        ``modifiedNewtonJacUpdatePerStep``) instead of only when the iteration stalls.
+        With modified Newton: a Jacobian at the start of every step, not only when it stalls.
     newton_relative_tolerance, newton_absolute_tolerance : float
-        Tolerances of the Newton iteration (relative to the initial residual, and absolute).
+        Newton tolerances (relative to the initial residual, and absolute).
     node_type : str
-        Rigid-body node of the bodies: ``"Rxyz"`` (Tait-Bryan angles), ``"EP"`` (Euler
-        parameters) or ``"RotVecLG"`` (rotation vector, Lie-group integration); see
-        :func:`cardan_exudyn.model.build.build_model` for which body gets which.
+        Node of spider and output: ``"Rxyz"`` (Tait-Bryan), ``"EP"`` (Euler parameters) or
+        ``"RotVecLG"`` (rotation vector, Lie group; spectral radius <= 0.8).
     sensors : str
-        ``"auto"``: record the pair reactions only when something reads them afterwards (the time
-        table, or ``uncoupled`` friction); ``"all"``: always.
+        ``"auto"``: pair reactions recorded only when read afterwards; ``"all"``: always.
     velocity_projection : bool
-        Report velocities projected onto the velocity constraints at the computed positions
-        (post-processing, :mod:`cardan_exudyn.model.projection`): exact speed ratio for a prescribed
-        input; the drive torque, reactions and friction keep the integrator's error.
+        Velocities projected onto the velocity constraints (post-processing): exact speed ratio for
+        a prescribed input; torques, reactions and friction keep the integrator's error.
     error_estimate : bool
-        With friction, run the pilot and companion that choose the step and estimate the mean
-        efficiency's error (:func:`cardan_exudyn.model.accuracy.run`). False: one run at the given
-        ``numerics.dt``, or a pilot run and one run at the step it plans for ``numerics.accuracy``,
-        no estimate (for a caller that estimates the error itself, such as step halving, which
-        would otherwise repeat the run it halves).
+        With friction, the pilot and companion runs that choose the step and estimate the mean
+        efficiency's error; False: no companion and no estimate.
     """
 
     spectral_radius: float = 0.6
@@ -81,8 +74,7 @@ class ExudynOptions:
         return {name: getattr(self, name) for name in self.__dataclass_fields__}
 
     def records_reactions(self, scene: Scene) -> bool:
-        """Whether the run records the pair-reaction sensors (see ``sensors``): also for a
-        summary-only run whose friction is ``uncoupled`` (evaluated afterwards on the recorded
-        reactions, so they must be there)."""
+        """Whether a run of ``scene`` records the pair reactions: ``sensors="all"``, a time table, or
+        ``uncoupled`` friction (evaluated afterwards on them)."""
         uncoupled = scene.has_friction and scene.friction.coupling == "uncoupled"
         return self.sensors == "all" or scene.record.timeseries or uncoupled

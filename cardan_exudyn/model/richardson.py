@@ -1,37 +1,12 @@
-"""Richardson extrapolation of two Exudyn runs (``Numerics.richardson``, frictionless scenes).
+"""Richardson extrapolation of two Exudyn runs at ``h`` and ``h / 2`` (``Numerics.richardson``,
+frictionless scenes only: with friction the mean efficiency is first order where sign ramps are
+unresolved). Generalized-alpha gives ``x_h = x + c h^2 + O(h^3)``, so on the coarse rows
 
-Generalized-alpha is second order: a history ``x`` computed at the step ``h`` is
-``x_h = x + c h^2 + O(h^3)``. The run at ``h / 2`` lands on every time of the run at ``h`` (both
-split the same span into whole steps, ``N`` and ``2 N``), and on those rows
-``(4 x_{h/2} - x_h) / 3`` removes the ``c h^2`` term.
+    x ~ (4 x_{h/2} - x_h) / 3
 
-What is extrapolated, and what is taken from the fine run (:data:`EXTRAPOLATED`, :func:`combine`):
-
-- extrapolated: the drive torque, the pair reactions, the shaft speeds, the pairs' relative speeds
-  and the kinetic energy (velocity-level histories, smooth in time, whose error is the
-  integrator's ``O(h^2)``); the input and output powers are recomputed as the products of the
-  extrapolated torques and speeds, and the instantaneous efficiency from those;
-- from the fine run: time, angles and potential energy (positions: index-3 integration keeps them
-  on the constraint manifold to the Newton tolerance, so their error is not ``c h^2`` and the
-  combination would only amplify that noise by 5/3), the prescribed output load and the friction
-  columns (zero: the combination is refused with friction).
-
-The force-level histories (drive torque, reactions: the Lagrange multipliers) carry
-generalized-alpha's start-up oscillation, which alternates in sign from step to step and decays
-over about a revolution. Taking every other row of the fine run aliases it. Those columns
-(:data:`FILTERED`) are therefore smoothed on each run's own grid by the three-point filter
-``(x[i-1] + 2 x[i] + x[i+1]) / 4`` (first and last rows kept), which removes the alternating
-part and adds ``h^2 x'' / 4 + O(h^4)`` to a smooth history: a ``c h^2`` term of the same form in
-both runs, which the extrapolation removes with the integrator's own.
-
-With the velocity projection the speeds of both runs are already exact; their combination stays
-exact (they are not filtered). The relative speeds are backward differences of the relative
-coordinates (BDF2, BDF1 in the second row): their first rows keep a first-order error, like every
-start-up row. Measured: docs/bench.md#velocity-projection-what-it-is-and-what-it-is-not.
-
-Friction: the mean efficiency is first order where the pairs' sign ramps are not resolved by the
-step, so an extrapolation at order 2 can make it worse; :func:`refusal` refuses the combination
-for a scene with friction.
+for the velocity-level histories (:data:`EXTRAPOLATED`); positions come from the fine run (index 3
+keeps them at the Newton tolerance, not ``c h^2``). Force-level histories carry an alternating
+start-up oscillation and are smoothed first by ``(x[i-1] + 2 x[i] + x[i+1]) / 4`` on each grid.
 """
 
 from __future__ import annotations
@@ -69,9 +44,8 @@ FILTERED = ("torque_in", *(f"{p}_{s}" for p in PAIR_NAMES for s in ("fx", "fy", 
 
 
 def smooth(x: np.ndarray) -> np.ndarray:
-    """``(x[i-1] + 2 x[i] + x[i+1]) / 4`` on the inner rows (the ends kept): removes a history's
-    component that alternates in sign from row to row, adds ``h^2 x'' / 4 + O(h^4)`` to a smooth
-    one (``h`` the row spacing)."""
+    """``(x[i-1] + 2 x[i] + x[i+1]) / 4`` on the inner rows (ends kept): removes a row-to-row alternating
+    component, adds ``h^2 x'' / 4 + O(h^4)`` to a smooth history."""
     x = np.asarray(x, float)
     out = x.copy()
     if len(x) > 2:
@@ -80,22 +54,8 @@ def smooth(x: np.ndarray) -> np.ndarray:
 
 
 def extrapolate(fine: np.ndarray, coarse: np.ndarray, ratio: float = 2.0, order: int = 2) -> np.ndarray:
-    """``x_fine + (x_fine - x_coarse) / (ratio^order - 1)``: exact for an error ``c h^order``.
-
-    Parameters
-    ----------
-    fine, coarse : ndarray, shape (n,)
-        A history of the fine and the coarse run on the same rows (any unit).
-    ratio : float
-        Step ratio coarse / fine [-].
-    order : int
-        Order of the error in the step.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The extrapolated history (the unit of ``fine``).
-    """
+    """``x_fine + (x_fine - x_coarse) / (ratio^order - 1)`` on the same rows, ``ratio`` the step ratio
+    coarse / fine: exact for an error ``c h^order``."""
     factor = 1.0 / (ratio ** order - 1.0)
     fine = np.asarray(fine, float)
     coarse = np.asarray(coarse, float)
@@ -104,28 +64,10 @@ def extrapolate(fine: np.ndarray, coarse: np.ndarray, ratio: float = 2.0, order:
 
 def combine(coarse: Mapping[str, np.ndarray], fine: Mapping[str, np.ndarray],
             rtol: float = 1e-9) -> dict[str, np.ndarray]:
-    """The extrapolated columns on the coarse run's rows (see the module docstring).
-
-    Parameters
-    ----------
-    coarse, fine : mapping
-        Column dicts (the result schema's columns, at least ``t``, the angles, speeds, torques and
-        ``energy_*``) of the runs at ``h`` (``N + 1`` rows) and ``h / 2`` (``2 N + 1`` rows).
-    rtol : float
-        Tolerance on the time grids, relative to the coarse step.
-
-    Returns
-    -------
-    dict
-        Every column of ``coarse``: :data:`EXTRAPOLATED` combined (:data:`FILTERED` smoothed
-        first), ``power_in``, ``power_out``
-        and ``efficiency`` recomputed, the rest from the fine run's even rows.
-
-    Raises
-    ------
-    ValueError
-        When the fine run's even rows are not at the coarse run's times.
-    """
+    """Every column of ``coarse`` (``N + 1`` rows at ``h``) combined with ``fine`` (``2 N + 1`` at
+    ``h / 2``): :data:`EXTRAPOLATED` extrapolated (:data:`FILTERED` smoothed first), powers and
+    efficiency recomputed, the rest from the fine run's even rows. ``ValueError`` when the grids
+    differ by more than ``rtol`` of the coarse step."""
     t_c = np.asarray(coarse["t"], float)
     t_f = np.asarray(fine["t"], float)
     n = len(t_c)
@@ -164,26 +106,8 @@ Columns = dict[str, np.ndarray]
 
 def run_pair(scene: Scene, run: Callable[[Scene], tuple[Summary, Columns | None]]
              ) -> tuple[Summary, Summary | None, Columns | None]:
-    """The two runs: ``scene`` at its step ``h`` (the given ``numerics.dt`` or the engine's
-    choice, read back from the coarse run's ``summary.dt``) and at ``h / 2``.
-
-    Parameters
-    ----------
-    scene : Scene
-    run : callable
-        ``run(scene) -> (summary, columns)``, columns on the model's clock, before any table.
-
-    Returns
-    -------
-    coarse_summary, fine_summary, columns
-        The fine summary is None when the coarse run has no columns; the combined columns
-        (:func:`combine`) None when either run has none (the summaries say why).
-
-    Raises
-    ------
-    ValueError
-        The time grids do not match (:func:`combine`).
-    """
+    """``(coarse summary, fine summary, combined columns)`` of ``run(scene) -> (summary, columns)`` at
+    the scene's step ``h`` and at ``h / 2``; the fine summary or columns None when a run has none."""
     coarse_summary, coarse = run(scene)
     if coarse is None or not coarse_summary.dt:
         return coarse_summary, None, None
@@ -194,27 +118,9 @@ def run_pair(scene: Scene, run: Callable[[Scene], tuple[Summary, Columns | None]
 
 
 def run_combined(scene: Scene, options: ExudynOptions) -> Result:
-    """``scene`` at its step and at half of it, combined (:func:`run_pair`).
-
-    Parameters
-    ----------
-    scene : Scene
-        Frictionless.
-    options : ExudynOptions
-
-    Returns
-    -------
-    Result
-        The fine run's summary with the combined table's means, the coarse run's step and grid,
-        both runs' counters and wall time; ``extras["richardson"]`` says what was combined. The
-        fine run solves the coarse run's model again where it can
-        (:func:`cardan_exudyn.model.solve.reusable`).
-
-    Raises
-    ------
-    SceneError
-        The scene has friction (:func:`refusal`).
-    """
+    """Frictionless ``scene`` at its step and at half of it, combined: the fine run's summary with the
+    combined table's means, the coarse step and grid, both runs' counters
+    (``extras["richardson"]``); ``SceneError`` with friction."""
     why = refusal(scene)
     if why is not None:
         raise SceneError(why)
@@ -239,8 +145,8 @@ def run_combined(scene: Scene, options: ExudynOptions) -> Result:
 
 
 def _combined_summary(coarse: Summary, fine: Summary, columns: Columns | None, scene: Scene) -> None:
-    """Turn the fine run's summary into the combination's: what was combined, the coarse step,
-    both runs' counters, and the means of the combined ``columns``."""
+    """Turn the fine run's summary into the combination's: what was combined, the coarse step, both
+    runs' counters, and the means of the combined ``columns``."""
     fine.extras["richardson"] = {
         "coarse_dt": coarse.dt, "fine_dt": fine.dt, "coarse_wall_time_s": coarse.wall_time_s,
         "fine_wall_time_s": fine.wall_time_s, "extrapolated": list(EXTRAPOLATED),

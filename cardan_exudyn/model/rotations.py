@@ -292,7 +292,7 @@ class WholeTurns:
         return counts[np.searchsorted(np.asarray(self.times, dtype=float), t, side="right")]
 
     def angle(self, t: np.ndarray, coordinate: np.ndarray) -> np.ndarray:
-        """The continuous angle [rad] of recorded states at times ``t`` [s], coordinates ``coordinate`` [rad]."""
+        """The continuous angle [rad] of recorded states at times ``t`` [s], coordinates ``coordinate``."""
         return coordinate + TWO_PI * self.at(t)
 
 
