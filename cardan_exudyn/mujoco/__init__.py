@@ -1,12 +1,5 @@
-"""MuJoCo, an optional engine for frictionless scenes: run it through
-:func:`cardan_exudyn.engines.run` with engine ``"mujoco"``.
-
-Inside: :mod:`~cardan_exudyn.mujoco.options` (settings, no MuJoCo import),
-:mod:`~cardan_exudyn.mujoco.timestep` (error model, automatic step), :mod:`~cardan_exudyn.mujoco.mjcf`
-(the model), :mod:`~cardan_exudyn.mujoco.drive` (drive plan, initial state),
-:mod:`~cardan_exudyn.mujoco.simulate` (the time loop), :mod:`~cardan_exudyn.mujoco.table` (result
-columns), :mod:`~cardan_exudyn.mujoco.engine` (``run``).
-"""
+"""MuJoCo, an optional engine for frictionless scenes: run it through :func:`cardan_exudyn.run` with
+engine ``"mujoco"``."""
 
 from __future__ import annotations
 

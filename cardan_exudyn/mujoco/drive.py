@@ -16,28 +16,9 @@ __all__ = ["DrivePlan", "drive_plan", "joint_state"]
 
 
 def joint_state(scene: Scene, theta: float, theta_t: float) -> tuple[np.ndarray, np.ndarray]:
-    """Assembled angles and rates of the input, spider and output hinges.
-
-    From the closed-form kinematics: the spider angle about the input yoke, and the output
-    hinge angle ``phi`` defined by ``R_output = R_spider Rz(beta) Rz(phi)``; the rates are the
-    relative angular velocities projected on the hinge axes.
-
-    Parameters
-    ----------
-    scene : Scene
-        The shaft angle is read.
-    theta : float
-        Input angle [rad].
-    theta_t : float
-        Input speed [rad/s].
-
-    Returns
-    -------
-    q : ndarray, shape (3,)
-        Hinge angles (input, spider, output) [rad].
-    qd : ndarray, shape (3,)
-        Hinge rates [rad/s].
-    """
+    """``(q, qd)``: assembled hinge angles [rad] and rates [rad/s] (input, spider, output) at input angle
+    ``theta`` [rad] and speed ``theta_t`` [rad/s]; the output hinge angle ``phi`` from
+    ``R_output = R_spider Rz(beta) Rz(phi)``."""
     beta = scene.joint.geometry.shaft_angle
     m = body_motions(np.array(theta), np.array(theta_t), np.array(0.0), beta)
     r_input, r_spider, r_output = (m[b].rotation for b in ("input", "spider", "output"))
@@ -52,20 +33,9 @@ def joint_state(scene: Scene, theta: float, theta_t: float) -> tuple[np.ndarray,
 
 @dataclass(frozen=True)
 class DrivePlan:
-    """How the input is driven.
-
-    Attributes
-    ----------
-    start, span : float
-        Start time and longest simulated time [s].
-    motion : callable or None
-        ``t -> (angle [rad], speed [rad/s], acceleration [rad/s^2])`` of a prescribed input;
-        None for the torque drive.
-    theta0, omega0 : float
-        Input angle [rad] and speed [rad/s] at ``start``.
-    turn : float
-        Input rotation [rad] after which the run stops (the scene's revolutions).
-    """
+    """How the input is driven: ``start`` and longest ``span`` [s]; ``motion(t) -> (angle [rad], speed
+    [rad/s], acceleration [rad/s^2])`` of a prescribed input (None: torque drive); ``theta0`` [rad],
+    ``omega0`` [rad/s] at the start; the ``turn`` [rad] after which the run stops."""
 
     start: float
     span: float
@@ -76,13 +46,7 @@ class DrivePlan:
 
 
 def drive_plan(scene: Scene) -> DrivePlan:
-    """The :class:`DrivePlan` of the scene's drive (speed, angle history or torque).
-
-    Raises
-    ------
-    NotImplementedError
-        A drive of another kind.
-    """
+    """The :class:`DrivePlan` of the scene's drive; ``NotImplementedError`` for an unknown kind."""
     drive = scene.drive
     turn = 2.0 * math.pi * scene.revolutions
     if isinstance(drive, SpeedDrive):

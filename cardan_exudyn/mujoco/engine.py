@@ -1,22 +1,6 @@
-"""The MuJoCo engine (optional: ``pip install mujoco``) for the frictionless Cardan joint.
-
-MuJoCo's friction loss is a constant-magnitude joint friction; it cannot express the paper's
-friction forces proportional to the pair reactions (eqs. (1)-(5)), so this engine refuses scenes
-with friction. Importing this module needs MuJoCo; :mod:`cardan_exudyn.engines` imports it on
-first use, so a missing MuJoCo makes only this engine unavailable.
-
-The engine in four steps: the time step (:mod:`~cardan_exudyn.mujoco.timestep`), the MJCF model
-(:mod:`~cardan_exudyn.mujoco.mjcf`), the time loop (:mod:`~cardan_exudyn.mujoco.simulate`) and
-the result columns (:mod:`~cardan_exudyn.mujoco.table`). Defaults: the settings study of
-``docs/mujoco.md`` (``python tests/benchmarks mujoco-settings``).
-
-References
-----------
-Cavacece, Stefanelli, Valentini, Vita, "A multibody dynamic model of a Cardan joint with
-experimental validation": Section 3 (RCCC model, pair frames) and eq. (18).
-MuJoCo documentation, "Computation" (soft constraints: impedance ``d``, reference acceleration
-``a_ref = -b J v - k r``) and "Modeling / Solver parameters" (``solref``, ``solimp``).
-"""
+"""The MuJoCo engine (optional: ``pip install mujoco``) for the frictionless Cardan joint: MuJoCo's
+constant joint friction cannot express friction proportional to the reactions (eqs. (1)-(5)).
+Defaults: ``docs/mujoco.md``."""
 
 from __future__ import annotations
 
@@ -70,29 +54,26 @@ def _check_closure(summary: Summary) -> None:
 
 
 def run(scene: Scene, options: MujocoOptions | None = None) -> Result:
-    """Simulate the frictionless ``scene`` with MuJoCo and return its time table and summary.
+    """Simulate the frictionless ``scene`` with MuJoCo.
 
     Parameters
     ----------
     scene : Scene
-        A scene with every friction coefficient zero.
+        Every friction coefficient zero, a constant load.
     options : MujocoOptions, optional
-        Solver settings; the defaults are the recommended ones (``docs/mujoco.md``).
+        Defaults: the recommended ones (``docs/mujoco.md``).
 
     Returns
     -------
     Result
-        The columns of :func:`reference.results.columns.table_columns` (pair forces and frame-pair
-        reactions NaN, see :mod:`~cardan_exudyn.mujoco.table`) and the summary with the mean
-        values.
+        The table (pair forces and frame-pair reactions NaN) and the summary with the means.
 
     Raises
     ------
     NotImplementedError
-        For scenes with friction (MuJoCo has no friction proportional to the reactions), with
-        ``numerics.richardson``, or with a load history.    SceneError
-        ``numerics.accuracy`` needs more steps than allowed
-        (:func:`~cardan_exudyn.mujoco.timestep.choose_timestep`).
+        A scene with friction, ``numerics.richardson`` or a load history.
+    SceneError
+        ``numerics.accuracy`` needs more steps than allowed.
     """
     _refuse(scene)
     options = options or MujocoOptions()

@@ -1,11 +1,6 @@
-"""The MJCF model of a frictionless Cardan joint for the MuJoCo engine.
-
-Three hinges through the joint centre O (input about global x, spider about the input yoke,
-output about the output yoke); one ``connect`` at the output bearing closes the loop. A
-prescribed input (speed or angle history) follows a heavy ``drive_reference`` hinge through a
-joint equality whose constraint force is the drive torque. Body frames are the canonical frames
-of :mod:`reference.scene.joint`. Why each choice: ``docs/mujoco.md#the-model``.
-"""
+"""The MJCF model of a frictionless Cardan joint: three hinges through the centre O, one ``connect``
+at the output bearing closing the loop; a prescribed input follows a heavy ``drive_reference``
+hinge through a joint equality whose force is the drive torque. Why: ``docs/mujoco.md#the-model``."""
 
 from __future__ import annotations
 
@@ -29,8 +24,8 @@ def _numbers(values: Iterable[float]) -> str:
 
 
 def _inertial(scene: Scene, name: str) -> str:
-    """The ``<inertial>`` of body ``name``: mass [kg], centre of mass [m] and the full inertia
-    about it [kg m^2], in the body's canonical frame."""
+    """The ``<inertial>`` of body ``name``: mass [kg], centre of mass [m], full inertia about it
+    [kg m^2], in its canonical frame."""
     mass, com, j = getattr(scene.joint, name).canonical()
     full = [j[0, 0], j[1, 1], j[2, 2], j[0, 1], j[0, 2], j[1, 2]]
     return f'<inertial pos="{_numbers(com)}" mass="{mass!r}" fullinertia="{_numbers(full)}"/>'
@@ -51,8 +46,8 @@ def _option(scene: Scene, options: MujocoOptions, dt: float) -> str:
 
 
 def _joint_bodies(scene: Scene) -> str:
-    """The ``input`` -> ``spider`` -> ``output`` chain of bodies with their hinges; the output
-    frame is turned by the shaft angle about z, and carries the ``bearing_output`` site."""
+    """The ``input`` -> ``spider`` -> ``output`` bodies with their hinges; the output frame turned by the
+    shaft angle about z, carrying the ``bearing_output`` site."""
     geo = scene.joint.geometry
     half = 0.5 * geo.shaft_angle
     return f"""<body name="input">
@@ -71,8 +66,7 @@ def _joint_bodies(scene: Scene) -> str:
 
 
 def _drive(scene: Scene, options: MujocoOptions, solref: str) -> tuple[str, str]:
-    """The drive-reference body and the equality that couples the input to it; empty for a
-    torque drive, which acts on the input directly."""
+    """The drive-reference body and the equality coupling the input to it; empty for a torque drive."""
     if isinstance(scene.drive, TorqueDrive):
         return "", ""
     i_ref = options.reference_inertia
@@ -84,22 +78,7 @@ def _drive(scene: Scene, options: MujocoOptions, solref: str) -> tuple[str, str]
 
 
 def mjcf(scene: Scene, options: MujocoOptions, dt: float) -> str:
-    """The MJCF model of ``scene`` (see the module docstring).
-
-    Parameters
-    ----------
-    scene : Scene
-        Joint bodies, geometry, gravity and the kind of drive are read.
-    options : MujocoOptions
-        Integrator, solver, ``solref``/``solimp`` of every equality, the contact override.
-    dt : float
-        Time step [s].
-
-    Returns
-    -------
-    str
-        The MJCF XML, for ``mujoco.MjModel.from_xml_string``.
-    """
+    """The MJCF XML of ``scene`` at step ``dt`` [s] with ``options``, for ``mujoco.MjModel.from_xml_string``."""
     geo = scene.joint.geometry
     solref = f'solref="{_numbers(options.solref_for(dt))}" solimp="{_numbers(options.solimp)}"'
     reference_body, drive = _drive(scene, options, solref)

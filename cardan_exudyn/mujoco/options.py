@@ -1,8 +1,5 @@
-"""The MuJoCo engine's solver settings (:class:`MujocoOptions`), validated on construction.
-
-Importing this module does not import MuJoCo: options can be made and checked where MuJoCo is
-not installed. The defaults and the study behind them: ``docs/mujoco.md``.
-"""
+"""The MuJoCo engine's solver settings (:class:`MujocoOptions`), validated on construction; importing
+it needs no MuJoCo. Defaults and their study: ``docs/mujoco.md``."""
 
 from __future__ import annotations
 
@@ -32,7 +29,7 @@ def _floats(name: str, value: Any) -> tuple[float, ...]:
 
 
 def _solref(name: str, value: Any) -> tuple[float, ...]:
-    """``value`` as a ``solref``: ``(timeconst > 0, dampratio > 0)`` or the direct form
+    """``value`` as a ``solref``: ``(timeconst > 0, dampratio > 0)`` or
     ``(-stiffness < 0, -damping <= 0)``."""
     ref = _floats(name, value)
     if len(ref) != 2 or not (min(ref) > 0.0 or (ref[0] < 0.0 and ref[1] <= 0.0)):
@@ -56,41 +53,29 @@ class MujocoOptions:
     Attributes
     ----------
     integrator : str
-        One of :data:`INTEGRATORS` (MuJoCo's ``option/integrator``).
+        One of :data:`INTEGRATORS`.
     timestep : float or None
-        Time step [s]; None takes ``scene.numerics.dt`` or, if that is None too, the step that
-        meets ``scene.numerics.accuracy``
-        (:func:`cardan_exudyn.mujoco.timestep.choose_timestep`).
+        Time step [s]; None: ``scene.numerics.dt``, else the step meeting ``numerics.accuracy``.
     timeconst_steps : float
-        Constraint time constant in time steps: ``solref = (timeconst_steps * dt, dampratio)``
-        when ``solref`` is None [-].
+        Constraint time constant in steps: ``solref = (timeconst_steps * dt, dampratio)`` [-].
     dampratio : float
-        Damping ratio of the constraint stabilisation when ``solref`` is None [-].
+        Damping ratio of the constraint stabilisation, when ``solref`` is None [-].
     solref : tuple of 2 float or None
-        Explicit ``solref`` of every equality: ``(timeconst [s], dampratio [-])`` or the direct
-        form ``(-stiffness [1/s^2], -damping [1/s])``.
+        Explicit ``solref`` of every equality: ``(timeconst [s], dampratio)`` or
+        ``(-stiffness [1/s^2], -damping [1/s])``.
     solimp : tuple of 5 float
-        ``solimp`` of every equality: ``(d0, dwidth, width [m or rad], midpoint, power)``.
+        ``(d0, dwidth, width [m or rad], midpoint, power)`` of every equality.
     refsafe : bool
-        MuJoCo's ``refsafe`` flag: the time constant is raised to at least ``2 dt``.
-    iterations : int
-        Maximum constraint-solver iterations [-].
-    tolerance : float
-        Constraint-solver tolerance [-].
+        MuJoCo's ``refsafe``: time constant at least ``2 dt``.
+    iterations, tolerance : int, float
+        Constraint-solver iterations and tolerance [-].
     noslip_iterations : int
-        Noslip post-processing iterations [-] (acts on friction rows only; there are none).
+        Noslip iterations (friction rows only; there are none).
     o_solref, o_solimp : tuple or None
-        When either is given, MuJoCo's contact override is enabled with these ``o_solref`` /
-        ``o_solimp`` (MuJoCo's defaults for the one not given). The override acts on contacts
-        only, and there are none: the study shows that it leaves the equalities alone.
+        Either given: MuJoCo's contact override on, with these (contacts only; there are none).
     reference_inertia : float
-        Inertia of the drive-reference body about its axis [kg m^2]: the drive torque changes its
-        speed by ``torque * dt / reference_inertia`` within a step before it is reset.
-
-    Raises
-    ------
-    OptionsError
-        A value out of its range, naming the field and showing what arrived.
+        Inertia of the drive-reference body [kg m^2]: the drive torque changes its speed by
+        ``torque * dt / reference_inertia`` within a step.
     """
 
     integrator: str = "RK4"

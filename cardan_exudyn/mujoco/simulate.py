@@ -1,8 +1,5 @@
-"""The MuJoCo engine's time loop: build the model, step it, and record every step.
-
-Every step runs ``mj_forward`` and ``mj_rnePostConstraint`` at the current state, records, and
-integrates, so that every record (state, drive torque, reactions) belongs to one instant.
-"""
+"""The MuJoCo engine's time loop. Each step runs ``mj_forward`` and ``mj_rnePostConstraint``, records,
+then integrates, so every record (state, drive torque, reactions) belongs to one instant."""
 
 from __future__ import annotations
 
@@ -24,38 +21,16 @@ RECORD_SHAPES = {"t": (), "q": (3,), "qd": (3,), "reference": (), "xmat": (3, 3,
                  "centre": (3,), "sites": (2, 3), "cfrc_int": (3, 6), "torque_in": ()}
 """Per-step shape of each field of :class:`Record`."""
 LAG_ALLOWANCE = 0.01
-"""Extra steps, as a fraction of the span's, for a prescribed input to reach the scene's
-revolutions: it lags its reference, by a fraction of a step with the recommended settings, by
-more with soft constraints. Measured: docs/mujoco.md#a-what-mujocos-defaults-give."""
+"""Extra steps, as a fraction of the span's, for a prescribed input (it lags its reference) to reach
+the scene's revolutions. Measured: docs/mujoco.md#a-what-mujocos-defaults-give."""
 
 
 class Record:
-    """Per-step copies of the mjData fields the result table is computed from, one row per step
-    (shapes: :data:`RECORD_SHAPES`; bodies in the order input, spider, output).
-
-    Attributes
-    ----------
-    t : ndarray
-        Time [s].
-    q, qd : ndarray
-        Input, spider and output hinge angles [rad] and rates [rad/s].
-    reference : ndarray
-        Angle of the drive reference [rad]; NaN for a torque drive.
-    xmat : ndarray
-        Rotation matrix of each body (columns: its canonical axes in the world).
-    cvel : ndarray
-        MuJoCo's com-based velocity of each body, ``[omega [rad/s], v(centre) [m/s]]``.
-    centre : ndarray
-        The point ``cvel`` and ``cfrc_int`` refer to: the centre of mass of the input's subtree [m].
-    sites : ndarray
-        The ``bearing_ground`` and ``bearing_output`` sites [m].
-    cfrc_int : ndarray
-        Wrench on each body from its parent, ``[moment [N m] about centre, force [N]]``.
-    torque_in : ndarray
-        Drive torque on the input [N m].
-    size : int
-        Rows recorded.
-    """
+    """Per-step copies of the mjData fields the table is computed from (shapes :data:`RECORD_SHAPES`,
+    bodies input, spider, output): ``t`` [s]; hinge ``q`` [rad], ``qd`` [rad/s]; drive ``reference``
+    angle [rad] (NaN: torque drive); body ``xmat``; ``cvel`` ``[omega, v(centre)]`` and ``cfrc_int``
+    ``[moment about centre, force]`` from the parent, ``centre`` the input subtree's CoM [m]; bearing
+    ``sites`` [m]; ``torque_in`` [N m]; ``size`` rows recorded."""
 
     def __init__(self, n: int) -> None:
         for name, shape in RECORD_SHAPES.items():
@@ -63,18 +38,8 @@ class Record:
         self.size = 0
 
     def take(self, d: Any, drive_row: int | None, torque: float) -> None:
-        """Append the state of ``d`` as the next row.
-
-        Parameters
-        ----------
-        d : mujoco.MjData
-            After ``mj_forward`` and ``mj_rnePostConstraint`` at the current state.
-        drive_row : int or None
-            The drive equality's constraint row, whose force is the drive torque; None for a
-            torque drive.
-        torque : float
-            The applied drive torque [N m] when ``drive_row`` is None.
-        """
+        """Append ``d``'s state (after ``mj_forward``, ``mj_rnePostConstraint``); the drive torque is the
+        force of constraint row ``drive_row``, or ``torque`` [N m] when that is None (torque drive)."""
         k = self.size
         bodies = slice(1, 4)
         self.t[k] = d.time
@@ -111,8 +76,8 @@ def _integrate(m: Any, d: Any) -> None:
 
 
 def _initial_state(scene: Scene, plan: DrivePlan, d: Any) -> float:
-    """Put the assembled joint, the load and a drive torque into ``d``; the drive torque [N m]
-    (zero for a prescribed input, whose torque is the drive equality's force)."""
+    """Put the assembled joint, the load and the drive torque into ``d``; that torque [N m] (0 for a
+    prescribed input)."""
     q0, qd0 = joint_state(scene, plan.theta0, plan.omega0)
     d.qpos[:3] = q0
     d.qvel[:3] = qd0
@@ -124,8 +89,7 @@ def _initial_state(scene: Scene, plan: DrivePlan, d: Any) -> float:
 
 
 def _step_count(plan: DrivePlan, dt: float) -> int:
-    """Most steps of the run: the span's, and :data:`LAG_ALLOWANCE` more for a prescribed input
-    (the run ends once the input itself has turned the scene's revolutions)."""
+    """Most steps of the run: the span's, plus :data:`LAG_ALLOWANCE` of them for a prescribed input."""
     steps = max(1, math.ceil(plan.span / dt - 1e-9))
     if plan.motion is not None:
         steps += math.ceil(LAG_ALLOWANCE * steps)
@@ -148,27 +112,8 @@ def _shortfall(scene: Scene, plan: DrivePlan, d: Any) -> str:
 
 
 def simulate(scene: Scene, options: MujocoOptions, dt: float) -> tuple[Record, Status, str]:
-    """Run the MuJoCo model of ``scene`` (see the module docstring).
-
-    Parameters
-    ----------
-    scene : Scene
-        A frictionless scene with a constant load.
-    options : MujocoOptions
-        The engine's settings.
-    dt : float
-        Time step [s].
-
-    Returns
-    -------
-    record : Record
-        One row per step taken.
-    status : Status
-        ``ok``, ``diverged`` (a non-finite state) or ``incomplete`` (the input did not turn the
-        scene's revolutions in the time allowed).
-    reason : str
-        Why the status is not ``ok`` ("" when it is).
-    """
+    """``(record, status, reason)`` of running the MuJoCo model of ``scene`` at step ``dt`` [s]: one row
+    per step; ``ok``, ``diverged`` or ``incomplete`` with its reason ("" when ok)."""
     plan = drive_plan(scene)
     m = mujoco.MjModel.from_xml_string(mjcf(scene, options, dt))
     d = mujoco.MjData(m)

@@ -1,9 +1,6 @@
-"""The MuJoCo engine's result columns and constraint measures, computed from its per-step records.
-
-MuJoCo's supports are not the schema's RCCC pairs, so the pair forces and the frame pairs'
-reactions are NaN; the spider pairs' moments, the same in both models, are filled
-(``docs/mujoco.md#reactions``). Friction columns are zero: the engine runs frictionless scenes.
-"""
+"""The MuJoCo engine's result columns and constraint measures from its per-step records. Its supports
+are not the RCCC pairs: pair forces and frame-pair reactions are NaN, the spider pairs' moments
+filled (``docs/mujoco.md#reactions``); friction columns zero."""
 
 from __future__ import annotations
 
@@ -44,21 +41,7 @@ def _body_motion(record: Record) -> tuple[dict[str, np.ndarray], dict[str, np.nd
 
 
 def mechanical_energy(scene: Scene, record: Record) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy of the three bodies [J], each of shape (n,) (potential zero
-    with every centre of mass at O).
-
-    Parameters
-    ----------
-    scene : Scene
-        Masses, centres of mass, inertias and gravity are read.
-    record : Record
-        The run's records.
-
-    Returns
-    -------
-    kinetic, potential : ndarray, shape (n,)
-        Per record row [J].
-    """
+    """Kinetic and potential energy [J] of the three bodies per record row."""
     rot, omega = _body_motion(record)
     kinetic = np.zeros(record.t.size)
     potential = np.zeros(record.t.size)
@@ -73,8 +56,7 @@ def mechanical_energy(scene: Scene, record: Record) -> tuple[np.ndarray, np.ndar
 
 
 def _pair_points(scene: Scene, record: Record) -> dict[str, np.ndarray]:
-    """Origin of each pair in the world [m], shape (n, 3): the frame pairs at their bearings,
-    the spider pairs at O."""
+    """Origin of each pair in the world [m], shape (n, 3): frame pairs at their bearings, spider pairs at O."""
     n = record.t.size
     geo = scene.joint.geometry
     return {"frame_input": np.broadcast_to([-geo.input_bearing, 0.0, 0.0], (n, 3)),
@@ -83,22 +65,8 @@ def _pair_points(scene: Scene, record: Record) -> dict[str, np.ndarray]:
 
 
 def pair_columns(scene: Scene, record: Record) -> dict[str, np.ndarray]:
-    """Relative motion, zero friction and the reactions of each pair (NaN where not filled).
-
-    Parameters
-    ----------
-    scene : Scene
-        The joint's geometry is read.
-    record : Record
-        The run's records.
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-        Per pair ``<pair>_omega_rel`` [rad/s], ``<pair>_slide_rel`` [m/s] along the pair axis,
-        ``power_loss_<pair>`` [W], ``<pair>_friction_torque`` [N m] and ``_force`` [N] (zero),
-        and the reactions ``<pair>_fx, fy, fz`` [N] and ``mx, my, mz`` [N m] in the pair frame.
-    """
+    """Per pair ``_omega_rel`` [rad/s], ``_slide_rel`` [m/s], zero friction and loss columns, and the
+    reactions ``fx, fy, fz`` [N], ``mx, my, mz`` [N m] in the pair frame (NaN where not filled)."""
     n = record.t.size
     rot, omega = _body_motion(record)
     points = _pair_points(scene, record)
@@ -124,20 +92,7 @@ def pair_columns(scene: Scene, record: Record) -> dict[str, np.ndarray]:
 
 
 def columns(scene: Scene, record: Record) -> dict[str, np.ndarray]:
-    """The result schema's columns (:func:`reference.results.columns.table_columns`), each of
-    shape (n,), one row per record row; units of the schema.
-
-    Parameters
-    ----------
-    scene : Scene
-        Geometry, load torque, bodies and gravity are read.
-    record : Record
-        The run's records.
-
-    Returns
-    -------
-    dict of str to ndarray, shape (n,)
-    """
+    """The result schema's columns, one row per record row."""
     n = record.t.size
     geo = scene.joint.geometry
     y_out = record.xmat[:, BODY_IDS["output"] - 1, :, 1]
@@ -158,23 +113,9 @@ def columns(scene: Scene, record: Record) -> dict[str, np.ndarray]:
 
 
 def constraint_violation(scene: Scene, record: Record) -> dict[str, float]:
-    """Largest loop-closure and drive violations over the run.
-
-    Parameters
-    ----------
-    scene : Scene
-        The output axis ``a2`` is read.
-    record : Record
-        The run's records.
-
-    Returns
-    -------
-    dict of str to float
-        ``max_constraint_violation_m``: distance of the output's bearing point from its place on
-        the ground [m]; ``max_constraint_violation_rad``: misalignment of the output axis from
-        ``a2`` [rad]; ``max_drive_error_rad``: input angle minus prescribed angle [rad] (NaN for
-        a torque drive).
-    """
+    """Largest ``max_constraint_violation_m`` (output bearing from its ground place [m]),
+    ``max_constraint_violation_rad`` (output axis from ``a2``) and ``max_drive_error_rad`` (NaN for
+    a torque drive)."""
     drift = np.linalg.norm(record.sites[:, 1] - record.sites[:, 0], axis=1)
     axis = record.xmat[:, BODY_IDS["output"] - 1, :, 0]
     tilt = np.linalg.norm(np.cross(axis, scene.joint.geometry.output_axis()), axis=1)

@@ -1,14 +1,11 @@
-"""The MuJoCo engine's time step: the a-priori speed-ratio error model and the step it chooses.
-
-With the recommended settings (RK4, ``solref`` from ``timeconst_steps``) the largest error of
-``omega_out / omega_in`` is modelled as::
+"""The MuJoCo engine's time step: the a-priori speed-ratio error model (recommended settings: RK4,
+``solref`` from ``timeconst_steps``) and the step it chooses::
 
     err = C_H (tan(b) / cos(b))^2 h^1.5 + C_G |g| tc / omega,   h = omega dt,   tc = timeconst_steps dt
 
-with ``b`` the shaft angle [rad], ``h`` the input angle per step [rad], ``omega`` the drive's
-highest speed [rad/s] and ``tc`` the constraint time constant [s]. The first term is the
-integration error at speed, the second the drift that the impedance cap lets gravity cause within
-one time constant. Measured: docs/mujoco.md#error-model-and-the-automatic-step.
+``b`` the shaft angle [rad], ``omega`` the drive's top speed [rad/s]: integration error at speed,
+and gravity's drift within one constraint time constant.
+Measured: docs/mujoco.md#error-model-and-the-automatic-step.
 """
 
 from __future__ import annotations
@@ -34,30 +31,21 @@ Measured: docs/mujoco.md#error-model-and-the-automatic-step."""
 MIN_STEPS_PER_REVOLUTION = 100
 """Fewest steps per input revolution the automatic step takes."""
 SECONDS_PER_STEP = 1e-4
-"""One RK4 step on one core [s], for the run time a refused step count would take (measured 40-81
-us). Measured: docs/mujoco.md#cost."""
+"""One RK4 step on one core [s], for a refused step count's run time. Measured: docs/mujoco.md#cost."""
 
 
 def speed_ratio_error_model(scene: Scene, options: MujocoOptions, steps: int) -> float:
-    """Predicted largest speed-ratio error [-] of a run with ``steps`` steps per revolution.
-
-    Valid for the recommended settings (RK4, ``solref`` from ``timeconst_steps``); the model is
-    the module docstring's. ``C_H`` bounds the measured values of the paper scenes at 10-75 deg,
-    2000 rpm by 1.2-8x; the rig scene's (6 rad/s) are half of the gravity term.
+    """Predicted largest error of ``omega_out / omega_in`` [-] at ``steps`` per input revolution (the
+    module's model; recommended settings only).
 
     Parameters
     ----------
     scene : Scene
-        Shaft angle, the drive's highest speed and gravity are read.
+        Shaft angle, the drive's top speed and gravity are read.
     options : MujocoOptions
         ``timeconst_steps`` is read.
     steps : int
-        Steps per input revolution [-].
-
-    Returns
-    -------
-    float
-        The predicted error of ``omega_out / omega_in`` [-].
+        Steps per input revolution.
     """
     beta = scene.joint.geometry.shaft_angle
     omega = scene.drive.max_speed()
@@ -69,34 +57,15 @@ def speed_ratio_error_model(scene: Scene, options: MujocoOptions, steps: int) ->
 
 
 def choose_timestep(scene: Scene, options: MujocoOptions) -> tuple[float, str]:
-    """The time step of a run and a sentence saying how it was chosen.
-
-    The options' ``timestep``, else the scene's ``numerics.dt``, else the fewest whole steps per
-    revolution (at the drive's highest speed), at least :data:`MIN_STEPS_PER_REVOLUTION`, whose
-    :func:`speed_ratio_error_model` meets ``scene.numerics.accuracy`` (beyond
-    :data:`reference.scene.validation.MAX_STEPS_PER_REVOLUTION`, 2e6, refused, never capped).
-
-    Parameters
-    ----------
-    scene : Scene
-        The scene to run.
-    options : MujocoOptions
-        The engine's settings.
-
-    Returns
-    -------
-    dt : float
-        Time step [s].
-    why : str
-        How it was chosen (the summary's ``dt_choice``).
+    """``(dt [s], why)``: the options' ``timestep``, else ``numerics.dt``, else the fewest steps per
+    revolution (at least :data:`MIN_STEPS_PER_REVOLUTION`) whose model meets ``numerics.accuracy``.
 
     Raises
     ------
     OptionsError
-        When no step is given and the settings are not the ones the error model was measured
-        with (another integrator or an explicit ``solref``).
+        No step given and settings other than those the model was measured with.
     SceneError
-        The accuracy needs more steps than allowed (the predicted steps and run time, one line).
+        The accuracy needs more steps than allowed.
     """
     if options.timestep is not None:
         return options.timestep, "given (engine settings)"
@@ -117,8 +86,8 @@ def choose_timestep(scene: Scene, options: MujocoOptions) -> tuple[float, str]:
 
 
 def _fewest_steps(scene: Scene, options: MujocoOptions, accuracy: float) -> int:
-    """The fewest steps per revolution, at least :data:`MIN_STEPS_PER_REVOLUTION`, whose predicted
-    error is at most ``accuracy``: doubling, then bisection of the last doubling."""
+    """The fewest steps per revolution (at least :data:`MIN_STEPS_PER_REVOLUTION`) whose predicted
+    error is at most ``accuracy``: doubling, then bisection."""
     low = MIN_STEPS_PER_REVOLUTION
     high = MIN_STEPS_PER_REVOLUTION
     while speed_ratio_error_model(scene, options, high) > accuracy and high < 2**60:  # falls with h
