@@ -126,8 +126,8 @@ class FrictionCoupling:
         d.useRecommendedStepSize = False
 
     def _read_inputs(self, t: float | None) -> list[tuple[float, float, float, float]]:
-        """Per pair the law's inputs ``(|F|, |M|, omega_rel, slide_rel)`` now (``t`` None: the initial
-        state, velocity-level speeds)."""
+        """Per pair the law's inputs ``(|F|, |M|, omega_rel, slide_rel)`` at the current state (``t``
+        None: the initial state, velocity-level speeds)."""
         self._last_inputs = self.reader.read(t)
         return self._last_inputs
 
@@ -138,7 +138,8 @@ class FrictionCoupling:
         return friction
 
     def evaluate(self, t: float | None) -> tuple[float, ...]:
-        """Friction now, flat ``(M_z, F_z)`` on body b of each pair [N m, N] (``t`` None: initial state)."""
+        """Friction at the current state, flat ``(M_z, F_z)`` on body b of each pair [N m, N] (``t``
+        None: the initial state)."""
         return self._law(self._read_inputs(t))
 
     def consistent_start(self, solver: Any, settings: Any,
@@ -191,7 +192,8 @@ class FrictionCoupling:
         return [0.0, -1.0]
 
     def new_step(self, t: float) -> bool:
-        """Bookkeeping at each evaluation; True at a step's first evaluation (the one before was accepted)."""
+        """Bookkeeping at each evaluation; True at a step's first evaluation (the previous step is then
+        accepted)."""
         log = self.log
         if t == self._step_t:
             self._step_iter += 1

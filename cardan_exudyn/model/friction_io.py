@@ -137,8 +137,8 @@ class PairReader:
                       for (a1, s1), (a2, s2) in zip(self._c1, self._c2, strict=True)]
 
     def read(self, t: float | None) -> list[tuple[float, float, float, float]]:
-        """Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])`` now, setting :attr:`regime`;
-        ``t`` [s] for BDF2 over the accepted steps, None for the initial state (velocity-level speeds)."""
+        """Per pair ``(|F| [N], |M| [N m], omega_rel [rad/s], slide_rel [m/s])`` at the current state,
+        setting :attr:`regime`; ``t`` [s] for BDF2 over the accepted steps, None for the initial state."""
         if t is None or self._back is None:
             return self._read_plain(t)
         h1 = t - self._t1

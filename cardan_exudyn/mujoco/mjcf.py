@@ -78,7 +78,8 @@ def _drive(scene: Scene, options: MujocoOptions, solref: str) -> tuple[str, str]
 
 
 def mjcf(scene: Scene, options: MujocoOptions, dt: float) -> str:
-    """The MJCF XML of ``scene`` at step ``dt`` [s] with ``options``, for ``mujoco.MjModel.from_xml_string``."""
+    """The MJCF XML of ``scene`` at step ``dt`` [s] with ``options``, for
+    ``mujoco.MjModel.from_xml_string``."""
     geo = scene.joint.geometry
     solref = f'solref="{_numbers(options.solref_for(dt))}" solimp="{_numbers(options.solimp)}"'
     reference_body, drive = _drive(scene, options, solref)

@@ -56,7 +56,8 @@ def mechanical_energy(scene: Scene, record: Record) -> tuple[np.ndarray, np.ndar
 
 
 def _pair_points(scene: Scene, record: Record) -> dict[str, np.ndarray]:
-    """Origin of each pair in the world [m], shape (n, 3): frame pairs at their bearings, spider pairs at O."""
+    """Origin of each pair in the world [m], shape (n, 3): frame pairs at their bearings, spider pairs
+    at O."""
     n = record.t.size
     geo = scene.joint.geometry
     return {"frame_input": np.broadcast_to([-geo.input_bearing, 0.0, 0.0], (n, 3)),
