@@ -41,12 +41,12 @@ from reference.scene.mapping import replace, scene_from_dict
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
+from rigdata.measurement import measure
 from rigdata.readers import read
 from rigdata.record import ChannelSource, RigDataError, RigRecord
 from rigdata.synthetic import RigSettings
 from rigdata.synthetic import write as synthetic_write
 from rigdata.transducer import Transducer
-from rigdata.measurement import measure
 from rigdata.validation import validate
 
 __all__ = ["CASES", "Case", "DIRECTORY", "ENTRY_POINTS", "MARKER"]

@@ -71,8 +71,8 @@ def test_bad_cli_input(args, message):
 
 def test_scene_command_prints_toml(tmp_path):
     """`cardan scene` prints the resolved scene, which loads back."""
-    from cardan_exudyn.scene_options import scene_from_args
     from cardan_exudyn.cli import build_parser
+    from cardan_exudyn.scene_options import scene_from_args
     from reference import load_scene
 
     argv = ["scene", "--name", "paper-literal-frictionless", "--angle", "12"]

@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 from processes import CLI, start, wait_for
 
-from cardan_exudyn.cli import main
 from cardan_exudyn import engines
+from cardan_exudyn.cli import main
 from cardan_exudyn.engines import run
 from cardan_exudyn.interrupts import Terminated, deferred_signals, terminate_raises, watch_signals
 from cardan_exudyn.sweep import read_records, run_sweep

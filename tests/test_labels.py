@@ -7,8 +7,8 @@ import json
 
 import pytest
 
-from cardan_exudyn.scene_options import override_name, scene_from_args
 from cardan_exudyn.cli import build_parser, main
+from cardan_exudyn.scene_options import override_name, scene_from_args
 from reference.paper.scenes import named_scene
 from reference.scene.files import scene_from_mapping
 from reference.scene.validation import SceneError

@@ -64,7 +64,7 @@ def test_a_scene_not_stored_is_solved():
 @pytest.mark.parametrize("name", ["paper-10deg", "paper-10deg-frictionless"])
 def test_building_a_named_scene_runs_no_engine(name):
     """A stored or frictionless named scene built in a fresh interpreter imports no engine module."""
-    code = ("import json, sys, reference; s = reference.named_scene(%r); " % name +
+    code = (f"import json, sys, reference; s = reference.named_scene({name!r}); "
             "print(json.dumps([s.load.torque, sorted(m for m in sys.modules "
             "if m.startswith('reference.engine'))]))")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)

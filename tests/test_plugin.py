@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 import cardan_exudyn.testing.plugin  # noqa: F401 (imported here: see below)
-from cardan_exudyn.model.error_estimate import SAFETY_FACTOR, AccuracyError, error_estimate
 from cardan_exudyn.engines import get_engine, make_options
+from cardan_exudyn.model.error_estimate import SAFETY_FACTOR, AccuracyError, error_estimate
 from cardan_exudyn.testing import CachingRunner, assert_efficiency, assert_engines_agree, make_scene
 from cardan_exudyn.testing.assertions import MAX_RELATIVE_ERROR, Limit, tolerance
 from reference.results.result import Result

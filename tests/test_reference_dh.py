@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 
 from reference.physics import dual, kinematics, rccc
 from reference.physics.dual import Dual
-from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 from reference.physics.loop_closure import LoopClosureError
+from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 
 EPS = np.finfo(float).eps
 DEG = math.pi / 180.0

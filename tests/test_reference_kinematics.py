@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 from reference.physics.kinematics import (
     body_motions,
     output_angle,
@@ -15,6 +14,7 @@ from reference.physics.kinematics import (
     pair_frames_in_body_a,
     relative_speeds,
 )
+from reference.scene.joint import PAIR_BODIES, PAIR_NAMES
 
 EPS = np.finfo(float).eps
 ANGLES_DEG = [0.0, 5.0, 37.0, 60.0, 85.0]

@@ -12,8 +12,8 @@ from reference.engine.gauss import adaptive_gauss, initial_panels
 from reference.engine.options import ReferenceOptions
 from reference.engine.solve import run
 from reference.paper.scenes import named_scene
-from reference.results.quadrature import jump_breaks, segment_integrals
 from reference.results.means import whole_revolution_window, window_integral
+from reference.results.quadrature import jump_breaks, segment_integrals
 from reference.scene.mapping import replace
 
 

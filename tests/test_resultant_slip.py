@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 import cardan_exudyn
-from cardan_exudyn.scene_options import scene_from_args
 from cardan_exudyn.cli import build_parser
 from cardan_exudyn.model.friction_law import PairLaw, pair_loads
+from cardan_exudyn.scene_options import scene_from_args
 from reference.paper.parameter_sets import RENAMED_SETS
 from reference.paper.scenes import named_scene
 from reference.physics.bands import characteristic_speeds, sign_bands

@@ -2,8 +2,8 @@
 estimate, a loop gain measured by the pilot wherever the friction feeds back, the limits on steps
 kept after every factor, the failure hints and the cost of the whole call.
 
-Each case was found by a review of the automatic step (``cardan_exudyn/model/accuracy.py``) and failed before its fix
-(the measured numbers are in the docstrings)."""
+Each case was found by a review of the automatic step (``cardan_exudyn/model/accuracy.py``) and
+failed before its fix (the measured numbers are in the docstrings)."""
 
 from __future__ import annotations
 

@@ -16,8 +16,15 @@ from processes import wait_for
 import reference.engine.batch.solve
 import reference.engine.solve
 from cardan_exudyn import engines
-from cardan_exudyn.sweep import Batch, CaseFunction, expand_cases, plan_tasks, read_records, run_sweep
-from cardan_exudyn.sweep import spec_from_mapping
+from cardan_exudyn.sweep import (
+    Batch,
+    CaseFunction,
+    expand_cases,
+    plan_tasks,
+    read_records,
+    run_sweep,
+    spec_from_mapping,
+)
 from reference.paper.scenes import named_scene
 from reference.scene.mapping import replace
 from reference.scene.validation import SceneError

@@ -14,6 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from cardan_exudyn.comparison import COMPARED, check_request, join_on_input_angle
+from cardan_exudyn.comparison import run_engines as comparison_runs  # with the session cache
+from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.model.error_estimate import (
     ESTIMATED_MEANS,
     SAFETY_FACTOR,
@@ -22,13 +25,10 @@ from cardan_exudyn.model.error_estimate import (
     error_estimate,
     mean_values,
 )
-from cardan_exudyn.comparison import COMPARED, check_request, join_on_input_angle
-from cardan_exudyn.comparison import run_engines as comparison_runs  # with the session cache
-from cardan_exudyn.engines import run as run_engine
 from cardan_exudyn.report.format import is_number, markdown_table, number
-from reference.scene.scene import Scene
 from reference.results.means import after_revolutions
 from reference.results.result import Result
+from reference.scene.scene import Scene
 
 __all__ = ["MAX_RELATIVE_ERROR", "ROUNDING", "DEFAULT_COLUMNS", "CardanToleranceWarning", "Limit",
            "Check", "assert_efficiency", "assert_engines_agree", "tolerance"]
