@@ -48,6 +48,9 @@ class Conditioned:
         Low-pass cut-off [Hz].
     settings : dict
         The Conditioning used.
+    speed_sources : dict
+        Per shaft (``in``, ``out``) where its speed came from: ``kind`` (``channel``, ``pulses`` or
+        ``angle``) and the pulse ``quantum`` [rad] (0.0 unless counted).
     """
 
     t: np.ndarray
@@ -64,6 +67,7 @@ class Conditioned:
     phase_fit: dict = field(default_factory=dict)
     cutoff: float = 0.0
     settings: dict = field(default_factory=dict)
+    speed_sources: dict = field(default_factory=dict)
 
     @property
     def dt(self) -> float:
@@ -128,6 +132,15 @@ def _speed(record: RigRecord, shaft: str, filtered_angle: Callable[[], np.ndarra
     return angular_speed(filtered_angle(), record.dt, cutoff, options.derivative)
 
 
+def _speed_source(record: RigRecord, shaft: str, edges: np.ndarray | None) -> dict:
+    """``kind`` of a shaft's speed (``channel``, ``pulses``, ``angle``) and its pulse ``quantum`` [rad]."""
+    if f"speed_{shaft}" in record.channels:
+        return {"kind": "channel", "quantum": 0.0}
+    if edges is not None:
+        return {"kind": "pulses", "quantum": float(record.sources[f"angle_{shaft}"].quantum)}
+    return {"kind": "angle", "quantum": 0.0}
+
+
 def _filtered(record: RigRecord, angles: dict[str, np.ndarray], cutoff: float,
               options: Conditioning) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Low-passed input angle [rad], and per shaft speed [rad/s] and torque [N m], at ``cutoff`` [Hz]."""
@@ -181,7 +194,9 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
         phase_fit = {"phase": float(options.phase), "source": "given"}
     else:
         ratio = speeds["out"][inside] / speeds["in"][inside]
-        phase_fit = estimate_phase(angles["in"][inside], ratio, float(shaft_angle))
+        # a low-pass at ``cutoff`` leaves two independent values per cut-off period
+        phase_fit = estimate_phase(angles["in"][inside], ratio, float(shaft_angle),
+                                   independent=2.0 * cutoff * (t_b - t_a))
     return Conditioned(
         t=t[keep], angle_in=angle_in[keep],
         speed_in=speeds["in"][keep], speed_out=speeds["out"][keep],
@@ -189,4 +204,5 @@ def condition(record: RigRecord, shaft_angle: float, options: Conditioning | Non
         raw_torque_in=np.asarray(record.channels["torque_in"])[keep],
         raw_torque_out=np.asarray(record.channels["torque_out"])[keep],
         window=(t_a, t_b), revolutions=n, phase=float(phase_fit["phase"]), phase_fit=phase_fit,
-        cutoff=float(cutoff), settings=asdict(options))
+        cutoff=float(cutoff), settings=asdict(options),
+        speed_sources={s: _speed_source(record, s, edges[s]) for s in SHAFTS})
