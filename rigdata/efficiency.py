@@ -152,6 +152,10 @@ def uncertainty_budget(c: Conditioned, transducers: tuple[Transducer, Transducer
         ("window start (edge timing)", c.dt / SQRT12, "s", -p_a / w_in),
         ("window end (edge timing)", c.dt / SQRT12, "s", p_b / w_in),
     ]
+    # a speed channel's gain scales that shaft's power: d eta / d gain = +-eta (pulse counts: no gain)
+    for shaft, tr, sign in (("in", tin, -1.0), ("out", tout, 1.0)):
+        if c.speed_sources.get(shaft, {}).get("kind") == "channel":
+            rows.append((f"speed gain, {shaft}put speed", tr.speed_accuracy / SQRT3, "-", sign * eta))
     return [{"quantity": q, "standard_uncertainty": u, "unit": unit, "sensitivity": s,
              "contribution": abs(s) * u} for q, u, unit, s in rows]
 

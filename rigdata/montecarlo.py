@@ -43,13 +43,26 @@ def _drawn_torques(c: Conditioned, transducers: tuple[Transducer, Transducer], s
     return torques, offsets_out
 
 
+def _speed_gains(c: Conditioned, transducers: tuple[Transducer, Transducer], rng: np.random.Generator,
+                 m: int) -> np.ndarray:
+    """``m`` draws of ``(1 + g_out) / (1 + g_in)`` [-]: each speed channel's gain error, uniform within
+    its limit; 1 for speeds from pulses or angles.
+    """
+    factor = np.ones(m)
+    for shaft, tr, power in (("in", transducers[0], -1.0), ("out", transducers[1], 1.0)):
+        if c.speed_sources.get(shaft, {}).get("kind") == "channel":
+            factor *= (1.0 + rng.uniform(-1, 1, m) * tr.speed_accuracy) ** power
+    return factor
+
+
 def monte_carlo(c: Conditioned, transducers: tuple[Transducer, Transducer], sigma: dict,
                 samples: int, seed: int) -> tuple[dict, dict]:
     """The measured efficiency drawn ``samples`` times through the filter and integrals.
 
     Per draw and transducer: constant offset (class, resolution), drift ramp, white noise ``sigma`` [N m]
-    low-passed; each window end shifted up to one sample. Returns ``summary`` (``samples``, ``seed``,
-    ``mean``, ``std``, ``interval_95`` [-]) and ``draws`` (``efficiency`` [-], ``offset_out`` [N m]).
+    low-passed, a speed channel's gain; each window end shifted up to one sample. Returns ``summary``
+    (``samples``, ``seed``, ``mean``, ``std``, ``interval_95`` [-]) and ``draws`` (``efficiency`` [-],
+    ``offset_out`` [N m]).
     """
     rng = np.random.default_rng(seed)
     ramp = (c.t - c.t[0]) / (c.t[-1] - c.t[0])
@@ -64,6 +77,7 @@ def monte_carlo(c: Conditioned, transducers: tuple[Transducer, Transducer], sigm
         for i in range(m):
             w = window_weights(c.t, t_a + shift[i, 0], t_b + shift[i, 1])
             values[start + i] = (w @ (torques[1][i] * c.speed_out)) / (w @ (torques[0][i] * c.speed_in))
+        values[start:start + m] *= _speed_gains(c, transducers, rng, m)
     lo, hi = np.percentile(values, [2.5, 97.5])
     summary = {"samples": int(samples), "seed": int(seed), "mean": float(np.mean(values)),
                "std": float(np.std(values, ddof=1)), "interval_95": [float(lo), float(hi)]}

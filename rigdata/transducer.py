@@ -29,6 +29,9 @@ PROVENANCE = {
     "zero_drift": "assumption: zero drift over one record within +-0.01 N m (0.01 % of full scale: "
                   "a temperature change of about 1 K in a run of seconds at 0.1 %/10 K); a limit "
                   "of a linear ramp over the record, rectangular",
+    "speed_accuracy": "assumption: a speed channel (rpm or rad/s, an analogue or converted speed output) "
+                      "reads within 0.1 % of reading (a gain error), a limit, rectangular; a pulse count's "
+                      "gain is its time base's and its error is the count's quantisation instead",
     "adc_range": "assumption: +-10 V input range of the acquisition card",
     "adc_bits": "assumption: 16-bit acquisition card",
 }
@@ -50,6 +53,8 @@ class Transducer:
         Limit of the constant torque error as a fraction of full scale [-], independent per transducer.
     zero_drift : float
         Limit of the zero's drift over a record [N m], a linear ramp from zero.
+    speed_accuracy : float
+        Limit of a speed channel's gain error as a fraction of reading [-] (not of pulse counts).
     adc_range : float
         Acquisition input range +- [V].
     adc_bits : int
@@ -61,6 +66,7 @@ class Transducer:
     pulses_per_rev: int = PULSES_PER_REV
     accuracy_class: float = 1e-3
     zero_drift: float = 0.01
+    speed_accuracy: float = 1e-3
     adc_range: float = 10.0
     adc_bits: int = 16
 
@@ -69,7 +75,7 @@ class Transducer:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(f"`{name}` must be a positive number, got {value!r}")
-        for name in ("accuracy_class", "zero_drift"):
+        for name in ("accuracy_class", "zero_drift", "speed_accuracy"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
                 raise ValueError(f"`{name}` must be a number >= 0, got {value!r}")
@@ -82,6 +88,9 @@ class Transducer:
         if self.accuracy_class > 1.0:
             raise ValueError(f"`accuracy_class` must be at most 1 (100 % of full scale), "
                              f"got {self.accuracy_class!r}")
+        if self.speed_accuracy > 1.0:
+            raise ValueError(f"`speed_accuracy` must be at most 1 (100 % of reading), "
+                             f"got {self.speed_accuracy!r}")
         for name in ("full_scale", "zero_drift", "adc_range"):
             if getattr(self, name) > 1e8:
                 raise ValueError(f"`{name}` must be at most 1e8, got {getattr(self, name)!r}")
