@@ -12,7 +12,7 @@ from reference.lazy import lazy_face
 
 __all__ = ["read", "read_table", "measure", "Measurement", "validate", "Validation", "MODEL_ENGINES",
            "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer", "Conditioning",
-           "RigSettings", "synthetic"]
+           "RigSettings", "synthetic", "RigDataWarning"]
 
 #: Public name -> the module that defines it (a name that is a module maps to itself).
 _WHERE = {
@@ -23,6 +23,7 @@ _WHERE = {
     "RigRecord": "rigdata.record", "RigDataError": "rigdata.record", "ChannelSource": "rigdata.record",
     "Transducer": "rigdata.transducer", "Conditioning": "rigdata.conditioning",
     "RigSettings": "rigdata.synthetic", "synthetic": "rigdata.synthetic",
+    "RigDataWarning": "rigdata.checks",
 }
 
 

@@ -11,6 +11,7 @@ import argparse
 import json
 import math
 import sys
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -53,8 +54,10 @@ def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
     return out
 
 
-def _shaft_angle(text: str) -> float:
-    """``--angle``: a shaft angle in [0, 90) deg."""
+def _shaft_angle(text: str) -> float | str:
+    """``--angle``: a shaft angle in [0, 90) deg, or ``auto`` (the recording's own)."""
+    if text.strip().lower() == "auto":
+        return "auto"
     value = arguments.number("deg", non_negative=True)(text)
     if value >= 90.0:
         raise argparse.ArgumentTypeError(f"must be below 90 deg (a joint at 90 deg transmits no motion), "
@@ -78,8 +81,26 @@ def _transducers(args: argparse.Namespace) -> tuple[rigdata.Transducer, rigdata.
     """Both transducers from the options (the rig's two are alike)."""
     t = _settings(rigdata.Transducer, full_scale=args.full_scale, sensitivity=args.sensitivity,
                   pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
-                  zero_drift=args.zero_drift)
+                  zero_drift=args.zero_drift, speed_accuracy=args.speed_accuracy / 100.0)
     return t, t
+
+
+def _signs(args: argparse.Namespace) -> dict[str, int]:
+    """``--sign CHANNEL=-1``: the channels recorded with the opposite sign convention."""
+    signs = {}
+    for channel, text in _pairs(args.sign, "--sign").items():
+        if text not in ("-1", "+1", "1"):
+            raise BadInput(f"--sign expects CHANNEL=-1 or CHANNEL=+1, got {channel}={text}")
+        signs[channel] = int(text)
+    return signs
+
+
+def _one_line_warnings(command: str) -> Callable[..., None]:
+    """A ``warnings.showwarning`` printing ``cardan rig COMMAND: warning: MESSAGE`` on stderr."""
+    def show(message: Warning | str, *args: Any, **kwargs: Any) -> None:
+        print(f"cardan rig {command}: warning: {message}", file=sys.stderr, flush=True)
+
+    return show
 
 
 def _draws(args: argparse.Namespace) -> int:
@@ -131,30 +152,47 @@ def cmd_inspect(args: argparse.Namespace) -> int:
 
 
 def cmd_measure(args: argparse.Namespace) -> int:
-    """``cardan rig measure``: measured efficiency with its uncertainty (:func:`rigdata.measure`)."""
+    """``cardan rig measure``: measured efficiency with its uncertainty (:func:`rigdata.measure`); exit 3
+    with the reason when a check fails (:mod:`rigdata.checks`).
+    """
     rec = _read(args)
     angle = 15.0 if args.angle is None else args.angle  # the paper's rig case
-    m = rigdata.measure(rec, angle, conditioning=_conditioning(args), transducers=_transducers(args),
-                        monte_carlo=_draws(args), seed=args.seed)
+    try:
+        m = rigdata.measure(rec, angle, conditioning=_conditioning(args), transducers=_transducers(args),
+                            monte_carlo=_draws(args), seed=args.seed, signs=_signs(args))
+    except ValueError as exc:  # a --sign channel the record lacks
+        if isinstance(exc, rigdata.RigDataError):
+            raise
+        raise BadInput(str(exc)) from None
     out = m.as_dict()
+    status = EXIT_OK if m.status == Status.OK else EXIT_FAILED
     if args.json:
         print(json.dumps(out, indent=2))
-        return EXIT_OK
+        return status
+    if m.status != Status.OK:
+        print(f"{rec.file}: status {m.status}: {m.reason}")
+        return status
     mc = m.measured.monte_carlo
     print(f"{rec.file}: efficiency {m.efficiency:.4f} +- {m.u:.4f} (standard uncertainty) over "
           f"{out['revolutions']} revolutions at {out['mean_speed_in']:.4g} rad/s, "
           f"{out['mean_torque_in']:.4g} N m"
           + (f"; Monte Carlo 95 % [{mc['interval_95'][0]:.4f}, {mc['interval_95'][1]:.4f}]" if mc else ""))
-    return EXIT_OK
+    return status
 
 
-def _scene(args: argparse.Namespace) -> Scene:
-    """The joint to drive: ``--scene`` (name or scene file) with ``--angle`` and ``--friction`` when given."""
-    from rigdata.validation import as_scene  # rigdata's modules load when a rig command runs
+def _scene(args: argparse.Namespace, rec: rigdata.RigRecord) -> Scene:
+    """The joint to drive: ``--scene`` (name or scene file) with ``--angle`` (``auto``: the recording's, from
+    ``rec``) and ``--friction`` when given.
+    """
+    from rigdata.checks import recorded_shaft_angle  # rigdata's modules load when a rig command runs
+    from rigdata.validation import as_scene
 
     base = as_scene(args.scene)
     changes: dict[str, Any] = {}
-    if args.angle is not None:
+    if args.angle == "auto":
+        recorded = recorded_shaft_angle(rec, _conditioning(args))
+        changes["joint.geometry.shaft_angle_deg"] = math.degrees(recorded)
+    elif args.angle is not None:
         changes["joint.geometry.shaft_angle_deg"] = args.angle
     if args.friction is not None:
         changes.update({f"joint.pairs.{p}.friction_coefficient": args.friction for p in PAIR_NAMES})
@@ -179,7 +217,9 @@ def _progress(args: argparse.Namespace) -> Callable[[str], None]:
 
 
 def _print_validation(s: dict[str, Any]) -> None:
-    """One line per engine: computed against measured efficiency, their difference, significance."""
+    """One line per engine: computed against measured efficiency, their difference, significance; one per
+    check that failed.
+    """
     measured = f"{s['measured_efficiency']:.4f} +- {s['measured_efficiency_u']:.4f}"
     for engine, comp in s["computed"].items():
         cmp = s["comparisons"].get(engine, {})
@@ -189,24 +229,38 @@ def _print_validation(s: dict[str, Any]) -> None:
         print(f"{engine}: computed {number(comp.get('mean_efficiency'), '.6f')}, measured {measured}; "
               f"difference {number(cmp.get('difference'), '.4f')}, significant (k=2): "
               f"{cmp.get('significant_k2', '-')}")
+    for finding in s.get("checks", []):
+        if finding["status"] != Status.OK:
+            print(f"check {finding['check']}: {finding['status']}: {finding['message']}")
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    """``cardan rig validate``: measured against computed efficiency and the report folder."""
+    """``cardan rig validate``: measured against computed efficiency and the report folder; exit 3 when an
+    engine failed or the measurement is ``unphysical`` or ``inconsistent``.
+    """
     engines = _engines(args.engines)
     arguments.out_folder(args.out)
-    scene = _scene(args)
+    signs = _signs(args)
     rec = _read(args)
-    v = rigdata.validate(rec, scene, engines, conditioning=_conditioning(args),
-                         transducers=_transducers(args), monte_carlo=_draws(args), seed=args.seed,
-                         progress=_progress(args))
+    scene = _scene(args, rec)
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", rigdata.RigDataWarning)
+        warnings.showwarning = _one_line_warnings("validate")
+        try:
+            v = rigdata.validate(rec, scene, engines, conditioning=_conditioning(args),
+                                 transducers=_transducers(args), monte_carlo=_draws(args), seed=args.seed,
+                                 progress=_progress(args), signs=signs)
+        except ValueError as exc:  # a --sign channel the record lacks
+            if isinstance(exc, rigdata.RigDataError):
+                raise
+            raise BadInput(str(exc)) from None
     s = rigdata.write_report(v, args.out)
     if args.json:
         print(json.dumps(s, indent=2))
     else:
         _print_validation(s)
         print(f"wrote {args.out}/report.md", file=sys.stderr)
-    return EXIT_OK if v.success else EXIT_FAILED
+    return EXIT_OK if v.success and v.measurement_usable else EXIT_FAILED
 
 
 def cmd_synthetic(args: argparse.Namespace) -> int:
@@ -246,8 +300,11 @@ def _file_options(p: argparse.ArgumentParser) -> None:
 def _measure_options(p: argparse.ArgumentParser) -> None:
     """Shaft angle, conditioning, transducers, Monte Carlo (``measure``, ``validate``)."""
     p.add_argument("--angle", type=_shaft_angle, default=None,
-                   help="shaft angle [deg] (default: validate the scene's, measure 15, the paper's "
-                        "rig case)")
+                   help="shaft angle [deg], or auto: the recording's own (Hooke's speed ratio fit) "
+                        "(default: validate the scene's, measure 15, the paper's rig case)")
+    p.add_argument("--sign", action="append", metavar="CHANNEL=-1",
+                   help="a channel recorded with the opposite sign convention, e.g. torque_out=-1 "
+                        "(refused without it when the output power comes out negative)")
     p.add_argument("--cutoff-harmonics", type=arguments.number("-", positive=True), default=10.0,
                    help="low-pass cut-off in input shaft harmonics (default 10)")
     p.add_argument("--settle", type=arguments.number("rev", non_negative=True), default=0.25,
@@ -260,6 +317,10 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
                    help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
     p.add_argument("--zero-drift", type=arguments.number("N m", non_negative=True), default=0.01,
                    help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
+    p.add_argument("--speed-accuracy", type=arguments.number("%", non_negative=True, maximum=100.0),
+                   default=0.1,
+                   help="speed channel gain error limit [%% of reading] (default 0.1, assumed; not "
+                        "used for pulse counts)")
     p.add_argument("--mc", type=arguments.count("--mc", minimum=0), default=2000,
                    help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only; at most "
                         f"{arguments.COUNT_LIMITS['--mc']})")

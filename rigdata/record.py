@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["CHANNELS", "SHAFTS", "RATE_TOLERANCE", "RigDataError", "ChannelSource", "RigRecord"]
+__all__ = ["CHANNELS", "SHAFTS", "RATE_TOLERANCE", "RigDataError", "ChannelSource", "RigRecord", "with_signs"]
 
 #: Channels a record may hold; SI units. ``angle_*`` come from pulse counts or an angle channel.
 CHANNELS = {
@@ -128,6 +128,26 @@ class RigRecord:
     def revolutions(self, shaft: str = "in") -> float:
         """Revolutions turned by ``shaft``, absolute [-]."""
         return abs(self.turned(shaft)) / (2.0 * math.pi)
+
+
+def with_signs(record: RigRecord, signs: Mapping[str, float] | None) -> RigRecord:
+    """``record`` with channels multiplied by ``signs`` (channel -> +1 or -1, a sign convention); itself when
+    None or empty. ValueError naming a channel the record lacks or a sign not +-1.
+    """
+    if not signs:
+        return record
+    channels = dict(record.channels)
+    sources = dict(record.sources)
+    for name, sign in signs.items():
+        if name not in channels:
+            raise ValueError(f"`signs`: no channel {name!r} in the record (it has {sorted(channels)})")
+        if isinstance(sign, bool) or sign not in (1, -1):
+            raise ValueError(f"`signs`: the sign of {name!r} must be +1 or -1, got {sign!r:.40}")
+        channels[name] = channels[name] * float(sign)
+        if sign == -1:
+            s = sources[name]
+            sources[name] = ChannelSource(s.column, s.unit, f"-({s.conversion})", s.quantum)
+    return RigRecord(record.time, channels, sources, {**record.provenance, "signs": dict(signs)})
 
 
 def _checked_time(time: Any, file: Any) -> np.ndarray:

@@ -189,9 +189,15 @@ def _computed(s: dict) -> list[str]:
     return lines
 
 
+def _checks(s: dict) -> list[str]:
+    """One line per check that failed (``rigdata.checks``), none when all passed."""
+    return [f"**Check {f['check']}: {f['status']}.** {f['message']}." for f in s.get("checks", [])
+            if f["status"] != "ok"] + ([""] if any(f["status"] != "ok" for f in s.get("checks", [])) else [])
+
+
 def markdown(s: dict) -> str:
     """The report's text, from :meth:`Validation.as_dict`."""
-    lines = ["# Rig measurement against the model", "", *_synthetic_banner(s), *_conditioning(s),
+    lines = ["# Rig measurement against the model", "", *_synthetic_banner(s), *_checks(s), *_conditioning(s),
              *_measured(s), *_accuracy(s), *_computed(s),
              "", "![Figure 10](figure10.png)", "", "## Assumptions", ""]
     lines += [f"- `{k}`: {v}" for k, v in s["assumptions"].items()]

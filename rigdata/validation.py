@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,12 +21,13 @@ from reference.paper.scenes import named_scene
 from reference.results.summary import Status
 from reference.scene.files import load_scene
 from reference.scene.scene import Scene
+from rigdata.checks import Finding, RigDataWarning, shaft_angle_agrees
 from rigdata.conditioning import Conditioned, Conditioning, condition
 from rigdata.efficiency import SQRT3, Measured, measured_efficiency, transducer_pair
-from rigdata.measurement import Source, as_record
+from rigdata.measurement import Source, as_record, measurement_findings
 from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
 from rigdata.montecarlo import check_draws
-from rigdata.record import RigRecord
+from rigdata.record import RigRecord, with_signs
 from rigdata.transducer import PROVENANCE, Transducer
 
 __all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare",
@@ -111,6 +113,8 @@ class Validation:
     sensitivities : dict
         :func:`rigdata.model.model_sensitivities`; empty when no engine ran ``ok``.
     transducers : tuple of Transducer
+    findings : tuple of Finding
+        The measurement's checks and the shaft angle's (:mod:`rigdata.checks`).
     """
 
     record: RigRecord
@@ -121,6 +125,14 @@ class Validation:
     comparisons: dict[str, dict[str, Any]]
     sensitivities: dict[str, float]
     transducers: tuple[Transducer, Transducer]
+    findings: tuple[Finding, ...] = ()
+
+    @property
+    def measurement_usable(self) -> bool:
+        """False when the measurement is ``unphysical`` or ``inconsistent`` (an error in the data); an
+        ``unresolved`` efficiency or a shaft angle ``mismatch`` is reported, the comparison stands.
+        """
+        return not any(f.status in ("unphysical", "inconsistent") for f in self.findings)
 
     @property
     def measured_efficiency(self) -> float:
@@ -145,7 +157,10 @@ class Validation:
         cond = self.conditioned
         meas = self.measured
         out = {
-            "file": str(rec.file), "provenance": {k: val for k, val in rec.provenance.items()
+            "file": str(rec.file),
+            "status": next((f.status for f in self.findings if not f.ok), "ok"),
+            "checks": [f.as_dict() for f in self.findings],
+            "provenance": {k: val for k, val in rec.provenance.items()
                                                   if k not in ("header", "synthetic")},
             "synthetic": rec.provenance.get("synthetic"), "sample_rate": rec.sample_rate,
             "duration_s": rec.duration,
@@ -174,7 +189,7 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
              engines: tuple[str, ...] = MODEL_ENGINES, *, conditioning: Conditioning | None = None,
              transducers: Transducer | tuple[Transducer, Transducer] | None = None,
              monte_carlo: int = 2000, seed: int = 0, progress: Callable[[str], None] | None = None,
-             **read_options: Any) -> Validation:
+             signs: dict[str, int] | None = None, **read_options: Any) -> Validation:
     """Measured against computed efficiency for one record; nothing is written (see :func:`write_report`).
 
     Parameters
@@ -189,6 +204,14 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
         As for :func:`rigdata.measurement.measure`.
     progress : callable(str), optional
         Called with a line before each long step.
+    signs : dict of str to int, optional
+        As for :func:`rigdata.measurement.measure`.
+
+    Warns
+    -----
+    RigDataWarning
+        Before the model runs, when the recording's own shaft angle differs from the scene's beyond
+        twice its uncertainty.
 
     Raises
     ------
@@ -204,15 +227,19 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
     check_draws(monte_carlo, seed)
     base = as_scene(scene)
     _check_engines(engines)  # now, not after the measurement
-    record = as_record(source, **read_options)
+    record = with_signs(as_record(source, **read_options), signs)
     pair = transducer_pair(transducers)
     say("conditioning")
     cond = condition(record, base.joint.geometry.shaft_angle, conditioning)
     say("measured efficiency and its uncertainty")
     measured = measured_efficiency(cond, pair, monte_carlo=monte_carlo, seed=seed)
+    findings = (*measurement_findings(cond, measured, pair, record.file),
+                shaft_angle_agrees(cond, base.joint.geometry.shaft_angle))
+    if not findings[-1].ok:
+        warnings.warn(findings[-1].message, RigDataWarning, stacklevel=2)
     model = measured_scene(cond, base)
     computed, comparisons, sens = _run_models(cond, base, model, engines, measured, pair, say)
-    return Validation(record, cond, measured, model, computed, comparisons, sens, pair)
+    return Validation(record, cond, measured, model, computed, comparisons, sens, pair, findings)
 
 
 def _check_engines(engines: tuple[str, ...]) -> None:
