@@ -11,7 +11,7 @@ _HOMES = {
     "rigdata.conditioning.options": ("DERIVATIVES", "Conditioning"),
     "rigdata.conditioning.pipeline": ("Conditioned", "condition"),
     "rigdata.conditioning.angles": ("pulse_edges", "angle_on_grid"),
-    "rigdata.conditioning.filters": ("lowpass", "angular_speed"),
+    "rigdata.conditioning.filters": ("lowpass", "lowpass_adjoint", "angular_speed"),
     "rigdata.conditioning.window": ("revolution_window", "window_weights"),
     "rigdata.conditioning.phase": ("estimate_phase",),
 }

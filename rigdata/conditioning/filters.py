@@ -10,7 +10,7 @@ from scipy.interpolate import make_smoothing_spline
 
 from rigdata.record import RigDataError
 
-__all__ = ["lowpass", "angular_speed"]
+__all__ = ["lowpass", "lowpass_adjoint", "angular_speed"]
 
 
 def lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray:
@@ -32,6 +32,41 @@ def lowpass(x: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray
         return np.asarray(x, float).copy()
     sos = signal.butter(order, cutoff / nyquist, output="sos")
     return signal.sosfiltfilt(sos, x)
+
+
+def _causal_adjoint(sos: np.ndarray, g: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """Transpose of ``y = sosfilt(sos, x, zi=zi * x[0])`` applied to ``g``, shape (..., N); ``start`` is
+    that filter's output for a unit ``x[0]`` through ``zi`` alone, shape (N,).
+    """
+    out = signal.sosfilt(sos, g[..., ::-1])[..., ::-1]
+    out[..., 0] += g @ start
+    return out
+
+
+def lowpass_adjoint(v: np.ndarray, cutoff: float, rate: float, order: int) -> np.ndarray:
+    """Transpose of :func:`lowpass` (same settings) applied to ``v``, shape (..., n), along the last axis:
+    ``v @ lowpass(x) == lowpass_adjoint(v) @ x`` for every ``x``, odd padding and edge states included.
+    """
+    v = np.asarray(v, float)
+    nyquist = 0.5 * rate
+    if cutoff >= nyquist:
+        return v.copy()
+    sos = signal.butter(order, cutoff / nyquist, output="sos")
+    ntaps = 2 * len(sos) + 1 - min(int(np.sum(sos[:, 2] == 0)), int(np.sum(sos[:, 5] == 0)))
+    pad = 3 * ntaps  # sosfiltfilt's default odd extension
+    n = v.shape[-1]
+    start = signal.sosfilt(sos, np.zeros(n + 2 * pad), zi=signal.sosfilt_zi(sos))[0]
+    g = np.zeros(v.shape[:-1] + (n + 2 * pad,))
+    g[..., pad:pad + n] = v
+    # lowpass = cut . reverse . F . reverse . F . extend, F the causal pass started at its first value
+    g = _causal_adjoint(sos, g[..., ::-1].copy(), start)
+    g = _causal_adjoint(sos, g[..., ::-1].copy(), start)
+    x = g[..., pad:pad + n].copy()
+    x[..., 0] += 2.0 * g[..., :pad].sum(axis=-1)
+    x[..., pad:0:-1] -= g[..., :pad]
+    x[..., -1] += 2.0 * g[..., pad + n:].sum(axis=-1)
+    x[..., n - 2 - np.arange(pad)] -= g[..., pad + n:]
+    return x
 
 
 def angular_speed(angle: np.ndarray, dt: float, cutoff: float, method: str) -> np.ndarray:
