@@ -1,5 +1,5 @@
 """Measured data from the test rig: readers, conditioning, measured efficiency, validation against the
-engines (``docs/rigdata.md``). ``rigdata.read``, ``measure``, ``validate``, ``write_report``,
+engines (``docs/rigdata.md``). ``rigdata.read``, ``read_frame``, ``measure``, ``validate``, ``write_report``,
 ``synthetic.write``.
 
 Names load on first use (PEP 562): ``cardan`` imports ``rigdata.cli`` at every start, and the
@@ -10,13 +10,13 @@ from __future__ import annotations
 
 from reference.lazy import lazy_face
 
-__all__ = ["read", "read_table", "measure", "Measurement", "validate", "Validation", "MODEL_ENGINES",
-           "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer", "Conditioning",
-           "RigSettings", "synthetic", "RigDataWarning"]
+__all__ = ["read", "read_table", "read_frame", "measure", "Measurement", "validate", "Validation",
+           "MODEL_ENGINES", "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer",
+           "Conditioning", "RigSettings", "synthetic", "RigDataWarning"]
 
 #: Public name -> the module that defines it (a name that is a module maps to itself).
 _WHERE = {
-    "read": "rigdata.readers", "read_table": "rigdata.readers",
+    "read": "rigdata.readers", "read_table": "rigdata.readers", "read_frame": "rigdata.readers",
     "measure": "rigdata.measurement", "Measurement": "rigdata.measurement",
     "validate": "rigdata.validation", "Validation": "rigdata.validation",
     "MODEL_ENGINES": "rigdata.validation", "write_report": "rigdata.report",

@@ -1,5 +1,6 @@
-"""Readers of rig files (delimited text, LabVIEW .lvm, NI TDMS): :func:`read_table` (what the file holds)
-and :func:`read` (a validated RigRecord in SI units); every file problem is one RigDataError.
+"""Readers of rig files (delimited text, LabVIEW .lvm, NI TDMS, MATLAB .mat, Parquet, Excel .xlsx, ASAM
+MDF): :func:`read_table` (what the file holds), :func:`read` (a validated RigRecord in SI units) and
+:func:`read_frame` (the same from a DataFrame); every file problem is one RigDataError.
 
 Assumed: a time column without unit is seconds; pulse counts are cumulative; a pulse frequency
 must say ``pulses/s`` (``Hz`` is ambiguous); raw conversions default to Magtrol TMB 210.
@@ -10,7 +11,7 @@ from __future__ import annotations
 from reference.lazy import lazy_face
 
 _HOMES = {
-    "rigdata.readers.dispatch": ("read", "read_table"),
+    "rigdata.readers.dispatch": ("read", "read_table", "read_frame"),
     "rigdata.readers.table": ("FORMATS", "RawTable", "TextCells"),
     "rigdata.readers.channels": ("KIND_WORDS", "SIDE_WORDS", "TIME_WORDS", "match_channels", "recognise"),
 }

@@ -6,13 +6,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rigdata.readers.binary import BINARY_FORMATS, BINARY_NAMES, EXTENSIONS, binary_format
 from rigdata.record import RigDataError
 
 __all__ = ["FORMAT_ALIASES", "file_bytes", "content_format", "choose_format", "decode"]
 
 #: Format names a caller may give -> the reader they select.
 FORMAT_ALIASES = {"auto": "auto", "csv": "csv", "text": "csv", "txt": "csv", "tsv": "csv", "dat": "csv",
-                  "lvm": "lvm", "tdms": "tdms"}
+                  "lvm": "lvm", "tdms": "tdms", "mat": "mat", "hdf5": "mat", "parquet": "parquet",
+                  "xlsx": "xlsx", "excel": "xlsx", "mdf": "mdf", "mf4": "mdf"}
 
 
 def file_bytes(path: Path) -> bytes:
@@ -50,14 +52,43 @@ def content_format(head: bytes) -> str | None:
     return "lvm" if text.lstrip().startswith(MAGIC["lvm"]) else None
 
 
-def choose_format(path: Path, format: str, head: bytes) -> str:
-    """Format to read (``"csv"``, ``"lvm"``, ``"tdms"``) from ``format`` (``"auto"``: the extension),
-    checked against ``head``; RigDataError on contradiction or a file cut inside its tag.
+def _binary_choice(path: Path, wanted: str, data: bytes) -> str | None:
+    """The binary format to read, None for the text and TDMS readers; RigDataError when content and
+    ``wanted`` (a format or ``"auto"``) disagree.
+    """
+    found = binary_format(data)
+    if found == "xls":
+        raise RigDataError("content is a legacy Excel .xls workbook (OLE), which is not read; save it as "
+                           ".xlsx", file=path)
+    if wanted == "auto":
+        if found is not None:
+            return found
+        wanted = EXTENSIONS.get(path.suffix.lower(), "auto")
+        said = "extension"
+    else:
+        said = "format"
+    if found is not None and found != wanted:
+        raise RigDataError(f"content is {BINARY_NAMES[found]} but the format says {wanted}; pass "
+                           f"format={found!r}", file=path)
+    if wanted not in BINARY_FORMATS or found == wanted or wanted == "mat":  # MAT v4 has no signature
+        return found or (wanted if wanted == "mat" else None)
+    raise RigDataError(f"not {BINARY_NAMES[wanted]}: the {said} says {wanted} but the content does not "
+                       f"start like one ({len(data)} bytes, first {data[:16]!r})", file=path)
+
+
+def choose_format(path: Path, format: str, data: bytes) -> str:
+    """Format to read (``"csv"``, ``"lvm"``, ``"tdms"`` or a binary one) from ``format`` (``"auto"``:
+    the content for a binary format, else the extension), checked against ``data``; RigDataError on
+    contradiction or a file cut inside its tag.
     """
     suffix = path.suffix.lower()
     if suffix == ".tdms_index":
         raise RigDataError("is a TDMS index file; read the .tdms file next to it", file=path)
     wanted = FORMAT_ALIASES[format]
+    binary = _binary_choice(path, wanted, data)
+    if binary is not None:
+        return binary
+    head = data[:64]
     said = "format" if wanted != "auto" else f"extension {path.suffix or '(none)'!r}"
     if wanted == "auto":
         wanted = {".lvm": "lvm", ".tdms": "tdms"}.get(suffix, "csv")
@@ -89,7 +120,7 @@ def decode(data: bytes, path: Path) -> str:
     controls = sum(head.count(bytes([b])) for b in range(32) if b not in (9, 10, 12, 13, 26))
     if b"\x00" in head or controls > 0.02 * len(head):
         raise RigDataError(f"not a text file (binary content: {head[:16]!r}...); expected delimited "
-                           f"text, LVM or TDMS", file=path)
+                           f"text, LVM, TDMS, MATLAB .mat, Parquet, Excel .xlsx or ASAM MDF", file=path)
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError:

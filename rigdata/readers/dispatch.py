@@ -5,8 +5,10 @@
 from __future__ import annotations
 
 import hashlib
+import importlib
 from collections.abc import Mapping
 from pathlib import Path, PurePath
+from typing import Any
 
 import numpy as np
 
@@ -14,13 +16,18 @@ from rigdata.readers.assemble import to_record
 from rigdata.readers.channels import match_channels
 from rigdata.readers.delimited import read_delimited
 from rigdata.readers.detect import FORMAT_ALIASES, choose_format, decode, file_bytes
+from rigdata.readers.frame import frame_table
 from rigdata.readers.lvm import read_lvm
 from rigdata.readers.table import FORMATS, RawTable
-from rigdata.readers.tdms import read_tdms
 from rigdata.record import RigRecord
 from rigdata.transducer import PULSES_PER_REV, SENSITIVITY
 
-__all__ = ["read_table", "read"]
+__all__ = ["read_table", "read", "read_frame"]
+
+#: Module and function reading each binary format (imported on use: scipy and pandas load slowly).
+BINARY_READERS = {"tdms": ("tdms", "read_tdms"), "mat": ("matlab", "read_mat"),
+                  "parquet": ("columnar", "read_parquet"), "xlsx": ("columnar", "read_xlsx"),
+                  "mdf": ("mdf", "read_mdf")}
 
 
 def read_table(path: str | Path, format: str = "auto") -> RawTable:
@@ -29,8 +36,9 @@ def read_table(path: str | Path, format: str = "auto") -> RawTable:
     Parameters
     ----------
     path : str or Path
-    format : {"auto", "csv", "lvm", "tdms"}
-        ``"auto"`` goes by the extension (else delimited text); contradicting content is an error.
+    format : {"auto", "csv", "lvm", "tdms", "mat", "parquet", "xlsx", "mdf"}
+        ``"auto"``: MATLAB, HDF5, Parquet, Excel and MDF by their first bytes, the others by the
+        extension (else delimited text); content contradicting a format is an error.
 
     Returns
     -------
@@ -47,10 +55,11 @@ def read_table(path: str | Path, format: str = "auto") -> RawTable:
         raise TypeError(f"`path` must be a str or pathlib.Path naming a rig file, got {path!r:.80}")
     path = Path(path)
     data = file_bytes(path)
-    fmt = choose_format(path, format, data[:64])
+    fmt = choose_format(path, format, data)
     sha = hashlib.sha256(data).hexdigest()
-    if fmt == "tdms":
-        return read_tdms(path, data, sha)
+    if fmt in BINARY_READERS:
+        module, function = BINARY_READERS[fmt]
+        return getattr(importlib.import_module(f"rigdata.readers.{module}"), function)(path, data, sha)
     text = decode(data, path)
     return read_lvm(path, text, sha) if fmt == "lvm" else read_delimited(path, text, sha)
 
@@ -63,8 +72,9 @@ def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | Non
     Parameters
     ----------
     path : str or Path
-        Delimited text (``.csv``, ``.tsv``, ``.txt``, ``.dat``), ``.lvm`` or ``.tdms``.
-    format : {"auto", "csv", "lvm", "tdms"}
+        Delimited text (``.csv``, ``.tsv``, ``.txt``, ``.dat``), ``.lvm``, ``.tdms``, MATLAB ``.mat``,
+        Parquet, Excel ``.xlsx`` or ASAM MDF (``.mf4``, ``.mdf``).
+    format : {"auto", "csv", "lvm", "tdms", "mat", "parquet", "xlsx", "mdf"}
         See :func:`read_table`.
     mapping : mapping of str to str or None, optional
         Channel (or ``"time"``) -> column; others recognised (:func:`recognise`); None drops one.
@@ -91,6 +101,43 @@ def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | Non
     """
     _check_read_arguments(sensitivity, pulses_per_rev, mapping, units)
     raw = read_table(path, format)
+    chosen = match_channels(raw, mapping)
+    return to_record(raw, chosen, dict(units or {}), sensitivity, pulses_per_rev)
+
+
+def read_frame(frame: Any, mapping: Mapping[str, str | None] | None = None,
+               units: Mapping[str, str] | None = None, metadata: Mapping[str, Any] | None = None,
+               sensitivity: float = SENSITIVITY, pulses_per_rev: int = PULSES_PER_REV,
+               name: str = "<frame>") -> RigRecord:
+    """Read a table from the caller's own loader into a validated record, like :func:`read`.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame or mapping of str to 1-D array
+        Columns by name, recognised as in a file (``"Time [s]"``, ``"Torque In [N m]"``, ...);
+        datetime columns become seconds from the first sample.
+    mapping, sensitivity, pulses_per_rev
+        As for :func:`read`.
+    units : mapping of str to str, optional
+        Unit by channel or column name, over a ``[unit]`` in the column name.
+    metadata : mapping, optional
+        Key/value header (a sample rate when there is no time column; ``synthetic`` labels).
+    name : str
+        What the record's ``file`` says.
+
+    Returns
+    -------
+    RigRecord
+        ``provenance["format"]`` is ``"frame"``; ``sha256`` hashes the columns.
+
+    Raises
+    ------
+    RigDataError
+        A frame that is not a table, or bad data, naming the channel.
+    """
+    _check_read_arguments(sensitivity, pulses_per_rev, mapping, units)
+    raw = frame_table(frame, str(name), "frame", units=units, metadata=metadata,
+                      reader={"name": "read_frame", "version": f"of a {type(frame).__name__}"})
     chosen = match_channels(raw, mapping)
     return to_record(raw, chosen, dict(units or {}), sensitivity, pulses_per_rev)
 

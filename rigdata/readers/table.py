@@ -14,7 +14,7 @@ from rigdata.record import RigDataError
 
 __all__ = ["FORMATS", "NUMBER", "RawTable", "TextCells", "find_text_cells", "cell_value", "is_number"]
 
-FORMATS = ("csv", "lvm", "tdms")
+FORMATS = ("csv", "lvm", "tdms", "mat", "parquet", "xlsx", "mdf")
 #: How many non-numeric cells of a column a RawTable keeps the text of.
 KEEP_TEXT = 5
 #: Cell texts that mark a missing value (NaN in the column, not an error by themselves).
@@ -50,7 +50,7 @@ class RawTable:
     Attributes
     ----------
     file : str
-    format : {"csv", "lvm", "tdms"}
+    format : {"csv", "lvm", "tdms", "mat", "parquet", "xlsx", "mdf", "frame"}
     time : str or None
         Time column name; None: time from :attr:`sampling` or the header's rate.
     columns : dict of str to ndarray
