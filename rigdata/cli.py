@@ -134,9 +134,24 @@ def _inspection(rec: rigdata.RigRecord) -> dict[str, Any]:
     }
 
 
+def _held(args: argparse.Namespace) -> dict[str, dict[str, Any]]:
+    """Every column (variable, channel) of ``FILE`` with its unit as written and its sample count."""
+    raw = rigdata.read_table(args.file, format=args.format)
+    return {name: {"unit": raw.units.get(name), "samples": int(values.size)}
+            for name, values in raw.columns.items()}
+
+
+def _print_held(held: dict[str, dict[str, Any]]) -> None:
+    """The file's columns, one line each."""
+    print(f"  {len(held)} columns in the file:")
+    for name, c in held.items():
+        print(f"    {name!r} [{c['unit'] or 'no unit'}], {c['samples']} samples")
+
+
 def cmd_inspect(args: argparse.Namespace) -> int:
-    """``cardan rig inspect``: channels, units, rate, duration, revolutions of a file."""
-    info = _inspection(_read(args))
+    """``cardan rig inspect``: channels, units, rate, duration, revolutions, and every column of a file."""
+    info = {**_inspection(_read(args)), "columns": _held(args)}
+    held = info["columns"]
     if args.json:
         print(json.dumps(info, indent=2))
         return EXIT_OK
@@ -148,6 +163,7 @@ def cmd_inspect(args: argparse.Namespace) -> int:
         print(f"  {name:<11} <- {c['column']!r} [{c['unit']}] {c['conversion']}"
               + (f", resolution {math.degrees(c['quantum']):.3g} deg" if c["quantum"] else "")
               + f"; mean {c['mean']:.6g}")
+    _print_held(held)
     return EXIT_OK
 
 
@@ -284,8 +300,10 @@ def cmd_synthetic(args: argparse.Namespace) -> int:
 
 def _file_options(p: argparse.ArgumentParser) -> None:
     """``FILE`` and how to read it (every rig command but ``synthetic``)."""
-    p.add_argument("file", metavar="FILE", help="rig file: delimited text, LabVIEW .lvm or NI .tdms")
-    p.add_argument("--format", choices=("auto", "csv", "lvm", "tdms"), default="auto")
+    p.add_argument("file", metavar="FILE", help="rig file: delimited text, LabVIEW .lvm, NI .tdms, MATLAB "
+                                                "(.mat, v7.3), Parquet, Excel .xlsx or ASAM MDF 3/4")
+    p.add_argument("--format", choices=("auto", "csv", "lvm", "tdms", "mat", "parquet", "xlsx", "mdf"),
+                   default="auto", help="auto (default): binary formats by content, others by extension")
     p.add_argument("--map", action="append", metavar="CHANNEL=COLUMN",
                    help="map a column to torque_in, torque_out, speed_in, speed_out, angle_in, angle_out")
     p.add_argument("--unit", action="append", metavar="CHANNEL=UNIT",

@@ -547,7 +547,7 @@ CASES: tuple[Case, ...] = (
          ("rig", "measure", "{d}/rig.csv", "--mc", "-1"),
          files=_RIG_FILE, match="--mc"),
     Case("rig-format-unknown", "cli", "unknown file format",
-         ("rig", "inspect", "{d}/rig.csv", "--format", "xlsx"),
+         ("rig", "inspect", "{d}/rig.csv", "--format", "sav"),
          files=_RIG_FILE, match="invalid choice"),
     Case("rig-synthetic-out-dir", "cli", "synthetic --out names an existing folder",
          ("rig", "synthetic", "--out", "{out}"), out="folder", match="is a directory"),
