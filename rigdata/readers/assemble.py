@@ -7,22 +7,27 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from rigdata.conversion import check_magnitudes, to_si
-from rigdata.readers.channels import MAP_HINT, channel_unit
+from rigdata.readers.channels import MAP_HINT, channel_unit, require_units
 from rigdata.readers.table import RawTable
 from rigdata.record import RATE_TOLERANCE, ChannelSource, RigDataError, RigRecord
 from rigdata.units import normalise, parse_unit, split_header
 
 __all__ = ["time_axis", "to_record"]
 
-RATE_KEYS = {"samplerate", "samplingrate", "samplingfrequency", "samplefrequency", "fs", "rate", "scanrate"}
+#: Header keys of a sample rate and interval (lower case, letters and digits only, accents removed):
+#: English, German (HBM catman's ``Messrate``), Italian, French.
+RATE_KEYS = {"samplerate", "samplingrate", "samplingfrequency", "samplefrequency", "fs", "rate", "scanrate",
+             "messrate", "abtastrate", "abtastfrequenz", "frequenzadicampionamento",
+             "frequencedechantillonnage"}
 INTERVAL_KEYS = {"dt", "deltax", "sampleinterval", "samplinginterval", "timestep", "timeincrement",
-                 "wfincrement", "sampleperiod", "samplingperiod", "interval"}
+                 "wfincrement", "sampleperiod", "samplingperiod", "interval", "abtastintervall"}
 START_KEYS = {"t0", "x0", "starttime", "wfstartoffset"}
 #: Rate units of a header's sample rate -> factor to Hz.
 RATE_UNITS = {"": 1.0, "hz": 1.0, "1/s": 1.0, "s^-1": 1.0, "s-1": 1.0, "sps": 1.0, "s/s": 1.0,
@@ -34,7 +39,8 @@ def _header_number(meta: Mapping[str, str], keys: set[str]) -> tuple[str, float,
     """A number from the header under one of ``keys`` (normalised): key, value, unit text."""
     for key, value in meta.items():
         bare, key_unit = split_header(key)
-        if re.sub(r"[^a-z0-9]", "", bare.lower()) not in keys:
+        plain = "".join(c for c in unicodedata.normalize("NFKD", bare) if not unicodedata.combining(c))
+        if re.sub(r"[^a-z0-9]", "", plain.lower()) not in keys:
             continue
         m = HEADER_NUMBER.match(str(value))
         if m:
@@ -146,6 +152,7 @@ def to_record(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str]
     ``pulses_per_rev`` [-]. RigDataError for a missing or wrong unit, bad time axis, absurd values.
     """
     n = _lengths(raw, chosen)
+    require_units(raw, chosen, units)
     time, time_info, assumptions = time_axis(raw, chosen, units, n)
     channels = {}
     sources = {}

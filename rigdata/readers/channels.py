@@ -5,6 +5,7 @@ and each column's and channel's unit.
 from __future__ import annotations
 
 import re
+import unicodedata
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -14,24 +15,40 @@ from rigdata.readers.table import RawTable
 from rigdata.record import CHANNELS, SHAFTS, RigDataError
 from rigdata.units import ACCEPTS, Unit, lookup, parse_unit, split_header
 
-__all__ = ["TIME_WORDS", "KIND_WORDS", "SIDE_WORDS", "MAP_HINT", "recognise", "time_column",
-           "column_unit", "channel_unit", "match_channels"]
+__all__ = ["TIME_WORDS", "TIME_NAMES", "KIND_WORDS", "SIDE_WORDS", "SIDE_NUMBERS", "HARDWARE_PREFIXES",
+           "MAP_HINT", "recognise", "time_column", "column_unit", "channel_unit", "match_channels",
+           "require_units"]
 
-# Vocabulary of channel recognition (tokens of a header's bare name, lower case).
-TIME_WORDS = {"time", "t", "zeit", "elapsed", "timestamp", "seconds"}
+# Vocabulary of channel recognition (tokens of a header's bare name, lower case, accents removed).
+TIME_WORDS = {"time", "t", "zeit", "elapsed", "timestamp", "timestamps", "seconds", "tempo", "temps"}
+#: Time channels that vendor software names with a number and a rate group (bare name, whole match).
+TIME_NAMES = {
+    "HBM catman": re.compile(r"(?:zeit|time)\s+\d+\s+-\s+\S.*", re.I),  # "Zeit  1 - Standardmessrate"
+}
 KIND_WORDS = {
-    "torque": {"torque", "trq", "tq", "moment", "drehmoment", "t", "m", "md"},
-    "speed": {"speed", "omega", "w", "n", "rpm", "velocity", "angvel", "drehzahl"},
+    "torque": {"torque", "trq", "tq", "moment", "drehmoment", "t", "m", "md", "coppia", "momento",
+               "couple"},
+    "speed": {"speed", "omega", "w", "n", "rpm", "velocity", "angvel", "drehzahl", "velocita", "giri",
+              "vitesse"},
     "angle": {"angle", "phi", "theta", "pulses", "pulse", "counts", "count", "cnt", "encoder", "enc",
-              "position", "pos", "winkel", "imp", "ticks"},
+              "position", "pos", "winkel", "imp", "ticks", "angolo"},
 }
 SIDE_WORDS = {
-    "in": {"in", "input", "1", "drive", "driving", "driver", "motor", "antrieb", "primary"},
-    "out": {"out", "output", "2", "brake", "load", "driven", "abtrieb", "secondary"},
+    "in": {"in", "input", "drive", "driving", "driver", "motor", "antrieb", "primary", "an", "eingang",
+           "ingresso", "entree"},
+    "out": {"out", "output", "brake", "load", "driven", "abtrieb", "secondary", "ab", "ausgang", "uscita",
+            "sortie"},
+}
+#: Shaft numbers ("Trq1", "n2"): a side only when the name has no side word.
+SIDE_NUMBERS = {"in": {"1"}, "out": {"2"}}
+#: Hardware-channel prefixes vendor software puts before a channel's name; dropped before recognition,
+#: their number is a connector, never a side.
+HARDWARE_PREFIXES = {
+    "DEWESoft": re.compile(r"(?:ai|ao|di|do|cnt|can|acc|math)\s*\d+\s*/\s*", re.I),  # "CNT 1/Speed_Out"
 }
 #: Words that may stand next to a side word when the kind comes from the unit ("Drive [N m]").
 FILLER = {"shaft", "side", "sensor", "transducer", "signal", "tmb", "magtrol", "measured", "meas"}
-ALL_SIDES = set().union(*SIDE_WORDS.values())
+ALL_SIDES = set().union(*SIDE_WORDS.values(), *SIDE_NUMBERS.values())
 #: Kind words that may be glued to a side word ("torquein", "speedout"), longest first.
 COMPOUND_KINDS = sorted({k for ks in KIND_WORDS.values() for k in ks if len(k) >= 3}, key=len, reverse=True)
 #: How to name a channel's column, for error messages (format with ``ch``).
@@ -42,8 +59,11 @@ UNIT_EXAMPLES = {"torque": ["N m", "V"], "speed": ["rad/s", "rpm", "pulses/s"],
 
 
 def tokens(name: str) -> list[str]:
-    """Words of a bare column name: camelCase, letters/digits and punctuation split, lower case."""
-    s = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", name)
+    """Words of a bare column name: camelCase, letters/digits and punctuation split, lower case, accents
+    removed (``Velocità`` -> ``velocita``).
+    """
+    s = "".join(c for c in unicodedata.normalize("NFKD", name) if not unicodedata.combining(c))
+    s = re.sub(r"(?<=[a-z])(?=[A-Z])", " ", s)
     s = re.sub(r"(?<=[A-Za-z])(?=\d)|(?<=\d)(?=[A-Za-z])", " ", s)
     words = [t for t in re.split(r"[^0-9a-z]+", s.lower()) if t]
     out = []
@@ -71,24 +91,26 @@ def is_time(words: list[str]) -> bool:
 def recognise(header: str, unit: str | None = None) -> str | None:
     """The record channel a column header names, ``"time"``, or None.
 
-    Case, separators, camelCase and a unit annotation do not matter:
+    Case, accents, separators, camelCase and a unit annotation do not matter; a hardware-channel
+    prefix (:data:`HARDWARE_PREFIXES`, ``CNT 1/``) is dropped. The words are those of
+    :data:`TIME_WORDS`, :data:`KIND_WORDS` and :data:`SIDE_WORDS` (English, German, Italian, French),
+    and the vendor time names of :data:`TIME_NAMES`.
 
-    * time: ``time``, ``t``, ``Time [s]``, ``time_ms``, ``X_Value``, ``Zeit``, ``elapsed``;
-    * kind: torque (``torque``, ``trq``, ``tq``, ``T``, ``M``, ``moment``), speed (``speed``,
-      ``omega``, ``w``, ``n``, ``rpm``, ``velocity``), angle (``angle``, ``phi``, ``theta``,
-      ``pulses``, ``counts``, ``cnt``, ``encoder``, ``position``);
-    * side: input (``in``, ``input``, ``1``, ``drive``, ``motor``), output (``out``,
-      ``output``, ``2``, ``brake``, ``load``, ``driven``).
-
-    Exactly one side and one kind (``Trq1``, ``Brake torque``, ``n2``); with a side and no or two
-    kinds, ``unit`` (or the header's) decides (``Drive [N m]``).
+    Exactly one side and one kind (``Trq1``, ``Brake torque``, ``Drehzahl_Ab``); a side word outranks
+    a shaft number (:data:`SIDE_NUMBERS`); with a side and no or two kinds, ``unit`` (or the header's)
+    decides (``Drive [N m]``).
     """
     bare, annotated = split_header(header)
+    if any(p.fullmatch(bare.strip()) for p in TIME_NAMES.values()):
+        return "time"
+    for prefix in HARDWARE_PREFIXES.values():
+        bare = prefix.sub("", bare.strip(), count=1) if prefix.match(bare.strip()) else bare
     words_list = tokens(bare)
     if is_time(words_list):
         return "time"
     words = set(words_list)
-    sides = [s for s, w in SIDE_WORDS.items() if w & words]
+    sides = [s for s, w in SIDE_WORDS.items() if w & words] or [
+        s for s, w in SIDE_NUMBERS.items() if w & words]
     if len(sides) != 1:
         return None
     kinds = {k for k, w in KIND_WORDS.items() if w & words}
@@ -96,7 +118,7 @@ def recognise(header: str, unit: str | None = None) -> str | None:
     by_unit = {k for k, q in ACCEPTS.items() if found is not None and found.quantity in q} - {"time"}
     if len(kinds) > 1:
         kinds &= by_unit
-    elif not kinds and not (words - SIDE_WORDS[sides[0]] - FILLER):
+    elif not kinds and not (words - SIDE_WORDS[sides[0]] - SIDE_NUMBERS[sides[0]] - FILLER):
         kinds = by_unit
     return f"{kinds.pop()}_{sides[0]}" if len(kinds) == 1 else None
 
@@ -137,6 +159,26 @@ def channel_unit(raw: RawTable, column: str, channel: str, units: Mapping[str, s
                            f"(read(..., units={{{channel!r}: UNIT}})), e.g. "
                            f"{', '.join(UNIT_EXAMPLES[kind])}", file=raw.file, channel=channel)
     return parse_unit(stated, kind=kind, column=column, file=raw.file, channel=channel)
+
+
+def require_units(raw: RawTable, chosen: Mapping[str, str], units: Mapping[str, str]) -> None:
+    """RigDataError naming every chosen channel (time aside: seconds assumed) whose column states no unit
+    and that ``units`` does not give, with the options that give them all.
+    """
+    missing = {ch: col for ch, col in chosen.items() if ch != "time" and raw.units.get(col) is None
+               and units.get(ch, units.get(col)) is None}
+    if len(missing) == 1:
+        ch, col = next(iter(missing.items()))
+        channel_unit(raw, col, ch, units)  # its one-channel message
+    if not missing:
+        return
+    columns = ", ".join(f"{col!r} ({ch})" for ch, col in missing.items())
+    options = " ".join(f"--unit {ch}=UNIT" for ch in missing)
+    given = ", ".join(f"{ch!r}: UNIT" for ch in missing)
+    kinds = dict.fromkeys(ch.split("_")[0] for ch in missing)
+    examples = "; ".join(f"{k}: {', '.join(UNIT_EXAMPLES[k])}" for k in kinds)
+    raise RigDataError(f"no unit: columns {columns} state none; give them with {options} "
+                       f"(read(..., units={{{given}}})), e.g. {examples}", file=raw.file)
 
 
 def _key(text: str) -> str:
