@@ -14,6 +14,7 @@ import numpy as np
 
 from rigdata.readers.channels import column_unit, time_column
 from rigdata.readers.table import RawTable, TextCells, find_text_cells, is_number
+from rigdata.readers.timestamps import timestamp_seconds
 from rigdata.record import RigDataError
 from rigdata.units import lookup
 
@@ -193,15 +194,22 @@ def _frame(lines: list[str], rows: list[int], lay: Layout, path: Path) -> Any:
         raise RigDataError(f"cannot parse the data rows (pandas: {exc})", file=path) from exc
 
 
-def _column(series: Any, decimal: str, file_lines: list[int]) -> tuple[np.ndarray, TextCells | None]:
-    """A parsed column as floats, and its text cells."""
+def _column(series: Any, decimal: str,
+            file_lines: list[int]) -> tuple[np.ndarray, TextCells | None, str | None]:
+    """A parsed column as floats, its text cells, and the first of its absolute timestamps (then the
+    floats are seconds from it).
+    """
     if series.dtype.kind in "biuf":
-        return series.to_numpy(dtype=float), None
+        return series.to_numpy(dtype=float), None, None
+    cells = series.to_list()
+    stamps = timestamp_seconds(cells) if all(isinstance(c, str) for c in cells) else None
+    if stamps is not None:
+        return stamps[0], None, stamps[1]
     cleaned = series.astype(object).where(series.notna(), None)
     if decimal == ",":
         cleaned = cleaned.map(lambda s: s.replace(",", ".") if isinstance(s, str) else s)
     values = _pandas().to_numeric(cleaned, errors="coerce").to_numpy(dtype=float)
-    return values, find_text_cells(series.to_numpy(dtype=object), values, file_lines)
+    return values, find_text_cells(series.to_numpy(dtype=object), values, file_lines), None
 
 
 def _notes(lay: Layout) -> tuple[str, ...]:
@@ -222,14 +230,19 @@ def read_delimited(path: Path, text: str, sha: str) -> RawTable:
     units = {}
     text_cells = {}
     file_lines = [k + 1 for k in rows]
+    notes = list(_notes(lay))
     for i, name in enumerate(names):
-        values, cells = _column(frame[i], lay.decimal, file_lines)
+        values, cells, first_stamp = _column(frame[i], lay.decimal, file_lines)
         if cells:
             text_cells[name] = cells
         if not headers[i] and np.all(np.isnan(values)) and name not in text_cells:
             continue  # an empty column after a trailing separator
         columns[name] = values
         units[name] = column_unit(name, row_units[i].strip("[](){} ") or None)
+        if first_stamp is not None:
+            units[name] = "s"
+            notes.append(f"column {name!r}: absolute timestamps from {first_stamp} converted to seconds "
+                         f"from the first")
     meta = preamble(lines[:lay.header], lay.sep)
     return RawTable(str(path), "csv", time_column(columns), columns, units, meta, text_cells, {},
-                    {"name": "pandas", "version": _pandas().__version__}, sha, _notes(lay))
+                    {"name": "pandas", "version": _pandas().__version__}, sha, tuple(notes))
