@@ -305,7 +305,8 @@ def _file_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--format", choices=("auto", "csv", "lvm", "tdms", "mat", "parquet", "xlsx", "mdf"),
                    default="auto", help="auto (default): binary formats by content, others by extension")
     p.add_argument("--map", action="append", metavar="CHANNEL=COLUMN",
-                   help="map a column to torque_in, torque_out, speed_in, speed_out, angle_in, angle_out")
+                   help="map a column to time, torque_in, torque_out, speed_in, speed_out, angle_in, "
+                        "angle_out (COLUMN as in the header)")
     p.add_argument("--unit", action="append", metavar="CHANNEL=UNIT",
                    help="unit of a channel where the file does not state it, e.g. speed_in=rpm")
     p.add_argument("--sensitivity", type=arguments.number("V/(N m)", positive=True), default=0.1,
