@@ -35,6 +35,10 @@ BAD_INPUT = (SceneError, BadInput, OutputError, EngineUnavailable, FileNotFoundE
              PermissionError)
 
 
+#: ``rigdata.synthetic.FORMATS``, spelled here so that parsing loads neither scipy nor pandas.
+SYNTHETIC_FORMATS = ("csv", "lvm", "tdms", "mat", "parquet")
+
+
 def _settings(cls: type, **kwargs: Any) -> Any:
     """A settings object (Conditioning, Transducer, RigSettings); a value it refuses is bad input."""
     try:
@@ -279,22 +283,40 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return EXIT_OK if v.success and v.measurement_usable else EXIT_FAILED
 
 
+def _synthetic_settings(args: argparse.Namespace) -> rigdata.RigSettings:
+    """The synthetic rig's settings from the options (``--rpm``/``--seconds`` converted to rad/s and
+    revolutions: the file spans ``revolutions + 0.25``)."""
+    speed = args.speed if args.rpm is None else args.rpm * 2.0 * math.pi / 60.0
+    revolutions = args.revolutions
+    if args.seconds is not None:
+        revolutions = args.seconds * speed / (2.0 * math.pi) - 0.25
+        if revolutions < 1.6:
+            raise BadInput(f"--seconds {args.seconds:g} at {speed:g} rad/s is {revolutions + 0.25:.3g} "
+                           f"revolutions; at least 1.85 are needed (1.6 after settling)")
+    exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
+    load = {"input_torque": args.input_torque} if args.load is None else {"load_torque": args.load}
+    return _settings(rigdata.RigSettings, scene=args.scene, shaft_angle_deg=args.angle, speed=speed,
+                     friction=args.friction, rate=args.rate, noise=args.noise, revolutions=revolutions,
+                     seed=args.seed, speed_channel=args.speed_channel,
+                     torque_out_sign=args.torque_out_sign, **load, **exact)
+
+
 def cmd_synthetic(args: argparse.Namespace) -> int:
-    """``cardan rig synthetic``: write a synthetic rig file, labelled as such."""
+    """``cardan rig synthetic``: write a synthetic rig file, labelled as such with its settings."""
     out = Path(args.out)
     if out.is_dir():
         raise BadInput(f"--out {args.out!r} is a directory; give the name of the file to write")
     if not out.parent.is_dir():
         raise BadInput(f"--out {args.out!r}: the folder {str(out.parent)!r} does not exist")
-    exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
-    settings = _settings(rigdata.RigSettings, revolutions=args.revolutions, seed=args.seed,
-                         speed_channel=args.speed_channel, **exact)
-    used = rigdata.synthetic.write(args.out, args.format, settings)
+    settings = _synthetic_settings(args)
+    transducer, _ = _transducers(args)
+    used = rigdata.synthetic.write(args.out, args.format, settings, transducer)
     if args.json:
         print(json.dumps(used, indent=2))
     else:
         print(f"wrote {args.out} (SYNTHETIC, {args.format}): true efficiency "
-              f"{used['true_efficiency']:.6f}, offsets {used['offsets']} N m", file=sys.stderr)
+              f"{used['true_efficiency']:.6f}, brake {used['brake_torque']:.6g} N m, offsets "
+              f"{used['offsets']} N m", file=sys.stderr)
     return EXIT_OK
 
 
@@ -329,6 +351,16 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--settle", type=arguments.number("rev", non_negative=True), default=0.25,
                    help="input revolutions dropped at each end (default 0.25)")
     p.add_argument("--derivative", choices=("savgol", "spline"), default="savgol")
+    _transducer_options(p)
+    p.add_argument("--mc", type=arguments.count("--mc", minimum=0), default=2000,
+                   help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only; at most "
+                        f"{arguments.COUNT_LIMITS['--mc']})")
+    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=0,
+                   help="seed of the Monte Carlo draws")
+
+
+def _transducer_options(p: argparse.ArgumentParser) -> None:
+    """Full scale, accuracy class, zero drift and speed accuracy of the transducers."""
     p.add_argument("--full-scale", type=arguments.number("N m", positive=True), default=100.0,
                    help="transducer full scale [N m] (default 100, paper)")
     p.add_argument("--accuracy-class", type=arguments.number("%", non_negative=True, maximum=100.0),
@@ -340,11 +372,6 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
                    default=0.1,
                    help="speed channel gain error limit [%% of reading] (default 0.1, assumed; not "
                         "used for pulse counts)")
-    p.add_argument("--mc", type=arguments.count("--mc", minimum=0), default=2000,
-                   help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only; at most "
-                        f"{arguments.COUNT_LIMITS['--mc']})")
-    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=0,
-                   help="seed of the Monte Carlo draws")
 
 
 def _validate_options(p: argparse.ArgumentParser) -> None:
@@ -362,13 +389,50 @@ def _validate_options(p: argparse.ArgumentParser) -> None:
 def _synthetic_options(p: argparse.ArgumentParser) -> None:
     """The file to write and the synthetic rig's settings (``synthetic``)."""
     p.add_argument("--out", required=True, metavar="FILE")
-    p.add_argument("--format", choices=("csv", "lvm", "tdms"), default="csv")
-    p.add_argument("--revolutions", type=arguments.number("rev", positive=True), default=5.0)
+    p.add_argument("--format", choices=SYNTHETIC_FORMATS, default="csv")
+    p.add_argument("--scene", default="rig", metavar="NAME|FILE",
+                   help="the joint: a named scene or a scene TOML file (default rig)")
+    p.add_argument("--angle", type=_synthetic_angle, default=None, help="shaft angle [deg] (default: the scene's)")
+    speed = p.add_mutually_exclusive_group()
+    speed.add_argument("--speed", type=arguments.number("rad/s", positive=True), default=6.0,
+                       help="mean input speed [rad/s] (default 6)")
+    speed.add_argument("--rpm", type=arguments.number("rpm", positive=True), help="mean input speed [rpm]")
+    load = p.add_mutually_exclusive_group()
+    load.add_argument("--input-torque", type=arguments.number("N m", positive=True), default=0.2,
+                      help="mean input torque [N m] the brake is set for (default 0.2, the paper's)")
+    load.add_argument("--load", type=arguments.number("N m", positive=True),
+                      help="constant brake torque on the output shaft [N m]")
+    p.add_argument("--friction", type=arguments.number("-", non_negative=True),
+                   help="friction coefficient of every pair (default: the scene's)")
+    p.add_argument("--rate", type=arguments.number("Hz", positive=True), default=1000.0,
+                   help="sample rate [Hz] (default 1000)")
+    length = p.add_mutually_exclusive_group()
+    length.add_argument("--revolutions", type=arguments.number("rev", positive=True), default=5.0,
+                        help="input revolutions driven (default 5; the file spans 0.25 more)")
+    length.add_argument("--seconds", type=arguments.number("s", positive=True),
+                        help="length of the file [s] (instead of --revolutions)")
+    p.add_argument("--noise", type=arguments.number("N m", non_negative=True), default=0.005,
+                   help="torque noise standard deviation [N m] (default 0.005)")
     p.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
+    p.add_argument("--torque-out-sign", type=int, choices=(1, -1), default=1,
+                   help="-1: the output torque recorded negative (read it with --sign torque_out=-1)")
+    _transducer_options(p)
+    p.add_argument("--sensitivity", type=arguments.number("V/(N m)", positive=True), default=0.1,
+                   help="torque output of the transducers [V/(N m)] (default 0.1, paper)")
+    p.add_argument("--pulses-per-rev", type=arguments.count("--pulses-per-rev"), default=60,
+                   help="speed pulses per revolution (default 60, paper)")
     p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=1,
                    help="seed of the drawn transducer errors and noise")
     p.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
     p.add_argument("--json", action="store_true", help="print the settings used as JSON")
+
+
+def _synthetic_angle(text: str) -> float:
+    """``--angle`` of ``synthetic``: a shaft angle in [0, 90) deg (no ``auto``)."""
+    value = _shaft_angle(text)
+    if value == "auto":
+        raise argparse.ArgumentTypeError("a synthetic file needs a shaft angle in [0, 90) deg, got 'auto'")
+    return value
 
 
 def register(sub: argparse._SubParsersAction) -> None:

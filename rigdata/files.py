@@ -1,4 +1,4 @@
-"""Atomic writers of rig files (delimited text, LVM, TDMS) that :mod:`rigdata.readers` reads back to
+"""Atomic writers of rig files (delimited text, LVM, TDMS, MATLAB v5, Parquet) that :mod:`rigdata.readers` reads back to
 the same numbers, units and metadata. A table is column name -> 1-D array with a time column [s];
 ``metadata`` (str -> str) goes to the preamble, LVM header or TDMS file properties.
 """
@@ -18,7 +18,7 @@ from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 from cardan_exudyn.outputs import atomic_open
 from rigdata.units import split_header
 
-__all__ = ["write_csv", "write_lvm", "write_tdms"]
+__all__ = ["write_csv", "write_lvm", "write_tdms", "write_mat", "write_parquet"]
 
 #: Column names recognised as time by the writers (the first such column is the time axis).
 _TIME_NAMES = ("time", "t", "x_value", "zeit")
@@ -175,4 +175,37 @@ def write_tdms(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: 
         objects.append(ChannelObject("Rig", name, values, properties=props))
     with atomic_open(path, "wb") as f, TdmsWriter(f) as writer:
         writer.write_segment(objects)
+    return Path(path)
+
+
+def _identifier(name: str) -> str:
+    """A MATLAB variable name for a column (``Torque In`` -> ``Torque_In``)."""
+    return "".join(c if c.isalnum() else "_" for c in name)
+
+
+def write_mat(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
+              metadata: Mapping[str, str]) -> Path:
+    """Write a MATLAB v5 ``.mat`` with ``scipy.io.savemat``: struct ``rig`` of column vectors, struct
+    ``units``, one text variable per metadata key. Returns ``path``.
+    """
+    from scipy.io import savemat  # scipy.io loads only for this format
+
+    columns, _ = _check(table, units, metadata)
+    rig = {_identifier(k): v for k, v in columns.items()}
+    unit_struct = {_identifier(k): units[k] for k in columns}
+    with atomic_open(path, "wb") as f:
+        savemat(f, {"rig": rig, "units": unit_struct, **{_identifier(k): v for k, v in metadata.items()}})
+    return Path(path)
+
+
+def write_parquet(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
+                  metadata: Mapping[str, str]) -> Path:
+    """Write Parquet with ``pandas.to_parquet`` (pyarrow): ``name [unit]`` columns, ``metadata`` in the
+    frame's ``attrs``. Returns ``path``.
+    """
+    columns, _ = _check(table, units, metadata)
+    frame = pd.DataFrame({f"{k} [{units[k]}]": v for k, v in columns.items()})
+    frame.attrs.update(metadata)
+    with atomic_open(path, "wb") as f:
+        frame.to_parquet(f)
     return Path(path)

@@ -21,9 +21,9 @@ from cardan_exudyn import engines
 from reference.engine.motion import input_motion
 from reference.engine.options import ReferenceOptions
 from reference.engine.table import columns_at
-from reference.paper.scenes import named_scene
 from reference.results.result import Result
 from reference.scene.drives import AngleDrive
+from reference.scene.joint import PAIR_NAMES
 from reference.scene.load import Load
 from reference.scene.mapping import replace as replace_field
 from reference.scene.scene import Scene
@@ -34,11 +34,11 @@ from rigdata.transducer import Transducer
 from rigdata.units import parse_unit
 
 __all__ = ["GENERATOR", "FORMATS", "MAX_SAMPLES", "RigSettings", "Truth", "motor_angle", "true_signals",
-           "measure", "metadata", "record", "write"]
+           "measure", "joint_scene", "metadata", "record", "write"]
 
 GENERATOR = "rigdata.synthetic 1"
 """The ``generator`` label of every synthetic file (name and version of this model)."""
-FORMATS = ("csv", "lvm", "tdms")
+FORMATS = ("csv", "lvm", "tdms", "mat", "parquet")
 """The file formats :func:`write` writes."""
 
 
@@ -49,7 +49,7 @@ class RigSettings:
     Attributes
     ----------
     scene : str
-        Named scene of the joint; its drive and load are replaced by motor and brake.
+        Named scene or scene TOML file of the joint; its drive and load are replaced by motor and brake.
     shaft_angle_deg : float or None
         Shaft angle [deg]; None: the scene's.
     speed : float
@@ -57,7 +57,11 @@ class RigSettings:
     ripple : tuple of float
         Relative motor speed ripple at 1x and 2x the input angle [-].
     input_torque : float
-        Target mean input torque [N m]; sets the brake torque.
+        Target mean input torque [N m]; sets the brake torque unless ``load_torque`` is given.
+    load_torque : float or None
+        Constant brake torque on the output shaft [N m]; None: from ``input_torque``.
+    friction : float or None
+        Friction coefficient of every pair [-]; None: the scene's.
     revolutions : float
         Input revolutions recorded [-].
     rate : float
@@ -72,6 +76,8 @@ class RigSettings:
         Offsets and zero drifts (input, output) [N m]; None: drawn within the transducer's limits.
     speed_channel : {"pulses", "rpm"}
         Pulse counts or a speed channel in rpm.
+    torque_out_sign : {1, -1}
+        Sign convention of the output torque column: -1 records the brake's torque as negative.
     seed : int
         Seed of the drawn errors and the noise.
     """
@@ -81,6 +87,8 @@ class RigSettings:
     speed: float = 6.0
     ripple: tuple = (0.01, 0.005)
     input_torque: float = 0.2
+    load_torque: float | None = None
+    friction: float | None = None
     revolutions: float = 5.0
     rate: float = 1000.0
     phase: float = 0.7
@@ -89,6 +97,7 @@ class RigSettings:
     offsets: tuple | None = None
     drifts: tuple | None = None
     speed_channel: str = "pulses"
+    torque_out_sign: int = 1
     seed: int = 1
 
     def __post_init__(self) -> None:
@@ -108,7 +117,20 @@ class RigSettings:
                 raise ValueError(f"`{name}` must be >= 0, got {getattr(self, name)!r}")
         if self.speed_channel not in ("pulses", "rpm"):
             raise ValueError(f"`speed_channel` must be 'pulses' or 'rpm', got {self.speed_channel!r}")
+        self._check_optional()
         self._check_size()
+
+    def _check_optional(self) -> None:
+        """ValueError for a load or friction that is not a positive/non-negative number, or a sign not +-1."""
+        for name, low in (("load_torque", "positive"), ("friction", ">= 0")):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            number = not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+            if not (number and math.isfinite(value) and (value > 0 or (low == ">= 0" and value == 0))):
+                raise ValueError(f"`{name}` must be {low} or None, got {value!r:.80}")
+        if isinstance(self.torque_out_sign, bool) or self.torque_out_sign not in (1, -1):
+            raise ValueError(f"`torque_out_sign` must be 1 or -1, got {self.torque_out_sign!r:.80}")
 
     def _check_types(self) -> None:
         """TypeError/ValueError for a setting of the wrong type."""
@@ -196,6 +218,27 @@ def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tupl
     return t, theta + settings.phase
 
 
+def joint_scene(settings: RigSettings) -> Scene:
+    """The settings' scene (name or TOML file) at their shaft angle and friction."""
+    from rigdata.validation import as_scene  # rigdata.validation loads the report code
+
+    changes = {}
+    if settings.shaft_angle_deg is not None:
+        changes["joint.geometry.shaft_angle_deg"] = settings.shaft_angle_deg
+    if settings.friction is not None:
+        changes.update({f"joint.pairs.{p}.friction_coefficient": settings.friction for p in PAIR_NAMES})
+    base = as_scene(settings.scene)
+    return replace_field(base, **changes) if changes else base
+
+
+def _run(scene: Scene) -> Result:
+    """The reference engine's run of ``scene``; ValueError when it fails."""
+    result = engines.run(scene, "reference")
+    if not result.success:
+        raise ValueError(f"the synthetic rig's model does not run: {result.message}")
+    return result
+
+
 def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
     """Brake torque [N m] for a mean input torque ``target`` [N m], and the engine's run with it.
 
@@ -203,11 +246,8 @@ def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
     """
     brake = target
     for _ in range(2):
-        result = engines.run(replace(scene, load=Load(brake)), "reference")
-        if not result.success:
-            raise ValueError(f"the synthetic rig's model does not run: {result.message}")
-        brake *= target / result.summary.mean_torque_in
-    return brake, engines.run(replace(scene, load=Load(brake)), "reference")
+        brake *= target / _run(replace(scene, load=Load(brake))).summary.mean_torque_in
+    return brake, _run(replace(scene, load=Load(brake)))
 
 
 def true_signals(settings: RigSettings) -> Truth:
@@ -215,12 +255,14 @@ def true_signals(settings: RigSettings) -> Truth:
     sampled on the rig's grid.
     """
     t_knots, angle = motor_angle(settings)
-    base = named_scene(settings.scene)
-    if settings.shaft_angle_deg is not None:
-        base = replace_field(base, **{"joint.geometry.shaft_angle_deg": settings.shaft_angle_deg})
+    base = joint_scene(settings)
     scene = replace(base, drive=AngleDrive(tuple(t_knots), tuple(angle)),
                     revolutions=1.0, record=replace(base.record, timeseries=False))
-    brake, result = _brake_torque(scene, settings.input_torque)
+    if settings.load_torque is None:
+        brake, result = _brake_torque(scene, settings.input_torque)
+    else:
+        brake = settings.load_torque
+        result = _run(replace(scene, load=Load(brake)))
     scene = replace(scene, load=Load(brake))
     t = np.arange(0.0, t_knots[-1] - 0.25 * 2 * math.pi / settings.speed, 1.0 / settings.rate)
     # the true signals on the rig's grid, from the engine's own closed-form input motion
@@ -286,7 +328,8 @@ def measure(truth: Truth, settings: RigSettings,
     ramp = (t - t[0]) / (t[-1] - t[0])
     table = {"Time": t - t[0]}
     units = {"Time": "s"}
-    for k, (name, torque) in enumerate((("In", truth.torque_in), ("Out", truth.torque_out))):
+    out = settings.torque_out_sign * truth.torque_out
+    for k, (name, torque) in enumerate((("In", truth.torque_in), ("Out", out))):
         table[f"Torque {name}"] = _torque_volts(torque, offsets[k], drifts[k] * ramp, settings,
                                                 transducer, rng)
         units[f"Torque {name}"] = "V"
@@ -303,7 +346,8 @@ def measure(truth: Truth, settings: RigSettings,
             units[f"Speed {name}"] = "rpm"
     # at an input edge the count reaches k q where the true angle is k q + angle[0] - start
     true_phase = float(truth.angle_in[0] - (encoder_start if settings.speed_channel == "pulses" else 0.0))
-    used = {**asdict(settings), "offsets": list(offsets), "drifts": list(drifts),
+    used = {**asdict(settings), "input_torque": None if settings.load_torque is not None else settings.input_torque,
+            "offsets": list(offsets), "drifts": list(drifts),
             "encoder_start": float(encoder_start), "true_phase": true_phase,
             "true_efficiency": truth.efficiency, "brake_torque": truth.brake_torque,
             "transducer": transducer.as_dict()}
@@ -364,8 +408,8 @@ def write(path, fmt: str, settings: RigSettings | None = None, transducer: Trans
     ----------
     path : str or path-like
         The file (replaced atomically).
-    fmt : {"csv", "lvm", "tdms"}
-        ``lvm`` is written with decimal comma.
+    fmt : {"csv", "lvm", "tdms", "mat", "parquet"}
+        ``lvm`` is written with decimal comma; ``mat`` is MATLAB v5 (scipy), ``parquet`` needs pyarrow.
     settings, transducer, truth : optional
         As for :func:`record`.
     """
@@ -381,10 +425,10 @@ def write(path, fmt: str, settings: RigSettings | None = None, transducer: Trans
     truth = truth or true_signals(settings)
     table, units, used = measure(truth, settings, transducer)
     meta = metadata(used)
-    if fmt == "csv":
-        files.write_csv(path, table, units, meta)
-    elif fmt == "lvm":
+    writers = {"csv": files.write_csv, "tdms": files.write_tdms, "mat": files.write_mat,
+               "parquet": files.write_parquet}
+    if fmt == "lvm":
         files.write_lvm(path, table, units, meta, decimal=",")
     else:
-        files.write_tdms(path, table, units, meta)
+        writers[fmt](path, table, units, meta)
     return used
