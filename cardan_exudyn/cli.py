@@ -312,10 +312,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    """The parsed command line ``argv``; a core command is parsed without the study modules and entry
-    points (import cost)."""
+    """The parsed command line ``argv``, itself kept as ``argv`` (for reports); a core command is parsed
+    without the study modules and entry points (import cost)."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    return build_parser(core_only=bool(argv) and argv[0] in CORE_COMMANDS).parse_args(argv)
+    args = build_parser(core_only=bool(argv) and argv[0] in CORE_COMMANDS).parse_args(argv)
+    args.argv = argv
+    return args
 
 
 def _run_command(args: argparse.Namespace) -> int:

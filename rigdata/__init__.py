@@ -1,6 +1,6 @@
 """Measured data from the test rig: readers, conditioning, measured efficiency, validation against the
 engines (``docs/rigdata.md``). ``rigdata.read``, ``read_frame``, ``measure``, ``validate``, ``write_report``,
-``synthetic.write``.
+``synthetic.write``, ``rerun``.
 
 Names load on first use (PEP 562): ``cardan`` imports ``rigdata.cli`` at every start, and the
 modules behind them pull in scipy, pandas and the engines (about a second).
@@ -12,7 +12,7 @@ from reference.lazy import lazy_face
 
 __all__ = ["read", "read_table", "read_frame", "measure", "Measurement", "validate", "Validation",
            "MODEL_ENGINES", "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer",
-           "Conditioning", "RigSettings", "synthetic", "RigDataWarning"]
+           "Conditioning", "RigSettings", "synthetic", "RigDataWarning", "rerun"]
 
 #: Public name -> the module that defines it (a name that is a module maps to itself).
 _WHERE = {
@@ -23,7 +23,7 @@ _WHERE = {
     "RigRecord": "rigdata.record", "RigDataError": "rigdata.record", "ChannelSource": "rigdata.record",
     "Transducer": "rigdata.transducer", "Conditioning": "rigdata.conditioning",
     "RigSettings": "rigdata.synthetic", "synthetic": "rigdata.synthetic",
-    "RigDataWarning": "rigdata.checks",
+    "RigDataWarning": "rigdata.checks", "rerun": "rigdata.reproduce",
 }
 
 

@@ -274,7 +274,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
             if isinstance(exc, rigdata.RigDataError):
                 raise
             raise BadInput(str(exc)) from None
-    s = rigdata.write_report(v, args.out)
+    command = ["cardan", *args.argv] if hasattr(args, "argv") else None
+    s = rigdata.write_report(v, args.out, command)
     if args.json:
         print(json.dumps(s, indent=2))
     else:

@@ -28,6 +28,7 @@ from rigdata.measurement import Source, as_record, measurement_findings
 from rigdata.model import computed_efficiency, measured_scene, model_sensitivities
 from rigdata.montecarlo import check_draws
 from rigdata.record import RigRecord, with_signs
+from rigdata.reproduce import model_settings, scene_entry
 from rigdata.transducer import PROVENANCE, Transducer
 
 __all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare",
@@ -150,14 +151,15 @@ class Validation:
         return all(comp["status"] == Status.OK for comp in self.computed.values())
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON summary (``validation.json``): file, provenance, conditioning, measured and computed
-        efficiencies, comparisons, sensitivities, assumptions.
+        """JSON summary (``validation.json``): file and its SHA-256, provenance, conditioning, measured and
+        computed efficiencies, comparisons, sensitivities, assumptions; the model ``scene`` run
+        (:func:`rigdata.reproduce.scene_entry`) and its ``model`` shaft angle and friction.
         """
         rec = self.record
         cond = self.conditioned
         meas = self.measured
         out = {
-            "file": str(rec.file),
+            "file": str(rec.file), "file_sha256": rec.provenance.get("sha256"),
             "status": next((f.status for f in self.findings if not f.ok), "ok"),
             "checks": [f.as_dict() for f in self.findings],
             "provenance": {k: val for k, val in rec.provenance.items()
@@ -174,6 +176,7 @@ class Validation:
             "model_sensitivities": self.sensitivities,
             "accuracy_class_for_u_0.01": accuracy_needed(meas),
             "assumptions": PROVENANCE,
+            "model": model_settings(self.scene), "scene": scene_entry(self.scene),
         }
         return to_jsonable(out)
 
