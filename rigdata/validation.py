@@ -271,7 +271,9 @@ def _run_models(cond: Conditioned, base: Scene, model: Scene, engines: tuple[str
             continue
         if sens is None:
             say("model sensitivities (load offset, yoke half turn)")
-            sens = model_sensitivities(cond, base, pair[1].accuracy_limit / SQRT3,
-                                       _ok_efficiency(computed.get("reference")))
+            # the load offset's standard uncertainty as the differencing step; with accuracy
+            # class 0 it is zero and any finite step gives the (then unused) sensitivity
+            step = pair[1].accuracy_limit / SQRT3 or 1e-3 * pair[1].full_scale
+            sens = model_sensitivities(cond, base, step, _ok_efficiency(computed.get("reference")))
         comparisons[engine] = compare(measured, computed[engine], sens)
     return computed, comparisons, sens or {}

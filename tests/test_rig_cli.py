@@ -88,6 +88,23 @@ def test_validate_writes_the_report(lvm, tmp_path):
     assert s["computed"]["reference"]["mean_efficiency"] == pytest.approx(used["true_efficiency"], abs=2e-3)
 
 
+def test_validate_with_a_perfect_torque_class(tmp_path):
+    """An accuracy class of 0 (no load-offset uncertainty) validates: the model's sensitivity to
+    the load offset is differenced over a finite step and contributes nothing."""
+    path = tmp_path / "class0.lvm"
+    proc = cardan("synthetic", "--format", "lvm", "--revolutions", "3", "--accuracy-class", "0",
+                  "--out", str(path), "--json")
+    assert proc.returncode == 0, proc.stderr
+    used = json.loads(proc.stdout)
+    out = tmp_path / "class0"
+    proc = cardan("validate", str(path), "--angle", "15", "--engines", "reference", "--mc", "0",
+                  "--accuracy-class", "0", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    s = json.loads((out / "validation.json").read_text())
+    assert s["computed"]["reference"]["mean_efficiency"] == pytest.approx(used["true_efficiency"], abs=2e-3)
+
+
 def test_validate_takes_the_users_joint_as_a_scene_file(lvm, tmp_path):
     """--scene takes a scene file (the user's own joint): the model is that joint, with the
     file's friction and shaft angle (no --angle given), and gives what the Python API gives on
