@@ -393,7 +393,8 @@ def _synthetic_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--format", choices=SYNTHETIC_FORMATS, default="csv")
     p.add_argument("--scene", default="rig", metavar="NAME|FILE",
                    help="the joint: a named scene or a scene TOML file (default rig)")
-    p.add_argument("--angle", type=_synthetic_angle, default=None, help="shaft angle [deg] (default: the scene's)")
+    p.add_argument("--angle", type=_synthetic_angle, default=None,
+                   help="shaft angle [deg] (default: the scene's)")
     speed = p.add_mutually_exclusive_group()
     speed.add_argument("--speed", type=arguments.number("rad/s", positive=True), default=6.0,
                        help="mean input speed [rad/s] (default 6)")

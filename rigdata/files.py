@@ -1,6 +1,7 @@
-"""Atomic writers of rig files (delimited text, LVM, TDMS, MATLAB v5, Parquet) that :mod:`rigdata.readers` reads back to
-the same numbers, units and metadata. A table is column name -> 1-D array with a time column [s];
-``metadata`` (str -> str) goes to the preamble, LVM header or TDMS file properties.
+"""Atomic writers of rig files (delimited text, LVM, TDMS, MATLAB v5, Parquet) that
+:mod:`rigdata.readers` reads back to the same numbers, units and metadata. A table is column
+name -> 1-D array with a time column [s]; ``metadata`` (str -> str) goes to the preamble, LVM
+header or TDMS file properties.
 """
 
 from __future__ import annotations

@@ -346,7 +346,8 @@ def measure(truth: Truth, settings: RigSettings,
             units[f"Speed {name}"] = "rpm"
     # at an input edge the count reaches k q where the true angle is k q + angle[0] - start
     true_phase = float(truth.angle_in[0] - (encoder_start if settings.speed_channel == "pulses" else 0.0))
-    used = {**asdict(settings), "input_torque": None if settings.load_torque is not None else settings.input_torque,
+    input_torque = None if settings.load_torque is not None else settings.input_torque
+    used = {**asdict(settings), "input_torque": input_torque,
             "offsets": list(offsets), "drifts": list(drifts),
             "encoder_start": float(encoder_start), "true_phase": true_phase,
             "true_efficiency": truth.efficiency, "brake_torque": truth.brake_torque,
