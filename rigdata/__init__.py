@@ -10,13 +10,15 @@ from __future__ import annotations
 
 from reference.lazy import lazy_face
 
-__all__ = ["read", "read_table", "read_frame", "measure", "Measurement", "validate", "Validation",
+__all__ = ["read", "read_table", "read_frame", "record_of_table", "measure", "Measurement", "validate",
+           "Validation",
            "MODEL_ENGINES", "write_report", "RigRecord", "RigDataError", "ChannelSource", "Transducer",
            "Conditioning", "RigSettings", "synthetic", "RigDataWarning", "rerun"]
 
 #: Public name -> the module that defines it (a name that is a module maps to itself).
 _WHERE = {
     "read": "rigdata.readers", "read_table": "rigdata.readers", "read_frame": "rigdata.readers",
+    "record_of_table": "rigdata.readers",
     "measure": "rigdata.measurement", "Measurement": "rigdata.measurement",
     "validate": "rigdata.validation", "Validation": "rigdata.validation",
     "MODEL_ENGINES": "rigdata.validation", "write_report": "rigdata.report",

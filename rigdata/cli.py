@@ -69,12 +69,15 @@ def _shaft_angle(text: str) -> float | str:
     return value
 
 
-def _read(args: argparse.Namespace) -> rigdata.RigRecord:
-    """The record of ``FILE`` with the file options; a refused option is :class:`BadInput`."""
+def _read(args: argparse.Namespace, raw: Any = None) -> rigdata.RigRecord:
+    """The record of ``FILE`` (or of its table ``raw``, already read) with the file options; a
+    refused option is :class:`BadInput`."""
+    options = {"mapping": _pairs(args.map, "--map") or None, "units": _pairs(args.unit, "--unit") or None,
+               "sensitivity": args.sensitivity, "pulses_per_rev": args.pulses_per_rev}
     try:
-        return rigdata.read(args.file, format=args.format, mapping=_pairs(args.map, "--map") or None,
-                            units=_pairs(args.unit, "--unit") or None, sensitivity=args.sensitivity,
-                            pulses_per_rev=args.pulses_per_rev)
+        if raw is None:
+            return rigdata.read(args.file, format=args.format, **options)
+        return rigdata.record_of_table(raw, **options)
     except rigdata.RigDataError:
         raise
     except ValueError as exc:  # read() refuses its arguments (a --map channel, ...) with ValueError
@@ -138,9 +141,9 @@ def _inspection(rec: rigdata.RigRecord) -> dict[str, Any]:
     }
 
 
-def _held(args: argparse.Namespace) -> dict[str, dict[str, Any]]:
-    """Every column (variable, channel) of ``FILE`` with its unit as written and its sample count."""
-    raw = rigdata.read_table(args.file, format=args.format)
+def _held(raw: Any) -> dict[str, dict[str, Any]]:
+    """Every column (variable, channel) of a file's table with its unit as written and its sample
+    count."""
     return {name: {"unit": raw.units.get(name), "samples": int(values.size)}
             for name, values in raw.columns.items()}
 
@@ -154,7 +157,8 @@ def _print_held(held: dict[str, dict[str, Any]]) -> None:
 
 def cmd_inspect(args: argparse.Namespace) -> int:
     """``cardan rig inspect``: channels, units, rate, duration, revolutions, and every column of a file."""
-    info = {**_inspection(_read(args)), "columns": _held(args)}
+    raw = rigdata.read_table(args.file, format=args.format)
+    info = {**_inspection(_read(args, raw)), "columns": _held(raw)}
     held = info["columns"]
     if args.json:
         print(json.dumps(info, indent=2))

@@ -11,7 +11,7 @@ from __future__ import annotations
 from reference.lazy import lazy_face
 
 _HOMES = {
-    "rigdata.readers.dispatch": ("read", "read_table", "read_frame"),
+    "rigdata.readers.dispatch": ("read", "read_table", "read_frame", "record_of_table"),
     "rigdata.readers.table": ("FORMATS", "RawTable", "TextCells"),
     "rigdata.readers.channels": ("KIND_WORDS", "SIDE_WORDS", "TIME_WORDS", "match_channels", "recognise"),
 }

@@ -22,7 +22,7 @@ from rigdata.readers.table import FORMATS, RawTable
 from rigdata.record import RigRecord
 from rigdata.transducer import PULSES_PER_REV, SENSITIVITY
 
-__all__ = ["read_table", "read", "read_frame"]
+__all__ = ["read_table", "read", "read_frame", "record_of_table"]
 
 #: Module and function reading each binary format (imported on use: scipy and pandas load slowly).
 BINARY_READERS = {"tdms": ("tdms", "read_tdms"), "mat": ("matlab", "read_mat"),
@@ -100,7 +100,15 @@ def read(path: str | Path, format: str = "auto", mapping: Mapping[str, str | Non
         Bad arguments.
     """
     _check_read_arguments(sensitivity, pulses_per_rev, mapping, units)
-    raw = read_table(path, format)
+    return record_of_table(read_table(path, format), mapping, units, sensitivity, pulses_per_rev)
+
+
+def record_of_table(raw: RawTable, mapping: Mapping[str, str | None] | None = None,
+                    units: Mapping[str, str] | None = None, sensitivity: float = SENSITIVITY,
+                    pulses_per_rev: int = PULSES_PER_REV) -> RigRecord:
+    """The record of a table :func:`read_table` returned, with :func:`read`'s arguments (so a
+    caller that also wants the table reads the file once)."""
+    _check_read_arguments(sensitivity, pulses_per_rev, mapping, units)
     chosen = match_channels(raw, mapping)
     return to_record(raw, chosen, dict(units or {}), sensitivity, pulses_per_rev)
 
