@@ -31,7 +31,7 @@ from rigdata.record import RigRecord, with_signs
 from rigdata.reproduce import model_settings, scene_entry
 from rigdata.transducer import PROVENANCE, Transducer
 
-__all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare",
+__all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare", "check_engines",
            "accuracy_needed", "validate"]
 
 #: Engines that take the measured angle drive and load history (MuJoCo takes constant loads only).
@@ -229,7 +229,7 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
                         f"one string: got {engines!r:.80}")
     check_draws(monte_carlo, seed)
     base = as_scene(scene)
-    _check_engines(engines)  # now, not after the measurement
+    check_engines(engines)  # now, not after the measurement
     record = with_signs(as_record(source, **read_options), signs)
     pair = transducer_pair(transducers)
     say("conditioning")
@@ -245,7 +245,7 @@ def validate(source: Source, scene: Scene | str | os.PathLike = "rig",
     return Validation(record, cond, measured, model, computed, comparisons, sens, pair, findings)
 
 
-def _check_engines(engines: tuple[str, ...]) -> None:
+def check_engines(engines: tuple[str, ...]) -> None:
     """:class:`EngineUnavailable` for an engine unknown, not installed, or unable to take a measured drive and
     load.
     """

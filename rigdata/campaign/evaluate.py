@@ -1,0 +1,180 @@
+"""The campaign's model runs: one recording's measured drive and load on the joint with given parameter
+values and input changes, run once (journal), many at a time on all cores.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import multiprocessing
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any
+
+from cardan_exudyn.engines import run
+from cardan_exudyn.sweep.executors import ignore_interrupts
+from reference.results.summary import Status
+from reference.scene.scene import Scene
+from rigdata.campaign.journal import Journal
+from rigdata.campaign.prepare import Prepared
+from rigdata.campaign.spec import Parameter, with_values
+from rigdata.model import measured_scene
+
+__all__ = ["ModelRun", "Outcome", "Evaluator", "model_pool"]
+
+
+@dataclass(frozen=True)
+class ModelRun:
+    """One model run asked for.
+
+    Attributes
+    ----------
+    recording : int
+        The recording's index in the campaign.
+    engine : str
+    values : tuple of float
+        The calibrated parameters' values, in the campaign's order.
+    changes : tuple of (str, float)
+        Other scene keys set to a value (the stated inputs' perturbations).
+    load_offset : float
+        Added to the measured load [N m].
+    phase_shift : float
+        Added to the input yoke phase [rad].
+    """
+
+    recording: int
+    engine: str
+    values: tuple[float, ...]
+    changes: tuple[tuple[str, float], ...] = ()
+    load_offset: float = 0.0
+    phase_shift: float = 0.0
+
+    def key(self, sha256: str) -> str:
+        """The journal's key of this run on the file with SHA-256 ``sha256``."""
+        return json.dumps([sha256, self.engine, [repr(v) for v in self.values],
+                           [[k, repr(v)] for k, v in self.changes], repr(self.load_offset),
+                           repr(self.phase_shift)], separators=(",", ":"))
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one model run gave.
+
+    Attributes
+    ----------
+    status : str
+        The engine's status (``ok``, ``locked``, ``failed``, ...).
+    reason : str or None
+    efficiency : float or None
+        Mean efficiency over the recording's window [-] (None unless ``ok``).
+    error_estimate : float or None
+        The engine's own estimate of the mean efficiency's error [-].
+    wall_s : float
+    reused : bool
+        Taken from the journal, not run now.
+    """
+
+    status: str
+    reason: str | None
+    efficiency: float | None
+    error_estimate: float | None
+    wall_s: float
+    reused: bool = field(default=False, compare=False)
+
+    @property
+    def ok(self) -> bool:
+        """True when the run ended ``ok`` with an efficiency."""
+        return self.status == Status.OK and self.efficiency is not None
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON fields (without ``reused``)."""
+        return {"status": str(self.status), "reason": self.reason, "efficiency": self.efficiency,
+                "error_estimate": self.error_estimate, "wall_s": self.wall_s}
+
+
+def run_scene(scene: Scene, engine: str) -> Outcome:
+    """Run ``scene`` on ``engine``; a worker's task (module level, so it pickles)."""
+    start = time.perf_counter()
+    summary = run(scene, engine).summary
+    eta = summary.mean_efficiency
+    return Outcome(str(summary.status), summary.reason, None if eta is None else float(eta),
+                   summary.efficiency_error_estimate, time.perf_counter() - start)
+
+
+@contextlib.contextmanager
+def model_pool(workers: int) -> Iterator[ProcessPoolExecutor | None]:
+    """``workers`` spawned processes for the whole campaign (None: run in this process)."""
+    if workers <= 1:
+        yield None
+        return
+    context = multiprocessing.get_context("spawn")
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=ignore_interrupts)
+    try:
+        yield pool
+    except BaseException:
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            with contextlib.suppress(OSError, ValueError, AttributeError):
+                process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
+class Evaluator:
+    """Runs :class:`ModelRun` requests on the prepared recordings, each at most once per journal.
+
+    ``prepared`` maps recording index to :class:`Prepared`; ``parameters`` are the campaign's; ``pool``
+    from :func:`model_pool`; ``journal`` keeps every outcome on disk; ``on_run(n)`` is told of each new run.
+    """
+
+    def __init__(self, prepared: Mapping[int, Prepared], parameters: tuple[Parameter, ...],
+                 journal: Journal | None = None, pool: ProcessPoolExecutor | None = None,
+                 on_run: Callable[[int], None] | None = None) -> None:
+        self.prepared = prepared
+        self.parameters = parameters
+        self.journal = journal
+        self.pool = pool
+        self.on_run = on_run or (lambda n: None)
+        self.memory: dict[str, Outcome] = dict(journal.outcomes) if journal else {}
+        self.runs = 0
+        self.reused = 0
+
+    def scene(self, request: ModelRun) -> Scene:
+        """The scene of ``request``: the recording's joint, parameter values and changes, measured
+        drive and load.
+        """
+        prepared = self.prepared[request.recording]
+        base = with_values(prepared.scene, self.parameters, request.values, dict(request.changes))
+        return measured_scene(prepared.conditioned, base, phase_shift=request.phase_shift,
+                              load_offset=request.load_offset)
+
+    def __call__(self, requests: Sequence[ModelRun]) -> list[Outcome]:
+        """The outcome of each request, in order; the ones not in the journal run now (in parallel)."""
+        keys = [r.key(self.prepared[r.recording].sha256) for r in requests]
+        todo = {key: r for key, r in zip(keys, requests) if key not in self.memory}
+        self.reused += sum(1 for key in set(keys) if key not in todo)
+        self._run(todo)
+        return [self.memory[key] for key in keys]
+
+    def _run(self, todo: Mapping[str, ModelRun]) -> None:
+        """Run ``todo`` (key -> request), record each outcome as it arrives."""
+        if not todo:
+            return
+        scenes = {key: self.scene(r) for key, r in todo.items()}
+        if self.pool is None:
+            for key, r in todo.items():
+                self._keep(key, run_scene(scenes[key], r.engine))
+            return
+        futures = {key: self.pool.submit(run_scene, scenes[key], r.engine) for key, r in todo.items()}
+        for key, future in futures.items():
+            self._keep(key, future.result())
+
+    def _keep(self, key: str, outcome: Outcome) -> None:
+        """Remember ``outcome`` under ``key``, in memory and the journal."""
+        self.memory[key] = outcome
+        if self.journal is not None:
+            self.journal.add(key, outcome)
+        self.runs += 1
+        self.on_run(self.runs)

@@ -1,0 +1,63 @@
+"""The campaign's journal: every model run's outcome, one JSON line each, on disk as it finishes, so an
+interrupted or failed campaign resumes without running any model again.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from cardan_exudyn.interrupts import deferred_signals
+
+if TYPE_CHECKING:
+    from rigdata.campaign.evaluate import Outcome
+
+__all__ = ["JOURNAL_FILE", "Journal"]
+
+JOURNAL_FILE = "runs.jsonl"
+"""The journal's file name in the campaign's output folder."""
+
+
+class Journal:
+    """Appends outcomes to ``folder/runs.jsonl`` (flushed and fsync'ed); :attr:`outcomes` holds the ones
+    found there when opened (a last line cut by a crash is dropped).
+    """
+
+    def __init__(self, folder: str | os.PathLike) -> None:
+        self.path = Path(folder) / JOURNAL_FILE
+        self.outcomes: dict[str, Outcome] = self._read()
+        self._file = open(self.path, "ab")
+
+    def _read(self) -> dict[str, Outcome]:
+        """The outcomes already in the file."""
+        from rigdata.campaign.evaluate import Outcome
+
+        if not self.path.is_file():
+            return {}
+        data = self.path.read_bytes()
+        whole = data[:data.rfind(b"\n") + 1]
+        if len(whole) < len(data):  # a line cut short when the run was killed: the next one starts clean
+            with open(self.path, "r+b") as f:
+                f.truncate(len(whole))
+        out = {}
+        for line in whole.splitlines():
+            try:
+                item: dict[str, Any] = json.loads(line)
+                out[item.pop("key")] = Outcome(**item, reused=True)
+            except (ValueError, TypeError, KeyError):
+                continue  # not a journal line: ignored, never trusted
+        return out
+
+    def add(self, key: str, outcome: Outcome) -> None:
+        """Append one outcome; on disk when this returns (Ctrl-C and SIGTERM wait for it)."""
+        line = json.dumps({"key": key, **outcome.as_dict()}, separators=(",", ":")) + "\n"
+        with deferred_signals():
+            self._file.write(line.encode("utf-8"))
+            self._file.flush()
+            os.fsync(self._file.fileno())
+
+    def close(self) -> None:
+        """Close the file."""
+        self._file.close()
