@@ -27,6 +27,7 @@ from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
+from rigdata.campaign import command as campaign_command
 
 __all__ = ["register", "cmd_inspect", "cmd_measure", "cmd_validate", "cmd_synthetic"]
 
@@ -455,6 +456,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         ("validate", "measured against computed efficiency: report like Figure 10", cmd_validate,
          (_file_options, _measure_options, _validate_options)),
         ("synthetic", "write a synthetic rig file (labelled as such)", cmd_synthetic, (_synthetic_options,)),
+        ("campaign", "calibrate on some recordings, validate on the others: model error with its "
+                     "V&V 20 uncertainty", campaign_command.cmd_campaign, (campaign_command.add_options,)),
     ]
     for name, help_text, handler, options in commands:
         q = rig.add_parser(name, help=help_text)

@@ -116,8 +116,9 @@ def budget_runs(prepared: Prepared, engine: str, values: tuple[float, ...], para
     input_runs = tuple(ModelRun(index, engine, values, ((i.key, _value(prepared, i.key) + i.std),))
                        for i in inputs)
     runs, steps = parameter_runs
-    return BudgetRuns(point, tuple(runs), steps, input_runs, ModelRun(index, engine, values, load_offset=delta),
-                      delta, ModelRun(index, engine, values, phase_shift=PHASE_SHIFT))
+    load_run = ModelRun(index, engine, values, load_offset=delta)
+    phase_run = ModelRun(index, engine, values, phase_shift=PHASE_SHIFT)
+    return BudgetRuns(point, tuple(runs), steps, input_runs, load_run, delta, phase_run)
 
 
 def _value(prepared: Prepared, key: str) -> float:
@@ -140,9 +141,10 @@ def budget(prepared: Prepared, runs: BudgetRuns, outcomes: Mapping[ModelRun, Out
     parameters', None without calibration).
     """
     s0 = _efficiency(outcomes[runs.point])
-    c = np.array([(_efficiency(outcomes[r]) - s0) / h for r, h in zip(runs.parameter_runs, runs.steps)])
+    stepped = zip(runs.parameter_runs, runs.steps, strict=True)
+    c = np.array([(_efficiency(outcomes[r]) - s0) / h for r, h in stepped])
     u_par = math.sqrt(max(float(c @ covariance @ c), 0.0)) if covariance is not None and c.size else 0.0
-    effects = {i.key: _efficiency(outcomes[r]) - s0 for i, r in zip(inputs, runs.input_runs)}
+    effects = {i.key: _efficiency(outcomes[r]) - s0 for i, r in zip(inputs, runs.input_runs, strict=True)}
     c_load = (_efficiency(outcomes[runs.load_run]) - s0) / runs.load_delta
     u_phase = 0.5 * abs(_efficiency(outcomes[runs.phase_run]) - s0) / SQRT3
     shared = [row for row in prepared.measured.budget if row["quantity"] in CONSTANT_OUTPUT_ERRORS]
@@ -151,7 +153,7 @@ def budget(prepared: Prepared, runs: BudgetRuns, outcomes: Mapping[ModelRun, Out
     u_inputs = math.sqrt(sum(e * e for e in effects.values()))
     u_input = math.sqrt(u_par**2 + u_inputs**2 + u_load**2 + u_phase**2)
     return Budget(prepared.measured.u, u_input, u_par, u_inputs, u_load, u_phase, float(cov),
-                  {p.name: float(x) for p, x in zip(parameters, c)}, effects, float(c_load))
+                  {p.name: float(x) for p, x in zip(parameters, c, strict=True)}, effects, float(c_load))
 
 
 def model_scatter(prepared: Prepared, engine: str, values: np.ndarray, covariance: np.ndarray | None,

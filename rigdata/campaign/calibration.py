@@ -22,7 +22,7 @@ from scipy import optimize, stats
 from rigdata.campaign.evaluate import ModelRun, Outcome
 from rigdata.campaign.spec import Parameter
 
-__all__ = ["IDENTIFIED_SHRINK", "RELATIVE_STEP", "Estimate", "Combination", "Calibration",
+__all__ = ["IDENTIFIED_SHRINK", "RELATIVE_STEP", "XTOL", "Estimate", "Combination", "Calibration",
            "CalibrationFailed", "calibrate", "jacobian_runs", "propagation_covariance"]
 
 IDENTIFIED_SHRINK = 0.5
@@ -31,6 +31,10 @@ of its bounds' (a uniform over them: width / sqrt(12)); the data must at least h
 RELATIVE_STEP = 1e-4
 """Forward-difference step of the Jacobian as a fraction of each parameter's bounds width [-]; the
 reference engine's efficiency is exact to about 1e-10, so the step's truncation error dominates."""
+
+XTOL = 1e-7
+"""Relative step at which the fit stops: far below any parameter's uncertainty from rig data (1e-2 and
+more), so the estimate's own error never shows in a budget."""
 
 Evaluate = Callable[[Sequence[ModelRun]], list[Outcome]]
 
@@ -163,7 +167,7 @@ class _Problem:
     def simulated(self, runs: Sequence[ModelRun]) -> np.ndarray:
         """The efficiency of each run; CalibrationFailed if one did not end ``ok``."""
         out = self.evaluate(runs)
-        for r, o in zip(runs, out):
+        for r, o in zip(runs, out, strict=True):
             if not o.ok:
                 raise CalibrationFailed(f"recording {r.recording} at {self._text(r.values)}: the model "
                                         f"ended {o.status}: {o.reason}")
@@ -171,7 +175,7 @@ class _Problem:
 
     def _text(self, values: Sequence[float]) -> str:
         """``name = value`` for each parameter."""
-        return ", ".join(f"{p.name} = {v:.6g}" for p, v in zip(self.parameters, values))
+        return ", ".join(f"{p.name} = {v:.6g}" for p, v in zip(self.parameters, values, strict=True))
 
     def residuals(self, x: np.ndarray) -> np.ndarray:
         """``(S - D) / sigma`` at ``x``."""
@@ -232,7 +236,7 @@ def calibrate(evaluate: Evaluate, engine: str, parameters: tuple[Parameter, ...]
     high = np.array([p.bounds[1] for p in parameters])
     fit = optimize.least_squares(problem.residuals, np.array([p.initial for p in parameters]),
                                  jac=problem.jacobian, bounds=(low, high), method="trf",
-                                 x_scale=high - low, xtol=1e-10, ftol=1e-12, gtol=1e-12)
+                                 x_scale=high - low, xtol=XTOL, ftol=1e-10, gtol=1e-10)
     jw = problem.jacobian(fit.x)
     residuals = problem.residuals(fit.x)
     return _summarise(fit, jw, residuals, problem, coverage)
@@ -244,7 +248,8 @@ def _summarise(fit: Any, jw: np.ndarray, residuals: np.ndarray, problem: _Proble
     parameters = problem.parameters
     cov, identified = propagation_covariance(jw, parameters)
     data_std = _data_std(jw)
-    estimates = tuple(_estimate(p, float(x), float(u)) for p, x, u in zip(parameters, fit.x, data_std))
+    found = zip(parameters, fit.x, data_std, strict=True)
+    estimates = tuple(_estimate(p, float(x), float(u)) for p, x, u in found)
     combos = () if all(e.identifiable for e in estimates) else _combinations(identified, fit.x, parameters)
     chi2 = float(residuals @ residuals)
     dof = len(residuals) - len(identified)
@@ -272,6 +277,6 @@ def _combinations(identified: list, x: np.ndarray, parameters: tuple[Parameter, 
     out = []
     for v, data_std in identified:
         scale = float(v[np.argmax(np.abs(v))])
-        coefficients = {p.name: float(c / scale) for p, c in zip(parameters, v)}
+        coefficients = {p.name: float(c / scale) for p, c in zip(parameters, v, strict=True)}
         out.append(Combination(coefficients, float(v @ x / scale), float(data_std / abs(scale))))
     return tuple(out)

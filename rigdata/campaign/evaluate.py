@@ -5,6 +5,7 @@ values and input changes, run once (journal), many at a time on all cores.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import multiprocessing
 import time
@@ -14,15 +15,17 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from cardan_exudyn.engines import run
+from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.sweep.executors import ignore_interrupts
 from reference.results.summary import Status
+from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
 from rigdata.campaign.journal import Journal
 from rigdata.campaign.prepare import Prepared
 from rigdata.campaign.spec import Parameter, with_values
 from rigdata.model import measured_scene
 
-__all__ = ["ModelRun", "Outcome", "Evaluator", "model_pool"]
+__all__ = ["ModelRun", "Outcome", "Evaluator", "model_pool", "run_key"]
 
 
 @dataclass(frozen=True)
@@ -51,11 +54,6 @@ class ModelRun:
     load_offset: float = 0.0
     phase_shift: float = 0.0
 
-    def key(self, sha256: str) -> str:
-        """The journal's key of this run on the file with SHA-256 ``sha256``."""
-        return json.dumps([sha256, self.engine, [repr(v) for v in self.values],
-                           [[k, repr(v)] for k, v in self.changes], repr(self.load_offset),
-                           repr(self.phase_shift)], separators=(",", ":"))
 
 
 @dataclass(frozen=True)
@@ -103,6 +101,14 @@ def run_scene(scene: Scene, engine: str) -> Outcome:
                    summary.efficiency_error_estimate, time.perf_counter() - start)
 
 
+def run_key(scene: Scene, engine: str) -> str:
+    """The journal's key of ``scene`` on ``engine``: SHA-256 of the whole scene (joint, parameters,
+    measured drive and load, numerics), so a run is reused only for exactly the same model.
+    """
+    text = json.dumps([engine, to_jsonable(scene_to_dict(scene))], sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 @contextlib.contextmanager
 def model_pool(workers: int) -> Iterator[ProcessPoolExecutor | None]:
     """``workers`` spawned processes for the whole campaign (None: run in this process)."""
@@ -138,6 +144,7 @@ class Evaluator:
         self.pool = pool
         self.on_run = on_run or (lambda n: None)
         self.memory: dict[str, Outcome] = dict(journal.outcomes) if journal else {}
+        self._keys: dict[ModelRun, str] = {}
         self.runs = 0
         self.reused = 0
 
@@ -152,22 +159,28 @@ class Evaluator:
 
     def __call__(self, requests: Sequence[ModelRun]) -> list[Outcome]:
         """The outcome of each request, in order; the ones not in the journal run now (in parallel)."""
-        keys = [r.key(self.prepared[r.recording].sha256) for r in requests]
-        todo = {key: r for key, r in zip(keys, requests) if key not in self.memory}
+        keys = [self._key(r) for r in requests]
+        todo = {key: r for key, r in zip(keys, requests, strict=True) if key not in self.memory}
         self.reused += sum(1 for key in set(keys) if key not in todo)
         self._run(todo)
         return [self.memory[key] for key in keys]
+
+    def _key(self, request: ModelRun) -> str:
+        """The journal key of ``request`` (its scene's fingerprint), remembered per request."""
+        key = self._keys.get(request)
+        if key is None:
+            key = self._keys[request] = run_key(self.scene(request), request.engine)
+        return key
 
     def _run(self, todo: Mapping[str, ModelRun]) -> None:
         """Run ``todo`` (key -> request), record each outcome as it arrives."""
         if not todo:
             return
-        scenes = {key: self.scene(r) for key, r in todo.items()}
         if self.pool is None:
             for key, r in todo.items():
-                self._keep(key, run_scene(scenes[key], r.engine))
+                self._keep(key, run_scene(self.scene(r), r.engine))
             return
-        futures = {key: self.pool.submit(run_scene, scenes[key], r.engine) for key, r in todo.items()}
+        futures = {key: self.pool.submit(run_scene, self.scene(r), r.engine) for key, r in todo.items()}
         for key, future in futures.items():
             self._keep(key, future.result())
 

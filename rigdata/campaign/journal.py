@@ -45,7 +45,8 @@ class Journal:
         for line in whole.splitlines():
             try:
                 item: dict[str, Any] = json.loads(line)
-                out[item.pop("key")] = Outcome(**item, reused=True)
+                key = item.pop("key")
+                out[key] = Outcome(**item, reused=True)
             except (ValueError, TypeError, KeyError):
                 continue  # not a journal line: ignored, never trusted
         return out

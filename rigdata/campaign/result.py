@@ -23,6 +23,11 @@ TABLE_COLUMNS = ("label", "use", "shaft_angle_deg", "speed_in_rpm", "torque_in",
 """The columns of :meth:`CampaignResult.table` and ``results.csv``."""
 
 
+def _pair(interval: tuple[float, float] | None) -> list[float] | None:
+    """An interval as a JSON list."""
+    return list(interval) if interval is not None else None
+
+
 @dataclass(frozen=True)
 class EngineComparison:
     """One engine's simulated efficiency ``S`` against the measured ``D`` of one recording.
@@ -49,7 +54,7 @@ class EngineComparison:
         return {"engine": self.engine, "status": self.status, "reason": self.reason,
                 "simulated": self.simulated, "comparison_error": self.comparison_error,
                 "u_num": self.u_num, "u_val": self.u_val,
-                "model_error_interval": list(self.model_error_interval) if self.model_error_interval else None,
+                "model_error_interval": _pair(self.model_error_interval),
                 "resolvable": self.resolvable, "difference_from_first": self.difference_from_first}
 
 
@@ -128,8 +133,7 @@ class RecordingResult:
                 "comparison_error": first.comparison_error, "u_num": first.u_num,
                 "u_input": self.budget.u_input if self.budget else None, "u_D": self.u_D,
                 "u_val": first.u_val, "k": self.k,
-                "model_error_interval": (list(first.model_error_interval)
-                                         if first.model_error_interval else None),
+                "model_error_interval": _pair(first.model_error_interval),
                 "resolvable": first.resolvable, "dominant": self.dominant,
                 "budget": self.budget.as_dict() if self.budget else None,
                 "by_engine": {name: c.as_dict() for name, c in self.engines.items()},
@@ -204,14 +208,14 @@ class CampaignResult:
         if self.calibration is None:
             return [{"name": p.name, "value": v, "standard_uncertainty": None, "identifiable": None,
                      "calibrated": False, "keys": list(p.keys), "bounds": list(p.bounds)}
-                    for p, v in zip(self.spec.parameters, self.parameter_values)]
+                    for p, v in zip(self.spec.parameters, self.parameter_values, strict=True)]
         return [{"name": e.name, "value": e.value, "standard_uncertainty": e.standard_uncertainty,
                  "identifiable": e.identifiable, "at_bound": e.at_bound, "calibrated": True,
                  "keys": list(p.keys), "bounds": list(e.bounds)}
-                for p, e in zip(self.spec.parameters, self.calibration.estimates)]
+                for p, e in zip(self.spec.parameters, self.calibration.estimates, strict=True)]
 
     def as_dict(self) -> dict[str, Any]:
-        """``results.json``: ``recordings``, ``parameters``, ``correlation``, ``calibration`` and the campaign."""
+        """``results.json``: ``recordings``, ``parameters``, ``correlation``, ``calibration``, campaign."""
         spec = self.spec
         cal = self.calibration
         return to_jsonable({

@@ -18,7 +18,7 @@ from pathlib import Path
 from scipy import stats
 
 from cardan_exudyn.sweep.executors import default_workers
-from rigdata.campaign.budget import Budget, BudgetRuns, budget, budget_runs, model_scatter
+from rigdata.campaign.budget import Budget, budget, budget_runs, model_scatter
 from rigdata.campaign.calibration import Calibration, CalibrationFailed, calibrate, jacobian_runs
 from rigdata.campaign.evaluate import Evaluator, ModelRun, Outcome, model_pool
 from rigdata.campaign.journal import Journal
@@ -86,19 +86,18 @@ def campaign(source: CampaignSpec | str | os.PathLike, out: str | os.PathLike | 
     spec = source if isinstance(source, CampaignSpec) else load_campaign(source)
     check_engines(spec.engines)
     clock = _Clock({})
-    with clock.stage("measure"):
-        prepared = _prepare_all(spec, say)
-    journal = _journal(out)
     workers = default_workers() if workers is None else max(1, int(workers))
+    journal = _journal(out)
     try:
-        with model_pool(min(workers, len(spec.recordings) * 2)) as pool:
+        with model_pool(workers) as pool:
+            with clock.stage("measure"):
+                prepared = _prepare_all(spec, pool, say)
             evaluate = Evaluator(prepared, spec.parameters, journal, pool,
                                  on_run=lambda n: say(f"model runs: {n}"))
-            result = _run(spec, prepared, evaluate, clock, say)
+            return _run(spec, prepared, evaluate, clock, say)
     finally:
         if journal is not None:
             journal.close()
-    return result
 
 
 def _journal(out: str | os.PathLike | None) -> Journal | None:
@@ -109,12 +108,20 @@ def _journal(out: str | os.PathLike | None) -> Journal | None:
     return Journal(out)
 
 
-def _prepare_all(spec: CampaignSpec, say: Progress) -> dict[int, Prepared]:
-    """Every recording measured, by index."""
+def _prepare_all(spec: CampaignSpec, pool, say: Progress) -> dict[int, Prepared]:
+    """Every recording measured (in ``pool`` if any), by index; the first that cannot be raises."""
+    total = len(spec.recordings)
+    if pool is None:
+        out = {}
+        for rec in spec.recordings:
+            say(f"measuring {rec.index}/{total}: {rec.label}")
+            out[rec.index] = prepare(rec, spec)
+        return out
+    futures = {rec.index: pool.submit(prepare, rec, spec) for rec in spec.recordings}
     out = {}
-    for rec in spec.recordings:
-        say(f"measuring {rec.index}/{len(spec.recordings)}: {rec.label}")
-        out[rec.index] = prepare(rec, spec)
+    for index, future in futures.items():
+        out[index] = future.result()
+        say(f"measured {len(out)}/{total}: {out[index].spec.label}")
     return out
 
 
@@ -144,7 +151,7 @@ def _calibrate(spec: CampaignSpec, recordings: Sequence[Prepared], evaluate: Eva
     """The fit over the calibration recordings whose model runs at the initial values."""
     engine = spec.engines[0]
     budgets = _budgets(spec, recordings, evaluate, spec.initial, None, engine, inputs=False)
-    kept = [(p, b, u) for p, (b, u) in zip(recordings, budgets) if b is not None]
+    kept = [(p, b, u) for p, (b, u) in zip(recordings, budgets, strict=True) if b is not None]
     if not kept:
         raise CalibrationFailed("no calibration recording has a model run that ends ok at the initial values")
     sigma = [b.u_val(u) for _, b, u in kept]
@@ -164,7 +171,7 @@ def _budgets(spec: CampaignSpec, recordings: Sequence[Prepared], evaluate: Evalu
                                  stated, jac))
     outcomes = _outcomes(evaluate, [r for plan in plans for r in plan.all])
     out = []
-    for p, plan in zip(recordings, plans):
+    for p, plan in zip(recordings, plans, strict=True):
         if not outcomes[plan.point].ok:
             out.append((None, None))
             continue
@@ -183,7 +190,7 @@ def _empty():
 
 def _outcomes(evaluate: Evaluator, runs: list[ModelRun]) -> dict[ModelRun, Outcome]:
     """The outcome of each run, by run."""
-    return dict(zip(runs, evaluate(runs)))
+    return dict(zip(runs, evaluate(runs), strict=True))
 
 
 def _u_num(outcome: Outcome) -> float:
@@ -206,7 +213,7 @@ def _compare_all(spec: CampaignSpec, prepared: dict[int, Prepared], evaluate: Ev
                for p in usable if spec.input_samples}
     extra = _outcomes(evaluate, others + [r for runs in scatter.values() for r in runs])
     budgets = dict(zip([p.spec.index for p in usable],
-                       _budgets(spec, usable, evaluate, values, cov, first)))
+                       _budgets(spec, usable, evaluate, values, cov, first), strict=True))
     out = []
     for index, p in prepared.items():
         if not p.usable:
