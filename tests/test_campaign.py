@@ -149,3 +149,14 @@ def test_a_recording_the_model_cannot_run_is_reported_and_the_rest_go_on(folder,
     assert "self_locking" in locked.reason
     assert locked.resolvable is None
     assert result.calibration is None
+
+
+@pytest.mark.slow
+def test_a_dask_cluster_gives_the_local_results(folder, result):
+    """On a two-process LocalCluster the campaign's numbers equal the in-process run's."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        remote = campaign(folder / "campaign.toml", None, scheduler=cluster.scheduler_address)
+    assert remote.calibration.values == result.calibration.values
+    assert [r.first.u_val for r in remote.recordings] == [r.first.u_val for r in result.recordings]

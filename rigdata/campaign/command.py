@@ -38,6 +38,8 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print results.json instead of the table")
     p.add_argument("--workers", type=int, default=None, metavar="N",
                    help="processes for the model runs (default: the cores available)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on a Dask cluster (tcp://host:port) instead of local processes")
     p.add_argument("--restart", action="store_true",
                    help="forget the journal's model runs and run every model again")
     p.add_argument("--strict", action="store_true",
@@ -92,6 +94,7 @@ def _line(r: dict[str, Any]) -> str:
 
 def cmd_campaign(args: argparse.Namespace) -> int:
     """Run the campaign, write the report into ``--out``; see the module's exit statuses."""
+    from cardan_exudyn.sweep.checks import SweepError
     from rigdata.campaign.journal import JOURNAL_FILE
     from rigdata.campaign.report import write_report
     from rigdata.campaign.run import campaign
@@ -108,7 +111,10 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     if args.restart and journal.is_file():
         journal.unlink()
     try:
-        result = campaign(spec, args.out, workers=args.workers, progress=_progress(args))
+        result = campaign(spec, args.out, workers=args.workers, scheduler=args.scheduler,
+                          progress=_progress(args))
+    except SweepError as exc:  # the Dask scheduler cannot be reached
+        raise BadInput(str(exc)) from None
     except KeyboardInterrupt as exc:
         raise CampaignInterrupted(f"every finished model run is kept in {journal}; rerun the same command "
                                   "to resume", getattr(exc, "signum", signal.SIGINT)) from None

@@ -16,7 +16,7 @@ from typing import Any
 
 from cardan_exudyn.engines import run
 from cardan_exudyn.jsonable import to_jsonable
-from cardan_exudyn.sweep.executors import ignore_interrupts
+from cardan_exudyn.sweep.executors import connect, ignore_interrupts
 from reference.results.summary import Status
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
@@ -110,8 +110,19 @@ def run_key(scene: Scene, engine: str) -> str:
 
 
 @contextlib.contextmanager
-def model_pool(workers: int) -> Iterator[ProcessPoolExecutor | None]:
-    """``workers`` spawned processes for the whole campaign (None: run in this process)."""
+def model_pool(workers: int, scheduler: Any = None) -> Iterator[Any]:
+    """Where the campaign's runs go: a Dask client for ``scheduler`` (an address or a client, as for
+    sweeps), else ``workers`` spawned processes, else (``workers <= 1``) None, this process. Each has
+    ``submit(function, *args)`` returning a future with ``result()``.
+    """
+    if scheduler is not None:
+        client = connect(scheduler)
+        try:
+            yield client
+        finally:
+            if client is not scheduler:  # made here: closed here
+                client.close()
+        return
     if workers <= 1:
         yield None
         return

@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from scipy import stats
 
@@ -54,7 +55,8 @@ class _Clock:
 
 
 def campaign(source: CampaignSpec | str | os.PathLike, out: str | os.PathLike | None = None, *,
-             workers: int | None = None, progress: Progress | None = None) -> CampaignResult:
+             workers: int | None = None, scheduler: Any = None,
+             progress: Progress | None = None) -> CampaignResult:
     """Run a validation campaign.
 
     Parameters
@@ -66,6 +68,9 @@ def campaign(source: CampaignSpec | str | os.PathLike, out: str | os.PathLike | 
         written (see :func:`rigdata.campaign.report.write_report`).
     workers : int, optional
         Processes for the model runs (default: the cores available; 1: this process).
+    scheduler : str or distributed.Client, optional
+        A Dask scheduler's address (``tcp://host:port``) or client: the measurements and model runs go
+        to its cluster instead (``workers`` is then ignored).
     progress : callable(str), optional
         Called with a line at each stage and model run.
 
@@ -89,7 +94,7 @@ def campaign(source: CampaignSpec | str | os.PathLike, out: str | os.PathLike | 
     workers = default_workers() if workers is None else max(1, int(workers))
     journal = _journal(out)
     try:
-        with model_pool(workers) as pool:
+        with model_pool(workers, scheduler) as pool:
             with clock.stage("measure"):
                 prepared = _prepare_all(spec, pool, say)
             evaluate = Evaluator(prepared, spec.parameters, journal, pool,
