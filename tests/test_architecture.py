@@ -30,7 +30,8 @@ MAX_MODULE_LINES = 600
 MAX_FUNCTION_LINES = 60
 # modules that may print: the command line and the study commands (their computations return
 # data, their reports write files)
-MAY_PRINT = re.compile(r"^(cardan_exudyn\.cli|cardan_exudyn\.studies\.\w+\.command|rigdata\.cli)$")
+MAY_PRINT = re.compile(r"^(cardan_exudyn\.cli|cardan_exudyn\.studies\.\w+\.command|rigdata\.cli"
+                       r"|rigdata\.campaign\.command)$")
 ENGINE_RUN_MODULES = {"cardan_exudyn.model.accuracy", "reference.engine.solve", "cardan_exudyn.mujoco.engine"}
 
 

@@ -11,16 +11,15 @@ import multiprocessing
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from cardan_exudyn.engines import run
 from cardan_exudyn.jsonable import to_jsonable
 from cardan_exudyn.sweep.executors import connect, ignore_interrupts
-from reference.results.summary import Status
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
-from rigdata.campaign.journal import Journal
+from rigdata.campaign.journal import Journal, Outcome
 from rigdata.campaign.prepare import Prepared
 from rigdata.campaign.spec import Parameter, with_values
 from rigdata.model import measured_scene
@@ -54,42 +53,6 @@ class ModelRun:
     load_offset: float = 0.0
     phase_shift: float = 0.0
 
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """What one model run gave.
-
-    Attributes
-    ----------
-    status : str
-        The engine's status (``ok``, ``locked``, ``failed``, ...).
-    reason : str or None
-    efficiency : float or None
-        Mean efficiency over the recording's window [-] (None unless ``ok``).
-    error_estimate : float or None
-        The engine's own estimate of the mean efficiency's error [-].
-    wall_s : float
-    reused : bool
-        Taken from the journal, not run now.
-    """
-
-    status: str
-    reason: str | None
-    efficiency: float | None
-    error_estimate: float | None
-    wall_s: float
-    reused: bool = field(default=False, compare=False)
-
-    @property
-    def ok(self) -> bool:
-        """True when the run ended ``ok`` with an efficiency."""
-        return self.status == Status.OK and self.efficiency is not None
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON fields (without ``reused``)."""
-        return {"status": str(self.status), "reason": self.reason, "efficiency": self.efficiency,
-                "error_estimate": self.error_estimate, "wall_s": self.wall_s}
 
 
 def run_scene(scene: Scene, engine: str) -> Outcome:

@@ -6,18 +6,53 @@ from __future__ import annotations
 
 import json
 import os
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from cardan_exudyn.interrupts import deferred_signals
+from reference.results.summary import Status
 
-if TYPE_CHECKING:
-    from rigdata.campaign.evaluate import Outcome
-
-__all__ = ["JOURNAL_FILE", "Journal"]
+__all__ = ["JOURNAL_FILE", "Outcome", "Journal"]
 
 JOURNAL_FILE = "runs.jsonl"
 """The journal's file name in the campaign's output folder."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What one model run gave.
+
+    Attributes
+    ----------
+    status : str
+        The engine's status (``ok``, ``locked``, ``failed``, ...).
+    reason : str or None
+    efficiency : float or None
+        Mean efficiency over the recording's window [-] (None unless ``ok``).
+    error_estimate : float or None
+        The engine's own estimate of the mean efficiency's error [-].
+    wall_s : float
+    reused : bool
+        Taken from the journal, not run now.
+    """
+
+    status: str
+    reason: str | None
+    efficiency: float | None
+    error_estimate: float | None
+    wall_s: float
+    reused: bool = field(default=False, compare=False)
+
+    @property
+    def ok(self) -> bool:
+        """True when the run ended ``ok`` with an efficiency."""
+        return self.status == Status.OK and self.efficiency is not None
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON fields (without ``reused``)."""
+        return {"status": str(self.status), "reason": self.reason, "efficiency": self.efficiency,
+                "error_estimate": self.error_estimate, "wall_s": self.wall_s}
 
 
 class Journal:
@@ -32,8 +67,6 @@ class Journal:
 
     def _read(self) -> dict[str, Outcome]:
         """The outcomes already in the file."""
-        from rigdata.campaign.evaluate import Outcome
-
         if not self.path.is_file():
             return {}
         data = self.path.read_bytes()
