@@ -50,22 +50,24 @@ def _num(value: Any) -> float:
 
 
 def _tick_label(rec: Mapping[str, Any]) -> str:
-    """A recording's tick: label, shaft angle [deg] and input speed [rpm]."""
-    rpm = rec.get("operating_point", {}).get("speed_in_rpm")
+    """A recording's tick: label, shaft angle [deg], input speed [rpm] and, without a comparison, why."""
+    rpm = (rec.get("operating_point") or {}).get("speed_in_rpm")
     speed = f", {rpm:.0f} rpm" if rpm is not None and math.isfinite(rpm) else ""
-    return f"{rec['label']}\n{rec['shaft_angle_deg']:g} deg{speed}"
+    failed = f"\nno comparison ({rec['status']})" if rec["status"] != "ok" else ""
+    return f"{rec['label']}\n{rec['shaft_angle_deg']:g} deg{speed}{failed}"
 
 
 def _recording_axis(ax: Any, recs: Sequence[Mapping[str, Any]]) -> None:
-    """Recordings along x in the campaign's order, calibration ones shaded, failed ones marked."""
+    """Recordings along x in the campaign's order, calibration ones shaded, failed ones' ticks in red."""
     for i, rec in enumerate(recs):
         if rec["use"] == "calibration":
             ax.axvspan(i - 0.5, i + 0.5, color=CALIBRATION_SHADE, zorder=0, lw=0)
-        if rec["status"] != "ok":
-            ax.text(i, 0.98, f"no comparison\n({rec['status']})", transform=ax.get_xaxis_transform(),
-                    ha="center", va="top", fontsize=8, color=RESOLVABLE)
     ax.set_xticks(range(len(recs)))
-    ax.set_xticklabels([_tick_label(r) for r in recs], fontsize=8, rotation=30 if len(recs) > 10 else 0)
+    ticks = ax.set_xticklabels([_tick_label(r) for r in recs], fontsize=8,
+                               rotation=30 if len(recs) > 10 else 0)
+    for tick, rec in zip(ticks, recs, strict=True):
+        if rec["status"] != "ok":
+            tick.set_color(RESOLVABLE)
     ax.set_xlim(-0.5, len(recs) - 0.5)
     ax.set_xlabel("recording (shaft angle, mean input speed), in the campaign's order")
     ax.grid(axis="y", alpha=0.3)

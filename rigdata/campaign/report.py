@@ -198,13 +198,13 @@ def _comparison(data: Mapping[str, Any]) -> Section:
     """The per-recording table and the efficiency and model-error figures."""
     recs = data["recordings"]
     headers = ("recording", "use", "shaft angle [deg]", "input speed [rpm]", "input torque [N m]", "S", "D",
-               "E = S - D", "u_num", "u_input", "u_D", "u_val", "E ± k u_val", "verdict")
+               "E", "u_num", "u_input", "u_D", "u_val", "E ± k u_val", "verdict")
     numeric = (False, False, *([True] * 11), False)
     tones = {(i, 13): verdict(r)[1] for i, r in enumerate(recs)}
     engine = data["campaign"]["engines"][0]
     return Section("Comparison per recording", (
-        Text(f"S: simulated ({engine}), D: measured, mean efficiency over whole revolutions [-]; the "
-             f"uncertainties are standard (k = 1); the interval is E ± k u_val with k = "
+        Text(f"S: simulated ({engine}), D: measured, mean efficiency over whole revolutions [-]; E = S - D; "
+             f"the uncertainties are standard (k = 1); the interval is E ± k u_val with k = "
              f"{number(data['campaign']['k'], '.3f')}."),
         _table(headers, [_comparison_row(r) for r in recs], numeric, tones),
         Image("efficiency", "Measured D (±k u_D) and simulated S of each engine (the first with ±k u_input) "
@@ -274,7 +274,7 @@ def _engines(data: Mapping[str, Any]) -> Section:
         Text(f"Each engine's simulated efficiency S at the same parameter values, its numerical "
              f"uncertainty u_num and its difference from the first engine ({first}); \"within k u_num\": "
              "the difference is at most k times the root sum of squares of the two engines' u_num."),
-        _table(headers, rows, [False, *([True] * (len(headers) - 1))])))
+        _table(headers, rows, [h not in ("recording", "within k u_num") for h in headers])))
 
 
 def _estimate_row(p: Mapping[str, Any]) -> list[str]:
@@ -318,6 +318,7 @@ def _combinations(cal: Mapping[str, Any], data: Mapping[str, Any]) -> list[Block
     lines = []
     for c in cal["combinations"]:
         terms = " + ".join(f"{number(v, '.3g')} {name}" for name, v in c["coefficients"].items())
+        terms = re.sub(r"(^|\+ )1 ", r"\1", terms).replace("+ -", "- ")
         u = c["standard_uncertainty"]
         lines.append(f"{terms} = {value(c['value'], u, '.6g')} ± {uncertainty(u)}")
     return [Text(f"The calibration recordings do not identify {', '.join(unidentified)}; they determine "
@@ -329,8 +330,8 @@ def _chi_square(cal: Mapping[str, Any], data: Mapping[str, Any]) -> Text:
     """The chi-square test of the fit, in plain words."""
     level = _level(data)
     p = cal.get("p_value")
-    head = (f"Chi-square test of the fit: chi-square = {number(cal['chi_square'], '.3g')} with {cal['dof']} "
-            f"degrees of freedom, p = {number(p, '.2g')}. ")
+    head = (f"Chi-square test of the fit: chi-square = {number(cal['chi_square'], '.3g')} with "
+            f"{cal['dof']} degree{'' if cal['dof'] == 1 else 's'} of freedom, p = {number(p, '.2g')}. ")
     if cal.get("rejected") is None:
         return Text(head + "No degrees of freedom are left (as many identified directions as calibration "
                            "recordings): the fit cannot be tested.", "warning")
@@ -388,7 +389,8 @@ HOW_TO_READ = (
     "the model's uncertain inputs (calibrated parameters included), the measurement, less what the "
     "simulation and the measurement share (the output transducer drives both).",
     "The interval E ± k u_val contains δ_model with the stated coverage.",
-    "|E| > k u_val: a **resolvable model error** - the data show the model is off by about E. "
+    "|E| > k u_val: a **resolvable model error** - the interval excludes zero: the data resolve the "
+    "model's error, about E. "
     "|E| ≤ k u_val: **not resolvable** - the model error is not resolvable at this level of data; "
     "this is no proof that the model is right, only that the data cannot tell.",
     "Calibration recordings fitted the parameters: their E is no validation and gets no verdict; the "
@@ -417,8 +419,8 @@ def document(data: Mapping[str, Any]) -> tuple[str, list[Section]]:
     name = c.get("title") or (Path(c["file"]).name if c.get("file") else "campaign")
     head = Section("", (*_synthetic(data), *_facts(data)))
     return f"Validation campaign: {name}", [
-        head, Section("Verdict", tuple(_summary(data))), _calibration(data), _comparison(data), _budget(data),
-        _engines(data), *_failures(data), Section("How to read this", (Items(HOW_TO_READ),)),
+        head, Section("Verdict", tuple(_summary(data))), Section("How to read this", (Items(HOW_TO_READ),)),
+        _calibration(data), _comparison(data), _budget(data), _engines(data), *_failures(data),
         _environment(data)]
 
 
@@ -506,8 +508,9 @@ code { font: .9em ui-monospace, "DejaVu Sans Mono", monospace; background: #f3f3
 .scroll { overflow-x: auto; margin: .8em 0; }
 table { border-collapse: collapse; font-size: .88em; }
 th, td { border: 1px solid #d0d0d0; padding: .3em .55em; vertical-align: top; }
-th { background: #eef1f4; text-align: left; }
-th.num, td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+th { background: #eef1f4; text-align: left; vertical-align: bottom; }
+th.num { text-align: right; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 tbody tr:nth-child(even) { background: #fafafa; }
 td.resolvable, td.not-resolvable, td.calibration, td.failed { white-space: nowrap; }
 td.resolvable { background: #fde2df; color: #a30f0f; font-weight: 600; }
