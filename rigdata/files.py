@@ -1,7 +1,7 @@
-"""Atomic writers of rig files (delimited text, LVM, TDMS, MATLAB v5, Parquet) that
+"""Atomic writers of rig files (delimited text, LVM, TDMS, MATLAB v5, Parquet, ASAM MDF 4) that
 :mod:`rigdata.readers` reads back to the same numbers, units and metadata. A table is column
 name -> 1-D array with a time column [s]; ``metadata`` (str -> str) goes to the preamble, LVM
-header or TDMS file properties.
+header, TDMS file properties or MDF header comment.
 """
 
 from __future__ import annotations
@@ -17,9 +17,11 @@ import pandas as pd
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
 from cardan_exudyn.outputs import atomic_open
+from rigdata.readers.binary import INSTALL
+from rigdata.record import RigDataError
 from rigdata.units import split_header
 
-__all__ = ["write_csv", "write_lvm", "write_tdms", "write_mat", "write_parquet"]
+__all__ = ["write_csv", "write_lvm", "write_tdms", "write_mat", "write_parquet", "write_mdf"]
 
 #: Column names recognised as time by the writers (the first such column is the time axis).
 _TIME_NAMES = ("time", "t", "x_value", "zeit")
@@ -209,4 +211,30 @@ def write_parquet(path: str | os.PathLike, table: Mapping[str, np.ndarray], unit
     frame.attrs.update(metadata)
     with atomic_open(path, "wb") as f:
         frame.to_parquet(f)
+    return Path(path)
+
+
+def write_mdf(path: str | os.PathLike, table: Mapping[str, np.ndarray], units: Mapping[str, str],
+              metadata: Mapping[str, str]) -> Path:
+    """Write ASAM MDF 4.10 with asammdf: one group, a channel with its unit per column on the time column's
+    master, ``metadata`` as ``key: value`` lines of the header comment. Returns ``path``; RigDataError
+    when asammdf is missing.
+    """
+    try:
+        import asammdf  # optional (the rig extra), and slow to import
+    except ImportError:
+        raise RigDataError(f"writing an ASAM MDF file needs the optional package asammdf: {INSTALL}",
+                           file=path) from None
+    columns, time = _check(table, units, metadata)
+    t = columns.pop(time)
+    mdf = asammdf.MDF(version="4.10")
+    try:
+        mdf.append([asammdf.Signal(v, t, name=k, unit=units[k]) for k, v in columns.items()])
+        mdf.header.comment = "\n".join(f"{k}: {v}" for k, v in metadata.items())
+        buffer = io.BytesIO()
+        mdf.save(buffer)
+    finally:
+        mdf.close()
+    with atomic_open(path, "wb") as f:
+        f.write(buffer.getvalue())
     return Path(path)
