@@ -37,7 +37,9 @@ BAD_INPUT = (SceneError, BadInput, OutputError, EngineUnavailable, FileNotFoundE
 
 
 #: ``rigdata.synthetic.FORMATS``, spelled here so that parsing loads neither scipy nor pandas.
-SYNTHETIC_FORMATS = ("csv", "lvm", "tdms", "mat", "parquet")
+SYNTHETIC_FORMATS = ("csv", "lvm", "tdms", "mat", "parquet", "mdf")
+#: The formats ``--decimal`` applies to (the others store numbers, not text).
+DECIMAL_FORMATS = ("csv", "lvm")
 
 
 def _settings(cls: type, **kwargs: Any) -> Any:
@@ -303,8 +305,8 @@ def _synthetic_settings(args: argparse.Namespace) -> rigdata.RigSettings:
     load = {"input_torque": args.input_torque} if args.load is None else {"load_torque": args.load}
     return _settings(rigdata.RigSettings, scene=args.scene, shaft_angle_deg=args.angle, speed=speed,
                      friction=args.friction, rate=args.rate, noise=args.noise, revolutions=revolutions,
-                     seed=args.seed, speed_channel=args.speed_channel,
-                     torque_out_sign=args.torque_out_sign, **load, **exact)
+                     seed=1 if args.seed is None else args.seed, speed_channel=args.speed_channel,
+                     torque_out_sign=args.torque_out_sign, drag_torque=args.drag_torque, **load, **exact)
 
 
 def cmd_synthetic(args: argparse.Namespace) -> int:
@@ -314,9 +316,17 @@ def cmd_synthetic(args: argparse.Namespace) -> int:
         raise BadInput(f"--out {args.out!r} is a directory; give the name of the file to write")
     if not out.parent.is_dir():
         raise BadInput(f"--out {args.out!r}: the folder {str(out.parent)!r} does not exist")
+    if args.decimal is not None and args.format not in DECIMAL_FORMATS:
+        raise BadInput(f"--decimal applies to {' and '.join(DECIMAL_FORMATS)} files, "
+                       f"got --format {args.format}")
     settings = _synthetic_settings(args)
     transducer, _ = _transducers(args)
-    used = rigdata.synthetic.write(args.out, args.format, settings, transducer)
+    try:
+        used = rigdata.synthetic.write(args.out, args.format, settings, transducer, decimal=args.decimal)
+    except ValueError as exc:  # the model refuses the settings (a drag that leaves no brake torque)
+        if isinstance(exc, rigdata.RigDataError):
+            raise
+        raise BadInput(str(exc)) from None
     if args.json:
         print(json.dumps(used, indent=2))
     else:
@@ -395,7 +405,10 @@ def _validate_options(p: argparse.ArgumentParser) -> None:
 def _synthetic_options(p: argparse.ArgumentParser) -> None:
     """The file to write and the synthetic rig's settings (``synthetic``)."""
     p.add_argument("--out", required=True, metavar="FILE")
-    p.add_argument("--format", choices=SYNTHETIC_FORMATS, default="csv")
+    p.add_argument("--format", choices=SYNTHETIC_FORMATS, default="csv",
+                   help="csv (default), lvm, tdms, mat (MATLAB v5), parquet, mdf (ASAM MDF 4, asammdf)")
+    p.add_argument("--decimal", choices=(".", ","), default=None,
+                   help="decimal mark of csv (',': fields apart by ';'; default '.') and lvm (default ',')")
     p.add_argument("--scene", default="rig", metavar="NAME|FILE",
                    help="the joint: a named scene or a scene TOML file (default rig)")
     p.add_argument("--angle", type=_synthetic_angle, default=None,
@@ -423,13 +436,16 @@ def _synthetic_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
     p.add_argument("--torque-out-sign", type=int, choices=(1, -1), default=1,
                    help="-1: the output torque recorded negative (read it with --sign torque_out=-1)")
+    p.add_argument("--drag-torque", type=arguments.number("N m", non_negative=True), default=0.0,
+                   help="constant drag between the joint and the output transducer [N m], a load the "
+                        "output transducer does not see (default 0)")
     _transducer_options(p)
     p.add_argument("--sensitivity", type=arguments.number("V/(N m)", positive=True), default=0.1,
                    help="torque output of the transducers [V/(N m)] (default 0.1, paper)")
     p.add_argument("--pulses-per-rev", type=arguments.count("--pulses-per-rev"), default=60,
                    help="speed pulses per revolution (default 60, paper)")
-    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=1,
-                   help="seed of the drawn transducer errors and noise")
+    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=None,
+                   help="seed of the drawn transducer errors and noise (default 1)")
     p.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
     p.add_argument("--json", action="store_true", help="print the settings used as JSON")
 

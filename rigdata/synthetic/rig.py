@@ -1,8 +1,9 @@
 """A synthetic rig: the reference engine's joint measured by a model of the paper's transducers.
 
 Motor speed ``w0 (1 + e1 cos th + e2 cos 2th)`` (the motion repeats each revolution, so the true
-efficiency over whole revolutions is the engine's mean efficiency), constant brake torque; torques
-get lag, offset, drift, noise, quantisation; speeds are pulse counts or rpm. Files say they are synthetic.
+efficiency over whole revolutions is the engine's mean efficiency), constant brake torque and an optional
+constant drag between the joint and the output transducer; torques get lag, offset, drift, noise,
+quantisation; speeds are pulse counts or rpm. Files say they are synthetic.
 """
 
 from __future__ import annotations
@@ -33,13 +34,18 @@ from rigdata.record import ChannelSource, RigRecord
 from rigdata.transducer import Transducer
 from rigdata.units import parse_unit
 
-__all__ = ["GENERATOR", "FORMATS", "MAX_SAMPLES", "RigSettings", "Truth", "motor_angle", "true_signals",
-           "measure", "joint_scene", "metadata", "record", "write"]
+__all__ = ["GENERATOR", "FORMATS", "EXTENSIONS", "MAX_SAMPLES", "RigSettings", "Truth", "motor_angle",
+           "true_signals", "measure", "joint_scene", "metadata", "record", "write"]
 
 GENERATOR = "rigdata.synthetic 1"
 """The ``generator`` label of every synthetic file (name and version of this model)."""
-FORMATS = ("csv", "lvm", "tdms", "mat", "parquet")
+FORMATS = ("csv", "lvm", "tdms", "mat", "parquet", "mdf")
 """The file formats :func:`write` writes."""
+EXTENSIONS = {"csv": ".csv", "lvm": ".lvm", "tdms": ".tdms", "mat": ".mat", "parquet": ".parquet",
+              "mdf": ".mf4"}
+"""The file extension of each format."""
+#: The decimal mark each format is written with when :func:`write` is given none.
+DECIMAL = {"csv": ".", "lvm": ","}
 
 
 @dataclass(frozen=True)
@@ -78,6 +84,12 @@ class RigSettings:
         Pulse counts or a speed channel in rpm.
     torque_out_sign : {1, -1}
         Sign convention of the output torque column: -1 records the brake's torque as negative.
+    drag_torque : float
+        Constant drag [N m] between the joint's output and the output torque transducer (a seal, say),
+        opposing the output rotation: the joint is loaded by brake + drag, the output transducer measures
+        the brake torque only. A model-form error: a joint model driven by the measured output torque
+        lacks it, so the measured efficiency is lower than such a model's, by ``drag / input_torque``
+        over whole revolutions (more at low load).
     seed : int
         Seed of the drawn errors and the noise.
     """
@@ -98,6 +110,7 @@ class RigSettings:
     drifts: tuple | None = None
     speed_channel: str = "pulses"
     torque_out_sign: int = 1
+    drag_torque: float = 0.0
     seed: int = 1
 
     def __post_init__(self) -> None:
@@ -112,7 +125,7 @@ class RigSettings:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"`{name}` must be positive, got {value!r}")
-        for name in ("noise", "lag"):
+        for name in ("noise", "lag", "drag_torque"):
             if not (math.isfinite(getattr(self, name)) and getattr(self, name) >= 0):
                 raise ValueError(f"`{name}` must be >= 0, got {getattr(self, name)!r}")
         if self.speed_channel not in ("pulses", "rpm"):
@@ -134,7 +147,7 @@ class RigSettings:
 
     def _check_types(self) -> None:
         """TypeError/ValueError for a setting of the wrong type."""
-        for name in ("speed", "input_torque", "revolutions", "rate", "phase", "noise", "lag"):
+        for name in ("speed", "input_torque", "revolutions", "rate", "phase", "noise", "lag", "drag_torque"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
                 raise TypeError(f"`{name}` must be a number, got {value!r:.80}")
@@ -182,11 +195,13 @@ class Truth:
     angle_in, angle_out, speed_in, speed_out : ndarray, shape (n,)
         Shaft angles [rad] and speeds [rad/s].
     torque_in, torque_out : ndarray, shape (n,)
-        Drive and brake torques [N m].
+        Drive and brake torques [N m] (the torques the transducers see).
     efficiency : float
-        Reference engine's mean efficiency over whole revolutions [-].
+        Reference engine's mean efficiency over whole revolutions [-] (the joint's).
     brake_torque : float
         Constant brake torque [N m].
+    drag_torque : float
+        Constant drag between the joint and the output transducer [N m]; the joint's load is brake + drag.
     """
 
     t: np.ndarray
@@ -198,6 +213,14 @@ class Truth:
     torque_out: np.ndarray
     efficiency: float
     brake_torque: float
+    drag_torque: float = 0.0
+
+    @property
+    def brake_efficiency(self) -> float:
+        """Brake over input work over whole revolutions [-]: what exact transducers measure (the joint's
+        efficiency times brake / (brake + drag), the load being constant).
+        """
+        return self.efficiency * self.brake_torque / (self.brake_torque + self.drag_torque)
 
 
 def motor_angle(settings: RigSettings, points_per_revolution: int = 240) -> tuple[np.ndarray, np.ndarray]:
@@ -239,39 +262,51 @@ def _run(scene: Scene) -> Result:
     return result
 
 
-def _brake_torque(scene: Scene, target: float) -> tuple[float, Result]:
-    """Brake torque [N m] for a mean input torque ``target`` [N m], and the engine's run with it.
+def _joint_load(scene: Scene, target: float) -> tuple[float, Result]:
+    """Output load [N m] for a mean input torque ``target`` [N m], and the engine's run with it.
 
     Efficiency barely depends on load level, so one correction step suffices.
     """
-    brake = target
+    load = target
     for _ in range(2):
-        brake *= target / _run(replace(scene, load=Load(brake))).summary.mean_torque_in
-    return brake, _run(replace(scene, load=Load(brake)))
+        load *= target / _run(replace(scene, load=Load(load))).summary.mean_torque_in
+    return load, _run(replace(scene, load=Load(load)))
+
+
+def _loads(scene: Scene, settings: RigSettings) -> tuple[float, float, Result]:
+    """Joint load and brake torque [N m] (load = brake + drag) and the engine's run; ValueError when the
+    drag leaves no brake torque for the settings' input torque.
+    """
+    drag = settings.drag_torque
+    if settings.load_torque is not None:
+        load = settings.load_torque + drag
+        return load, settings.load_torque, _run(replace(scene, load=Load(load)))
+    load, result = _joint_load(scene, settings.input_torque)
+    if not load - drag > 0:
+        raise ValueError(f"`drag_torque` {drag!r} N m leaves no brake torque: an input torque of "
+                         f"{settings.input_torque:g} N m loads the joint with {load:.4g} N m in all")
+    return load, load - drag, result
 
 
 def true_signals(settings: RigSettings) -> Truth:
-    """Reference engine on the rig driven by :func:`motor_angle` and braked for the settings' input torque,
-    sampled on the rig's grid.
+    """Reference engine on the rig driven by :func:`motor_angle` and loaded by brake + drag for the settings'
+    input torque, sampled on the rig's grid.
     """
     t_knots, angle = motor_angle(settings)
     base = joint_scene(settings)
     scene = replace(base, drive=AngleDrive(tuple(t_knots), tuple(angle)),
                     revolutions=1.0, record=replace(base.record, timeseries=False))
-    if settings.load_torque is None:
-        brake, result = _brake_torque(scene, settings.input_torque)
-    else:
-        brake = settings.load_torque
-        result = _run(replace(scene, load=Load(brake)))
-    scene = replace(scene, load=Load(brake))
+    load, brake, result = _loads(scene, settings)
+    scene = replace(scene, load=Load(load))
     t = np.arange(0.0, t_knots[-1] - 0.25 * 2 * math.pi / settings.speed, 1.0 / settings.rate)
     # the true signals on the rig's grid, from the engine's own closed-form input motion
     motion = input_motion(scene, ReferenceOptions())
     cols = columns_at(scene, motion, t)
     return Truth(t=t, angle_in=cols["theta_in"], angle_out=cols["theta_out"],
                  speed_in=cols["omega_in"], speed_out=cols["omega_out"],
-                 torque_in=cols["torque_in"], torque_out=cols["torque_out"],
-                 efficiency=float(result.mean_efficiency), brake_torque=float(brake))
+                 torque_in=cols["torque_in"], torque_out=cols["torque_out"] - settings.drag_torque,
+                 efficiency=float(result.mean_efficiency), brake_torque=float(brake),
+                 drag_torque=float(settings.drag_torque))
 
 
 def _errors(settings: RigSettings, transducer: Transducer,
@@ -319,7 +354,9 @@ def measure(truth: Truth, settings: RigSettings,
     units : dict of str to str
         Each column's unit.
     used : dict
-        Settings, drawn errors, encoder start, true phase and efficiency, brake torque, transducer.
+        Settings, drawn errors, encoder start, true phase, true efficiency of the joint
+        (``true_efficiency``) and of brake over input (``true_brake_efficiency``), brake torque,
+        transducer.
     """
     transducer = transducer or Transducer()
     rng = np.random.default_rng(settings.seed)
@@ -350,7 +387,8 @@ def measure(truth: Truth, settings: RigSettings,
     used = {**asdict(settings), "input_torque": input_torque,
             "offsets": list(offsets), "drifts": list(drifts),
             "encoder_start": float(encoder_start), "true_phase": true_phase,
-            "true_efficiency": truth.efficiency, "brake_torque": truth.brake_torque,
+            "true_efficiency": truth.efficiency, "true_brake_efficiency": truth.brake_efficiency,
+            "brake_torque": truth.brake_torque,
             "transducer": transducer.as_dict()}
     return table, units, used
 
@@ -402,34 +440,50 @@ def record(settings: RigSettings | None = None, transducer: Transducer | None = 
 
 
 def write(path, fmt: str, settings: RigSettings | None = None, transducer: Transducer | None = None,
-          truth: Truth | None = None) -> dict:
+          truth: Truth | None = None, *, decimal: str | None = None) -> dict:
     """Write a synthetic measurement file labelled as such; return ``used`` (:func:`measure`).
 
     Parameters
     ----------
     path : str or path-like
         The file (replaced atomically).
-    fmt : {"csv", "lvm", "tdms", "mat", "parquet"}
-        ``lvm`` is written with decimal comma; ``mat`` is MATLAB v5 (scipy), ``parquet`` needs pyarrow.
+    fmt : {"csv", "lvm", "tdms", "mat", "parquet", "mdf"}
+        ``mat`` is MATLAB v5 (scipy), ``parquet`` needs pyarrow, ``mdf`` (ASAM MDF 4, ``.mf4``) asammdf.
     settings, transducer, truth : optional
         As for :func:`record`.
+    decimal : {".", ","}, optional
+        Decimal mark of ``csv`` (``","``: fields apart by ``;``) and ``lvm``; None: ``.`` for csv, ``,``
+        for lvm. The other formats store numbers, not text, and take none.
     """
-    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
-        raise TypeError(f"`path` must be a str or path naming the file to write, got {path!r:.80}")
-    if not isinstance(fmt, str) or fmt not in FORMATS:
-        raise ValueError(f"`fmt` must be one of {FORMATS}, got {fmt!r:.80}")
-    for name, value, cls in (("settings", settings, RigSettings), ("transducer", transducer, Transducer),
-                             ("truth", truth, Truth)):
-        if value is not None and not isinstance(value, cls):
-            raise TypeError(f"`{name}` must be a {cls.__name__} or None, got {type(value).__name__}")
+    _check_write(path, fmt, decimal, settings, transducer, truth)
     settings = settings or RigSettings()
     truth = truth or true_signals(settings)
     table, units, used = measure(truth, settings, transducer)
     meta = metadata(used)
-    writers = {"csv": files.write_csv, "tdms": files.write_tdms, "mat": files.write_mat,
-               "parquet": files.write_parquet}
-    if fmt == "lvm":
-        files.write_lvm(path, table, units, meta, decimal=",")
+    mark = decimal or DECIMAL.get(fmt)
+    if fmt == "csv":
+        files.write_csv(path, table, units, meta, sep=";" if mark == "," else ",", decimal=mark)
+    elif fmt == "lvm":
+        files.write_lvm(path, table, units, meta, decimal=mark)
     else:
+        writers = {"tdms": files.write_tdms, "mat": files.write_mat, "parquet": files.write_parquet,
+                   "mdf": files.write_mdf}
         writers[fmt](path, table, units, meta)
     return used
+
+
+def _check_write(path: object, fmt: object, decimal: object, settings: object, transducer: object,
+                 truth: object) -> None:
+    """TypeError/ValueError naming the argument of :func:`write` that is wrong."""
+    if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise TypeError(f"`path` must be a str or path naming the file to write, got {path!r:.80}")
+    if not isinstance(fmt, str) or fmt not in FORMATS:
+        raise ValueError(f"`fmt` must be one of {FORMATS}, got {fmt!r:.80}")
+    if decimal is not None and (fmt not in DECIMAL or decimal not in (".", ",")):
+        raise ValueError(f"`decimal` must be '.' or ',' for csv and lvm and None for the other formats, "
+                         f"got {decimal!r:.80} for {fmt}")
+    for name, value, cls in (("settings", settings, RigSettings), ("transducer", transducer, Transducer),
+                             ("truth", truth, Truth)):
+        if value is not None and not isinstance(value, cls):
+            raise TypeError(f"`{name}` must be a {cls.__name__} or None, got {type(value).__name__}")
+
