@@ -309,8 +309,29 @@ def _synthetic_settings(args: argparse.Namespace) -> rigdata.RigSettings:
                      torque_out_sign=args.torque_out_sign, drag_torque=args.drag_torque, **load, **exact)
 
 
+def _synthetic_campaign(args: argparse.Namespace) -> int:
+    """``cardan rig synthetic --campaign DIR``: the campaign's files and ``campaign.toml`` (its path on
+    stdout)."""
+    if Path(args.campaign).exists() and not Path(args.campaign).is_dir():
+        raise BadInput(f"--campaign {args.campaign!r} is a file; give the folder to write the campaign in")
+    options = {"friction": args.friction, "seed": args.seed, "seconds": args.seconds}
+    try:
+        path = rigdata.synthetic.write_campaign(
+            args.campaign, drag_torque=args.drag_torque, rate=args.rate, scene=args.scene,
+            **{k: v for k, v in options.items() if v is not None})
+    except ValueError as exc:  # write_campaign refuses its settings with ValueError
+        if isinstance(exc, rigdata.RigDataError):
+            raise
+        raise BadInput(str(exc)) from None
+    print(path)
+    return EXIT_OK
+
+
 def cmd_synthetic(args: argparse.Namespace) -> int:
-    """``cardan rig synthetic``: write a synthetic rig file, labelled as such with its settings."""
+    """``cardan rig synthetic``: write a synthetic rig file, labelled as such with its settings, or with
+    ``--campaign`` a synthetic validation campaign."""
+    if args.campaign is not None:
+        return _synthetic_campaign(args)
     out = Path(args.out)
     if out.is_dir():
         raise BadInput(f"--out {args.out!r} is a directory; give the name of the file to write")
@@ -404,7 +425,12 @@ def _validate_options(p: argparse.ArgumentParser) -> None:
 
 def _synthetic_options(p: argparse.ArgumentParser) -> None:
     """The file to write and the synthetic rig's settings (``synthetic``)."""
-    p.add_argument("--out", required=True, metavar="FILE")
+    target = p.add_mutually_exclusive_group(required=True)
+    target.add_argument("--out", metavar="FILE", help="the file to write")
+    target.add_argument("--campaign", metavar="DIR",
+                        help="write a synthetic validation campaign (eight files and campaign.toml) in DIR "
+                             "and print the toml's path; takes --friction (default 0.12), --drag-torque, "
+                             "--seed (default 0), --seconds (default 12), --rate, --scene, no other option")
     p.add_argument("--format", choices=SYNTHETIC_FORMATS, default="csv",
                    help="csv (default), lvm, tdms, mat (MATLAB v5), parquet, mdf (ASAM MDF 4, asammdf)")
     p.add_argument("--decimal", choices=(".", ","), default=None,
@@ -445,7 +471,7 @@ def _synthetic_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--pulses-per-rev", type=arguments.count("--pulses-per-rev"), default=60,
                    help="speed pulses per revolution (default 60, paper)")
     p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=None,
-                   help="seed of the drawn transducer errors and noise (default 1)")
+                   help="seed of the drawn transducer errors and noise (default 1; campaign 0)")
     p.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
     p.add_argument("--json", action="store_true", help="print the settings used as JSON")
 
