@@ -15,6 +15,7 @@ import rigdata
 from reference.scene.joint import PAIR_NAMES
 from reference.scene.mapping import replace as replace_field
 from rigdata import synthetic
+from rigdata.campaign.spec import load_campaign
 from rigdata.validation import as_scene
 
 try:
@@ -22,10 +23,10 @@ try:
 except ImportError:  # Python 3.10
     import tomli as tomllib
 
-#: The keys of campaign.toml that ``cardan rig campaign`` reads.
+#: The keys of campaign.toml that ``cardan rig campaign`` reads (rigdata.campaign.spec).
 TOP_KEYS = {"scene", "engines", "coverage", "parameters", "transducers", "recording"}
 RECORDING_KEYS = {"file", "shaft_angle_deg", "use"}
-RECORDING_OPTIONAL = {"read", "map", "unit", "sign"}
+RECORDING_OPTIONAL = {"label", "format", "map", "unit", "sign", "transducers"}
 
 
 @pytest.fixture(scope="module")
@@ -40,10 +41,11 @@ def settings_of(rec) -> dict:
     return json.loads(rec.provenance["synthetic"]["settings"])
 
 
-def read_recording(path, entry):
+def read_recording(path, entry, transducers=None):
     """The record of one ``[[recording]]`` read with the options the toml gives."""
+    t = rigdata.Transducer(**(transducers or {}))
     return rigdata.read(path.parent / entry["file"], mapping=entry.get("map"), units=entry.get("unit"),
-                        **entry.get("read", {}))
+                        sensitivity=t.sensitivity, pulses_per_rev=t.pulses_per_rev)
 
 
 def test_toml_has_the_campaign_keys(campaign):
@@ -61,6 +63,39 @@ def test_toml_has_the_campaign_keys(campaign):
     assert toml["transducers"] == {"full_scale": 5.0, "accuracy_class": 0.0005}
     for entry in toml["recording"]:
         assert RECORDING_KEYS <= set(entry) <= RECORDING_KEYS | RECORDING_OPTIONAL, entry
+
+
+def test_campaign_loads(campaign):
+    """``cardan rig campaign``'s parser takes the file: eight recordings with their use and sign, the
+    campaign's transducers, the friction parameter on every pair."""
+    path, toml = campaign
+    spec = load_campaign(path)
+    assert [r.file.name for r in spec.recordings] == [e["file"] for e in toml["recording"]]
+    assert [r.use for r in spec.recordings] == [e["use"] for e in toml["recording"]]
+    assert [r.signs for r in spec.recordings] == [e.get("sign", {}) for e in toml["recording"]]
+    assert all(r.transducers == (synthetic.CAMPAIGN_TRANSDUCER,) * 2 for r in spec.recordings)
+    assert [p.name for p in spec.parameters] == ["f"] and len(spec.parameters[0].keys) == 4
+
+
+def test_own_transducer_reaches_the_toml(tmp_path):
+    """A transducer of other sensitivity, pulses and drift: ``[transducers]`` states them, the parser
+    reads the file with them."""
+    t = rigdata.Transducer(full_scale=5.0, accuracy_class=5e-4, sensitivity=2.0, pulses_per_rev=360,
+                           zero_drift=5e-4)
+    point = {"shaft_angle_deg": 20.0, "speed": 6.0, "input_torque": 2.0, "use": "calibration",
+             "format": "csv"}
+    path = synthetic.write_campaign(tmp_path, points=[point], seconds=3.0, transducer=t)
+    toml = tomllib.loads(path.read_text())
+    assert toml["transducers"] == {"full_scale": 5.0, "accuracy_class": 5e-4, "sensitivity": 2.0,
+                                   "pulses_per_rev": 360, "zero_drift": 5e-4}
+    spec = load_campaign(path)
+    assert spec.recordings[0].transducers == (t, t)
+    rec = rigdata.read(spec.recordings[0].file, **spec.recordings[0].read)
+    assert math.degrees(rec.sources["angle_in"].quantum) == pytest.approx(1.0)
+    # volts read at 2 V/(N m) (at the default 0.1 the torque would read 20 times too large): the mean input
+    # torque over whole revolutions is the 2 N m set, within the class, drift and noise (under 0.2 %)
+    m = rigdata.measure(rec, 20.0, transducers=t, monte_carlo=0)
+    assert m.as_dict()["mean_torque_in"] == pytest.approx(2.0, rel=2e-3)
 
 
 def test_parameter_keys_set_every_pair(campaign):
@@ -90,7 +125,7 @@ def test_every_file_reads_with_the_toml_options(campaign):
     path, toml = campaign
     t = rigdata.Transducer(**toml["transducers"])
     for entry in toml["recording"]:
-        rec = read_recording(path, entry)
+        rec = read_recording(path, entry, toml["transducers"])
         stored = settings_of(rec)
         assert (stored["shaft_angle_deg"], stored["friction"]) == (entry["shaft_angle_deg"], 0.12)
         m = rigdata.measure(rec, entry["shaft_angle_deg"], transducers=t, monte_carlo=0,
@@ -175,9 +210,44 @@ def test_bad_settings_are_refused_before_writing(tmp_path, changes, match):
     assert not (tmp_path / "c").exists()
 
 
+@pytest.mark.parametrize("argv, expected", [
+    ([], {"drag_torque": 0.0, "rate": 1000.0, "scene": "rig"}),
+    (["--friction", "0.2", "--drag-torque", "0.01", "--seed", "3", "--seconds", "5", "--rate", "500"],
+     {"friction": 0.2, "drag_torque": 0.01, "seed": 3, "seconds": 5.0, "rate": 500.0, "scene": "rig"}),
+], ids=["defaults", "options"])
+def test_cli_campaign_options(tmp_path, monkeypatch, capsys, argv, expected):
+    """``--campaign DIR``: the options reach write_campaign (the library's defaults where none is given),
+    the toml's path is printed."""
+    from cardan_exudyn.cli import main
+
+    calls = []
+
+    def fake(folder, **kwargs):
+        calls.append((folder, kwargs))
+        return tmp_path / "c" / "campaign.toml"
+
+    monkeypatch.setattr(synthetic, "write_campaign", fake)
+    assert main(["rig", "synthetic", "--campaign", str(tmp_path / "c"), *argv]) == 0
+    assert calls == [(str(tmp_path / "c"), expected)]
+    assert capsys.readouterr().out.strip() == str(tmp_path / "c" / "campaign.toml")
+
+
+def test_cli_campaign_needs_a_folder(tmp_path, capsys):
+    """``--campaign`` naming a file, or with ``--out``: one line, exit 2."""
+    from cardan_exudyn.cli import main
+
+    (tmp_path / "f").write_text("")
+    assert main(["rig", "synthetic", "--campaign", str(tmp_path / "f")]) == 2
+    assert "is a file" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["rig", "synthetic", "--campaign", str(tmp_path), "--out", str(tmp_path / "x.csv")])
+    assert "not allowed with argument" in capsys.readouterr().err
+
+
+@pytest.mark.slow
 def test_cli_campaign(tmp_path):
-    """``cardan rig synthetic --campaign DIR``: prints the toml's path; friction, drag and seed reach the
-    files and the toml's first line."""
+    """``cardan rig synthetic --campaign DIR`` end to end: prints the toml's path; friction, drag and seed
+    reach the files and the toml's first line."""
     pytest.importorskip("asammdf")
     proc = subprocess.run([sys.executable, "-m", "cardan_exudyn.cli", "rig", "synthetic", "--campaign",
                            str(tmp_path / "c"), "--friction", "0.2", "--drag-torque", "0.01", "--seed", "3",

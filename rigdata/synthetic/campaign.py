@@ -16,7 +16,7 @@ import numpy as np
 from cardan_exudyn.outputs import atomic_open
 from reference.scene.joint import PAIR_NAMES
 from rigdata.synthetic.rig import EXTENSIONS, FORMATS, RigSettings, write
-from rigdata.transducer import PULSES_PER_REV, SENSITIVITY, Transducer
+from rigdata.transducer import Transducer
 
 __all__ = ["CAMPAIGN_TRANSDUCER", "DEFAULT_POINTS", "POINT_KEYS", "USES", "write_campaign"]
 
@@ -121,31 +121,26 @@ def _inline(table: Mapping[str, Any]) -> str:
     return "{ " + ", ".join(f"{k} = {v!r}" for k, v in table.items()) + " }"
 
 
-def _recording(name: str, point: Mapping[str, Any], transducer: Transducer) -> list[str]:
-    """The ``[[recording]]`` lines of one file: name, shaft angle, use and how to read it."""
+def _recording(name: str, point: Mapping[str, Any]) -> list[str]:
+    """The ``[[recording]]`` lines of one file: name, shaft angle, use and the output torque's sign."""
     lines = ["", "[[recording]]",
              f"# {point['format']}, {point['speed']:g} rad/s, {point['input_torque']:g} N m input torque",
              f"file = {_string(name)}", f"shaft_angle_deg = {float(point['shaft_angle_deg'])!r}",
              f"use = {_string(point['use'])}"]
-    read = {k: v for k, v, default in (("sensitivity", transducer.sensitivity, SENSITIVITY),
-                                       ("pulses_per_rev", transducer.pulses_per_rev, PULSES_PER_REV))
-            if v != default}
-    if read:
-        lines.append(f"read = {_inline(read)}")
     if point.get("torque_out_sign", 1) == -1:
         lines.append(f"sign = {_inline({'torque_out': -1})}")
     return lines
 
 
 def _transducer_lines(transducer: Transducer) -> list[str]:
-    """The ``[transducers]`` table: full scale and class, and any other measuring field not at its default
-    (:class:`Transducer`'s; sensitivity and pulses go to each recording's ``read``)."""
+    """The ``[transducers]`` table: full scale and class, and every other field not at :class:`Transducer`'s
+    default (the sensitivity and pulses read the files, the others state the uncertainty)."""
     lines = ["", "[transducers]", f"full_scale = {float(transducer.full_scale)!r}",
              f"accuracy_class = {float(transducer.accuracy_class)!r}"]
     default = Transducer()
-    for key in ("zero_drift", "speed_accuracy", "adc_range", "adc_bits"):
-        if getattr(transducer, key) != getattr(default, key):
-            lines.append(f"{key} = {getattr(transducer, key)!r}")
+    for key, value in transducer.as_dict().items():
+        if key not in ("full_scale", "accuracy_class") and value != getattr(default, key):
+            lines.append(f"{key} = {value!r}")
     return lines
 
 
@@ -229,7 +224,7 @@ def write_campaign(folder: str | os.PathLike, *, friction: float = 0.12, drag_to
         name = _name(k, point)
         write(folder / name, point["format"], rig, transducer,
               decimal="," if point["format"] == "csv" else None)
-        recordings.append(_recording(name, point, transducer))
+        recordings.append(_recording(name, point))
     path = folder / "campaign.toml"
     with atomic_open(path, "w", encoding="utf-8", newline="\n") as f:
         f.write(_toml(common, transducer, recordings))
