@@ -1,5 +1,6 @@
-"""The campaign report (rigdata.campaign.report): files, self-contained HTML, verdicts, calibration
-sentences and failed recordings, on a CampaignResult built by hand from the campaign's dataclasses.
+"""The campaign report (rigdata.campaign.report, content, render): files, self-contained HTML, verdicts,
+calibration sentences and failed recordings, on a CampaignResult built by hand from the campaign's
+dataclasses.
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from scipy import stats
 
 from rigdata.campaign.budget import Budget
 from rigdata.campaign.calibration import Calibration, Estimate
-from rigdata.campaign.report import uncertainty, value, verdict, write_report
+from rigdata.campaign.content import uncertainty, value, verdict
+from rigdata.campaign.report import write_report
 from rigdata.campaign.result import TABLE_COLUMNS, CampaignResult, EngineComparison, RecordingResult
 from rigdata.campaign.spec import CampaignSpec, Parameter
 from rigdata.conditioning import Conditioning
