@@ -16,7 +16,7 @@ __all__ = ["CSS", "markdown", "html_page"]
 
 
 def _md_block(block: Block) -> str:
-    """One block as markdown."""
+    """One block as markdown; a table's numeric columns right-aligned."""
     if isinstance(block, Text):
         return block.text
     if isinstance(block, Items):
@@ -26,7 +26,8 @@ def _md_block(block: Block) -> str:
     rows = [{str(j): _md_cell(cell, block.tones.get((i, j))) for j, cell in enumerate(row)}
             for i, row in enumerate(block.rows)]
     keys = [str(j) for j in range(len(block.headers))]
-    return markdown_table(rows, keys, headers=block.headers).rstrip("\n")
+    right = [key for key, numeric in zip(keys, block.numeric, strict=True) if numeric]
+    return markdown_table(rows, keys, headers=block.headers, right=right).rstrip("\n")
 
 
 def _md_cell(text: str, tone: str | None) -> str:
