@@ -1,14 +1,17 @@
-"""The campaign report (rigdata.campaign.report): files, self-contained HTML, verdicts, calibration
-sentences and failed recordings, on a CampaignResult built by hand from the campaign's dataclasses.
+"""The campaign report (rigdata.campaign.report, content, render): files, self-contained HTML, verdicts,
+calibration sentences and failed recordings, on a CampaignResult built by hand from the campaign's
+dataclasses.
 """
 
 from __future__ import annotations
 
 import base64
 import dataclasses
+import itertools
 import json
 import math
 import re
+from html import unescape
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +21,8 @@ from scipy import stats
 
 from rigdata.campaign.budget import Budget
 from rigdata.campaign.calibration import Calibration, Estimate
-from rigdata.campaign.report import uncertainty, value, verdict, write_report
+from rigdata.campaign.content import uncertainty, value, verdict
+from rigdata.campaign.report import write_report
 from rigdata.campaign.result import TABLE_COLUMNS, CampaignResult, EngineComparison, RecordingResult
 from rigdata.campaign.spec import CampaignSpec, Parameter
 from rigdata.conditioning import Conditioning
@@ -161,6 +165,33 @@ def test_markdown_links_each_figure(report):
     _, md, _ = report
     for name in FIGURES:
         assert f"]({name})" in md
+
+
+def _md_alignments(md: str) -> list[list[tuple[str, bool]]]:
+    """Each markdown table's (header, right-aligned) pairs, read from its header and rule lines."""
+    lines = md.splitlines()
+    tables = []
+    for head, rule in itertools.pairwise(lines):
+        if head.startswith("| ") and rule.startswith("|---"):
+            headers = [cell.strip() for cell in head.strip("|").split("|")]
+            tables.append(list(zip(headers, [r == "---:" for r in rule.strip("|").split("|")], strict=True)))
+    return tables
+
+
+def _html_alignments(page: str) -> list[list[tuple[str, bool]]]:
+    """Each HTML table's (header, numeric) pairs, read from its <th> classes."""
+    return [[(unescape(h), c == "num") for c, h in re.findall(r'<th class="(\w+)">(.*?)</th>', head)]
+            for head in re.findall(r"<thead><tr>(.*?)</tr></thead>", page)]
+
+
+def test_markdown_right_aligns_the_numeric_columns(report):
+    """report.md right-aligns exactly the columns report.html marks as numbers: in the comparison table
+    every column but recording, use and verdict."""
+    _, md, page = report
+    tables = _md_alignments(md)
+    assert tables == _html_alignments(page)
+    comparison = dict(next(t for t in tables if ("verdict", False) in t))
+    assert [h for h, right in comparison.items() if not right] == ["recording", "use", "verdict"]
 
 
 def test_resolvable_recording_shows_as_such(report):

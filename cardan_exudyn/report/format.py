@@ -6,7 +6,7 @@ A value that is not a finite number prints as ``missing`` ("-" by default), neve
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import Any
 
 __all__ = ["is_number", "number", "markdown_table"]
@@ -41,7 +41,7 @@ def _cell(value: Any, spec: str | None, missing: str) -> str:
 
 def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[str],
                    formats: Mapping[str, str] | None = None, headers: Sequence[str] | None = None,
-                   missing: str = "-") -> str:
+                   missing: str = "-", right: Collection[str] = ()) -> str:
     """A GitHub-flavoured markdown table, ending in a line end.
 
     Parameters
@@ -55,6 +55,8 @@ def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[st
         Column titles (default: the keys).
     missing : str
         What a value that is not a finite number prints as.
+    right : collection of str
+        Keys of the columns to right-align (``---:``); the others keep the renderer's default.
     """
     if hasattr(rows, "to_dict") and hasattr(rows, "columns"):  # a DataFrame
         rows = rows.to_dict("records")
@@ -62,7 +64,11 @@ def markdown_table(rows: Iterable[Mapping[str, Any]] | Any, columns: Sequence[st
     titles = list(headers) if headers is not None else list(columns)
     if len(titles) != len(columns):
         raise ValueError(f"`headers` must have {len(columns)} entries, got {len(titles)}")
-    lines = ["| " + " | ".join(titles) + " |", "|" + "---|" * len(columns)]
+    unknown = sorted(set(right) - set(columns))
+    if unknown:
+        raise ValueError(f"`right` must name shown columns, got {unknown!r} not in {list(columns)!r}")
+    rule = "".join("---:|" if c in right else "---|" for c in columns)
+    lines = ["| " + " | ".join(titles) + " |", "|" + rule]
     for row in rows:
         cells = [_cell(row.get(c), formats.get(c), missing) for c in columns]
         lines.append("| " + " | ".join(cells) + " |")
