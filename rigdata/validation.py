@@ -31,8 +31,8 @@ from rigdata.record import RigRecord, with_signs
 from rigdata.reproduce import model_settings, scene_entry
 from rigdata.transducer import PROVENANCE, Transducer
 
-__all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare", "check_engines",
-           "accuracy_needed", "validate"]
+__all__ = ["K", "MODEL_ENGINES", "CONSTANT_OUTPUT_ERRORS", "Validation", "as_scene", "compare",
+           "check_engines", "accuracy_needed", "validate"]
 
 #: Engines that take the measured angle drive and load history (MuJoCo takes constant loads only).
 MODEL_ENGINES = ("reference", "exudyn")

@@ -17,6 +17,9 @@ BENCHMARKS: dict[str, str] = {
     "coupling": "benchmarks.friction_numerics",
     "sign-band": "benchmarks.friction_numerics",
     "mujoco-settings": "benchmarks.mujoco_settings.command",
+    "campaign-truth": "benchmarks.campaign.command",
+    "campaign-coverage": "benchmarks.campaign.command",
+    "campaign-groups": "benchmarks.campaign.command",
 }
 """Benchmark name -> the module whose ``register(subparsers, name)`` adds it, in the order
 ``python tests/benchmarks --help`` lists them."""
