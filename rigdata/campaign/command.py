@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInput
+from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInput, out_folder
 from cardan_exudyn.report.format import number
 
 __all__ = ["EXIT_RESOLVABLE", "add_options", "cmd_campaign", "CampaignInterrupted"]
@@ -46,20 +46,33 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help=f"exit {EXIT_RESOLVABLE} when a validation recording's model error is resolvable")
 
 
-def _progress(args: argparse.Namespace):
-    """Stage lines on stderr; model-run counts overwrite one line on a terminal; nothing with --json."""
-    tty = sys.stderr.isatty()
+class _Progress:
+    """Stage lines on stderr, nothing with ``--json``. Recordings measured and model-run counts overwrite
+    one line on a terminal and are left out elsewhere, so that a recording found unreadable while
+    measuring is still the one line of a bad input.
+    """
 
-    def say(line: str) -> None:
-        if args.json:
-            return
-        if line.startswith("model runs"):
-            if tty:
-                print(f"\rcardan rig campaign: {line}", end="", file=sys.stderr, flush=True)
-            return
-        print(("\n" if tty else "") + f"cardan rig campaign: {line}", file=sys.stderr, flush=True)
+    def __init__(self, quiet: bool) -> None:
+        self.quiet = quiet
+        self.tty = sys.stderr.isatty()
+        self.open = False
 
-    return say
+    def __call__(self, line: str) -> None:
+        if self.quiet:
+            return
+        if line.startswith(("model runs", "measur")):
+            if self.tty:
+                print(f"\r\033[Kcardan rig campaign: {line}", end="", file=sys.stderr, flush=True)
+                self.open = True
+            return
+        self.close()
+        print(f"cardan rig campaign: {line}", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        """End the line being overwritten, if any."""
+        if self.open:
+            print(file=sys.stderr, flush=True)
+            self.open = False
 
 
 def _print_table(s: dict[str, Any]) -> None:
@@ -96,12 +109,12 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     """Run the campaign, write the report into ``--out``; see the module's exit statuses."""
     from cardan_exudyn.sweep.checks import SweepError
     from rigdata.campaign.journal import JOURNAL_FILE
-    from rigdata.campaign.report import write_report
     from rigdata.campaign.run import campaign
     from rigdata.campaign.spec import CampaignError, load_campaign
 
     if args.workers is not None and args.workers < 1:
         raise BadInput(f"--workers must be >= 1, got {args.workers}")
+    out_folder(args.out, replace=False)
     try:
         spec = load_campaign(args.campaign)
     except CampaignError as exc:
@@ -110,14 +123,19 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     journal = Path(args.out) / JOURNAL_FILE
     if args.restart and journal.is_file():
         journal.unlink()
+    progress = _Progress(args.json)
     try:
         result = campaign(spec, args.out, workers=args.workers, scheduler=args.scheduler,
-                          progress=_progress(args))
+                          progress=progress)
     except SweepError as exc:  # the Dask scheduler cannot be reached
         raise BadInput(str(exc)) from None
     except KeyboardInterrupt as exc:
         raise CampaignInterrupted(f"every finished model run is kept in {journal}; rerun the same command "
                                   "to resume", getattr(exc, "signum", signal.SIGINT)) from None
+    finally:
+        progress.close()
+    from rigdata.campaign.report import write_report  # matplotlib: loaded only once there is a result
+
     s = result.as_dict()
     write_report(result, args.out)
     if args.json:
