@@ -66,11 +66,14 @@ def operating_point(c: Conditioned) -> dict[str, float]:
 
 
 def prepare(rec: RecordingSpec, campaign: CampaignSpec) -> Prepared:
-    """Read, condition and measure recording ``rec``; RigDataError naming the recording if it cannot be."""
+    """Read, condition and measure recording ``rec``; RigDataError naming the campaign file and the
+    recording if it cannot be.
+    """
+    where = f"{campaign.path}: {rec.where}" if campaign.path is not None else rec.where
     try:
         record = with_signs(read(rec.file, **rec.read), rec.signs)
     except ValueError as exc:  # RigDataError, or read() refusing a channel of `map`
-        raise RigDataError(f"{rec.where}: {exc}") from None
+        raise RigDataError(f"{where}: {exc}") from None
     beta = math.radians(rec.shaft_angle_deg)
     try:
         cond = condition(record, beta, campaign.conditioning)
@@ -79,7 +82,7 @@ def prepare(rec: RecordingSpec, campaign: CampaignSpec) -> Prepared:
         findings = (*measurement_findings(cond, measured, rec.transducers, rec.file),
                     shaft_angle_agrees(cond, beta))
     except ValueError as exc:
-        raise RigDataError(f"{rec.where}: {exc}") from None
+        raise RigDataError(f"{where}: {exc}") from None
     scene = replace(campaign.scene, **{"joint.geometry.shaft_angle": beta})
     provenance = {k: v for k, v in record.provenance.items() if k not in ("header",)}
     return Prepared(rec, str(record.provenance.get("sha256", "")), cond, measured, findings, scene,

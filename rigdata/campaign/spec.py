@@ -20,6 +20,7 @@ from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
+from rigdata.readers.table import FORMATS
 from rigdata.record import SHAFTS
 from rigdata.transducer import Transducer
 from rigdata.validation import MODEL_ENGINES, as_scene
@@ -228,11 +229,11 @@ def _known(table: Mapping[str, Any], known: set[str], where: str) -> None:
         raise CampaignError(f"{where}: unknown key {unknown[0]!r} (known: {', '.join(sorted(known))})")
 
 
-def _table(data: Mapping[str, Any], key: str) -> Mapping[str, Any]:
+def _table(data: Mapping[str, Any], key: str, where: str = "the campaign") -> Mapping[str, Any]:
     """``data[key]`` as a table (empty if absent)."""
     value = data.get(key, {})
     if not isinstance(value, Mapping):
-        raise CampaignError(f"`{key}` must be a table, got {value!r:.80}")
+        raise CampaignError(f"{where}: `{key}` must be a table, got {value!r:.80}")
     return value
 
 
@@ -242,6 +243,13 @@ def _text(data: Mapping[str, Any], key: str, where: str, default: str) -> str:
     if not isinstance(value, str) or (key != "title" and not value.strip()):
         raise CampaignError(f"{where}: `{key}` must be a string, got {value!r:.80}")
     return value
+
+
+def _required(table: Mapping[str, Any], key: str, where: str) -> Any:
+    """``table[key]``; CampaignError naming ``where`` when it is missing."""
+    if key not in table:
+        raise CampaignError(f"{where}: `{key}` is missing")
+    return table[key]
 
 
 def _number(value: Any, where: str) -> float:
@@ -291,14 +299,15 @@ def _coverage(value: Any) -> float:
     return p
 
 
-def _scene_key(scene: Scene, key: Any, value: float, where: str) -> None:
-    """CampaignError unless ``key`` is a dotted scene path that takes ``value``."""
+def _scene_key(scene: Scene, key: Any, value: float, where: str, what: str = "is not a number of the scene"
+               ) -> None:
+    """CampaignError unless ``key`` is a dotted scene path that takes ``value`` (``what``: the complaint)."""
     if not isinstance(key, str) or not key.strip():
         raise CampaignError(f"{where}: a key must be a dotted scene path, got {key!r:.80}")
     try:
         replace(scene, **{key: value})
     except (SceneError, TypeError, ValueError, KeyError) as exc:
-        raise CampaignError(f"{where}: key {key!r} is not a number of the scene ({exc})") from None
+        raise CampaignError(f"{where}: key {key!r} {what} ({exc})") from None
 
 
 def _parameters(table: Mapping[str, Any], scene: Scene) -> tuple[Parameter, ...]:
@@ -310,18 +319,20 @@ def _parameters(table: Mapping[str, Any], scene: Scene) -> tuple[Parameter, ...]
         if not isinstance(spec, Mapping):
             raise CampaignError(f"{where} must be a table with keys, initial and bounds")
         _known(spec, {"keys", "initial", "bounds"}, where)
-        keys = spec.get("keys")
+        keys = _required(spec, "keys", where)
         if isinstance(keys, str):
             keys = [keys]
         if not isinstance(keys, list) or not keys:
             raise CampaignError(f"{where}: `keys` must be a non-empty list of scene paths, got {keys!r:.80}")
-        initial = _number(spec.get("initial"), f"{where} `initial`")
-        bounds = _bounds(spec.get("bounds"), initial, where)
+        initial = _number(_required(spec, "initial", where), f"{where} `initial`")
+        bounds = _bounds(_required(spec, "bounds", where), initial, where)
         for key in keys:
             if key in tied:
                 raise CampaignError(f"{where}: key {key!r} is already tied to [parameters.{tied[key]}]")
             tied[key] = name
             _scene_key(scene, key, initial, where)
+            for side, value in zip(("low", "high"), bounds, strict=True):
+                _scene_key(scene, key, value, where, f"does not take `bounds` {side} {value:g}")
         out.append(Parameter(name, tuple(keys), initial, bounds))
     return tuple(out)
 
@@ -344,7 +355,7 @@ def _inputs(table: Mapping[str, Any], scene: Scene, parameters: tuple[Parameter,
     calibrated = {key for p in parameters for key in p.keys}
     out = []
     for key, spec in table.items():
-        where = f"[inputs.{key!r}]"
+        where = f'[inputs."{key}"]'
         if not isinstance(spec, Mapping):
             raise CampaignError(f"{where} must be a table with distribution and std or half_width")
         _known(spec, {"distribution", "std", "half_width"}, where)
@@ -370,7 +381,7 @@ def _current(scene: Scene, key: str) -> float:
     for part in key.split("."):
         node = getattr(node, part, None)
     if isinstance(node, bool) or not isinstance(node, (int, float)):
-        raise CampaignError(f"[inputs.{key!r}]: key {key!r} is not a number of the scene")
+        raise CampaignError(f'[inputs."{key}"]: key {key!r} is not a number of the scene')
     return float(node)
 
 
@@ -403,8 +414,8 @@ def _recordings(value: Any, base: Path, transducer: Transducer) -> tuple[Recordi
     for index, table in enumerate(value, start=1):
         rec = _recording(index, table, base, transducer)
         if rec.file in seen:
-            raise CampaignError(f"{rec.where}: file {str(rec.file)!r} is also [[recording]] "
-                                f"{seen[rec.file]}")
+            raise CampaignError(f"[[recording]] {index} ({table['file']}): `file` is {str(rec.file)!r}, "
+                                f"the file of [[recording]] {seen[rec.file]} already")
         seen[rec.file] = index
         out.append(rec)
     return tuple(out)
@@ -415,31 +426,41 @@ def _recording(index: int, table: Any, base: Path, transducer: Transducer) -> Re
     where = f"[[recording]] {index}"
     if not isinstance(table, Mapping):
         raise CampaignError(f"{where} must be a table")
+    _required(table, "file", where)
     name = _text(table, "file", where, default="")
     file = (base / name).resolve()
     where = f"{where} ({name})"
     _known(table, _RECORDING_KEYS, where)
     if not file.is_file():
         raise CampaignError(f"{where}: `file` {str(file)!r} does not exist or is not a file")
-    angle = _number(table.get("shaft_angle_deg"), f"{where} `shaft_angle_deg`")
+    angle = _number(_required(table, "shaft_angle_deg", where), f"{where} `shaft_angle_deg`")
     if not 0.0 <= angle < 90.0:
         raise CampaignError(f"{where}: `shaft_angle_deg` must be in [0, 90) deg, got {angle!r}")
-    use = table.get("use")
+    use = _required(table, "use", where)
     if use not in USES:
         raise CampaignError(f"{where}: `use` must be \"calibration\" or \"validation\", got {use!r:.80}")
-    own = _transducer(_table(table, "transducers"), f"{where} `transducers`", transducer)
+    own = _transducer(_table(table, "transducers", where), f"{where} `transducers`", transducer)
     read = {"mapping": _channels(table, "map", where, str) or None,
             "units": _channels(table, "unit", where, str) or None,
             "sensitivity": own.sensitivity, "pulses_per_rev": own.pulses_per_rev}
     if "format" in table:
-        read["format"] = _text(table, "format", where, default="auto")
+        read["format"] = _format(table, where)
     label = _text(table, "label", where, default=Path(name).name)
     return RecordingSpec(index, file, label, angle, use, read, _signs(table, where), (own, own))
 
 
+def _format(table: Mapping[str, Any], where: str) -> str:
+    """``format``: ``auto`` or a reader's format name."""
+    value = table["format"]
+    if value != "auto" and value not in FORMATS:
+        raise CampaignError(f"{where}: `format` must be \"auto\" or one of {', '.join(FORMATS)}, "
+                            f"got {value!r:.80}")
+    return value
+
+
 def _channels(table: Mapping[str, Any], key: str, where: str, kind: type) -> dict[str, Any]:
     """``table[key]``: a table from channel names to ``kind`` values."""
-    value = _table(table, key) if key in table else {}
+    value = _table(table, key, where)
     for channel, item in value.items():
         if key == "map" and channel not in _CHANNELS:
             raise CampaignError(f"{where}: `{key}` names an unknown channel {channel!r} "
