@@ -20,18 +20,25 @@ from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 from rigdata.conditioning import Conditioning
+from rigdata.montecarlo import check_draws
 from rigdata.readers.table import FORMATS
 from rigdata.record import SHAFTS
 from rigdata.transducer import Transducer
 from rigdata.validation import MODEL_ENGINES, as_scene
 
-__all__ = ["USES", "DISTRIBUTIONS", "CampaignError", "Parameter", "InputUncertainty", "RecordingSpec",
-           "CampaignSpec", "load_campaign", "campaign_from_mapping", "with_values"]
+__all__ = ["USES", "DISTRIBUTIONS", "MEASURED_KEYS", "SHAFT_ANGLE_KEY", "CampaignError", "Parameter",
+           "InputUncertainty", "RecordingSpec", "CampaignSpec", "load_campaign", "campaign_from_mapping",
+           "with_values"]
 
 USES = ("calibration", "validation")
 """What a recording is for: calibration recordings fit the parameters, validation recordings test them."""
 DISTRIBUTIONS = ("normal", "uniform")
 """Distributions of a stated input uncertainty: ``normal`` (``std``) or ``uniform`` (``half_width``)."""
+MEASURED_KEYS = ("drive", "load", "revolutions", "record")
+"""Scene keys (and the keys under them) that each recording replaces with its measured drive and load: a
+parameter or stated input there would change nothing."""
+SHAFT_ANGLE_KEY = "joint.geometry.shaft_angle"
+"""Each recording's ``shaft_angle_deg``: a stated input may perturb it, one calibrated value cannot be it."""
 
 _TOP_KEYS = {"scene", "engines", "coverage", "parameters", "inputs", "transducers", "conditioning",
              "recording", "monte_carlo", "seed", "input_samples", "title"}
@@ -210,6 +217,7 @@ def _campaign(data: Mapping[str, Any], base: Path) -> CampaignSpec:
     inputs = _inputs(_table(data, "inputs"), scene, parameters)
     transducer = _transducer(_table(data, "transducers"), "[transducers]")
     recordings = _recordings(data.get("recording"), base, transducer)
+    draws = _draws(data)
     if parameters and not any(r.use == "calibration" for r in recordings):
         raise CampaignError("[parameters] asks for a calibration but no [[recording]] has "
                             "use = \"calibration\"")
@@ -218,8 +226,7 @@ def _campaign(data: Mapping[str, Any], base: Path) -> CampaignSpec:
         scene_source=scene_source, engines=_engines(data.get("engines", MODEL_ENGINES)),
         coverage=_coverage(data.get("coverage", 0.95)), parameters=parameters, inputs=inputs,
         recordings=recordings, conditioning=_conditioning(_table(data, "conditioning")),
-        monte_carlo=_count(data, "monte_carlo", 2000), seed=_count(data, "seed", 0),
-        input_samples=_count(data, "input_samples", 0))
+        monte_carlo=draws[0], seed=draws[1], input_samples=_count(data, "input_samples", 0))
 
 
 def _known(table: Mapping[str, Any], known: set[str], where: str) -> None:
@@ -267,6 +274,17 @@ def _count(data: Mapping[str, Any], key: str, default: int) -> int:
     return value
 
 
+def _draws(data: Mapping[str, Any]) -> tuple[int, int]:
+    """``monte_carlo`` and ``seed``, within what the measurement's Monte Carlo takes."""
+    monte_carlo = _count(data, "monte_carlo", 2000)
+    seed = _count(data, "seed", 0)
+    try:
+        check_draws(monte_carlo, seed)
+    except ValueError as exc:
+        raise CampaignError(str(exc)) from None
+    return monte_carlo, seed
+
+
 def _scene(source: str, base: Path) -> Scene:
     """The campaign's joint: a scene file (relative to the campaign) or a named scene."""
     candidate = base / source
@@ -304,6 +322,9 @@ def _scene_key(scene: Scene, key: Any, value: float, where: str, what: str = "is
     """CampaignError unless ``key`` is a dotted scene path that takes ``value`` (``what``: the complaint)."""
     if not isinstance(key, str) or not key.strip():
         raise CampaignError(f"{where}: a key must be a dotted scene path, got {key!r:.80}")
+    if key.split(".")[0] in MEASURED_KEYS:
+        raise CampaignError(f"{where}: key {key!r} is replaced by each recording's measured drive and load, "
+                            f"as is every key under {', '.join(MEASURED_KEYS)}")
     try:
         replace(scene, **{key: value})
     except (SceneError, TypeError, ValueError, KeyError) as exc:
@@ -330,11 +351,19 @@ def _parameters(table: Mapping[str, Any], scene: Scene) -> tuple[Parameter, ...]
             if key in tied:
                 raise CampaignError(f"{where}: key {key!r} is already tied to [parameters.{tied[key]}]")
             tied[key] = name
-            _scene_key(scene, key, initial, where)
-            for side, value in zip(("low", "high"), bounds, strict=True):
-                _scene_key(scene, key, value, where, f"does not take `bounds` {side} {value:g}")
+            _parameter_key(scene, key, initial, bounds, where)
         out.append(Parameter(name, tuple(keys), initial, bounds))
     return tuple(out)
+
+
+def _parameter_key(scene: Scene, key: Any, initial: float, bounds: tuple[float, float], where: str) -> None:
+    """CampaignError unless the scene takes ``initial`` and both bounds at ``key``."""
+    if key == SHAFT_ANGLE_KEY:
+        raise CampaignError(f"{where}: key {key!r} is each recording's `shaft_angle_deg`; it cannot be one "
+                            "calibrated value")
+    _scene_key(scene, key, initial, where)
+    for side, value in zip(("low", "high"), bounds, strict=True):
+        _scene_key(scene, key, value, where, f"does not take `bounds` {side} {value:g}")
 
 
 def _bounds(value: Any, initial: float, where: str) -> tuple[float, float]:
