@@ -29,7 +29,9 @@ def rig_campaign(request: pytest.FixtureRequest) -> Callable[..., Any]:
     from rigdata.campaign.testing import run_campaign
 
     config = request.config
-    root = None if config.getoption("rig_campaign_no_cache") else config.cache.mkdir("rigdata-campaign")
+    cache = getattr(config, "cache", None)  # None under -p no:cacheprovider: no journal across sessions
+    keep = cache is not None and not config.getoption("rig_campaign_no_cache")
+    root = cache.mkdir("rigdata-campaign") if keep else None
     done: dict[tuple, Any] = {}
 
     def run(path: str | Path, **options: Any) -> Any:
