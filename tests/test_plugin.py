@@ -378,7 +378,9 @@ def test_an_explicit_tolerance_below_the_runs_accuracy_fails(reference_rig):
 
 
 def docs_blocks(language: str) -> list[str]:
-    return re.findall(rf"```{language}\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.DOTALL)
+    """The blocks of docs/pytest.md in ``language``, without those marked not run (tests/test_docs.py)."""
+    blocks = re.findall(rf"```{language}\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.DOTALL)
+    return [b for b in blocks if not b.startswith("# not run by tests/test_docs.py")]
 
 
 def test_the_docs_examples_run(pytester):
