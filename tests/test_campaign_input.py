@@ -18,7 +18,13 @@ import rigdata
 from rigdata.campaign.spec import CampaignError, load_campaign
 from rigdata.synthetic import write
 
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python 3.10
+    import tomli as tomllib
+
 ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs" / "rigdata.md"
 FRICTION = "joint.pairs.input_spider.friction_coefficient"
 HEAD = 'scene = "rig"\nmonte_carlo = 0\n'
 PARAMETER = f'[parameters.f]\nkeys = ["{FRICTION}"]\ninitial = 0.2\nbounds = [0.0, 0.6]\n'
@@ -239,3 +245,26 @@ def test_out_is_a_file_is_one_line(folder, tmp_path):
     line = one_line(cardan_campaign(str(path), "--out", str(target)))
     assert f"--out: '{target}' exists and is not a folder" in line
     assert target.read_text(encoding="utf-8") == "previous\n"
+
+
+def known_keys(folder: Path, text: str) -> set[str]:
+    """The keys a table of the campaign file takes, as the unknown-key message lists them."""
+    with pytest.raises(CampaignError, match=r"unknown key 'colour' \(known: ") as info:
+        load_campaign(written(folder, "known", text))
+    return set(re.search(r"\(known: (.*)\)$", str(info.value))[1].split(", "))
+
+
+def test_the_docs_example_campaign_shows_every_key_and_loads(folder, tmp_path):
+    """The campaign file of docs/rigdata.md uses every key the file takes, and loads."""
+    text = re.search(r"```toml\n(# campaign.toml\n.*?)```", DOCS.read_text(encoding="utf-8"), re.DOTALL)[1]
+    data = tomllib.loads(text)
+    assert set(data) == known_keys(folder, campaign(top="colour = 1\n"))
+    shown = {key for table in data["recording"] for key in table}
+    assert shown == known_keys(folder, campaign(recordings=(recording(extra="colour = 1\n"), VALIDATION)))
+    for table in data["recording"]:
+        (tmp_path / table["file"]).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / table["file"]).write_bytes(b"")  # read only when the campaign runs
+    (tmp_path / "campaign.toml").write_text(text, encoding="utf-8")
+    spec = load_campaign(tmp_path / "campaign.toml")
+    assert [r.use for r in spec.recordings] == ["calibration", "validation"]
+    assert spec.parameters[0].keys == tuple(data["parameters"]["friction"]["keys"])
