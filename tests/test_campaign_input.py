@@ -234,7 +234,7 @@ def test_workers_zero_is_one_line(folder, tmp_path):
     """--workers 0: one line naming the option."""
     path = written(folder, "workers", campaign())
     line = one_line(cardan_campaign(str(path), "--out", str(tmp_path / "out"), "--workers", "0"))
-    assert "--workers must be >= 1, got 0" in line
+    assert "argument --workers: must be >= 1 (--workers), got '0'" in line
 
 
 def test_out_is_a_file_is_one_line(folder, tmp_path):

@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInput, out_folder
+from cardan_exudyn.arguments import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, BadInput, count, out_folder
 from cardan_exudyn.report.format import number
 
 __all__ = ["EXIT_RESOLVABLE", "add_options", "cmd_campaign", "CampaignInterrupted"]
@@ -36,7 +36,7 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, metavar="DIR",
                    help="folder of the report and of the journal of model runs (rerun to resume)")
     p.add_argument("--json", action="store_true", help="print results.json instead of the table")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
+    p.add_argument("--workers", type=count("--workers"), default=None, metavar="N",
                    help="processes for the model runs (default: the cores available)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run on a Dask cluster (tcp://host:port) instead of local processes")
@@ -112,8 +112,6 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     from rigdata.campaign.run import campaign
     from rigdata.campaign.spec import CampaignError, load_campaign
 
-    if args.workers is not None and args.workers < 1:
-        raise BadInput(f"--workers must be >= 1, got {args.workers}")
     out_folder(args.out, replace=False)
     try:
         spec = load_campaign(args.campaign)
