@@ -160,3 +160,24 @@ def test_a_dask_cluster_gives_the_local_results(folder, result):
         remote = campaign(folder / "campaign.toml", None, scheduler=cluster.scheduler_address)
     assert remote.calibration.values == result.calibration.values
     assert [r.first.u_val for r in remote.recordings] == [r.first.u_val for r in result.recordings]
+
+
+def test_the_monte_carlo_checks_each_measured_uncertainty(result):
+    """Each recording carries its Monte Carlo draws' spread, an independent propagation of the same
+    measurement model as the GUM u_D (200 draws: about 5 % sampling error)."""
+    for r in result.recordings:
+        mc = r.as_dict()["measured_monte_carlo"]
+        assert mc["samples"] == 200
+        assert mc["std"] == pytest.approx(r.u_D, rel=0.3)
+
+
+def test_an_unreadable_recording_leaves_no_journal(folder, tmp_path):
+    """Bad data are found before any model runs: nothing is written."""
+    from rigdata.record import RigDataError
+
+    (tmp_path / "bad.csv").write_text("not,a\nrig,file\n")
+    text = campaign_text().replace(f'file = "{POINTS[3][0]}.csv"', f'file = "{tmp_path / "bad.csv"}"')
+    (tmp_path / "campaign.toml").write_text(text.replace('file = "', f'file = "{folder}/', 3))
+    with pytest.raises(RigDataError, match=r"\[\[recording\]\] 4"):
+        campaign(tmp_path / "campaign.toml", tmp_path / "out", workers=1)
+    assert not (tmp_path / "out").exists()

@@ -86,6 +86,9 @@ class RecordingResult:
     engines : dict of str to EngineComparison
         In the campaign's engine order; the first is the one reported at the top level.
     provenance : dict
+    monte_carlo : dict
+        The Monte Carlo check of ``D``'s GUM uncertainty (``samples``, ``std``, ``interval_95``); empty
+        without draws.
     """
 
     index: int
@@ -104,6 +107,7 @@ class RecordingResult:
     budget: Budget | None = None
     engines: dict[str, EngineComparison] = field(default_factory=dict)
     provenance: dict[str, Any] = field(default_factory=dict)
+    monte_carlo: dict[str, Any] = field(default_factory=dict)
 
     @property
     def first(self) -> EngineComparison | None:
@@ -137,7 +141,8 @@ class RecordingResult:
                 "resolvable": first.resolvable, "dominant": self.dominant,
                 "budget": self.budget.as_dict() if self.budget else None,
                 "by_engine": {name: c.as_dict() for name, c in self.engines.items()},
-                "checks": list(self.findings), "provenance": self.provenance}
+                "checks": list(self.findings), "measured_monte_carlo": self.monte_carlo,
+                "provenance": self.provenance}
 
     def row(self) -> dict[str, Any]:
         """One row of :meth:`CampaignResult.table`."""

@@ -92,17 +92,17 @@ def campaign(source: CampaignSpec | str | os.PathLike, out: str | os.PathLike | 
     check_engines(spec.engines)
     clock = _Clock({})
     workers = default_workers() if workers is None else max(1, int(workers))
-    journal = _journal(out)
-    try:
-        with model_pool(workers, scheduler) as pool:
-            with clock.stage("measure"):
-                prepared = _prepare_all(spec, pool, say)
+    with model_pool(workers, scheduler) as pool:
+        with clock.stage("measure"):
+            prepared = _prepare_all(spec, pool, say)
+        journal = _journal(out)  # only once every recording is measured: bad data leave nothing
+        try:
             evaluate = Evaluator(prepared, spec.parameters, journal, pool,
                                  on_run=lambda n: say(f"model runs: {n}"))
             return _run(spec, prepared, evaluate, clock, say)
-    finally:
-        if journal is not None:
-            journal.close()
+        finally:
+            if journal is not None:
+                journal.close()
 
 
 def _journal(out: str | os.PathLike | None) -> Journal | None:
@@ -247,7 +247,7 @@ def _unusable(p: Prepared, k: float) -> RecordingResult:
     return RecordingResult(p.spec.index, p.spec.label, p.spec.file, p.sha256, p.spec.use,
                            p.spec.shaft_angle_deg, "measurement", reason, operating_point(p.conditioned),
                            p.measured.efficiency, p.measured.u, tuple(f.as_dict() for f in p.findings), k,
-                           provenance=p.provenance)
+                           provenance=p.provenance, monte_carlo=p.measured.monte_carlo)
 
 
 def _recording(spec: CampaignSpec, p: Prepared, b: Budget | None, u_num: float | None,
@@ -268,7 +268,8 @@ def _recording(spec: CampaignSpec, p: Prepared, b: Budget | None, u_num: float |
     reason = None if status == "ok" else f"{spec.engines[0]}: {first.status}: {first.reason}"
     return RecordingResult(p.spec.index, p.spec.label, p.spec.file, p.sha256, p.spec.use,
                            p.spec.shaft_angle_deg, status, reason, operating_point(p.conditioned), d,
-                           p.measured.u, tuple(f.as_dict() for f in p.findings), k, b, engines, p.provenance)
+                           p.measured.u, tuple(f.as_dict() for f in p.findings), k, b, engines, p.provenance,
+                           p.measured.monte_carlo)
 
 
 def _compare(engine: str, outcome: Outcome, d: float, b: Budget | None, k: float,

@@ -40,6 +40,8 @@ parameter or stated input there would change nothing."""
 SHAFT_ANGLE_KEY = "joint.geometry.shaft_angle"
 """Each recording's ``shaft_angle_deg``: a stated input may perturb it, one calibrated value cannot be it."""
 
+MAX_INPUT_SAMPLES = 10000
+"""The most samples of the sampling check of ``u_input`` (each is one model run per recording)."""
 _TOP_KEYS = {"scene", "engines", "coverage", "parameters", "inputs", "transducers", "conditioning",
              "recording", "monte_carlo", "seed", "input_samples", "title"}
 _RECORDING_KEYS = {"file", "shaft_angle_deg", "use", "label", "format", "map", "unit", "sign",
@@ -101,7 +103,7 @@ class RecordingSpec:
     file : Path
         Absolute path.
     label : str
-        Short name in tables and figures (default: the file name).
+        Short name in tables and figures (default: ``file`` as written), unique in the campaign.
     shaft_angle_deg : float
         The rig's shaft angle for this recording [deg].
     use : {"calibration", "validation"}
@@ -226,7 +228,7 @@ def _campaign(data: Mapping[str, Any], base: Path) -> CampaignSpec:
         scene_source=scene_source, engines=_engines(data.get("engines", MODEL_ENGINES)),
         coverage=_coverage(data.get("coverage", 0.95)), parameters=parameters, inputs=inputs,
         recordings=recordings, conditioning=_conditioning(_table(data, "conditioning")),
-        monte_carlo=draws[0], seed=draws[1], input_samples=_count(data, "input_samples", 0))
+        monte_carlo=draws[0], seed=draws[1], input_samples=_samples(data))
 
 
 def _known(table: Mapping[str, Any], known: set[str], where: str) -> None:
@@ -264,6 +266,15 @@ def _number(value: Any, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise CampaignError(f"{where} must be a finite number, got {value!r:.80}")
     return float(value)
+
+
+def _samples(data: Mapping[str, Any]) -> int:
+    """``input_samples``: an integer in [0, MAX_INPUT_SAMPLES]."""
+    value = _count(data, "input_samples", 0)
+    if value > MAX_INPUT_SAMPLES:
+        raise CampaignError(f"`input_samples` must be at most {MAX_INPUT_SAMPLES} (each is a model run per "
+                            f"recording), got {value}")
+    return value
 
 
 def _count(data: Mapping[str, Any], key: str, default: int) -> int:
@@ -446,6 +457,8 @@ def _recordings(value: Any, base: Path, transducer: Transducer) -> tuple[Recordi
             raise CampaignError(f"[[recording]] {index} ({table['file']}): `file` is {str(rec.file)!r}, "
                                 f"the file of [[recording]] {seen[rec.file]} already")
         seen[rec.file] = index
+        if any(r.label == rec.label for r in out):
+            raise CampaignError(f"{rec.where}: `label` {rec.label!r} is already another recording's")
         out.append(rec)
     return tuple(out)
 
@@ -474,7 +487,7 @@ def _recording(index: int, table: Any, base: Path, transducer: Transducer) -> Re
             "sensitivity": own.sensitivity, "pulses_per_rev": own.pulses_per_rev}
     if "format" in table:
         read["format"] = _format(table, where)
-    label = _text(table, "label", where, default=Path(name).name)
+    label = _text(table, "label", where, default=name)
     return RecordingSpec(index, file, label, angle, use, read, _signs(table, where), (own, own))
 
 
