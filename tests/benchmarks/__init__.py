@@ -20,6 +20,7 @@ BENCHMARKS: dict[str, str] = {
     "campaign-truth": "benchmarks.campaign.command",
     "campaign-coverage": "benchmarks.campaign.command",
     "campaign-groups": "benchmarks.campaign.command",
+    "campaign-sampling": "benchmarks.campaign.command",
 }
 """Benchmark name -> the module whose ``register(subparsers, name)`` adds it, in the order
 ``python tests/benchmarks --help`` lists them."""

@@ -1,5 +1,5 @@
-"""``python tests/benchmarks campaign-truth | campaign-coverage | campaign-groups``: the campaign studies
-(:mod:`.studies`), printed and written as JSON into ``--out``."""
+"""``python tests/benchmarks campaign-truth | campaign-coverage | campaign-groups | campaign-sampling``:
+the campaign studies (:mod:`.studies`), printed and written as JSON into ``--out``."""
 
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ HELP = {
                       "torque the model lacks: estimate, chi-square test, verdicts, wall time by stage",
     "campaign-coverage": "the consistent campaign over many noise seeds: interval coverage",
     "campaign-groups": "spider and frame friction as two parameters on quasi-static recordings",
+    "campaign-sampling": "u_input by sensitivity coefficients against sampled model runs",
 }
 
 
@@ -46,6 +47,8 @@ def _handler(name: str):
                        for d in (args.drag or [0.0, 0.03])]
         elif name == "campaign-coverage":
             summary = studies.coverage(out, args.seeds, args.seconds, args.workers)
+        elif name == "campaign-sampling":
+            summary = studies.sampling_check(out, workers=args.workers)
         else:
             summary = studies.tied_groups(out, workers=args.workers)
         text = json.dumps(to_jsonable(summary), indent=1)

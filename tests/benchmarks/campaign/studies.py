@@ -114,3 +114,22 @@ def tied_groups(folder: Path, seconds: float = 30.0, workers: int | None = None)
             "correlation": cal.correlation.tolist(), "combinations": combos,
             "chi_square": cal.chi_square, "dof": cal.dof, "p_value": cal.p_value,
             "recordings": _rows(result)}
+
+
+def sampling_check(folder: Path, samples: int = 100, seconds: float = 4.0,
+                   workers: int | None = None) -> dict[str, Any]:
+    """The consistent campaign with a stated arm-radius uncertainty: ``u_input``'s parameter and input
+    parts by sensitivity coefficients against the spread of ``samples`` sampled model runs."""
+    toml = write_campaign(folder, friction=TRUTH, seed=0, seconds=seconds)
+    inputs = {"joint.geometry.arm_radius": {"distribution": "normal", "std": 0.0005}}
+    spec = _spec(toml, engines=["reference"], monte_carlo=0, inputs=inputs, input_samples=samples)
+    result = campaign(spec, None, workers=workers)
+    rows = []
+    for r in result.recordings:
+        b = r.budget
+        by_sensitivity = math.sqrt(b.u_parameters**2 + b.u_inputs**2)
+        rows.append({"label": r.label, "u_parameters": b.u_parameters, "u_inputs": b.u_inputs,
+                     "sensitivity": by_sensitivity, "sampled": b.u_input_sampled,
+                     "ratio": b.u_input_sampled / by_sensitivity})
+    return {"samples": samples, "relative_sd_of_sampled_std": 1.0 / math.sqrt(2 * (samples - 1)),
+            "recordings": rows}
