@@ -8,9 +8,13 @@ stated rate over many seeds) is ``python tests/benchmarks campaign-coverage``.
 
 from __future__ import annotations
 
+import json
 import math
+import os
+import signal
 
 import pytest
+from processes import start, wait_for
 
 from rigdata.campaign import campaign
 from rigdata.campaign.journal import JOURNAL_FILE
@@ -181,3 +185,25 @@ def test_an_unreadable_recording_leaves_no_journal(folder, tmp_path):
     with pytest.raises(RigDataError, match=r"\[\[recording\]\] 4"):
         campaign(tmp_path / "campaign.toml", tmp_path / "out", workers=1)
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, pytest.param(signal.SIGTERM, marks=pytest.mark.slow)])
+def test_an_interrupted_campaign_keeps_its_runs_and_resumes(folder, tmp_path, signum):
+    """A signal to the whole process group once some model runs are journalled: exit 128 + signal with one
+    line saying how to resume, the journal's lines intact; the same command finishes, reusing them."""
+    out = tmp_path / "out"
+    journal = out / JOURNAL_FILE
+    argv = ["rig", "campaign", str(folder / "campaign.toml"), "--out", str(out), "--workers", "2"]
+    proc = start(argv, tmp_path)
+    wait_for(lambda: journal.is_file() and journal.read_bytes().count(b"\n") >= 3, proc)
+    os.killpg(proc.pid, signum)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + signum, stderr
+    assert "rerun the same command to resume" in stderr.splitlines()[-1] and "Traceback" not in stderr
+    kept = journal.read_bytes().count(b"\n")
+    assert kept >= 3
+    again = start(argv + ["--json"], tmp_path)
+    stdout, stderr = again.communicate(timeout=300)
+    assert again.returncode == 0, stderr
+    timing = json.loads(stdout)["timing"]
+    assert timing["model_runs_reused"] >= kept

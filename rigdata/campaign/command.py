@@ -128,8 +128,9 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     except SweepError as exc:  # the Dask scheduler cannot be reached
         raise BadInput(str(exc)) from None
     except KeyboardInterrupt as exc:
+        signum = getattr(exc, "signum", signal.SIGINT)
         raise CampaignInterrupted(f"every finished model run is kept in {journal}; rerun the same command "
-                                  "to resume", getattr(exc, "signum", signal.SIGINT)) from None
+                                  "to resume", signum) from None
     finally:
         progress.close()
     from rigdata.campaign.report import write_report  # matplotlib: loaded only once there is a result

@@ -8,6 +8,7 @@ import contextlib
 import hashlib
 import json
 import multiprocessing
+import signal
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -16,7 +17,7 @@ from typing import Any
 
 from cardan_exudyn.engines import run
 from cardan_exudyn.jsonable import to_jsonable
-from cardan_exudyn.sweep.executors import connect, ignore_interrupts
+from cardan_exudyn.sweep.executors import connect
 from reference.scene.mapping import scene_to_dict
 from reference.scene.scene import Scene
 from rigdata.campaign.journal import Journal, Outcome
@@ -90,15 +91,38 @@ def model_pool(workers: int, scheduler: Any = None) -> Iterator[Any]:
         yield None
         return
     context = multiprocessing.get_context("spawn")
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=ignore_interrupts)
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=_ignore_signals)
     try:
         yield pool
     except BaseException:
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
-            with contextlib.suppress(OSError, ValueError, AttributeError):
-                process.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
+        _stop(pool)
         raise
+    pool.shutdown(wait=True)
+
+
+def _ignore_signals() -> None:
+    """Worker initializer: Ctrl-C and SIGTERM to the process group are the driver's to act on."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+
+
+STOP_GRACE_S = 2.0
+"""How long an interrupted campaign lets its workers finish the runs in hand before stopping them [s]."""
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started, let the runs in hand finish for :data:`STOP_GRACE_S`, then stop the
+    workers still running: a worker stopped mid-run leaves the pool's semaphores for multiprocessing's
+    tracker to report at exit."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    deadline = time.monotonic() + STOP_GRACE_S
+    for process in processes:
+        process.join(max(0.0, deadline - time.monotonic()))
+    for process in processes:
+        if process.is_alive():
+            with contextlib.suppress(OSError, ValueError, AttributeError):
+                process.kill()  # SIGKILL: the workers ignore SIGINT and SIGTERM
     pool.shutdown(wait=True)
 
 
