@@ -207,3 +207,22 @@ def test_an_interrupted_campaign_keeps_its_runs_and_resumes(folder, tmp_path, si
     assert again.returncode == 0, stderr
     timing = json.loads(stdout)["timing"]
     assert timing["model_runs_reused"] >= kept
+
+
+def test_the_command_prints_the_calibration_and_a_line_per_recording(folder, result, capsys):
+    """``cardan rig campaign`` (journal reused): the estimate with two significant digits of its
+    uncertainty, the test's verdict, a verdict per recording, and the report files."""
+    from cardan_exudyn.cli import main
+
+    status = main(["rig", "campaign", str(folder / "campaign.toml"), "--out", str(folder / "out"),
+                   "--workers", "1"])
+    lines = capsys.readouterr().out.splitlines()
+    (estimate,) = result.calibration.estimates
+    u = f"{estimate.standard_uncertainty:#.2g}"
+    assert status == 0
+    assert lines[0] == f"parameter f = {estimate.value:.4g} +- {u}"
+    assert lines[1].startswith("calibration: chi-square ")
+    assert [line.rsplit(": ", 1)[-1] for line in lines[2:]] == ["calibration", "calibration",
+                                                              "not resolvable", "not resolvable"]
+    assert all((folder / "out" / name).is_file() for name in ("report.html", "report.md", "results.json",
+                                                             "results.csv", "model_error.png"))

@@ -79,7 +79,9 @@ def _print_table(s: dict[str, Any]) -> None:
     """The calibration and one line per recording."""
     for p in s["parameters"]:
         u = p["standard_uncertainty"]
-        text = "not identifiable" if p["identifiable"] is False else f"+- {number(u, '.2g')}"
+        text = "not identifiable" if p["identifiable"] is False else f"+- {number(u, '#.2g')}"
+        if not p["calibrated"]:
+            text = "(not calibrated: the initial value)"
         print(f"parameter {p['name']} = {number(p['value'], '.4g')} {text}")
     cal = s["calibration"]
     if cal is not None:
@@ -102,7 +104,7 @@ def _line(r: dict[str, Any]) -> str:
     verdict = "calibration" if r["use"] == "calibration" else (
         "RESOLVABLE model error" if r["resolvable"] else "not resolvable")
     return (f"{head} S {r['simulated']:.5f} D {r['measured']:.5f} E {r['comparison_error']:+.5f} "
-            f"in [{low:+.5f}, {high:+.5f}] (k u_val {r['k'] * r['u_val']:.2g}): {verdict}")
+            f"in [{low:+.5f}, {high:+.5f}] (k u_val {r['k'] * r['u_val']:#.2g}): {verdict}")
 
 
 def cmd_campaign(args: argparse.Namespace) -> int:
