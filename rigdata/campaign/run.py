@@ -8,6 +8,7 @@ resumes without running any model again.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 import time
@@ -16,10 +17,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from scipy import stats
 
 from cardan_exudyn.sweep.executors import default_workers
-from rigdata.campaign.budget import Budget, budget, budget_runs, model_scatter
+from rigdata.campaign.budget import Budget, BudgetRuns, budget, budget_runs, model_scatter
 from rigdata.campaign.calibration import Calibration, CalibrationFailed, calibrate, jacobian_runs
 from rigdata.campaign.evaluate import Evaluator, ModelRun, Outcome, model_pool
 from rigdata.campaign.journal import Journal
@@ -155,7 +157,9 @@ def _run(spec: CampaignSpec, prepared: dict[int, Prepared], evaluate: Evaluator,
 def _calibrate(spec: CampaignSpec, recordings: Sequence[Prepared], evaluate: Evaluator) -> Calibration:
     """The fit over the calibration recordings whose model runs at the initial values."""
     engine = spec.engines[0]
-    budgets = _budgets(spec, recordings, evaluate, spec.initial, None, engine, inputs=False)
+    plans = _plans(spec, recordings, spec.initial, engine, propagate=False, inputs=False)
+    outcomes = _outcomes(evaluate, [r for plan in plans for r in plan.all])
+    budgets = _budgets(spec, recordings, plans, outcomes, None, inputs=False)
     kept = [(p, b, u) for p, (b, u) in zip(recordings, budgets, strict=True) if b is not None]
     if not kept:
         raise CalibrationFailed("no calibration recording has a model run that ends ok at the initial values")
@@ -164,33 +168,34 @@ def _calibrate(spec: CampaignSpec, recordings: Sequence[Prepared], evaluate: Eva
                      [p.measured.efficiency for p, _, _ in kept], sigma, spec.coverage)
 
 
-def _budgets(spec: CampaignSpec, recordings: Sequence[Prepared], evaluate: Evaluator, values: Sequence[float],
-             covariance, engine: str, inputs: bool = True) -> list[tuple[Budget | None, float | None]]:
-    """Each recording's budget at ``values`` and its ``u_num`` (``(None, None)`` when its run fails)."""
+def _plans(spec: CampaignSpec, recordings: Sequence[Prepared], values: Sequence[float], engine: str,
+           propagate: bool, inputs: bool) -> list[BudgetRuns]:
+    """The runs of each recording's budget at ``values`` (parameter steps when ``propagate``, stated-input
+    steps when ``inputs``)."""
+    parameters = spec.parameters if propagate else ()
     stated = spec.inputs if inputs else ()
     plans = []
     for p in recordings:
         point = ModelRun(p.spec.index, engine, tuple(values))
-        jac = jacobian_runs(point, spec.parameters) if covariance is not None else ([], _empty())
-        plans.append(budget_runs(p, engine, tuple(values), spec.parameters if covariance is not None else (),
-                                 stated, jac))
-    outcomes = _outcomes(evaluate, [r for plan in plans for r in plan.all])
+        steps = jacobian_runs(point, parameters) if propagate else ([], np.empty(0))
+        plans.append(budget_runs(p, engine, tuple(values), parameters, stated, steps))
+    return plans
+
+
+def _budgets(spec: CampaignSpec, recordings: Sequence[Prepared], plans: Sequence[BudgetRuns],
+             outcomes: dict[ModelRun, Outcome], covariance: np.ndarray | None,
+             inputs: bool) -> list[tuple[Budget | None, float | None]]:
+    """Each recording's budget and its ``u_num`` from its plan's ``outcomes`` (``(None, None)`` when its
+    run fails)."""
+    parameters = spec.parameters if covariance is not None else ()
+    stated = spec.inputs if inputs else ()
     out = []
     for p, plan in zip(recordings, plans, strict=True):
         if not outcomes[plan.point].ok:
             out.append((None, None))
             continue
-        params = spec.parameters if covariance is not None else ()
-        out.append((budget(p, plan, outcomes, params, covariance, stated),
-                    _u_num(outcomes[plan.point])))
+        out.append((budget(p, plan, outcomes, parameters, covariance, stated), _u_num(outcomes[plan.point])))
     return out
-
-
-def _empty():
-    """No parameter steps."""
-    import numpy as np
-
-    return np.empty(0)
 
 
 def _outcomes(evaluate: Evaluator, runs: list[ModelRun]) -> dict[ModelRun, Outcome]:
@@ -206,37 +211,33 @@ def _u_num(outcome: Outcome) -> float:
 
 def _compare_all(spec: CampaignSpec, prepared: dict[int, Prepared], evaluate: Evaluator,
                  values: Sequence[float], cal: Calibration | None, k: float) -> tuple[RecordingResult, ...]:
-    """Every recording's result: budget on the first engine, ``S`` on each."""
-    import numpy as np
-
+    """Every recording's result: budget on the first engine, ``S`` on each; all runs in one request."""
     usable = [p for p in prepared.values() if p.usable]
     cov = cal.covariance if cal is not None else None
     first = spec.engines[0]
+    plans = _plans(spec, usable, values, first, propagate=cov is not None, inputs=True)
     others = [ModelRun(p.spec.index, e, tuple(values)) for p in usable for e in spec.engines[1:]]
     scatter = {p.spec.index: model_scatter(p, first, np.asarray(values), cov, spec.parameters, spec.inputs,
                                            spec.input_samples, spec.seed + p.spec.index)
                for p in usable if spec.input_samples}
-    extra = _outcomes(evaluate, others + [r for runs in scatter.values() for r in runs])
+    runs = [r for plan in plans for r in plan.all] + others + [r for rs in scatter.values() for r in rs]
+    outcomes = _outcomes(evaluate, runs)
     budgets = dict(zip([p.spec.index for p in usable],
-                       _budgets(spec, usable, evaluate, values, cov, first), strict=True))
+                       _budgets(spec, usable, plans, outcomes, cov, inputs=True), strict=True))
     out = []
     for index, p in prepared.items():
         if not p.usable:
             out.append(_unusable(p, k))
             continue
-        b, u_num = budgets[index]
+        b = budgets[index][0]
         if b is not None and index in scatter:
-            b = _with_sampled(b, [extra[r] for r in scatter[index]])
-        out.append(_recording(spec, p, b, u_num, values, evaluate, extra, k))
+            b = _with_sampled(b, [outcomes[r] for r in scatter[index]])
+        out.append(_recording(spec, p, b, values, outcomes, k))
     return tuple(out)
 
 
 def _with_sampled(b: Budget, outcomes: list[Outcome]) -> Budget:
     """``b`` with the sampling check of ``u_parameters`` and ``u_inputs`` (std of the sampled ``S``)."""
-    import dataclasses
-
-    import numpy as np
-
     s = np.array([o.efficiency for o in outcomes if o.ok])
     return dataclasses.replace(b, u_input_sampled=float(np.std(s, ddof=1)) if s.size > 1 else None)
 
@@ -250,15 +251,14 @@ def _unusable(p: Prepared, k: float) -> RecordingResult:
                            provenance=p.provenance, monte_carlo=p.measured.monte_carlo)
 
 
-def _recording(spec: CampaignSpec, p: Prepared, b: Budget | None, u_num: float | None,
-               values: Sequence[float], evaluate: Evaluator, extra: dict[ModelRun, Outcome],
-               k: float) -> RecordingResult:
-    """One recording's result from its budget and each engine's run."""
+def _recording(spec: CampaignSpec, p: Prepared, b: Budget | None, values: Sequence[float],
+               outcomes: dict[ModelRun, Outcome], k: float) -> RecordingResult:
+    """One recording's result from its budget and each engine's run (in ``outcomes``)."""
     d = p.measured.efficiency
     engines = {}
     s_first = None
     for engine in spec.engines:
-        outcome = evaluate([ModelRun(p.spec.index, engine, tuple(values))])[0]
+        outcome = outcomes[ModelRun(p.spec.index, engine, tuple(values))]
         comparison = _compare(engine, outcome, d, b, k, s_first)
         if s_first is None:
             s_first = comparison.simulated
