@@ -226,3 +226,25 @@ def test_the_command_prints_the_calibration_and_a_line_per_recording(folder, res
                                                               "not resolvable", "not resolvable"]
     assert all((folder / "out" / name).is_file() for name in ("report.html", "report.md", "results.json",
                                                              "results.csv", "model_error.png"))
+
+
+def test_a_full_disk_is_one_line_and_the_rerun_resumes(folder, tmp_path):
+    """The journal's disk full (a file-size limit) mid-calibration: exit 2, one line naming the journal;
+    the runs written before are reused by the rerun."""
+    import resource
+
+    def small_files() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (3000, 3000))
+
+    out = tmp_path / "out"
+    argv = ["rig", "campaign", str(folder / "campaign.toml"), "--out", str(out), "--workers", "1"]
+    proc = start(argv, tmp_path, preexec_fn=small_files)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 2, stderr
+    expected = f"cardan rig campaign: error: cannot write '{out / JOURNAL_FILE}': File too large"
+    assert stderr.splitlines()[-1] == expected
+    again = start([*argv, "--json"], tmp_path)
+    stdout, stderr = again.communicate(timeout=120)
+    assert again.returncode == 0, stderr
+    assert json.loads(stdout)["timing"]["model_runs_reused"] > 0

@@ -4,6 +4,7 @@ interrupted or failed campaign resumes without running any model again.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from dataclasses import dataclass, field
@@ -11,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from cardan_exudyn.interrupts import deferred_signals
+from cardan_exudyn.outputs import write_error
 from reference.results.summary import Status
 
 __all__ = ["JOURNAL_FILE", "Outcome", "Journal"]
@@ -88,10 +90,14 @@ class Journal:
         """Append one outcome; on disk when this returns (Ctrl-C and SIGTERM wait for it)."""
         line = json.dumps({"key": key, **outcome.as_dict()}, separators=(",", ":")) + "\n"
         with deferred_signals():
-            self._file.write(line.encode("utf-8"))
-            self._file.flush()
-            os.fsync(self._file.fileno())
+            try:
+                self._file.write(line.encode("utf-8"))
+                self._file.flush()
+                os.fsync(self._file.fileno())
+            except OSError as exc:  # a full disk: the runs before stay, the cut line is dropped on resume
+                raise write_error(exc, self.path) from None
 
     def close(self) -> None:
-        """Close the file."""
-        self._file.close()
+        """Close the file (after a failed write its unwritten rest is dropped; the runs before are kept)."""
+        with contextlib.suppress(OSError):
+            self._file.close()
