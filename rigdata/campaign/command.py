@@ -107,26 +107,19 @@ def _line(r: dict[str, Any]) -> str:
             f"in [{low:+.5f}, {high:+.5f}] (k u_val {r['k'] * r['u_val']:#.2g}): {verdict}")
 
 
-def cmd_campaign(args: argparse.Namespace) -> int:
-    """Run the campaign, write the report into ``--out``; see the module's exit statuses."""
+def _run(args: argparse.Namespace, spec: Any) -> Any:
+    """The campaign of ``spec`` into ``--out``: an unreachable scheduler is bad input; an interruption
+    says where the journal is."""
     from cardan_exudyn.sweep.checks import SweepError
     from rigdata.campaign.journal import JOURNAL_FILE
     from rigdata.campaign.run import campaign
-    from rigdata.campaign.spec import CampaignError, load_campaign
 
-    out_folder(args.out, replace=False)
-    try:
-        spec = load_campaign(args.campaign)
-    except CampaignError as exc:
-        print(f"cardan rig campaign: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
     journal = Path(args.out) / JOURNAL_FILE
     if args.restart and journal.is_file():
         journal.unlink()
     progress = _Progress(args.json)
     try:
-        result = campaign(spec, args.out, workers=args.workers, scheduler=args.scheduler,
-                          progress=progress)
+        return campaign(spec, args.out, workers=args.workers, scheduler=args.scheduler, progress=progress)
     except SweepError as exc:  # the Dask scheduler cannot be reached
         raise BadInput(str(exc)) from None
     except KeyboardInterrupt as exc:
@@ -135,6 +128,19 @@ def cmd_campaign(args: argparse.Namespace) -> int:
                                   "to resume", signum) from None
     finally:
         progress.close()
+
+
+def cmd_campaign(args: argparse.Namespace) -> int:
+    """Run the campaign, write the report into ``--out``; see the module's exit statuses."""
+    from rigdata.campaign.spec import CampaignError, load_campaign
+
+    out_folder(args.out, replace=False)
+    try:
+        spec = load_campaign(args.campaign)
+    except CampaignError as exc:
+        print(f"cardan rig campaign: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    result = _run(args, spec)
     from rigdata.campaign.report import write_report  # matplotlib: loaded only once there is a result
 
     s = result.as_dict()
