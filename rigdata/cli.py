@@ -13,7 +13,6 @@ import math
 import sys
 import warnings
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import rigdata
@@ -28,54 +27,22 @@ from reference.scene.mapping import replace
 from reference.scene.scene import Scene
 from reference.scene.validation import SceneError
 from rigdata.campaign import command as campaign_command
+from rigdata.options import pairs, settings, shaft_angle, transducer_options, transducers
+from rigdata.synthetic import command as synthetic_command
 
-__all__ = ["register", "cmd_inspect", "cmd_measure", "cmd_validate", "cmd_synthetic"]
+__all__ = ["register", "cmd_inspect", "cmd_measure", "cmd_validate"]
 
 #: The input errors a ``rig`` command reports in one line with exit status 2.
 BAD_INPUT = (SceneError, BadInput, OutputError, EngineUnavailable, FileNotFoundError, IsADirectoryError,
              PermissionError)
 
 
-#: ``rigdata.synthetic.FORMATS``, spelled here so that parsing loads neither scipy nor pandas.
-SYNTHETIC_FORMATS = ("csv", "lvm", "tdms", "mat", "parquet", "mdf")
-#: The formats ``--decimal`` applies to (the others store numbers, not text).
-DECIMAL_FORMATS = ("csv", "lvm")
-
-
-def _settings(cls: type, **kwargs: Any) -> Any:
-    """A settings object (Conditioning, Transducer, RigSettings); a value it refuses is bad input."""
-    try:
-        return cls(**kwargs)
-    except ValueError as exc:
-        raise BadInput(str(exc)) from None
-
-
-def _pairs(values: list[str] | None, option: str) -> dict[str, str]:
-    """``CHANNEL=VALUE`` items of a repeatable option as a dict; :class:`BadInput` otherwise."""
-    out = {}
-    for item in values or []:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip() or not value.strip():
-            raise BadInput(f"{option} expects CHANNEL=VALUE, got {item!r}")
-        out[key.strip()] = value.strip()
-    return out
-
-
-def _shaft_angle(text: str) -> float | str:
-    """``--angle``: a shaft angle in [0, 90) deg, or ``auto`` (the recording's own)."""
-    if text.strip().lower() == "auto":
-        return "auto"
-    value = arguments.number("deg", non_negative=True)(text)
-    if value >= 90.0:
-        raise argparse.ArgumentTypeError(f"must be below 90 deg (a joint at 90 deg transmits no motion), "
-                                         f"got {text!r}")
-    return value
 
 
 def _read(args: argparse.Namespace, raw: Any = None) -> rigdata.RigRecord:
     """The record of ``FILE`` (or of its table ``raw``, already read) with the file options; a
     refused option is :class:`BadInput`."""
-    options = {"mapping": _pairs(args.map, "--map") or None, "units": _pairs(args.unit, "--unit") or None,
+    options = {"mapping": pairs(args.map, "--map") or None, "units": pairs(args.unit, "--unit") or None,
                "sensitivity": args.sensitivity, "pulses_per_rev": args.pulses_per_rev}
     try:
         if raw is None:
@@ -87,18 +54,10 @@ def _read(args: argparse.Namespace, raw: Any = None) -> rigdata.RigRecord:
         raise BadInput(str(exc)) from None
 
 
-def _transducers(args: argparse.Namespace) -> tuple[rigdata.Transducer, rigdata.Transducer]:
-    """Both transducers from the options (the rig's two are alike)."""
-    t = _settings(rigdata.Transducer, full_scale=args.full_scale, sensitivity=args.sensitivity,
-                  pulses_per_rev=args.pulses_per_rev, accuracy_class=args.accuracy_class / 100.0,
-                  zero_drift=args.zero_drift, speed_accuracy=args.speed_accuracy / 100.0)
-    return t, t
-
-
 def _signs(args: argparse.Namespace) -> dict[str, int]:
     """``--sign CHANNEL=-1``: the channels recorded with the opposite sign convention."""
     signs = {}
-    for channel, text in _pairs(args.sign, "--sign").items():
+    for channel, text in pairs(args.sign, "--sign").items():
         if text not in ("-1", "+1", "1"):
             raise BadInput(f"--sign expects CHANNEL=-1 or CHANNEL=+1, got {channel}={text}")
         signs[channel] = int(text)
@@ -122,7 +81,7 @@ def _draws(args: argparse.Namespace) -> int:
 
 def _conditioning(args: argparse.Namespace) -> rigdata.Conditioning:
     """The conditioning settings from the options."""
-    return _settings(rigdata.Conditioning, cutoff_harmonics=args.cutoff_harmonics,
+    return settings(rigdata.Conditioning, cutoff_harmonics=args.cutoff_harmonics,
                      settle_revolutions=args.settle, derivative=args.derivative)
 
 
@@ -185,7 +144,7 @@ def cmd_measure(args: argparse.Namespace) -> int:
     rec = _read(args)
     angle = 15.0 if args.angle is None else args.angle  # the paper's rig case
     try:
-        m = rigdata.measure(rec, angle, conditioning=_conditioning(args), transducers=_transducers(args),
+        m = rigdata.measure(rec, angle, conditioning=_conditioning(args), transducers=transducers(args),
                             monte_carlo=_draws(args), seed=args.seed, signs=_signs(args))
     except ValueError as exc:  # a --sign channel the record lacks
         if isinstance(exc, rigdata.RigDataError):
@@ -275,7 +234,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         warnings.showwarning = _one_line_warnings("validate")
         try:
             v = rigdata.validate(rec, scene, engines, conditioning=_conditioning(args),
-                                 transducers=_transducers(args), monte_carlo=_draws(args), seed=args.seed,
+                                 transducers=transducers(args), monte_carlo=_draws(args), seed=args.seed,
                                  progress=_progress(args), signs=signs)
         except ValueError as exc:  # a --sign channel the record lacks
             if isinstance(exc, rigdata.RigDataError):
@@ -289,72 +248,6 @@ def cmd_validate(args: argparse.Namespace) -> int:
         _print_validation(s)
         print(f"wrote {args.out}/report.md", file=sys.stderr)
     return EXIT_OK if v.success and v.measurement_usable else EXIT_FAILED
-
-
-def _synthetic_settings(args: argparse.Namespace) -> rigdata.RigSettings:
-    """The synthetic rig's settings from the options (``--rpm``/``--seconds`` converted to rad/s and
-    revolutions: the file spans ``revolutions + 0.25``)."""
-    speed = args.speed if args.rpm is None else args.rpm * 2.0 * math.pi / 60.0
-    revolutions = args.revolutions
-    if args.seconds is not None:
-        revolutions = args.seconds * speed / (2.0 * math.pi) - 0.25
-        if revolutions < 1.6:
-            raise BadInput(f"--seconds {args.seconds:g} at {speed:g} rad/s is {revolutions + 0.25:.3g} "
-                           f"revolutions; at least 1.85 are needed (1.6 after settling)")
-    exact = {"offsets": (0.0, 0.0), "drifts": (0.0, 0.0)} if args.perfect else {}
-    load = {"input_torque": args.input_torque} if args.load is None else {"load_torque": args.load}
-    return _settings(rigdata.RigSettings, scene=args.scene, shaft_angle_deg=args.angle, speed=speed,
-                     friction=args.friction, rate=args.rate, noise=args.noise, revolutions=revolutions,
-                     seed=1 if args.seed is None else args.seed, speed_channel=args.speed_channel,
-                     torque_out_sign=args.torque_out_sign, drag_torque=args.drag_torque, **load, **exact)
-
-
-def _synthetic_campaign(args: argparse.Namespace) -> int:
-    """``cardan rig synthetic --campaign DIR``: the campaign's files and ``campaign.toml`` (its path on
-    stdout)."""
-    if Path(args.campaign).exists() and not Path(args.campaign).is_dir():
-        raise BadInput(f"--campaign {args.campaign!r} is a file; give the folder to write the campaign in")
-    options = {"friction": args.friction, "seed": args.seed, "seconds": args.seconds}
-    try:
-        path = rigdata.synthetic.write_campaign(
-            args.campaign, drag_torque=args.drag_torque, rate=args.rate, scene=args.scene,
-            **{k: v for k, v in options.items() if v is not None})
-    except ValueError as exc:  # write_campaign refuses its settings with ValueError
-        if isinstance(exc, rigdata.RigDataError):
-            raise
-        raise BadInput(str(exc)) from None
-    print(path)
-    return EXIT_OK
-
-
-def cmd_synthetic(args: argparse.Namespace) -> int:
-    """``cardan rig synthetic``: write a synthetic rig file, labelled as such with its settings, or with
-    ``--campaign`` a synthetic validation campaign."""
-    if args.campaign is not None:
-        return _synthetic_campaign(args)
-    out = Path(args.out)
-    if out.is_dir():
-        raise BadInput(f"--out {args.out!r} is a directory; give the name of the file to write")
-    if not out.parent.is_dir():
-        raise BadInput(f"--out {args.out!r}: the folder {str(out.parent)!r} does not exist")
-    if args.decimal is not None and args.format not in DECIMAL_FORMATS:
-        raise BadInput(f"--decimal applies to {' and '.join(DECIMAL_FORMATS)} files, "
-                       f"got --format {args.format}")
-    settings = _synthetic_settings(args)
-    transducer, _ = _transducers(args)
-    try:
-        used = rigdata.synthetic.write(args.out, args.format, settings, transducer, decimal=args.decimal)
-    except ValueError as exc:  # the model refuses the settings (a drag that leaves no brake torque)
-        if isinstance(exc, rigdata.RigDataError):
-            raise
-        raise BadInput(str(exc)) from None
-    if args.json:
-        print(json.dumps(used, indent=2))
-    else:
-        print(f"wrote {args.out} (SYNTHETIC, {args.format}): true efficiency "
-              f"{used['true_efficiency']:.6f}, brake {used['brake_torque']:.6g} N m, offsets "
-              f"{used['offsets']} N m", file=sys.stderr)
-    return EXIT_OK
 
 
 def _file_options(p: argparse.ArgumentParser) -> None:
@@ -377,7 +270,7 @@ def _file_options(p: argparse.ArgumentParser) -> None:
 
 def _measure_options(p: argparse.ArgumentParser) -> None:
     """Shaft angle, conditioning, transducers, Monte Carlo (``measure``, ``validate``)."""
-    p.add_argument("--angle", type=_shaft_angle, default=None,
+    p.add_argument("--angle", type=shaft_angle, default=None,
                    help="shaft angle [deg], or auto: the recording's own (Hooke's speed ratio fit) "
                         "(default: validate the scene's, measure 15, the paper's rig case)")
     p.add_argument("--sign", action="append", metavar="CHANNEL=-1",
@@ -388,27 +281,12 @@ def _measure_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--settle", type=arguments.number("rev", non_negative=True), default=0.25,
                    help="input revolutions dropped at each end (default 0.25)")
     p.add_argument("--derivative", choices=("savgol", "spline"), default="savgol")
-    _transducer_options(p)
+    transducer_options(p)
     p.add_argument("--mc", type=arguments.count("--mc", minimum=0), default=2000,
                    help="Monte Carlo draws for the uncertainty (default 2000; 0: GUM only; at most "
                         f"{arguments.COUNT_LIMITS['--mc']})")
     p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=0,
                    help="seed of the Monte Carlo draws")
-
-
-def _transducer_options(p: argparse.ArgumentParser) -> None:
-    """Full scale, accuracy class, zero drift and speed accuracy of the transducers."""
-    p.add_argument("--full-scale", type=arguments.number("N m", positive=True), default=100.0,
-                   help="transducer full scale [N m] (default 100, paper)")
-    p.add_argument("--accuracy-class", type=arguments.number("%", non_negative=True, maximum=100.0),
-                   default=0.1,
-                   help="transducer accuracy class [%% of full scale] (default 0.1, assumed)")
-    p.add_argument("--zero-drift", type=arguments.number("N m", non_negative=True), default=0.01,
-                   help="limit of the zero drift over the record [N m] (default 0.01, assumed)")
-    p.add_argument("--speed-accuracy", type=arguments.number("%", non_negative=True, maximum=100.0),
-                   default=0.1,
-                   help="speed channel gain error limit [%% of reading] (default 0.1, assumed; not "
-                        "used for pulse counts)")
 
 
 def _validate_options(p: argparse.ArgumentParser) -> None:
@@ -421,67 +299,6 @@ def _validate_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--friction", type=arguments.number("-", non_negative=True),
                    help="friction coefficient of every pair (default: the scene's, 0.42 for the rig)")
     p.add_argument("--engines", default="reference,exudyn", help="reference and/or exudyn")
-
-
-def _synthetic_options(p: argparse.ArgumentParser) -> None:
-    """The file to write and the synthetic rig's settings (``synthetic``)."""
-    target = p.add_mutually_exclusive_group(required=True)
-    target.add_argument("--out", metavar="FILE", help="the file to write")
-    target.add_argument("--campaign", metavar="DIR",
-                        help="write a synthetic validation campaign (eight files and campaign.toml) in DIR "
-                             "and print the toml's path; takes --friction (default 0.12), --drag-torque, "
-                             "--seed (default 0), --seconds (default 12), --rate, --scene, no other option")
-    p.add_argument("--format", choices=SYNTHETIC_FORMATS, default="csv",
-                   help="csv (default), lvm, tdms, mat (MATLAB v5), parquet, mdf (ASAM MDF 4, asammdf)")
-    p.add_argument("--decimal", choices=(".", ","), default=None,
-                   help="decimal mark of csv (',': fields apart by ';'; default '.') and lvm (default ',')")
-    p.add_argument("--scene", default="rig", metavar="NAME|FILE",
-                   help="the joint: a named scene or a scene TOML file (default rig)")
-    p.add_argument("--angle", type=_synthetic_angle, default=None,
-                   help="shaft angle [deg] (default: the scene's)")
-    speed = p.add_mutually_exclusive_group()
-    speed.add_argument("--speed", type=arguments.number("rad/s", positive=True), default=6.0,
-                       help="mean input speed [rad/s] (default 6)")
-    speed.add_argument("--rpm", type=arguments.number("rpm", positive=True), help="mean input speed [rpm]")
-    load = p.add_mutually_exclusive_group()
-    load.add_argument("--input-torque", type=arguments.number("N m", positive=True), default=0.2,
-                      help="mean input torque [N m] the brake is set for (default 0.2, the paper's)")
-    load.add_argument("--load", type=arguments.number("N m", positive=True),
-                      help="constant brake torque on the output shaft [N m]")
-    p.add_argument("--friction", type=arguments.number("-", non_negative=True),
-                   help="friction coefficient of every pair (default: the scene's)")
-    p.add_argument("--rate", type=arguments.number("Hz", positive=True), default=1000.0,
-                   help="sample rate [Hz] (default 1000)")
-    length = p.add_mutually_exclusive_group()
-    length.add_argument("--revolutions", type=arguments.number("rev", positive=True), default=5.0,
-                        help="input revolutions driven (default 5; the file spans 0.25 more)")
-    length.add_argument("--seconds", type=arguments.number("s", positive=True),
-                        help="length of the file [s] (instead of --revolutions)")
-    p.add_argument("--noise", type=arguments.number("N m", non_negative=True), default=0.005,
-                   help="torque noise standard deviation [N m] (default 0.005)")
-    p.add_argument("--speed-channel", choices=("pulses", "rpm"), default="pulses")
-    p.add_argument("--torque-out-sign", type=int, choices=(1, -1), default=1,
-                   help="-1: the output torque recorded negative (read it with --sign torque_out=-1)")
-    p.add_argument("--drag-torque", type=arguments.number("N m", non_negative=True), default=0.0,
-                   help="constant drag between the joint and the output transducer [N m], a load the "
-                        "output transducer does not see (default 0)")
-    _transducer_options(p)
-    p.add_argument("--sensitivity", type=arguments.number("V/(N m)", positive=True), default=0.1,
-                   help="torque output of the transducers [V/(N m)] (default 0.1, paper)")
-    p.add_argument("--pulses-per-rev", type=arguments.count("--pulses-per-rev"), default=60,
-                   help="speed pulses per revolution (default 60, paper)")
-    p.add_argument("--seed", type=arguments.count("--seed", minimum=0), default=None,
-                   help="seed of the drawn transducer errors and noise (default 1; campaign 0)")
-    p.add_argument("--perfect", action="store_true", help="no accuracy-class offsets or drift")
-    p.add_argument("--json", action="store_true", help="print the settings used as JSON")
-
-
-def _synthetic_angle(text: str) -> float:
-    """``--angle`` of ``synthetic``: a shaft angle in [0, 90) deg (no ``auto``)."""
-    value = _shaft_angle(text)
-    if value == "auto":
-        raise argparse.ArgumentTypeError("a synthetic file needs a shaft angle in [0, 90) deg, got 'auto'")
-    return value
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -497,7 +314,8 @@ def register(sub: argparse._SubParsersAction) -> None:
          (_file_options, _measure_options)),
         ("validate", "measured against computed efficiency: report like Figure 10", cmd_validate,
          (_file_options, _measure_options, _validate_options)),
-        ("synthetic", "write a synthetic rig file (labelled as such)", cmd_synthetic, (_synthetic_options,)),
+        ("synthetic", "write a synthetic rig file (labelled as such)", synthetic_command.cmd_synthetic,
+         (synthetic_command.add_options,)),
         ("campaign", "calibrate on some recordings, validate on the others: model error with its "
                      "V&V 20 uncertainty", campaign_command.cmd_campaign, (campaign_command.add_options,)),
     ]

@@ -31,7 +31,7 @@ MAX_FUNCTION_LINES = 60
 # modules that may print: the command line and the study commands (their computations return
 # data, their reports write files)
 MAY_PRINT = re.compile(r"^(cardan_exudyn\.cli|cardan_exudyn\.studies\.\w+\.command|rigdata\.cli"
-                       r"|rigdata\.campaign\.command)$")
+                       r"|rigdata\.campaign\.command|rigdata\.synthetic\.command)$")
 ENGINE_RUN_MODULES = {"cardan_exudyn.model.accuracy", "reference.engine.solve", "cardan_exudyn.mujoco.engine"}
 
 

@@ -286,7 +286,7 @@ def test_cli_bad_values_are_one_line_naming_the_option(tmp_path, args, option):
 
 
 def test_cli_formats_are_the_writers():
-    from rigdata.cli import SYNTHETIC_FORMATS
+    from rigdata.synthetic.command import SYNTHETIC_FORMATS
 
     assert SYNTHETIC_FORMATS == synthetic.FORMATS
 
