@@ -21,7 +21,7 @@ import numpy as np
 
 from rigdata.campaign.evaluate import ModelRun, Outcome
 from rigdata.campaign.prepare import Prepared
-from rigdata.campaign.spec import InputUncertainty, Parameter
+from rigdata.campaign.spec import InputUncertainty, Parameter, scene_value
 from rigdata.efficiency import SQRT3
 from rigdata.validation import CONSTANT_OUTPUT_ERRORS
 
@@ -113,20 +113,12 @@ def budget_runs(prepared: Prepared, engine: str, values: tuple[float, ...], para
     point = ModelRun(index, engine, values)
     output = prepared.spec.transducers[1]
     delta = output.accuracy_limit / SQRT3 or 1e-3 * output.full_scale
-    input_runs = tuple(ModelRun(index, engine, values, ((i.key, _value(prepared, i.key) + i.std),))
+    input_runs = tuple(ModelRun(index, engine, values, ((i.key, scene_value(prepared.scene, i.key) + i.std),))
                        for i in inputs)
     runs, steps = parameter_runs
     load_run = ModelRun(index, engine, values, load_offset=delta)
     phase_run = ModelRun(index, engine, values, phase_shift=PHASE_SHIFT)
     return BudgetRuns(point, tuple(runs), steps, input_runs, load_run, delta, phase_run)
-
-
-def _value(prepared: Prepared, key: str) -> float:
-    """The scene's value at dotted ``key``."""
-    node: Any = prepared.scene
-    for part in key.split("."):
-        node = getattr(node, part)
-    return float(node)
 
 
 def _efficiency(outcome: Outcome) -> float:
@@ -171,7 +163,7 @@ def model_scatter(prepared: Prepared, engine: str, values: np.ndarray, covarianc
         drawn = values
         if covariance is not None and len(parameters):
             drawn = np.clip(rng.multivariate_normal(values, covariance), low, high)
-        changes = tuple((i.key, _value(prepared, i.key) + _draw(rng, i)) for i in inputs)
+        changes = tuple((i.key, scene_value(prepared.scene, i.key) + _draw(rng, i)) for i in inputs)
         out.append(ModelRun(prepared.spec.index, engine, tuple(float(v) for v in drawn), changes))
     return out
 

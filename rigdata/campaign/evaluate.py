@@ -143,6 +143,7 @@ class Evaluator:
         self.on_run = on_run or (lambda n: None)
         self.memory: dict[str, Outcome] = dict(journal.outcomes) if journal else {}
         self._keys: dict[ModelRun, str] = {}
+        self._scenes: dict[str, Scene] = {}
         self.runs = 0
         self.reused = 0
 
@@ -160,25 +161,31 @@ class Evaluator:
         keys = [self._key(r) for r in requests]
         todo = {key: r for key, r in zip(keys, requests, strict=True) if key not in self.memory}
         self.reused += sum(1 for key in set(keys) if key not in todo)
-        self._run(todo)
+        scenes = {key: self._scenes.pop(key, None) or self.scene(r) for key, r in todo.items()}
+        for key in keys:  # scenes of runs already made are not needed
+            self._scenes.pop(key, None)
+        self._run(todo, scenes)
         return [self.memory[key] for key in keys]
 
     def _key(self, request: ModelRun) -> str:
-        """The journal key of ``request`` (its scene's fingerprint), remembered per request."""
+        """The journal key of ``request`` (its scene's fingerprint), remembered per request; the scene
+        built for it is kept until it runs."""
         key = self._keys.get(request)
         if key is None:
-            key = self._keys[request] = run_key(self.scene(request), request.engine)
+            scene = self.scene(request)
+            key = self._keys[request] = run_key(scene, request.engine)
+            self._scenes[key] = scene
         return key
 
-    def _run(self, todo: Mapping[str, ModelRun]) -> None:
-        """Run ``todo`` (key -> request), record each outcome as it arrives."""
+    def _run(self, todo: Mapping[str, ModelRun], scenes: Mapping[str, Scene]) -> None:
+        """Run ``todo`` (key -> request) on its ``scenes``, record each outcome as it arrives."""
         if not todo:
             return
         if self.pool is None:
             for key, r in todo.items():
-                self._keep(key, run_scene(self.scene(r), r.engine))
+                self._keep(key, run_scene(scenes[key], r.engine))
             return
-        futures = {key: self.pool.submit(run_scene, self.scene(r), r.engine) for key, r in todo.items()}
+        futures = {key: self.pool.submit(run_scene, scenes[key], r.engine) for key, r in todo.items()}
         for key, future in futures.items():
             self._keep(key, future.result())
 

@@ -27,7 +27,7 @@ from rigdata.validation import MODEL_ENGINES, as_scene
 
 __all__ = ["USES", "DISTRIBUTIONS", "MEASURED_KEYS", "SHAFT_ANGLE_KEY", "CampaignError", "Parameter",
            "InputUncertainty", "RecordingSpec", "CampaignSpec", "load_campaign", "campaign_from_mapping",
-           "with_values"]
+           "with_values", "scene_value"]
 
 DISTRIBUTIONS = ("normal", "uniform")
 """Distributions of a stated input uncertainty: ``normal`` (``std``) or ``uniform`` (``half_width``)."""
@@ -315,13 +315,13 @@ def _inputs(table: Mapping[str, Any], scene: Scene, parameters: tuple[Parameter,
         value = number(spec.get(width), f"{where} `{width}`")
         if value <= 0:
             raise CampaignError(f"{where}: `{width}` must be > 0, got {value!r}")
-        _scene_key(scene, key, _current(scene, key) + value, where)
+        _scene_key(scene, key, scene_value(scene, key) + value, where)
         std = value if distribution == "normal" else value / math.sqrt(3.0)
         out.append(InputUncertainty(key, distribution, std))
     return tuple(out)
 
 
-def _current(scene: Scene, key: str) -> float:
+def scene_value(scene: Scene, key: str) -> float:
     """The scene's value at dotted ``key`` (CampaignError if it is not a number)."""
     node: Any = scene
     for part in key.split("."):
